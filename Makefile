@@ -1,0 +1,36 @@
+# contactid: the two commands of the README, and the environment they share.
+#   make reproduce  - set up, then run the whole workflow
+#   make test       - set up, then run the test suite
+#   make env        - create .venv/ with the pinned packages (and TeX Live via apt where missing)
+
+VENV := .venv
+PY := $(VENV)/bin/python
+CORES ?= 2
+
+.PHONY: env reproduce test clean-results tex
+
+env: $(VENV)/.installed tex
+
+$(VENV)/.installed: requirements.txt pyproject.toml
+	test -x $(PY) || python3 -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -r requirements.txt
+	$(PY) -m pip install --quiet --no-deps -e .
+	touch $@
+
+tex:
+	@if ! command -v latexmk >/dev/null 2>&1; then \
+	  echo "installing TeX Live and latexmk with apt-get (about a minute)"; \
+	  if [ "$$(id -u)" = 0 ]; then SUDO=""; else SUDO="sudo"; fi; \
+	  $$SUDO apt-get update -qq && $$SUDO apt-get install -y -qq texlive-latex-base texlive-latex-recommended \
+	    texlive-latex-extra latexmk >/dev/null || echo "WARNING: TeX Live could not be installed; the report rule will say how"; \
+	fi
+
+reproduce: env
+	$(VENV)/bin/snakemake --cores $(CORES)
+
+test: env
+	$(PY) -m pytest -q
+
+clean-results:
+	rm -rf results data/raw data/truth logs benchmarks/rules .snakemake/metadata

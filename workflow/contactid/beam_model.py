@@ -1,0 +1,303 @@
+"""Finite-element model of the test structure (Sections 2-4, Appendix A).
+
+Euler-Bernoulli beam with Hermite cubic elements, clamped at x = 0 (optionally
+through a rotational spring), with the discrete coordinates of the paper:
+u (axial tip motion, spring k_b = EA/L), y_s (stretch of the string k_s) and
+theta_s (pendulum angle of the hanging block). The mass and stiffness matrices
+follow the energies (A2)-(A3); transducers are point masses at their nodes.
+
+Contact kinematics (linear parts of Eqs. 8-9):
+    eta = w(L) + r_n w'(L)            (Eq. 8; positive when the contact opens)
+    xi  = u + a w'(L)                 (Eq. 9 without the shortening term)
+with r_n the normal lever arm (the paper's r) and a the tangential lever arm
+(the paper's r; see ``config/README.md`` for why it is a separate value).
+
+The linear contact springs of Eq. (13) enter as k_t xi^2/2 and k_n eta^2/2 in
+the potential energy, so that S = k_t xi and the dynamic normal force is
+N_dyn = -k_n eta (compression positive: N = N0 - k_n eta). Eq. (13) of the
+paper prints N = k_n eta; the sign follows from the virtual work (A4).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg
+
+from .parameters import StructureParameters
+
+
+@dataclass(frozen=True)
+class FEModel:
+    """Assembled linear model.
+
+    Attributes:
+        nodes: beam node positions (m), node 0 at the clamp.
+        mass, stiffness: (n_dof, n_dof) matrices (kg, N/m in mixed units).
+        w_dof, theta_dof: dof index of w and w' at each node (-1 where clamped).
+        u_dof, ys_dof, thetas_dof: indices of u, y_s, theta_s.
+        xi_vector, eta_vector: row vectors with xi = xi_vector @ q, eta = eta_vector @ q.
+        force_vector: generalized force of a unit force at d_p.
+        sensor_vectors: (n_sensors, n_dof), w(x_s) = sensor_vectors @ q.
+        block_lateral_vector, block_axial_vector: the block's absolute lateral
+            (eta - y_s) and axial (hanging point + l_s theta_s) displacements.
+        params: the parameters it was built from.
+    """
+
+    nodes: np.ndarray
+    mass: np.ndarray
+    stiffness: np.ndarray
+    w_dof: np.ndarray
+    theta_dof: np.ndarray
+    u_dof: int
+    ys_dof: int
+    thetas_dof: int
+    xi_vector: np.ndarray
+    eta_vector: np.ndarray
+    force_vector: np.ndarray
+    sensor_vectors: np.ndarray
+    block_lateral_vector: np.ndarray
+    block_axial_vector: np.ndarray
+    params: StructureParameters
+
+    @property
+    def n_dof(self) -> int:
+        return self.mass.shape[0]
+
+    @property
+    def contact_stiffness_matrix(self) -> np.ndarray:
+        """k_t xi xi^T + k_n eta eta^T (N/m)."""
+        p = self.params
+        return p.k_t * np.outer(self.xi_vector, self.xi_vector) + p.k_n * np.outer(self.eta_vector, self.eta_vector)
+
+    @property
+    def stiffness_without_contact(self) -> np.ndarray:
+        """Stiffness matrix with the contact springs removed (Eq. 12's K when
+        S and N are the whole contact forces)."""
+        return self.stiffness - self.contact_stiffness_matrix
+
+
+def mesh_nodes(length: float, key_points, n_elements: int) -> np.ndarray:
+    """Node positions (m) with a node at every key point and about
+    ``n_elements`` elements of near-equal size."""
+    pts = sorted({0.0, float(length), *(float(x) for x in key_points)})
+    h_target = length / max(int(n_elements), 1)
+    nodes = [0.0]
+    for a, b in zip(pts[:-1], pts[1:]):
+        if b - a <= 1e-12:
+            continue
+        n = max(1, int(math.ceil((b - a) / h_target - 1e-9)))
+        nodes.extend(np.linspace(a, b, n + 1)[1:].tolist())
+    return np.asarray(nodes)
+
+
+def _element_matrices(EI: float, rhoA: float, le: float):
+    k = EI / le**3 * np.array(
+        [[12, 6 * le, -12, 6 * le], [6 * le, 4 * le**2, -6 * le, 2 * le**2],
+         [-12, -6 * le, 12, -6 * le], [6 * le, 2 * le**2, -6 * le, 4 * le**2]]
+    )
+    m = rhoA * le / 420.0 * np.array(
+        [[156, 22 * le, 54, -13 * le], [22 * le, 4 * le**2, 13 * le, -3 * le**2],
+         [54, 13 * le, 156, -22 * le], [-13 * le, -3 * le**2, -22 * le, 4 * le**2]]
+    )
+    return k, m
+
+
+def _node_index(nodes: np.ndarray, x: float) -> int:
+    i = int(np.argmin(np.abs(nodes - x)))
+    if abs(nodes[i] - x) > 1e-9:
+        raise ValueError(f"no FE node at x = {x} m")
+    return i
+
+
+def assemble(params: StructureParameters) -> FEModel:
+    """Assemble mass and stiffness matrices from the energies (A2)-(A3)."""
+    p = params
+    key = [*p.sensor_positions, p.excitation_position]
+    for x in key:
+        if not 0.0 < x <= p.length:
+            raise ValueError(f"position {x} m is outside the beam (0, {p.length}] m")
+    nodes = mesh_nodes(p.length, key, p.n_elements)
+    n_nodes = len(nodes)
+    clamp_free_rotation = math.isfinite(p.clamp_rotational_stiffness)
+
+    w_dof = -np.ones(n_nodes, dtype=int)
+    theta_dof = -np.ones(n_nodes, dtype=int)
+    idx = 0
+    if clamp_free_rotation:
+        theta_dof[0] = idx
+        idx += 1
+    for i in range(1, n_nodes):
+        w_dof[i] = idx
+        theta_dof[i] = idx + 1
+        idx += 2
+    u_dof, ys_dof, thetas_dof = idx, idx + 1, idx + 2
+    n = idx + 3
+
+    M = np.zeros((n, n))
+    K = np.zeros((n, n))
+    EI, rhoA = p.bending_stiffness, p.mass_per_length
+    for e in range(n_nodes - 1):
+        ke, me = _element_matrices(EI, rhoA, nodes[e + 1] - nodes[e])
+        dofs = [w_dof[e], theta_dof[e], w_dof[e + 1], theta_dof[e + 1]]
+        for a, da in enumerate(dofs):
+            if da < 0:
+                continue
+            for b, db in enumerate(dofs):
+                if db < 0:
+                    continue
+                K[da, db] += ke[a, b]
+                M[da, db] += me[a, b]
+    if clamp_free_rotation:
+        K[theta_dof[0], theta_dof[0]] += p.clamp_rotational_stiffness
+
+    # transducers as point masses
+    for x, m in zip(p.sensor_positions, p.sensor_masses):
+        M[w_dof[_node_index(nodes, x)], w_dof[_node_index(nodes, x)]] += m
+    i_dp = _node_index(nodes, p.excitation_position)
+    M[w_dof[i_dp], w_dof[i_dp]] += p.force_transducer_mass
+
+    iL = n_nodes - 1
+    wL, tL = w_dof[iL], theta_dof[iL]
+
+    def unit(*pairs):
+        v = np.zeros(n)
+        for d, c in pairs:
+            v[d] += c
+        return v
+
+    eta = unit((wL, 1.0), (tL, p.normal_lever_arm))  # Eq. 8
+    xi = unit((u_dof, 1.0), (tL, p.tangential_lever_arm))  # Eq. 9, linear part
+
+    # pin: lateral translation of its centre and rotation (A2); axial inertia optional
+    M += p.pin_mass * np.outer(eta, eta)
+    M[tL, tL] += p.pin_inertia
+    # block: lateral (eta - y_s) and axial (hanging point + l_s theta_s) translations (A2)
+    lateral = eta - unit((ys_dof, 1.0))
+    axial = unit((u_dof, 1.0), (tL, -p.hanger_lever_arm), (thetas_dof, p.string_length))
+    M += p.block_mass * (np.outer(lateral, lateral) + np.outer(axial, axial))
+    M[thetas_dof, thetas_dof] += p.block_inertia
+    if p.axial_inertia:
+        M[u_dof, u_dof] += p.mass_per_length * p.length / 3.0 + p.pin_mass
+
+    # potential energy (A3) and the linear contact springs (Eq. 13)
+    K[u_dof, u_dof] += p.axial_stiffness
+    K[ys_dof, ys_dof] += p.string_stiffness
+    K[thetas_dof, thetas_dof] += p.block_mass * p.gravity * p.string_length
+    K += p.k_t * np.outer(xi, xi) + p.k_n * np.outer(eta, eta)
+
+    force = unit((w_dof[i_dp], 1.0))
+    sensors = np.array([unit((w_dof[_node_index(nodes, x)], 1.0)) for x in p.sensor_positions])
+    return FEModel(nodes, M, K, w_dof, theta_dof, u_dof, ys_dof, thetas_dof, xi, eta, force, sensors, lateral, axial, p)
+
+
+@dataclass(frozen=True)
+class Modes:
+    """Undamped modes of an :class:`FEModel`.
+
+    frequencies_hz: natural frequencies (Hz); shapes: (n_dof, n_modes),
+    mass-normalised (shapes.T @ M @ shapes = I); block_energy_fraction: share of
+    each mode's kinetic energy carried by the hanging block's own coordinates.
+    """
+
+    frequencies_hz: np.ndarray
+    shapes: np.ndarray
+    block_energy_fraction: np.ndarray
+
+
+def all_modes(model: FEModel) -> Modes:
+    """All undamped modes, sorted by frequency, mass-normalised."""
+    lam, vec = scipy.linalg.eigh(model.stiffness, model.mass)
+    lam = np.clip(lam, 0.0, None)
+    # share of the (unit, mass-normalised) kinetic energy carried by the block
+    p = model.params
+    frac = (
+        p.block_mass * ((model.block_lateral_vector @ vec) ** 2 + (model.block_axial_vector @ vec) ** 2)
+        + p.block_inertia * vec[model.thetas_dof] ** 2
+    )
+    return Modes(np.sqrt(lam) / (2 * np.pi), vec, frac)
+
+
+def structural_modes(model: FEModel, n_modes: int | None = None, max_block_fraction: float = 0.5) -> Modes:
+    """Modes of the beam (the paper's modes 1, 2, 3, ...), sorted by frequency.
+
+    Suspension modes of the hanging block (pendulum swing, bounce on the string),
+    whose kinetic energy lies mostly in y_s and theta_s, are left out: they sit
+    near 1 Hz and 10 Hz, far below the band of interest, and no beam sensor
+    sees them.
+    """
+    m = all_modes(model)
+    keep = np.flatnonzero(m.block_energy_fraction < max_block_fraction)
+    if n_modes is not None:
+        if len(keep) < n_modes:
+            raise ValueError(f"the model has only {len(keep)} structural modes, {n_modes} requested")
+        keep = keep[:n_modes]
+    return Modes(m.frequencies_hz[keep], m.shapes[:, keep], m.block_energy_fraction[keep])
+
+
+def natural_frequencies(params: StructureParameters, n_modes: int = 3) -> np.ndarray:
+    """First ``n_modes`` structural natural frequencies (Hz) of the linear system
+    with the contact springs of Eq. (13)."""
+    return structural_modes(assemble(params), n_modes).frequencies_hz
+
+
+class ContactFrequencyMap:
+    """Natural frequencies (Hz) as a function of (k_t, k_n) for one structure,
+    reusing the assembly: K = K_0 + k_t xi xi^T + k_n eta eta^T.
+
+    Used in the stiffness fit, where the structure is evaluated many times.
+    """
+
+    def __init__(self, params: StructureParameters, n_modes: int = 3, max_block_fraction: float = 0.5):
+        self.model = assemble(params)
+        self.n_modes = n_modes
+        self.max_block_fraction = max_block_fraction
+        self._k0 = self.model.stiffness_without_contact
+        self._xx = np.outer(self.model.xi_vector, self.model.xi_vector)
+        self._ee = np.outer(self.model.eta_vector, self.model.eta_vector)
+
+    def __call__(self, k_t: float, k_n: float) -> np.ndarray:
+        m = self.model
+        K = self._k0 + k_t * self._xx + k_n * self._ee
+        n_check = min(m.n_dof, self.n_modes + 6)
+        lam, vec = scipy.linalg.eigh(K, m.mass, subset_by_index=[0, n_check - 1])
+        p = m.params
+        frac = (p.block_mass * ((m.block_lateral_vector @ vec) ** 2 + (m.block_axial_vector @ vec) ** 2)
+                + p.block_inertia * vec[m.thetas_dof] ** 2)
+        keep = np.flatnonzero(frac < self.max_block_fraction)[: self.n_modes]
+        if len(keep) < self.n_modes:
+            raise ValueError(f"fewer than {self.n_modes} structural modes among the lowest {n_check}")
+        return np.sqrt(np.clip(lam[keep], 0, None)) / (2 * np.pi)
+
+
+def shape_on_grid(model: FEModel, q: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Lateral deflection w(x) (m) and slope w'(x) (rad) of dof vector(s) ``q``
+    (n_dof,) or (n_dof, k), evaluated with the Hermite shape functions."""
+    q = np.asarray(q)
+    squeeze = q.ndim == 1
+    if squeeze:
+        q = q[:, None]
+    nodes = model.nodes
+
+    def nodal(dofs):
+        out = np.zeros((len(nodes), q.shape[1]))
+        ok = dofs >= 0
+        out[ok] = q[dofs[ok]]
+        return out
+
+    W, T = nodal(model.w_dof), nodal(model.theta_dof)
+    x = np.asarray(x, dtype=float)
+    e = np.clip(np.searchsorted(nodes, x, side="right") - 1, 0, len(nodes) - 2)
+    le = nodes[e + 1] - nodes[e]
+    s = (x - nodes[e]) / le
+    N1, N2 = 1 - 3 * s**2 + 2 * s**3, le * (s - 2 * s**2 + s**3)
+    N3, N4 = 3 * s**2 - 2 * s**3, le * (-(s**2) + s**3)
+    d1, d2 = (-6 * s + 6 * s**2) / le, 1 - 4 * s + 3 * s**2
+    d3, d4 = (6 * s - 6 * s**2) / le, -2 * s + 3 * s**2
+    w = N1[:, None] * W[e] + N2[:, None] * T[e] + N3[:, None] * W[e + 1] + N4[:, None] * T[e + 1]
+    dw = d1[:, None] * W[e] + d2[:, None] * T[e] + d3[:, None] * W[e + 1] + d4[:, None] * T[e + 1]
+    if squeeze:
+        return w[:, 0], dw[:, 0]
+    return w, dw

@@ -1,0 +1,75 @@
+"""Checks of the configuration that a JSON schema cannot express.
+
+Each failure names the key, the value, the allowed range and the fix; the
+Snakefile calls :func:`check_config` before any rule runs.
+"""
+
+from __future__ import annotations
+
+from typing import Mapping
+
+
+class ConfigError(ValueError):
+    """An inconsistent configuration."""
+
+
+def check_config(cfg: Mapping, source: str = "config/config.yaml") -> None:
+    """Raise :class:`ConfigError` on cross-field inconsistencies of ``cfg``."""
+    errors = []
+    st = cfg["structure"]
+    L = st["beam"]["length_m"]
+    sens = st["sensors"]
+    n_sens = len(sens["positions_m"])
+    for key in ("names", "masses_kg"):
+        if len(sens[key]) != n_sens:
+            errors.append(f"structure.sensors.{key} has {len(sens[key])} entries but positions_m has {n_sens}; "
+                          "give one per sensor")
+    for i, x in enumerate(sens["positions_m"]):
+        if not 0 < x <= L:
+            errors.append(f"structure.sensors.positions_m[{i}] = {x} m lies outside the beam; allowed range (0, {L}] m "
+                          "(structure.beam.length_m)")
+    if not 0 < st["excitation_position_m"] <= L:
+        errors.append(f"structure.excitation_position_m = {st['excitation_position_m']} m lies outside the beam; "
+                      f"allowed range (0, {L}] m")
+    for block in ("modal", "linear_modes"):
+        n_modes = cfg.get(block, {}).get("n_modes", 3)
+        if n_modes > n_sens:
+            errors.append(f"{block}.n_modes = {n_modes} exceeds the number of sensors ({n_sens}); "
+                          f"Eq. 15 needs at least as many sensors as modes: lower {block}.n_modes or add sensors")
+    rt = cfg.get("random_test", {})
+    if rt.get("source", "rig") == "measured" and not rt.get("file"):
+        errors.append("random_test.source is 'measured' but random_test.file is not set; give the path of the raw record")
+    fs = rt.get("sampling_rate_hz", 5120.0)
+    lo, hi = rt.get("band_hz", [5.0, 1000.0])
+    if not lo < hi:
+        errors.append(f"random_test.band_hz = [{lo}, {hi}]: the lower edge must be below the upper")
+    if hi >= 0.4 * fs:
+        errors.append(f"random_test.band_hz upper edge {hi} Hz must stay below 0.4 x sampling_rate_hz = {0.4 * fs} Hz "
+                      "(anti-alias filter transition)")
+    mlo, mhi = cfg.get("modal", {}).get("band_hz", [20.0, 450.0])
+    if not mlo < mhi:
+        errors.append(f"modal.band_hz = [{mlo}, {mhi}]: the lower edge must be below the upper")
+    if rt.get("source", "rig") == "rig" and (mlo < lo or mhi > hi):
+        errors.append(f"modal.band_hz = [{mlo}, {mhi}] must lie inside random_test.band_hz = [{lo}, {hi}]")
+    seg = cfg.get("frf", {}).get("segment_length", 16384)
+    blocks = cfg.get("modal", {}).get("uncertainty_blocks", 4)
+    n = rt.get("duration_s", 64.0) * fs
+    if rt.get("source", "rig") == "rig" and n / blocks < 2 * seg:
+        errors.append(f"random_test.duration_s = {rt.get('duration_s', 64.0)} s gives {int(n)} samples, fewer than "
+                      f"2 x frf.segment_length x modal.uncertainty_blocks = {2 * seg * blocks}; lengthen the record "
+                      "or shorten the segment")
+    for name in ("k_t_bounds_n_per_m", "k_n_bounds_n_per_m"):
+        b = cfg.get("stiction", {}).get(name)
+        if b is not None and not b[0] < b[1]:
+            errors.append(f"stiction.{name} = {b}: the lower bound must be below the upper")
+    for case, lc in (cfg.get("load_cases") or {}).items():
+        if lc.get("source", "rig") == "measured":
+            if not lc.get("file"):
+                errors.append(f"load_cases.{case}.source is 'measured' but load_cases.{case}.file is not set")
+        else:
+            for key in ("A1_m_per_s2", "A2_m_per_s2"):
+                if key not in lc:
+                    errors.append(f"load_cases.{case}.{key} is missing: a rig load case needs its target "
+                                  "driving-point harmonic amplitudes (Table 2)")
+    if errors:
+        raise ConfigError(f"{source}: invalid configuration:\n  - " + "\n  - ".join(errors))

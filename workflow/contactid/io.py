@@ -1,0 +1,165 @@
+"""Reading and writing the datasets passed between rules (netCDF4 engine).
+
+Raw format (shared by the rig, measured files and importers; see
+``config/README.md``):
+    force(time)               N
+    acceleration(sensor, time) m/s^2
+    coords: time (s), sensor (names), position(sensor) (m from the clamp)
+    global attribute sampling_rate_hz; dual-sine records add excitation_frequency_hz.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import subprocess
+import tempfile
+from pathlib import Path
+from typing import Mapping
+
+import numpy as np
+import xarray as xr
+
+from . import __version__
+
+ENGINE = "netcdf4"
+
+
+class RawDataError(ValueError):
+    """A raw record that does not follow the documented format."""
+
+
+def file_digest(path: str | os.PathLike) -> str:
+    """sha256 of a file's bytes (hex)."""
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for chunk in iter(lambda: fh.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()
+
+
+def config_digest(subset) -> str:
+    """sha256 of a config subset, serialised canonically."""
+    return hashlib.sha256(json.dumps(subset, sort_keys=True, default=str).encode()).hexdigest()
+
+
+def git_revision() -> str:
+    try:
+        out = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True, timeout=5,
+                             cwd=Path(__file__).resolve().parent)
+        return out.stdout.strip() or "unknown"
+    except (OSError, subprocess.SubprocessError):
+        return "unknown"
+
+
+def provenance(rule: str, config_subset=None, inputs: Mapping[str, str] | None = None) -> dict:
+    """Global attributes naming the producing rule, package version, git
+    revision, a digest of the config subset used and digests of the inputs."""
+    attrs = {
+        "producer_rule": rule,
+        "contactid_version": __version__,
+        "git_revision": git_revision(),
+        "config_digest": config_digest(config_subset if config_subset is not None else {}),
+    }
+    for name, path in (inputs or {}).items():
+        attrs[f"input_{name}"] = str(path)
+        attrs[f"input_{name}_sha256"] = file_digest(path)
+    return attrs
+
+
+def write_dataset(ds: xr.Dataset, path: str | os.PathLike) -> None:
+    """Write ``ds`` whole or not at all: to a temporary file beside ``path``,
+    then renamed over it. Every data variable must carry ``units`` and
+    ``long_name``."""
+    for name, var in ds.data_vars.items():
+        missing = [a for a in ("units", "long_name") if a not in var.attrs]
+        if missing:
+            raise ValueError(f"variable {name!r} lacks attribute(s) {missing}")
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(suffix=".nc.tmp", dir=path.parent)
+    os.close(fd)
+    try:
+        ds.to_netcdf(tmp, engine=ENGINE)
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+
+
+def load_dataset(path: str | os.PathLike) -> xr.Dataset:
+    """Eagerly load a dataset (the file is closed on return)."""
+    return xr.load_dataset(path, engine=ENGINE)
+
+
+def raw_dataset(time, force, acceleration, sensor_names, positions, sampling_rate_hz: float,
+                attrs: Mapping | None = None) -> xr.Dataset:
+    """Build a raw record in the documented format."""
+    ds = xr.Dataset(
+        {
+            "force": ("time", np.asarray(force, dtype=float), {"units": "N", "long_name": "excitation force at d_p"}),
+            "acceleration": (("sensor", "time"), np.asarray(acceleration, dtype=float),
+                             {"units": "m/s^2", "long_name": "lateral acceleration"}),
+        },
+        coords={
+            "time": ("time", np.asarray(time, dtype=float), {"units": "s", "long_name": "time"}),
+            "sensor": ("sensor", list(sensor_names)),
+            "position": ("sensor", np.asarray(positions, dtype=float), {"units": "m", "long_name": "distance from the clamp"}),
+        },
+        attrs={"sampling_rate_hz": float(sampling_rate_hz), **dict(attrs or {})},
+    )
+    return ds
+
+
+_ACC_UNITS = {"m/s^2", "m/s2", "m s-2", "m/s**2"}
+_FORCE_UNITS = {"N", "newton"}
+
+
+def read_raw(path: str | os.PathLike, dual_sine: bool = False, min_samples: int = 16) -> xr.Dataset:
+    """Load and check a raw record; raise :class:`RawDataError` naming the file,
+    the field and the fix when it does not follow the documented format."""
+    path = str(path)
+    if not os.path.exists(path):
+        raise RawDataError(f"{path}: file not found; set 'file:' to an existing netCDF raw record")
+    try:
+        ds = load_dataset(path)
+    except Exception as exc:  # noqa: BLE001 - any reader failure is a format problem for the user
+        raise RawDataError(f"{path}: cannot be read as netCDF ({exc}); write it in the raw format of config/README.md") from exc
+
+    def fail(msg):
+        raise RawDataError(f"{path}: {msg} (raw format: see config/README.md)")
+
+    for var in ("force", "acceleration"):
+        if var not in ds:
+            fail(f"variable '{var}' is missing")
+    if ds["force"].dims != ("time",):
+        fail(f"'force' must have dims ('time',), has {ds['force'].dims}")
+    if set(ds["acceleration"].dims) != {"sensor", "time"}:
+        fail(f"'acceleration' must have dims ('sensor', 'time'), has {ds['acceleration'].dims}")
+    ds["acceleration"] = ds["acceleration"].transpose("sensor", "time")
+    if "position" not in ds.coords:
+        fail("coordinate 'position' (m from the clamp, on 'sensor') is missing")
+    if "sampling_rate_hz" not in ds.attrs:
+        fail("global attribute 'sampling_rate_hz' is missing")
+    if dual_sine and "excitation_frequency_hz" not in ds.attrs:
+        fail("global attribute 'excitation_frequency_hz' is missing (required for dual-sine records)")
+    units_f = ds["force"].attrs.get("units")
+    if units_f not in _FORCE_UNITS:
+        fail(f"'force' has units {units_f!r}; convert to 'N'")
+    units_a = ds["acceleration"].attrs.get("units")
+    if units_a not in _ACC_UNITS:
+        fail(f"'acceleration' has units {units_a!r}; convert to 'm/s^2' (1 g = 9.80665 m/s^2)")
+    if ds.sizes["time"] < min_samples:
+        fail(f"only {ds.sizes['time']} samples; at least {min_samples} are needed")
+    for var in ("force", "acceleration"):
+        bad = ~np.isfinite(ds[var].values)
+        if bad.any():
+            fail(f"'{var}' holds {int(bad.sum())} NaN or infinite samples")
+    fs = float(ds.attrs["sampling_rate_hz"])
+    if not fs > 0:
+        fail(f"sampling_rate_hz = {fs}; must be positive")
+    dt = np.diff(ds["time"].values)
+    if dt.size and not np.allclose(dt, 1.0 / fs, rtol=1e-6, atol=0):
+        fail(f"time steps are not uniform at 1/sampling_rate_hz = {1.0 / fs:g} s")
+    return ds

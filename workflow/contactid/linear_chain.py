@@ -1,0 +1,201 @@
+"""The linear chain's datasets: FRF -> modal fit -> stiction stiffness -> linear modes.
+
+Each function takes the previous step's dataset (and config values) and returns
+the next step's dataset, so the rule scripts stay a few lines long.
+"""
+
+from __future__ import annotations
+
+import logging
+from typing import Mapping
+
+import numpy as np
+import xarray as xr
+
+from .beam_model import assemble, shape_on_grid, structural_modes
+from .io import RawDataError
+from .modal_fit import fit_modes
+from .parameters import structure_from_config
+from .signals import h1_frf
+from .stiction import frequency_sigma, stiction_stiffness
+
+log = logging.getLogger(__name__)
+
+
+def check_sensor_layout(raw: xr.Dataset, structure_cfg: Mapping, path: str, tol_m: float = 1e-3) -> None:
+    """The raw record's sensor positions must be those of the structure model."""
+    pos = np.asarray(raw["position"].values, dtype=float)
+    want = np.asarray(structure_cfg["sensors"]["positions_m"], dtype=float)
+    if pos.shape != want.shape or np.max(np.abs(pos - want)) > tol_m:
+        raise RawDataError(
+            f"{path}: sensor positions {pos.tolist()} m differ from structure.sensors.positions_m "
+            f"{want.tolist()} m; make the model's sensor layout (config) match the test")
+
+
+def frf_dataset(raw: xr.Dataset, segment_length: int, overlap: float, window: str, blocks: int) -> xr.Dataset:
+    """H1 and coherence of every accelerometer over the force for the whole
+    record, plus H1 of ``blocks`` consecutive sub-records (for the modal
+    fit's statistical uncertainty)."""
+    fs = float(raw.attrs["sampling_rate_hz"])
+    force = raw["force"].values
+    acc = raw["acceleration"].values
+    n = force.size
+    if n < 2 * segment_length:
+        raise RawDataError(f"record of {n} samples is shorter than two FRF segments of {segment_length}; "
+                           "lengthen the record or lower frf.segment_length")
+    full = h1_frf(force, acc, fs, segment_length, overlap, window)
+    nb = n // blocks
+    block_h1 = []
+    seg_b = segment_length if nb >= 2 * segment_length else nb // 2
+    for b in range(blocks):
+        sl = slice(b * nb, (b + 1) * nb)
+        est = h1_frf(force[sl], acc[:, sl], fs, seg_b, overlap, window)
+        block_h1.append(np.stack([np.interp(full.frequency_hz, est.frequency_hz, h.real)
+                                  + 1j * np.interp(full.frequency_hz, est.frequency_hz, h.imag) for h in est.h1]))
+    block_h1 = np.array(block_h1)
+    ds = xr.Dataset(
+        {
+            "h1_real": (("sensor", "frequency"), full.h1.real, {"units": "m/s^2/N", "long_name": "H1 accelerance, real part"}),
+            "h1_imag": (("sensor", "frequency"), full.h1.imag, {"units": "m/s^2/N", "long_name": "H1 accelerance, imaginary part"}),
+            "coherence": (("sensor", "frequency"), full.coherence, {"units": "1", "long_name": "ordinary coherence"}),
+            "block_h1_real": (("block", "sensor", "frequency"), block_h1.real,
+                              {"units": "m/s^2/N", "long_name": "H1 of consecutive sub-records, real part"}),
+            "block_h1_imag": (("block", "sensor", "frequency"), block_h1.imag,
+                              {"units": "m/s^2/N", "long_name": "H1 of consecutive sub-records, imaginary part"}),
+        },
+        coords={
+            "frequency": ("frequency", full.frequency_hz, {"units": "Hz", "long_name": "frequency"}),
+            "sensor": raw["sensor"].values,
+            "position": ("sensor", raw["position"].values, {"units": "m", "long_name": "distance from the clamp"}),
+            "block": np.arange(blocks),
+        },
+        attrs={"n_averages": full.n_averages, "segment_length": segment_length, "overlap": overlap, "window": window,
+               "sampling_rate_hz": fs, "driving_point_sensor": str(raw["sensor"].values[0])},
+    )
+    return ds
+
+
+def complex_frf(ds: xr.Dataset, prefix: str = "h1") -> np.ndarray:
+    return ds[f"{prefix}_real"].values + 1j * ds[f"{prefix}_imag"].values
+
+
+def modal_dataset(frf: xr.Dataset, n_modes: int, band_hz, order: int) -> xr.Dataset:
+    """Natural frequencies and damping ratios of the first ``n_modes`` modes
+    (LSCF poles + LSFD residues), with standard uncertainties from the spread
+    of the sub-record estimates (batch means: std / sqrt(n_blocks))."""
+    f = frf["frequency"].values
+    est = fit_modes(f, complex_frf(frf), n_modes, tuple(band_hz), order)
+    blocks_f, blocks_z = [], []
+    bh = complex_frf(frf, "block_h1")
+    for b in range(bh.shape[0]):
+        try:
+            e = fit_modes(f, bh[b], n_modes, tuple(band_hz), order)
+        except ValueError as exc:
+            log.warning("sub-record %d: modal fit failed (%s)", b, exc)
+            continue
+        blocks_f.append(e.natural_frequency_hz)
+        blocks_z.append(e.damping_ratio)
+    if len(blocks_f) >= 2:
+        sf = np.std(blocks_f, axis=0, ddof=1) / np.sqrt(len(blocks_f))
+        sz = np.std(blocks_z, axis=0, ddof=1) / np.sqrt(len(blocks_z))
+    else:
+        sf = np.full(n_modes, np.nan)
+        sz = np.full(n_modes, np.nan)
+    # the poles must agree with neighbouring model orders (stabilisation check)
+    spread = []
+    for o in (order - 2, order + 2):
+        try:
+            spread.append(np.abs(fit_modes(f, complex_frf(frf), n_modes, tuple(band_hz), o).natural_frequency_hz
+                                 - est.natural_frequency_hz))
+        except ValueError:
+            pass
+    order_spread = np.max(spread, axis=0) if spread else np.full(n_modes, np.nan)
+    return xr.Dataset(
+        {
+            "natural_frequency": ("mode", est.natural_frequency_hz, {"units": "Hz", "long_name": "undamped natural frequency |s_r|/2pi"}),
+            "natural_frequency_std": ("mode", sf, {"units": "Hz", "long_name": "standard uncertainty of the natural frequency (sub-records)"}),
+            "order_spread": ("mode", order_spread, {"units": "Hz", "long_name": "change of the frequency at model order +-2"}),
+            "damping_ratio": ("mode", est.damping_ratio, {"units": "1", "long_name": "modal damping ratio"}),
+            "damping_ratio_std": ("mode", sz, {"units": "1", "long_name": "standard uncertainty of the damping ratio"}),
+            "residue_abs": (("sensor", "mode"), np.abs(est.residues), {"units": "m/s^2/N rad/s", "long_name": "|accelerance residue|"}),
+        },
+        coords={"mode": np.arange(1, n_modes + 1), "sensor": frf["sensor"].values},
+        attrs={"method": "LSCF poles + LSFD residues", "order": order, "band_low_hz": band_hz[0], "band_high_hz": band_hz[1],
+               "n_blocks_used": len(blocks_f)},
+    )
+
+
+def stiction_dataset(modal: xr.Dataset, structure_cfg: Mapping, stiction_cfg: Mapping) -> xr.Dataset:
+    """k_t and k_n of Eq. (13) fitted to the identified frequencies, with
+    confidence intervals and the profile misfits."""
+    f_id = modal["natural_frequency"].values
+    stat = np.nan_to_num(modal["natural_frequency_std"].values, nan=0.0)
+    sigma = frequency_sigma(f_id, stat, float(stiction_cfg.get("frequency_uncertainty_floor", 1e-3)))
+    params = structure_from_config(structure_cfg, 1e7, 1e8)
+    fit = stiction_stiffness(params, f_id, sigma, tuple(stiction_cfg.get("k_t_bounds_n_per_m", (1e5, 1e9))),
+                             tuple(stiction_cfg.get("k_n_bounds_n_per_m", (1e5, 1e11))),
+                             float(stiction_cfg.get("confidence", 0.95)))
+    gt, pt = fit.profiles["k_t"]
+    gn, pn = fit.profiles["k_n"]
+    return xr.Dataset(
+        {
+            "k_t": ((), fit.k_t, {"units": "N/m", "long_name": "tangential contact stiffness at stiction (best fit)"}),
+            "k_n": ((), fit.k_n, {"units": "N/m", "long_name": "normal contact stiffness (best fit; see k_n_bounded_above)"}),
+            "k_t_interval": ("bound", np.asarray(fit.k_t_interval), {"units": "N/m", "long_name": "confidence interval of k_t"}),
+            "k_n_interval": ("bound", np.asarray(fit.k_n_interval), {"units": "N/m", "long_name": "confidence interval of k_n (inf: unbounded above)"}),
+            "model_frequency": ("mode", fit.model_frequencies_hz, {"units": "Hz", "long_name": "model natural frequency at the best fit"}),
+            "identified_frequency": ("mode", f_id, {"units": "Hz", "long_name": "identified natural frequency"}),
+            "frequency_sigma": ("mode", sigma, {"units": "Hz", "long_name": "frequency uncertainty used as weight"}),
+            "profile_k_t_chi2": ("k_t_grid", pt, {"units": "1", "long_name": "profile misfit over k_t"}),
+            "profile_k_n_chi2": ("k_n_grid", pn, {"units": "1", "long_name": "profile misfit over k_n"}),
+        },
+        coords={"bound": ["lower", "upper"], "mode": modal["mode"].values,
+                "k_t_grid": ("k_t_grid", gt, {"units": "N/m"}), "k_n_grid": ("k_n_grid", gn, {"units": "N/m"})},
+        attrs={"chi2_min": fit.chi2_min, "confidence": fit.confidence,
+               "k_t_bounded": int(fit.k_t_bounded), "k_n_bounded_above": int(fit.k_n_bounded_above),
+               "k_n_bounded_below": int(fit.k_n_bounded_below)},
+    )
+
+
+def contact_stiffness_for_modes(stiction: xr.Dataset, k_n_prior: float) -> tuple[float, float, str]:
+    """(k_t, k_n, how k_n was chosen) for the linear modes: the best fit where
+    the data bound k_n on both sides; otherwise the prior, raised to the
+    lower bound if it lies below it."""
+    k_t = float(stiction["k_t"])
+    if int(stiction.attrs["k_n_bounded_above"]) and int(stiction.attrs["k_n_bounded_below"]):
+        return k_t, float(stiction["k_n"]), "best fit"
+    lower = float(stiction["k_n_interval"].values[0])
+    return k_t, max(float(k_n_prior), lower), "prior (data bound k_n from one side only)"
+
+
+def linear_modes_dataset(stiction: xr.Dataset, structure_cfg: Mapping, n_modes: int, grid_points: int,
+                         k_n_prior: float) -> xr.Dataset:
+    """Mass-normalised linear modes (Eq. 14): phi_i(x) on a grid, its slope,
+    u_i, y_si, theta_si, the contact coordinates xi_i, eta_i and the values at
+    the sensors and the driving point."""
+    k_t, k_n, how = contact_stiffness_for_modes(stiction, k_n_prior)
+    params = structure_from_config(structure_cfg, k_t, k_n)
+    model = assemble(params)
+    modes = structural_modes(model, n_modes)
+    x = np.linspace(0.0, params.length, grid_points)
+    phi, dphi = shape_on_grid(model, modes.shapes, x)
+    V = modes.shapes
+    return xr.Dataset(
+        {
+            "natural_frequency": ("mode", modes.frequencies_hz, {"units": "Hz", "long_name": "natural frequency of the linear model"}),
+            "phi": (("x", "mode"), phi, {"units": "kg^-1/2", "long_name": "mass-normalised lateral mode shape phi_i(x)"}),
+            "dphi_dx": (("x", "mode"), dphi, {"units": "kg^-1/2/m", "long_name": "slope of the mode shape"}),
+            "u": ("mode", V[model.u_dof], {"units": "kg^-1/2", "long_name": "axial tip motion u_i"}),
+            "y_s": ("mode", V[model.ys_dof], {"units": "kg^-1/2", "long_name": "string stretch y_si"}),
+            "theta_s": ("mode", V[model.thetas_dof], {"units": "rad kg^-1/2", "long_name": "pendulum angle theta_si"}),
+            "xi": ("mode", model.xi_vector @ V, {"units": "kg^-1/2", "long_name": "tangential contact motion xi_i (Eq. 9, linear part)"}),
+            "eta": ("mode", model.eta_vector @ V, {"units": "kg^-1/2", "long_name": "normal contact motion eta_i (Eq. 8)"}),
+            "phi_sensor": (("sensor", "mode"), model.sensor_vectors @ V, {"units": "kg^-1/2", "long_name": "mode shape at the sensors"}),
+            "phi_drive": ("mode", model.force_vector @ V, {"units": "kg^-1/2", "long_name": "mode shape at the driving point d_p"}),
+            "k_t": ((), k_t, {"units": "N/m", "long_name": "tangential contact stiffness used"}),
+            "k_n": ((), k_n, {"units": "N/m", "long_name": "normal contact stiffness used"}),
+        },
+        coords={"x": ("x", x, {"units": "m", "long_name": "distance from the clamp"}), "mode": np.arange(1, n_modes + 1),
+                "sensor": list(structure_cfg["sensors"]["names"])},
+        attrs={"k_n_choice": how, "normalisation": "phi^T M phi = 1"},
+    )

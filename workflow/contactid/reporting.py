@@ -1,0 +1,101 @@
+"""Tables, figures and headline numbers for people (Tables 1 and 3, Fig. 3, summary.json)."""
+
+from __future__ import annotations
+
+import math
+from typing import Mapping
+
+import numpy as np
+import pandas as pd
+import xarray as xr
+
+from .consistency import TABLE1_HZ, TABLE3
+
+
+def _pct(a, b):
+    return 100.0 * (a / b - 1.0) if b is not None and np.isfinite(b) and b != 0 else np.nan
+
+
+def table1(modal: xr.Dataset, truth: xr.Dataset | None) -> pd.DataFrame:
+    """Table 1: natural frequencies, identified vs paper vs rig truth (Hz, %)."""
+    rows = []
+    for i, f in enumerate(modal["natural_frequency"].values):
+        paper = TABLE1_HZ[i] if i < len(TABLE1_HZ) else np.nan
+        tr = float(truth["natural_frequency"].values[i]) if truth is not None else np.nan
+        rows.append({"mode": i + 1, "identified_hz": f, "std_hz": float(modal["natural_frequency_std"].values[i]),
+                     "damping_ratio": float(modal["damping_ratio"].values[i]), "paper_hz": paper, "truth_hz": tr,
+                     "diff_vs_paper_pct": _pct(f, paper), "diff_vs_truth_pct": _pct(f, tr)})
+    return pd.DataFrame(rows)
+
+
+def table3(stiction: xr.Dataset, truth: xr.Dataset | None) -> pd.DataFrame:
+    """Table 3: contact stiffness at stiction, identified (or bound) vs paper vs truth (N/m, %)."""
+    rows = []
+    for name in ("k_t", "k_n"):
+        lo, hi = (float(v) for v in stiction[f"{name}_interval"].values)
+        bounded = not math.isinf(hi)
+        value = float(stiction[name]) if bounded else np.nan
+        tr = float(truth[name]) if truth is not None else np.nan
+        rows.append({"parameter": name, "identified_n_per_m": value, "interval_low_n_per_m": lo,
+                     "interval_high_n_per_m": hi, "reported_as": "value" if bounded else "lower bound",
+                     "paper_n_per_m": TABLE3[name], "truth_n_per_m": tr,
+                     "diff_vs_paper_pct": _pct(value if bounded else lo, TABLE3[name]),
+                     "diff_vs_truth_pct": _pct(value if bounded else lo, tr),
+                     "truth_inside_interval": bool(lo <= tr <= hi) if np.isfinite(tr) else None})
+    return pd.DataFrame(rows)
+
+
+def stiction_summary(stiction: xr.Dataset) -> dict:
+    """The ``stiction`` block of summary.json: k_t and k_n, or k_n_lower_bound."""
+    out = {"k_t": float(stiction["k_t"]),
+           "k_t_interval": [float(v) for v in stiction["k_t_interval"].values]}
+    lo, hi = (float(v) for v in stiction["k_n_interval"].values)
+    if math.isinf(hi):
+        out["k_n_lower_bound"] = lo
+    else:
+        out["k_n"] = float(stiction["k_n"])
+        out["k_n_interval"] = [lo, hi]
+    return out
+
+
+def linear_summary(modal: xr.Dataset, stiction: xr.Dataset, truth: xr.Dataset | None) -> dict:
+    out = {"natural_frequencies_hz": [float(f) for f in modal["natural_frequency"].values],
+           "damping_ratios": [float(z) for z in modal["damping_ratio"].values],
+           "stiction": stiction_summary(stiction)}
+    if truth is not None:
+        n = modal.sizes["mode"]
+        out["truth"] = {"natural_frequencies_hz": [float(f) for f in truth["natural_frequency"].values[:n]],
+                        "stiction": {"k_t": float(truth["k_t"]), "k_n": float(truth["k_n"])}}
+    return out
+
+
+def plot_fig03(frf: xr.Dataset, modal: xr.Dataset, png: str, pdf: str, f_max_hz: float = 500.0) -> None:
+    """Fig. 3: driving-point accelerance magnitude with coherence, identified peaks marked."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    f = frf["frequency"].values
+    sel = (f > 0) & (f <= f_max_hz)
+    h = np.abs(frf["h1_real"].values[0] + 1j * frf["h1_imag"].values[0])
+    coh = frf["coherence"].values[0]
+    fig, (ax, axc) = plt.subplots(2, 1, figsize=(6.5, 5.0), sharex=True, gridspec_kw={"height_ratios": [3, 1]})
+    ax.semilogy(f[sel], h[sel], lw=1.0, color="C0", label=f"H1, sensor {frf.attrs.get('driving_point_sensor', 'a1')}")
+    for i, fn in enumerate(modal["natural_frequency"].values):
+        hp = np.interp(fn, f, h)
+        ax.plot(fn, hp, "v", color="C3", ms=7, label="identified modes" if i == 0 else None)
+        ax.annotate(f"{fn:.2f} Hz", (fn, hp), textcoords="offset points", xytext=(6, 4), fontsize=8)
+    ax.set_ylabel("|accelerance| (m s$^{-2}$/N)")
+    ax.set_title("Driving-point FRF at low-level random excitation")
+    ax.legend(loc="lower right", fontsize=8)
+    ax.grid(True, which="both", alpha=0.3)
+    axc.plot(f[sel], coh[sel], lw=1.0, color="C2")
+    axc.set_ylim(0, 1.05)
+    axc.set_ylabel("coherence (-)")
+    axc.set_xlabel("frequency (Hz)")
+    axc.grid(True, alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(png, dpi=150)
+    fig.savefig(pdf)
+    plt.close(fig)

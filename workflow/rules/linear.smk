@@ -1,0 +1,66 @@
+# The linear chain (Sections 3-4): FRF, modal fit, stiction stiffness, linear modes.
+
+
+rule frf:
+    input:
+        raw=random_test_raw(),
+    output:
+        frf="results/linear/frf.nc",
+    params:
+        frf=config.get("frf", {}),
+        structure=config["structure"],
+        blocks=config.get("modal", {}).get("uncertainty_blocks", 4),
+    log:
+        "logs/frf.log",
+    benchmark:
+        "benchmarks/rules/frf.tsv"
+    script:
+        "../scripts/frf.py"
+
+
+rule modal:
+    input:
+        frf="results/linear/frf.nc",
+    output:
+        modal="results/linear/modal.nc",
+    params:
+        modal=config.get("modal", {}),
+    log:
+        "logs/modal.log",
+    benchmark:
+        "benchmarks/rules/modal.tsv"
+    script:
+        "../scripts/modal.py"
+
+
+rule stiction_stiffness:
+    input:
+        modal="results/linear/modal.nc",
+    output:
+        stiction="results/linear/stiction.nc",
+    params:
+        structure=config["structure"],
+        stiction=config.get("stiction", {}),
+    log:
+        "logs/stiction_stiffness.log",
+    benchmark:
+        "benchmarks/rules/stiction_stiffness.tsv"
+    script:
+        "../scripts/stiction_stiffness.py"
+
+
+rule linear_modes:
+    input:
+        stiction="results/linear/stiction.nc",
+    output:
+        modes="results/linear/linear_modes.nc",
+    params:
+        structure=config["structure"],
+        linear_modes=config.get("linear_modes", {}),
+        k_n_prior=config.get("stiction", {}).get("k_n_prior_n_per_m", 2.37e7),
+    log:
+        "logs/linear_modes.log",
+    benchmark:
+        "benchmarks/rules/linear_modes.tsv"
+    script:
+        "../scripts/linear_modes.py"

@@ -1,0 +1,12 @@
+"""Rule fig03_frf: driving-point FRF with coherence and identified peaks (Fig. 3)."""
+
+from pathlib import Path
+
+from contactid.io import load_dataset
+from contactid.logs import setup_logging
+from contactid.reporting import plot_fig03
+
+setup_logging(snakemake.log[0])
+Path(snakemake.output.png).parent.mkdir(parents=True, exist_ok=True)
+plot_fig03(load_dataset(snakemake.input.frf), load_dataset(snakemake.input.modal), snakemake.output.png,
+           snakemake.output.pdf)

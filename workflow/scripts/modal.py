@@ -1,0 +1,13 @@
+"""Rule modal: natural frequencies and damping ratios from the FRFs (LSCF/LSFD)."""
+
+from contactid.io import load_dataset, provenance, write_dataset
+from contactid.linear_chain import modal_dataset
+from contactid.logs import setup_logging
+
+log = setup_logging(snakemake.log[0])
+m = snakemake.params.modal
+ds = modal_dataset(load_dataset(snakemake.input.frf), int(m.get("n_modes", 3)), m.get("band_hz", [20.0, 450.0]),
+                   int(m.get("order", 16)))
+ds.attrs.update(provenance("modal", m, {"frf": snakemake.input.frf}))
+write_dataset(ds, snakemake.output.modal)
+log.info("natural frequencies %s Hz", ds["natural_frequency"].values)
