@@ -2,9 +2,16 @@
 # micro-vibro-impacting joint (Pourahmadian, Ahmadian & Jalali, JSV 2012).
 # The only Snakefile: it validates the config and includes the rule files.
 
+import os
+import sys
+
 from snakemake.utils import min_version, validate
 
 min_version("9.0")
+
+# the package contactid lives in workflow/ (installed into .venv by `make env`; the
+# rule files import it at parse time from the source tree as well)
+sys.path.insert(0, os.path.join(workflow.basedir, "workflow"))
 
 
 configfile: "config/config.yaml"

@@ -86,6 +86,8 @@ def plot_fig03(frf: xr.Dataset, modal: xr.Dataset, png: str, pdf: str, f_max_hz:
         hp = np.interp(fn, f, h)
         ax.plot(fn, hp, "v", color="C3", ms=7, label="identified modes" if i == 0 else None)
         ax.annotate(f"{fn:.2f} Hz", (fn, hp), textcoords="offset points", xytext=(6, 4), fontsize=8)
+    lo, hi = ax.get_ylim()
+    ax.set_ylim(lo, hi * 4)  # room for the peak labels below the title
     ax.set_ylabel("|accelerance| (m s$^{-2}$/N)")
     ax.set_title("Driving-point FRF at low-level random excitation")
     ax.legend(loc="lower right", fontsize=8)

@@ -10,6 +10,8 @@ rule frf:
         frf=config.get("frf", {}),
         structure=config["structure"],
         blocks=config.get("modal", {}).get("uncertainty_blocks", 4),
+    conda:
+        "../envs/contactid.yaml"
     log:
         "logs/frf.log",
     benchmark:
@@ -25,6 +27,8 @@ rule modal:
         modal="results/linear/modal.nc",
     params:
         modal=config.get("modal", {}),
+    conda:
+        "../envs/contactid.yaml"
     log:
         "logs/modal.log",
     benchmark:
@@ -41,6 +45,8 @@ rule stiction_stiffness:
     params:
         structure=config["structure"],
         stiction=config.get("stiction", {}),
+    conda:
+        "../envs/contactid.yaml"
     log:
         "logs/stiction_stiffness.log",
     benchmark:
@@ -58,6 +64,8 @@ rule linear_modes:
         structure=config["structure"],
         linear_modes=config.get("linear_modes", {}),
         k_n_prior=config.get("stiction", {}).get("k_n_prior_n_per_m", 2.37e7),
+    conda:
+        "../envs/contactid.yaml"
     log:
         "logs/linear_modes.log",
     benchmark:

@@ -11,6 +11,8 @@ rule paper_consistency:
     params:
         structure=config["structure"],
         truth=config.get("rig", {}).get("truth", {}),
+    conda:
+        "../envs/contactid.yaml"
     log:
         "logs/paper_consistency.log",
     benchmark:
@@ -27,6 +29,8 @@ rule linear_tables:
     output:
         table1=report("results/tables/table1.csv", caption="../report/table1.rst", category="Tables"),
         table3=report("results/tables/table3.csv", caption="../report/table3.rst", category="Tables"),
+    conda:
+        "../envs/contactid.yaml"
     log:
         "logs/linear_tables.log",
     script:
@@ -40,6 +44,8 @@ rule fig03_frf:
     output:
         png=report("results/figures/fig03_frf.png", caption="../report/fig03.rst", category="Figures"),
         pdf="results/figures/fig03_frf.pdf",
+    conda:
+        "../envs/contactid.yaml"
     log:
         "logs/fig03_frf.log",
     script:
@@ -53,6 +59,8 @@ rule summary:
         truth=random_test_truth(),
     output:
         summary="results/summary.json",
+    conda:
+        "../envs/contactid.yaml"
     log:
         "logs/summary.log",
     script:

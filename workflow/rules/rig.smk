@@ -15,6 +15,8 @@ rule rig_random_test:
         structure=config["structure"],
         rig=config.get("rig", {}),
         random_test=config.get("random_test", {}),
+    conda:
+        "../envs/contactid.yaml"
     log:
         "logs/rig_random_test.log",
     benchmark:

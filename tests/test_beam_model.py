@@ -1,0 +1,91 @@
+import math
+
+import numpy as np
+import pytest
+
+from contactid.analytic import beam_frequencies_hz, clamped_free_eigenvalues, clamped_pinned_eigenvalues
+from contactid.beam_model import ContactFrequencyMap, assemble, natural_frequencies, shape_on_grid, structural_modes
+from contactid.parameters import StructureParameters
+
+
+def bare_beam(**kw):
+    """The beam alone: no transducers, no pin, the block decoupled (k_s = 0, g = 0, J_s = 0)."""
+    base = dict(pin_mass=0.0, pin_inertia=0.0, force_transducer_mass=0.0, sensor_masses=(0.0, 0.0, 0.0),
+                block_inertia=0.0, string_stiffness=0.0, gravity=0.0, k_t=0.0, k_n=0.0, normal_lever_arm=0.0,
+                tangential_lever_arm=0.0, hanger_lever_arm=0.0, axial_inertia=True, n_elements=60)
+    base.update(kw)
+    return StructureParameters(**base)
+
+
+def test_clamped_free_limit_matches_analytic():
+    p = bare_beam()
+    f = natural_frequencies(p, 4)
+    exact = beam_frequencies_hz(clamped_free_eigenvalues(4), p.bending_stiffness, p.mass_per_length, p.length)
+    assert np.max(np.abs(f / exact - 1)) < 1e-4
+
+
+def test_clamped_pinned_limit_matches_analytic():
+    p = bare_beam(k_n=1e11)
+    f = natural_frequencies(p, 4)
+    exact = beam_frequencies_hz(clamped_pinned_eigenvalues(4), p.bending_stiffness, p.mass_per_length, p.length)
+    assert np.max(np.abs(f / exact - 1)) < 1e-4
+
+
+def test_analytic_eigenvalues_known_values():
+    assert clamped_free_eigenvalues(2) == pytest.approx([1.875104069, 4.694091133], rel=1e-9)
+    assert clamped_pinned_eigenvalues(2) == pytest.approx([3.926602312, 7.068582745], rel=1e-9)
+
+
+def test_modes_are_mass_normalised_and_structural():
+    m = assemble(StructureParameters())
+    modes = structural_modes(m, 3)
+    gen_mass = modes.shapes.T @ m.mass @ modes.shapes
+    assert np.allclose(gen_mass, np.eye(3), atol=1e-9)
+    assert np.all(modes.block_energy_fraction < 0.01)
+    assert 40 < modes.frequencies_hz[0] < 70  # the suspension modes (about 1 and 8.5 Hz) are left out
+
+
+def test_contact_springs_follow_the_energies():
+    """N_dyn = -k_n eta: the contact stiffness matrix is k_t xi xi^T + k_n eta eta^T (positive semi-definite),
+    and a static tip deflection pushing the contact closed (eta < 0) raises the compression."""
+    p = StructureParameters()
+    m = assemble(p)
+    kc = m.contact_stiffness_matrix
+    assert np.min(np.linalg.eigvalsh(kc)) > -1e-6 * np.max(np.abs(kc))
+    q = np.zeros(m.n_dof)
+    q[m.w_dof[-1]] = -1e-6  # tip pushed into the support
+    eta = m.eta_vector @ q
+    n_dyn = -p.k_n * eta
+    assert eta < 0 and n_dyn > 0
+    # the generalized contact force equals the gradient of the spring energy
+    energy_grad = kc @ q
+    assert np.allclose(energy_grad, p.k_n * eta * m.eta_vector + p.k_t * (m.xi_vector @ q) * m.xi_vector)
+
+
+def test_frequency_map_agrees_with_full_solution():
+    p = StructureParameters()
+    fmap = ContactFrequencyMap(p, 3)
+    for kt, kn in [(3.95e6, 2.37e7), (1.4e7, 1e9)]:
+        assert fmap(kt, kn) == pytest.approx(natural_frequencies(p.with_contact(kt, kn), 3), rel=1e-7)
+
+
+def test_shape_on_grid_interpolates_nodes():
+    m = assemble(StructureParameters())
+    modes = structural_modes(m, 2)
+    w, dw = shape_on_grid(m, modes.shapes[:, 0], m.nodes)
+    assert w[0] == 0 and dw[0] == 0
+    assert np.allclose(w[1:], modes.shapes[m.w_dof[1:], 0])
+    assert np.allclose(dw[1:], modes.shapes[m.theta_dof[1:], 0])
+
+
+def test_positions_outside_beam_are_refused():
+    with pytest.raises(ValueError, match="outside the beam"):
+        assemble(StructureParameters(sensor_positions=(0.55, 0.3, 0.7)))
+
+
+def test_stiffer_tangential_contact_raises_frequencies():
+    p = StructureParameters()
+    f_soft = natural_frequencies(p.with_contact(1e6, 2.37e7))
+    f_stiff = natural_frequencies(p.with_contact(1e8, 2.37e7))
+    assert np.all(f_stiff > f_soft)
+    assert math.isclose(p.axial_stiffness, p.youngs_modulus * p.area / p.length)

@@ -1,0 +1,62 @@
+import numpy as np
+import pytest
+
+from contactid.modal_fit import fit_modes, lsfd_residues
+from contactid.signals import h1_frf
+
+
+def synthetic_accelerance(f_hz, fn, zeta, residues):
+    """Accelerance of a sum of modes with known poles and residues."""
+    iw = 2j * np.pi * f_hz
+    H = np.zeros((residues.shape[0], f_hz.size), dtype=complex)
+    for r, (f0, z) in enumerate(zip(fn, zeta)):
+        w0 = 2 * np.pi * f0
+        s = -z * w0 + 1j * w0 * np.sqrt(1 - z**2)
+        H += iw**2 * (residues[:, r, None] / (iw - s) + np.conj(residues[:, r, None]) / (iw - np.conj(s)))
+    return H
+
+
+def test_lscf_recovers_known_poles():
+    f = np.arange(0, 500, 0.3125)
+    fn = np.array([54.85, 166.2, 339.25])
+    zeta = np.array([0.005, 0.004, 0.006])
+    R = np.array([[-0.02j, -0.05j, -0.1j], [-0.01j, 0.03j, -0.02j], [-0.001j, 0.004j, -0.01j]]) * 2 * np.pi
+    H = synthetic_accelerance(f, fn, zeta, R)
+    est = fit_modes(f, H, 3, (20, 450), order=16)
+    assert est.natural_frequency_hz == pytest.approx(fn, rel=1e-6)
+    assert est.damping_ratio == pytest.approx(zeta, rel=1e-3)
+
+
+def test_lscf_picks_dominant_modes_with_noise():
+    rng = np.random.default_rng(1)
+    f = np.arange(0, 500, 0.3125)
+    fn = np.array([60.0, 170.0, 330.0])
+    zeta = np.array([0.01, 0.01, 0.01])
+    R = np.array([[-0.03j, -0.05j, -0.1j]]) * 2 * np.pi
+    H = synthetic_accelerance(f, fn, zeta, R)
+    H = H * (1 + 0.01 * (rng.standard_normal(H.shape) + 1j * rng.standard_normal(H.shape)))
+    est = fit_modes(f, H, 3, (20, 450), order=20)
+    assert est.natural_frequency_hz == pytest.approx(fn, rel=1e-3)
+
+
+def test_lsfd_residues_reproduce_frf():
+    f = np.arange(20, 450, 0.5)
+    fn, zeta = np.array([100.0, 300.0]), np.array([0.01, 0.02])
+    R = np.array([[1 - 2j, 0.5 + 1j]])
+    H = synthetic_accelerance(f, fn, zeta, R)
+    w0 = 2 * np.pi * fn
+    s = -zeta * w0 + 1j * w0 * np.sqrt(1 - zeta**2)
+    res, fit = lsfd_residues(f, H, s)
+    assert res[0] == pytest.approx(R[0], rel=1e-8)
+    assert np.max(np.abs(fit - H)) < 1e-8 * np.max(np.abs(H))
+
+
+def test_h1_of_a_known_filter():
+    """H1 of y = x filtered by a 2-tap FIR equals the filter's frequency response."""
+    rng = np.random.default_rng(0)
+    x = rng.standard_normal(2**16)
+    y = 0.5 * x + 0.25 * np.roll(x, 1)
+    est = h1_frf(x, y[None, :], 1000.0, 1024)
+    true = 0.5 + 0.25 * np.exp(-2j * np.pi * est.frequency_hz / 1000.0)
+    assert np.max(np.abs(est.h1[0] - true)) < 0.01
+    assert np.min(est.coherence[0]) > 0.99

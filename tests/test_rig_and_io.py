@@ -1,0 +1,63 @@
+import copy
+
+import numpy as np
+import pytest
+
+from contactid.io import RawDataError, raw_dataset, read_raw, write_dataset
+from contactid.rig.random_test import random_test_datasets
+
+
+@pytest.fixture(scope="module")
+def short_cfg(default_config):
+    cfg = copy.deepcopy(default_config)
+    cfg["random_test"]["duration_s"] = 2.0
+    return cfg
+
+
+def test_same_seed_same_bytes_other_seed_other_noise(short_cfg):
+    c = short_cfg
+    raw1, _ = random_test_datasets(c["structure"], c["rig"], c["random_test"], seed=7)
+    raw2, _ = random_test_datasets(c["structure"], c["rig"], c["random_test"], seed=7)
+    raw3, _ = random_test_datasets(c["structure"], c["rig"], c["random_test"], seed=8)
+    assert np.array_equal(raw1["acceleration"].values, raw2["acceleration"].values)
+    assert np.array_equal(raw1["force"].values, raw2["force"].values)
+    assert not np.allclose(raw1["force"].values, raw3["force"].values)
+
+
+def test_raw_record_holds_no_truth(short_cfg, tmp_path):
+    c = short_cfg
+    raw, truth = random_test_datasets(c["structure"], c["rig"], c["random_test"], seed=1)
+    assert set(raw.data_vars) == {"force", "acceleration"}
+    assert not any(k.startswith("param_") for k in raw.attrs)
+    assert "k_t" in truth and "natural_frequency" in truth
+    path = tmp_path / "raw.nc"
+    write_dataset(raw, path)
+    back = read_raw(path)
+    assert back["acceleration"].attrs["units"] == "m/s^2"
+    assert back.attrs["sampling_rate_hz"] == c["random_test"]["sampling_rate_hz"]
+
+
+def _raw(n=256, **kw):
+    t = np.arange(n) / 1000.0
+    return raw_dataset(t, np.sin(t), np.vstack([np.cos(t)] * 3), ["a1", "a2", "a3"], [0.55, 0.3, 0.05], 1000.0, **kw)
+
+
+@pytest.mark.parametrize(
+    "mutate, message",
+    [
+        (lambda ds: ds.drop_vars("force"), "variable 'force' is missing"),
+        (lambda ds: ds.assign(force=ds["force"].where(ds["time"] < 0.1)), "NaN"),
+        (lambda ds: ds.assign(acceleration=ds["acceleration"].assign_attrs(units="g")), "convert to 'm/s\\^2'"),
+        (lambda ds: ds.isel(time=slice(0, 4)), "only 4 samples"),
+    ],
+)
+def test_bad_raw_files_get_clear_errors(tmp_path, mutate, message):
+    path = tmp_path / "bad.nc"
+    ds = mutate(_raw())
+    for v in ds.data_vars.values():
+        v.attrs.setdefault("units", "N")
+        v.attrs.setdefault("long_name", "x")
+    ds.to_netcdf(path, engine="netcdf4")
+    with pytest.raises(RawDataError, match=message) as err:
+        read_raw(path)
+    assert str(path) in str(err.value)

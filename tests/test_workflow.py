@@ -1,0 +1,102 @@
+"""The workflow end to end on the default rig data (integration tests)."""
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+import yaml
+
+ROOT = Path(__file__).resolve().parents[1]
+pytestmark = pytest.mark.workflow
+
+
+def make_project(tmp: Path, overrides: dict | None = None) -> Path:
+    shutil.copy(ROOT / "Snakefile", tmp / "Snakefile")
+    shutil.copytree(ROOT / "workflow", tmp / "workflow", ignore=shutil.ignore_patterns("__pycache__", "*.egg-info"))
+    (tmp / "config").mkdir()
+    cfg = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
+    for dotted, value in (overrides or {}).items():
+        d = cfg
+        *head, last = dotted.split(".")
+        for k in head:
+            d = d[k]
+        d[last] = value
+    (tmp / "config" / "config.yaml").write_text(yaml.safe_dump(cfg))
+    return tmp
+
+
+def snakemake(cwd: Path, *args) -> subprocess.CompletedProcess:
+    env = {**os.environ, "PYTHONPATH": str(cwd / "workflow")}
+    return subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", *args], cwd=cwd, env=env,
+                          capture_output=True, text=True, timeout=600)
+
+
+@pytest.fixture(scope="module")
+def default_run(tmp_path_factory):
+    proj = make_project(tmp_path_factory.mktemp("default"))
+    res = snakemake(proj)
+    assert res.returncode == 0, res.stderr[-3000:]
+    return proj
+
+
+def test_linear_chain_recovers_rig_truth(default_run):
+    s = json.loads((default_run / "results" / "summary.json").read_text())
+    f_id, f_true = s["natural_frequencies_hz"], s["truth"]["natural_frequencies_hz"]
+    assert len(f_id) == 3
+    for a, b in zip(f_id, f_true):
+        assert abs(a / b - 1) < 0.003
+    k_t, k_t_true = s["stiction"]["k_t"], s["truth"]["stiction"]["k_t"]
+    assert abs(k_t / k_t_true - 1) < 0.03
+    k_n_true = s["truth"]["stiction"]["k_n"]
+    if "k_n" in s["stiction"]:
+        lo, hi = s["stiction"]["k_n_interval"]
+        assert lo <= k_n_true <= hi
+    else:
+        assert s["stiction"]["k_n_lower_bound"] <= k_n_true
+
+
+def test_outputs_for_people_exist(default_run):
+    import pandas as pd
+
+    t1 = pd.read_csv(default_run / "results/tables/table1.csv")
+    assert {"paper_hz", "identified_hz", "truth_hz", "diff_vs_paper_pct", "diff_vs_truth_pct"} <= set(t1.columns)
+    assert (t1["diff_vs_paper_pct"].abs() < 1.0).all()  # the rig's linear frequencies meet Table 1 within 1 %
+    t3 = pd.read_csv(default_run / "results/tables/table3.csv")
+    assert set(t3["parameter"]) == {"k_t", "k_n"}
+    assert (default_run / "results/tables/paper_consistency.csv").stat().st_size > 0
+    assert (default_run / "results/figures/fig03_frf.png").stat().st_size > 10000
+
+
+def test_rerun_same_seed_identical_other_seed_differs(default_run, tmp_path):
+    (tmp_path / "same").mkdir()
+    (tmp_path / "other").mkdir()
+    same = make_project(tmp_path / "same")
+    other = make_project(tmp_path / "other", {"seed": 1234})
+    for proj in (same, other):
+        res = snakemake(proj, "results/summary.json")
+        assert res.returncode == 0, res.stderr[-3000:]
+    s0 = (default_run / "results/summary.json").read_text()
+    assert (same / "results/summary.json").read_text() == s0
+    s_other = json.loads((other / "results/summary.json").read_text())
+    assert s_other["natural_frequencies_hz"] != json.loads(s0)["natural_frequencies_hz"]
+
+
+@pytest.mark.parametrize(
+    "overrides, message",
+    [
+        ({"structure.beam.length_m": -0.6}, "length_m"),
+        ({"structure.sensors.positions_m": [0.55, 0.3, 0.9]}, "positions_m[2] = 0.9 m lies outside the beam"),
+        ({"linear_modes.n_modes": 4, "modal.n_modes": 3}, "linear_modes.n_modes = 4 exceeds the number of sensors"),
+        ({"frf.segmnt_length": 8192}, "segmnt_length"),
+    ],
+)
+def test_bad_config_fails_before_any_rule(tmp_path, overrides, message):
+    proj = make_project(tmp_path, overrides)
+    res = snakemake(proj, "-n")
+    assert res.returncode != 0
+    assert message in res.stderr + res.stdout
+    assert not (proj / "results").exists() and not (proj / "data").exists()
