@@ -1,0 +1,52 @@
+"""Benchmark: wall time of the linear chain, rig included, from a clean project copy.
+
+Goal (issue 2): under 60 s on the 2-core machine. Prints the time of the
+workflow run and, as a plain baseline in the same process, the time of one
+dense generalized eigen-solution of the rig's FE model repeated as often as
+the stiffness fit evaluates it, so machine speed can be factored out.
+
+Usage: .venv/bin/python benchmarks/linear_chain.py
+"""
+
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import scipy.linalg
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "workflow"))
+
+from contactid.beam_model import assemble  # noqa: E402
+from contactid.parameters import StructureParameters  # noqa: E402
+
+
+def main():
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        shutil.copy(ROOT / "Snakefile", tmp)
+        shutil.copytree(ROOT / "workflow", tmp / "workflow", ignore=shutil.ignore_patterns("__pycache__"))
+        shutil.copytree(ROOT / "config", tmp / "config")
+        t0 = time.perf_counter()
+        res = subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", "results/summary.json",
+                              "results/linear/linear_modes.nc", "results/figures/fig03_frf.png",
+                              "results/tables/table1.csv", "results/tables/paper_consistency.csv"],
+                             cwd=tmp, capture_output=True, text=True)
+        wall = time.perf_counter() - t0
+        if res.returncode:
+            print(res.stderr[-2000:])
+            raise SystemExit(1)
+    m = assemble(StructureParameters())
+    t0 = time.perf_counter()
+    for _ in range(500):
+        scipy.linalg.eigh(m.stiffness, m.mass)
+    base = time.perf_counter() - t0
+    print(f"linear chain (rig -> FRF -> modal -> stiction -> modes, tables, fig03): {wall:.1f} s (goal < 60 s)")
+    print(f"baseline: 500 dense eigen-solutions of the FE model: {base:.2f} s; ratio {wall / base:.1f}")
+
+
+if __name__ == "__main__":
+    main()
