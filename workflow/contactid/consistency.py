@@ -89,30 +89,24 @@ def paper_consistency_table(structure_cfg: Mapping, friction_truth: Mapping | No
     rows = []
     for sc in scenarios:
         ch, f = fit_scenario(base, sc)
-        p = base.replace(**{**sc.fixed, **ch})
-        err = 100.0 * (f / TABLE1_HZ - 1.0)
-        rows.append({
-            "scenario": sc.name, "assumption": sc.description,
-            "fitted": "; ".join(f"{k}={v:.4g}" for k, v in ch.items()) or "-",
-            "k_t_n_per_m": p.k_t, "k_n_n_per_m": p.k_n, "tangential_lever_arm_m": p.tangential_lever_arm,
-            "youngs_modulus_pa": p.youngs_modulus,
-            "rotational_restraint_nm_per_rad": p.tangential_lever_arm**2 * p.k_t * p.axial_stiffness / (p.k_t + p.axial_stiffness),
-            "f1_hz": f[0], "f2_hz": f[1], "f3_hz": f[2],
-            "err1_pct": err[0], "err2_pct": err[1], "err3_pct": err[2], "max_abs_err_pct": np.max(np.abs(err)),
-        })
+        rows.append(_row(sc.name, sc.description, ch, base.replace(**{**sc.fixed, **ch}), f))
     # the configured structure itself (the rig's default truth uses it with e_0 at the preload)
     if friction_truth:
         fr = ValanisParameters.from_config(friction_truth)
-        k_t_rig = float(stiction_shear_stiffness(n0, fr.e_f, fr.k_c))
-        p = cfg_params.with_contact(k_t_rig, TABLE3["k_n"])
-        f = natural_frequencies(p, 3)
-        err = 100.0 * (f / TABLE1_HZ - 1.0)
-        rows.append({
-            "scenario": "config", "assumption": "configured structure with the rig's k_t = e_0(N0) (the rig's default truth)",
-            "fitted": "-", "k_t_n_per_m": p.k_t, "k_n_n_per_m": p.k_n, "tangential_lever_arm_m": p.tangential_lever_arm,
-            "youngs_modulus_pa": p.youngs_modulus,
-            "rotational_restraint_nm_per_rad": p.tangential_lever_arm**2 * p.k_t * p.axial_stiffness / (p.k_t + p.axial_stiffness),
-            "f1_hz": f[0], "f2_hz": f[1], "f3_hz": f[2],
-            "err1_pct": err[0], "err2_pct": err[1], "err3_pct": err[2], "max_abs_err_pct": np.max(np.abs(err)),
-        })
+        p = cfg_params.with_contact(float(stiction_shear_stiffness(n0, fr.e_f, fr.k_c)), TABLE3["k_n"])
+        rows.append(_row("config", "configured structure with the rig's k_t = e_0(N0) (the rig's default truth)",
+                         {}, p, natural_frequencies(p, 3)))
     return pd.DataFrame(rows)
+
+
+def _row(name: str, description: str, fitted: Mapping, p: StructureParameters, f: np.ndarray) -> dict:
+    err = 100.0 * (f / TABLE1_HZ - 1.0)
+    return {
+        "scenario": name, "assumption": description,
+        "fitted": "; ".join(f"{k}={v:.4g}" for k, v in fitted.items()) or "-",
+        "k_t_n_per_m": p.k_t, "k_n_n_per_m": p.k_n, "tangential_lever_arm_m": p.tangential_lever_arm,
+        "youngs_modulus_pa": p.youngs_modulus,
+        "rotational_restraint_nm_per_rad": p.tangential_lever_arm**2 * p.k_t * p.axial_stiffness / (p.k_t + p.axial_stiffness),
+        "f1_hz": f[0], "f2_hz": f[1], "f3_hz": f[2],
+        "err1_pct": err[0], "err2_pct": err[1], "err3_pct": err[2], "max_abs_err_pct": float(np.max(np.abs(err))),
+    }
