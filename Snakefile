@@ -23,6 +23,7 @@ validate(config, "workflow/schemas/config.schema.yaml")
 include: "workflow/rules/common.smk"
 include: "workflow/rules/rig.smk"
 include: "workflow/rules/linear.smk"
+include: "workflow/rules/nonlinear.smk"
 include: "workflow/rules/outputs.smk"
 
 

@@ -105,6 +105,28 @@ def _element_matrices(EI: float, rhoA: float, le: float):
     return k, m
 
 
+def _element_shortening(le: float):
+    """int N'^T N' dx of a Hermite element (the geometric stiffness of a unit axial tension), 1/m."""
+    return 1.0 / (30.0 * le) * np.array(
+        [[36, 3 * le, -36, 3 * le], [3 * le, 4 * le**2, -3 * le, -(le**2)],
+         [-36, -3 * le, 36, -3 * le], [3 * le, -(le**2), -3 * le, 4 * le**2]]
+    )
+
+
+def shortening_matrix(model: "FEModel") -> np.ndarray:
+    """G with int_0^L w'^2 dx = q^T G q, so the beam shortening of Eq. (9) is -q^T G q / 2 (1/m)."""
+    G = np.zeros((model.n_dof, model.n_dof))
+    nodes = model.nodes
+    for e in range(len(nodes) - 1):
+        ge = _element_shortening(nodes[e + 1] - nodes[e])
+        dofs = [model.w_dof[e], model.theta_dof[e], model.w_dof[e + 1], model.theta_dof[e + 1]]
+        for a, da in enumerate(dofs):
+            for b, db in enumerate(dofs):
+                if da >= 0 and db >= 0:
+                    G[da, db] += ge[a, b]
+    return G
+
+
 def _node_index(nodes: np.ndarray, x: float) -> int:
     i = int(np.argmin(np.abs(nodes - x)))
     if abs(nodes[i] - x) > 1e-9:

@@ -71,5 +71,11 @@ def check_config(cfg: Mapping, source: str = "config/config.yaml") -> None:
                 if key not in lc:
                     errors.append(f"load_cases.{case}.{key} is missing: a rig load case needs its target "
                                   "driving-point harmonic amplitudes (Table 2)")
+    try:
+        from .rig.effects import effect_magnitudes
+
+        effect_magnitudes((cfg.get("rig") or {}).get("effects"))
+    except ValueError as exc:
+        errors.append(str(exc))
     if errors:
         raise ConfigError(f"{source}: invalid configuration:\n  - " + "\n  - ".join(errors))

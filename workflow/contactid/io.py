@@ -116,9 +116,13 @@ _ACC_UNITS = {"m/s^2", "m/s2", "m s-2", "m/s**2"}
 _FORCE_UNITS = {"N", "newton"}
 
 
-def read_raw(path: str | os.PathLike, dual_sine: bool = False, min_samples: int = 16) -> xr.Dataset:
+def read_raw(path: str | os.PathLike, dual_sine: bool = False, min_samples: int = 16, min_periods: int = 8,
+             max_harmonic: int = 1) -> xr.Dataset:
     """Load and check a raw record; raise :class:`RawDataError` naming the file,
-    the field and the fix when it does not follow the documented format."""
+    the field and the fix when it does not follow the documented format.
+
+    For dual-sine records, the record must also hold ``min_periods`` periods of the
+    excitation and resolve ``max_harmonic`` harmonics below the Nyquist frequency."""
     path = str(path)
     if not os.path.exists(path):
         raise RawDataError(f"{path}: file not found; set 'file:' to an existing netCDF raw record")
@@ -162,4 +166,15 @@ def read_raw(path: str | os.PathLike, dual_sine: bool = False, min_samples: int 
     dt = np.diff(ds["time"].values)
     if dt.size and not np.allclose(dt, 1.0 / fs, rtol=1e-6, atol=0):
         fail(f"time steps are not uniform at 1/sampling_rate_hz = {1.0 / fs:g} s")
+    if dual_sine:
+        f0 = float(ds.attrs["excitation_frequency_hz"])
+        if not f0 > 0:
+            fail(f"excitation_frequency_hz = {f0}; must be positive")
+        periods = ds.sizes["time"] / fs * f0
+        if periods < min_periods:
+            fail(f"the record holds {periods:.1f} periods of {f0:g} Hz, too short for the Fourier fit; "
+                 f"record at least {min_periods} periods")
+        if max_harmonic * f0 >= fs / 2:
+            fail(f"sampling_rate_hz = {fs:g} cannot resolve harmonic {max_harmonic} of {f0:g} Hz; "
+                 f"sample faster than {2 * max_harmonic * f0:g} Hz")
     return ds

@@ -1,31 +1,56 @@
 # Shared helpers: config checks and path functions, so that rules stay declarative.
 
 from contactid.config import check_config
+from contactid.rig.structure import random_test_rig_config
 
 check_config(config)
+
+
+def _is_measured(block):
+    return (block or {}).get("source", "rig") == "measured"
+
+
+def load_cases():
+    """Names of every configured load case."""
+    return sorted(config.get("load_cases") or {}, key=lambda c: int(c[2:]))
+
+
+def rig_cases():
+    """Load cases whose raw record the rig produces."""
+    return [c for c in load_cases() if not _is_measured(config["load_cases"][c])]
+
+
+def rig_case_pattern():
+    """Wildcard constraint matching exactly the rig's load cases (or nothing)."""
+    return "|".join(rig_cases()) or "(?!)"
 
 
 def random_test_raw():
     """The random-test record: the rig's output or the user's measured file."""
     rt = config.get("random_test", {})
-    if rt.get("source", "rig") == "measured":
-        return rt["file"]
-    return "data/raw/random_test.nc"
+    return rt["file"] if _is_measured(rt) else "data/raw/random_test.nc"
 
 
 def random_test_truth():
     """Truth of the random test, only where the rig produced it."""
-    if config.get("random_test", {}).get("source", "rig") == "measured":
-        return []
-    return "data/truth/random_test.nc"
+    return [] if _is_measured(config.get("random_test")) else "data/truth/random_test.nc"
+
+
+def raw_record(case):
+    """The dual-sine record of a load case: the rig's output or the user's measured file."""
+    lc = config["load_cases"][case]
+    return lc["file"] if _is_measured(lc) else f"data/raw/{case}.nc"
+
+
+def truth_records():
+    """Truth of every rig load case, by case."""
+    return {c: f"data/truth/{c}.nc" for c in rig_cases()}
 
 
 def rig_outputs():
     """Every raw record the config asks the rig to produce."""
-    out = []
-    if config.get("random_test", {}).get("source", "rig") == "rig":
-        out.append("data/raw/random_test.nc")
-    return out
+    out = [] if _is_measured(config.get("random_test")) else ["data/raw/random_test.nc"]
+    return out + [f"data/raw/{c}.nc" for c in rig_cases()]
 
 
 def all_outputs():
@@ -36,5 +61,6 @@ def all_outputs():
         "results/tables/paper_consistency.csv",
         "results/figures/fig03_frf.png",
         "results/figures/fig03_frf.pdf",
+        *[f"results/{c}/raw_check.nc" for c in load_cases()],
         "results/summary.json",
     ]

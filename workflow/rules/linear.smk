@@ -72,3 +72,4 @@ rule linear_modes:
         "benchmarks/rules/linear_modes.tsv"
     script:
         "../scripts/linear_modes.py"
+

@@ -13,7 +13,7 @@ rule rig_random_test:
     params:
         seed=config["seed"],
         structure=config["structure"],
-        rig=config.get("rig", {}),
+        rig=random_test_rig_config(config.get("rig", {})),
         random_test=config.get("random_test", {}),
     conda:
         "../envs/contactid.yaml"
@@ -23,3 +23,25 @@ rule rig_random_test:
         "benchmarks/rules/rig_random_test.tsv"
     script:
         "../scripts/rig_random_test.py"
+
+
+rule rig_dual_sine:
+    output:
+        raw="data/raw/{case}.nc",
+        truth="data/truth/{case}.nc",
+    wildcard_constraints:
+        case=rig_case_pattern(),
+    params:
+        seed=config["seed"],
+        structure=config["structure"],
+        rig=config.get("rig", {}),
+        case_cfg=lambda wc: config["load_cases"][wc.case],
+        sampling_rate_hz=config.get("random_test", {}).get("sampling_rate_hz", 5120.0),
+    conda:
+        "../envs/contactid.yaml"
+    log:
+        "logs/rig_dual_sine_{case}.log",
+    benchmark:
+        "benchmarks/rules/rig_dual_sine_{case}.tsv"
+    script:
+        "../scripts/rig_dual_sine.py"

@@ -17,6 +17,7 @@ import scipy.signal
 
 from ..beam_model import FEModel, all_modes
 from ..random_streams import generator
+from .frontend import add_noise, anti_alias_decimate, delay_channels
 
 
 @dataclass(frozen=True)
@@ -27,7 +28,8 @@ class RandomTestSettings:
     band_hz: (low, high) band of the random force; force_rms_n: its rms (N);
     noise_fraction: sensor noise rms as a fraction of each channel's rms;
     modal_damping_ratio: damping ratio of every mode; oversampling: internal
-    integration rate over output rate; settle_s: discarded start-up time.
+    integration rate over output rate; settle_s: discarded start-up time;
+    channel_delays_s: per-accelerometer sampling delay (effect channel_time_skew).
     """
 
     sampling_rate_hz: float = 5120.0
@@ -38,6 +40,7 @@ class RandomTestSettings:
     modal_damping_ratio: float = 0.005
     oversampling: int = 4
     settle_s: float = 2.0
+    channel_delays_s: tuple | None = None
 
 
 @dataclass(frozen=True)
@@ -99,20 +102,21 @@ def simulate_random_test(model: FEModel, settings: RandomTestSettings, seed: int
         qdd = scipy.signal.lfilter(num, den, f_sim)
         acc_sim += np.outer(part, qdd)
 
-    def front_end(x):
-        return scipy.signal.decimate(x, q, ftype="fir", zero_phase=True, axis=-1)[..., n_settle:n_settle + n_out]
-
-    force = front_end(f_sim)
-    acc = front_end(acc_sim)
+    if s.channel_delays_s is not None:
+        acc_sim = delay_channels(acc_sim, s.channel_delays_s, fs_sim)
+    force = anti_alias_decimate(f_sim, q)[n_settle:n_settle + n_out]
+    acc = anti_alias_decimate(acc_sim, q)[:, n_settle:n_settle + n_out]
     rng_noise = generator(seed, "random_test/noise")
-    force = force + s.noise_fraction * np.std(force) * rng_noise.standard_normal(force.shape)
-    acc = acc + s.noise_fraction * np.std(acc, axis=1, keepdims=True) * rng_noise.standard_normal(acc.shape)
+    force = add_noise(force, s.noise_fraction, rng_noise)
+    acc = add_noise(acc, s.noise_fraction, rng_noise)
     time = np.arange(n_out) / s.sampling_rate_hz
     return RandomTestRecord(time, force, acc)
 
 
-def settings_from_config(random_test_cfg, rig_cfg) -> RandomTestSettings:
+def settings_from_config(random_test_cfg, rig_cfg, n_channels: int = 3) -> RandomTestSettings:
     """RandomTestSettings from the ``random_test`` and ``rig`` config blocks."""
+    from .structure import channel_delays
+
     d = RandomTestSettings()
     return RandomTestSettings(
         sampling_rate_hz=float(random_test_cfg.get("sampling_rate_hz", d.sampling_rate_hz)),
@@ -122,6 +126,7 @@ def settings_from_config(random_test_cfg, rig_cfg) -> RandomTestSettings:
         noise_fraction=float(rig_cfg.get("noise_fraction", d.noise_fraction)),
         modal_damping_ratio=float(rig_cfg.get("modal_damping_ratio", d.modal_damping_ratio)),
         oversampling=int(rig_cfg.get("oversampling", d.oversampling)),
+        channel_delays_s=channel_delays(rig_cfg, n_channels),
     )
 
 
@@ -141,7 +146,7 @@ def random_test_datasets(structure_cfg, rig_cfg, random_test_cfg, seed: int, n_t
 
     params = rig_structure(structure_cfg, rig_cfg)
     model = assemble(params)
-    settings = settings_from_config(random_test_cfg, rig_cfg)
+    settings = settings_from_config(random_test_cfg, rig_cfg, len(params.sensor_positions))
     rec = simulate_random_test(model, settings, seed)
     names = structure_cfg["sensors"]["names"]
     raw = raw_dataset(rec.time, rec.force, rec.acceleration, names, params.sensor_positions,

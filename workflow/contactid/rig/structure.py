@@ -7,6 +7,7 @@ from typing import Mapping
 
 from ..contact_laws import NormalLaw, ValanisParameters, stiction_shear_stiffness
 from ..parameters import StructureParameters, structure_from_config
+from .effects import effect_magnitudes
 
 
 def rig_contact_stiffness(structure_cfg: Mapping, rig_cfg: Mapping) -> tuple[float, float]:
@@ -21,6 +22,32 @@ def rig_contact_stiffness(structure_cfg: Mapping, rig_cfg: Mapping) -> tuple[flo
 
 
 def rig_structure(structure_cfg: Mapping, rig_cfg: Mapping) -> StructureParameters:
-    """StructureParameters of the rig (finer mesh, true contact stiffnesses)."""
+    """StructureParameters of the rig (finer mesh, true contact stiffnesses; the
+    effect transducer_mass_error scales every transducer mass by 1 + m)."""
     k_t, k_n = rig_contact_stiffness(structure_cfg, rig_cfg)
-    return structure_from_config(structure_cfg, k_t, k_n, n_elements=int(rig_cfg.get("fe_elements", 96)))
+    p = structure_from_config(structure_cfg, k_t, k_n, n_elements=int(rig_cfg.get("fe_elements", 96)))
+    m = effect_magnitudes(rig_cfg.get("effects"))["transducer_mass_error"]
+    if m:
+        p = p.replace(sensor_masses=tuple((1 + m) * x for x in p.sensor_masses),
+                      force_transducer_mass=(1 + m) * p.force_transducer_mass)
+    return p
+
+
+def channel_delays(rig_cfg: Mapping, n_channels: int):
+    """Per-accelerometer delays (s) of the effect channel_time_skew, or None when off:
+    channel k of n is late by m (k + 1) / n."""
+    m = effect_magnitudes(rig_cfg.get("effects"))["channel_time_skew"]
+    if not m:
+        return None
+    return tuple(m * (k + 1) / n_channels for k in range(n_channels))
+
+
+RANDOM_TEST_EFFECTS = ("transducer_mass_error", "channel_time_skew")
+
+
+def random_test_rig_config(rig_cfg: Mapping) -> dict:
+    """The part of the ``rig`` config the random test depends on (so that changing a
+    dual-sine setting or a dual-sine-only effect does not rerun it)."""
+    out = {k: v for k, v in rig_cfg.items() if k not in ("dual_sine", "effects")}
+    out["effects"] = {k: v for k, v in (rig_cfg.get("effects") or {}).items() if k in RANDOM_TEST_EFFECTS}
+    return out

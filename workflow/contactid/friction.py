@@ -1,0 +1,52 @@
+"""The modified Valanis friction law (Eqs. 21-22).
+
+    dS/dxi = e_0 [1 + (lambda/e_0) sgn(xi') (e_t xi - S)] / [1 + kappa (lambda/e_0) sgn(xi') (e_t xi - S)]
+    lambda = e_0 / (alpha_0 (1 - kappa e_t / e_0)),  alpha_0 = mu N,  e_0 = e_f (1 - exp(-k_c N / e_f))
+
+with N the total normal force (static preload + dynamic part, compression positive) and xi the
+relative tangential displacement (Eq. 9). The law is rate independent: S changes only with xi,
+along the direction sgn(dxi).
+
+Regularisation (documented): where N <= ``n_min`` the contact carries no friction (S = 0, the
+contact is open); and |S| is kept at most mu N, so that a falling normal force makes the contact
+slip back to the friction limit. With |S| <= mu N the denominator stays >= 1 - kappa > 0 for
+kappa < 1.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True)
+def valanis_slope(S, xi, direction, normal_force, e_f, k_c, e_t, kappa, mu):
+    """dS/dxi (N/m) of Eq. 21 at friction force S (N), displacement xi (m), motion
+    direction +-1 and total normal force N (N)."""
+    e0 = e_f * (1.0 - np.exp(-k_c * normal_force / e_f))  # Eq. 22
+    alpha0 = mu * normal_force
+    ratio = 1.0 / (alpha0 * (1.0 - kappa * e_t / e0))  # lambda / e_0
+    d = ratio * direction * (e_t * xi - S)
+    return e0 * (1.0 + d) / (1.0 + kappa * d)
+
+
+@njit(cache=True)
+def valanis_step(S, xi0, xi1, n0, n1, e_f, k_c, e_t, kappa, mu, n_min):
+    """Friction force after xi moves from xi0 to xi1 while N moves from n0 to n1
+    (Heun's method in xi; N linear over the step). Returns S (N)."""
+    if n1 <= n_min:
+        return 0.0
+    if n0 <= n_min:  # re-contact: the contact sticks where it lands
+        return 0.0
+    dxi = xi1 - xi0
+    if dxi == 0.0:
+        lim = mu * n1
+        return min(max(S, -lim), lim)
+    direction = 1.0 if dxi > 0.0 else -1.0
+    k1 = valanis_slope(S, xi0, direction, n0, e_f, k_c, e_t, kappa, mu)
+    s_pred = S + k1 * dxi
+    lim = mu * n1
+    s_pred = min(max(s_pred, -lim), lim)
+    k2 = valanis_slope(s_pred, xi1, direction, n1, e_f, k_c, e_t, kappa, mu)
+    s_new = S + 0.5 * (k1 + k2) * dxi
+    return min(max(s_new, -lim), lim)

@@ -1,0 +1,179 @@
+"""One response-controlled dual-sine test on the virtual rig: raw record + truth.
+
+The excitation frequency is snapped to the record's frequency grid,
+f = k fs / n_samples with k integer, so that the record holds exactly k periods
+(as a test engineer sets a generator that shares the acquisition clock).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+from typing import Mapping
+
+import numpy as np
+import xarray as xr
+
+from ..beam_model import assemble
+from ..contact_laws import NormalLaw, ValanisParameters
+from ..io import raw_dataset
+from ..random_streams import generator
+from .effects import effect_magnitudes
+from .frontend import add_noise, anti_alias_decimate, delay_channels
+from ..signals import harmonic_amplitudes
+from .nonlinear import ContactParameters, DualSineSimulator, control_response, reduced_model
+from .structure import channel_delays, rig_structure
+
+log = logging.getLogger(__name__)
+
+DEFAULTS = {"excitation_frequency_hz": 54.4, "record_samples": 16384, "n_modes": 8, "oversampling": 8,
+            "control_tolerance": 0.001, "steady_state_tolerance": 1e-4}
+
+
+def dual_sine_settings(rig_cfg: Mapping, case_cfg: Mapping, sampling_rate_hz: float) -> dict:
+    """Merged settings of one load case: rig.dual_sine defaults, overridden per case."""
+    s = {**DEFAULTS, **(rig_cfg.get("dual_sine") or {})}
+    if "excitation_frequency_hz" in case_cfg:
+        s["excitation_frequency_hz"] = case_cfg["excitation_frequency_hz"]
+    n = int(s["record_samples"])
+    k = max(1, int(round(float(s["excitation_frequency_hz"]) * n / sampling_rate_hz)))
+    s["periods"] = k
+    s["excitation_frequency_hz"] = k * sampling_rate_hz / n
+    s["sampling_rate_hz"] = float(sampling_rate_hz)
+    return s
+
+
+def contact_parameters(structure_cfg: Mapping, rig_cfg: Mapping) -> ContactParameters:
+    """The rig's true contact laws with the configured effects."""
+    truth = rig_cfg["truth"]
+    fr = ValanisParameters.from_config(truth["friction"])
+    n0 = float(structure_cfg["preload_n"])
+    law = NormalLaw(n0, float(truth["normal"]["stiffness_at_preload_n_per_m"]), float(truth["normal"]["exponent"]))
+    eff = effect_magnitudes(rig_cfg.get("effects"))
+    return ContactParameters(
+        friction=(fr.e_f, fr.k_c, fr.e_t, fr.kappa, fr.mu), preload=n0, static_approach=law.static_approach,
+        exponent=law.exponent, hunt_crossley=eff["normal_contact_damping"], viscous=eff["viscous_friction"],
+        iwan_share=eff["multi_asperity_friction"], preload_drift=eff["preload_drift"],
+    )
+
+
+def build_simulator(structure_cfg: Mapping, rig_cfg: Mapping, settings: Mapping, n_modes: int | None = None,
+                    oversampling: int | None = None) -> DualSineSimulator:
+    """The rig's reduced model and integrator for the dual-sine tests."""
+    params = rig_structure(structure_cfg, rig_cfg)
+    model = assemble(params)
+    red = reduced_model(model, int(n_modes or settings["n_modes"]))
+    eff = effect_magnitudes(rig_cfg.get("effects"))
+    zeta = np.full(red.omega.size, float(rig_cfg.get("modal_damping_ratio", 0.005)))
+    zeta[red.beam_mode] += eff["structural_damping"]
+    q = int(oversampling or settings["oversampling"])
+    return DualSineSimulator(red, contact_parameters(structure_cfg, rig_cfg), zeta, 1.0 / (q * settings["sampling_rate_hz"]))
+
+
+def energy_balance(out: dict, sim: DualSineSimulator) -> dict:
+    """Energies over the recorded (integer-period) window (J): input work, modal
+    damping, friction and normal-contact dissipation, and the relative residual."""
+    dt = sim.dt
+    r = sim.red
+    v_drive = out["v"] @ r.drive
+    w_in = np.sum(out["f"] * v_drive) * dt
+    c = 2 * sim.zeta * r.omega
+    w_damp = np.sum((out["v"] ** 2) @ c) * dt
+    w_fric = np.sum(out["S"] * out["dxi"]) * dt
+    w_norm = -np.sum((out["N"] - sim.contact.preload) * out["deta"]) * dt
+    dissipated = w_damp + w_fric + w_norm
+    return {"input_work_j": float(w_in), "damping_work_j": float(w_damp), "friction_work_j": float(w_fric),
+            "normal_work_j": float(w_norm), "energy_residual": float((w_in - dissipated) / w_in)}
+
+
+def dual_sine_test(structure_cfg: Mapping, rig_cfg: Mapping, case_cfg: Mapping, sampling_rate_hz: float,
+                   noise_fraction: float, seed: int, case: str, sensor_names) -> tuple[xr.Dataset, xr.Dataset]:
+    """Run the response-controlled dual-sine test of one load case.
+
+    Returns (raw, truth). The raw record holds force and accelerations only (with
+    anti-alias filtering, channel delays if that effect is on, and sensor noise);
+    the truth holds S, N, xi, eta, the reduced coordinates, the force amplitudes,
+    the control and steady-state histories and the energy balance.
+    """
+    s = dual_sine_settings(rig_cfg, case_cfg, sampling_rate_hz)
+    eff = effect_magnitudes(rig_cfg.get("effects"))
+    scale = eff["contact_separation"] or 1.0
+    target = (scale * float(case_cfg["A1_m_per_s2"]), scale * float(case_cfg["A2_m_per_s2"]))
+    sim = build_simulator(structure_cfg, rig_cfg, s)
+    w = 2 * np.pi * s["excitation_frequency_hz"]
+    ctl = control_response(sim, target[0], target[1], w, tol=float(s["control_tolerance"]))
+    if not ctl.converged:
+        log.warning("%s: response control did not converge: %s", case, ctl.history[-1])
+    q = int(s["oversampling"])
+    n_rec = int(s["record_samples"]) * q
+    margin = 64 * q * 8
+    # preload drift (effect) runs over the recorded window
+    if sim.contact.preload_drift:
+        sim.drift_t0 = sim.t + margin * sim.dt
+        sim.drift_rate = sim.contact.preload_drift / (n_rec * sim.dt)
+    out = sim.run(ctl.F1, ctl.F3, w, n_rec + 2 * margin, store_from=0)
+    win = slice(margin, margin + n_rec)
+    rec = {k: v[win] for k, v in out.items()}
+    energy = energy_balance(rec, sim) if not sim.contact.preload_drift else {}
+
+    red = sim.red
+    acc_sim = out["a"] @ red.sensors.T  # (n, sensors)
+    acc_sim = acc_sim.T
+    delays = channel_delays(rig_cfg, acc_sim.shape[0])
+    if delays is not None:
+        acc_sim = delay_channels(acc_sim, delays, 1.0 / sim.dt)
+    acc = anti_alias_decimate(acc_sim, q)[:, margin // q: (margin + n_rec) // q]
+    force = anti_alias_decimate(out["f"], q)[margin // q: (margin + n_rec) // q]
+    rng = generator(seed, f"{case}/noise")
+    force = add_noise(force, noise_fraction, rng)
+    acc = add_noise(acc, noise_fraction, rng)
+    n_out = int(s["record_samples"])
+    time = np.arange(n_out) / sampling_rate_hz
+
+    # stationarity of the recorded window: harmonics of the first and last thirds
+    drive = rec["a"] @ red.drive
+    third = n_rec // 3
+    h_first = np.abs(harmonic_amplitudes(drive[:third], rec["t"][:third], w, (1, 3)))
+    h_last = np.abs(harmonic_amplitudes(drive[-third:], rec["t"][-third:], w, (1, 3)))
+
+    raw = raw_dataset(time, force, acc, sensor_names, rig_structure(structure_cfg, rig_cfg).sensor_positions,
+                      sampling_rate_hz, attrs={"test": "dual_sine", "excitation_frequency_hz": s["excitation_frequency_hz"]})
+    sub = slice(0, n_rec, q)
+    hist = np.array(ctl.history, dtype=float)
+    truth = xr.Dataset(
+        {
+            "S": ("time", rec["S"][sub], {"units": "N", "long_name": "true friction force S(t)"}),
+            "N": ("time", rec["N"][sub], {"units": "N", "long_name": "true total normal force N(t) (compression positive)"}),
+            "xi": ("time", rec["xi"][sub], {"units": "m", "long_name": "true tangential contact motion xi(t), Eq. 9"}),
+            "eta": ("time", rec["eta"][sub], {"units": "m", "long_name": "true normal contact motion eta(t), Eq. 8"}),
+            "xi_dot": ("time", rec["dxi"][sub], {"units": "m/s", "long_name": "true tangential contact velocity"}),
+            "eta_dot": ("time", rec["deta"][sub], {"units": "m/s", "long_name": "true normal contact velocity"}),
+            "force_true": ("time", rec["f"][sub], {"units": "N", "long_name": "excitation force without noise"}),
+            "acceleration_true": (("sensor", "time"), (rec["a"] @ red.sensors.T)[sub].T,
+                                  {"units": "m/s^2", "long_name": "accelerations without front end or noise"}),
+            "reduced_coordinate": (("time", "reduced_mode"), rec["z"][sub],
+                                   {"units": "kg^1/2 m", "long_name": "coordinates of the rig's reduced basis"}),
+            "reduced_frequency": ("reduced_mode", red.omega / (2 * np.pi),
+                                  {"units": "Hz", "long_name": "frequencies of the rig's reduced stuck basis"}),
+            "control_history": (("iteration", "control_field"), hist,
+                                {"units": "mixed", "long_name": "response control: F1 (N), F3 (N), A1, A3 (m/s^2), steady"}),
+            "steady_state_change": ("chunk", np.asarray(ctl.steady_state.change or [np.nan]),
+                                    {"units": "1", "long_name": "relative change of the driving-point harmonics between 8-period chunks"}),
+        },
+        coords={"time": ("time", time, {"units": "s", "long_name": "time"}), "sensor": list(sensor_names),
+                "control_field": ["F1", "F3", "A1", "A3", "steady"]},
+        attrs={
+            "F1_n": ctl.F1, "F3_n": ctl.F3, "A1_m_per_s2": ctl.A1, "A2_m_per_s2": ctl.A3,
+            "target_A1_m_per_s2": target[0], "target_A2_m_per_s2": target[1], "control_converged": int(ctl.converged),
+            "excitation_frequency_hz": s["excitation_frequency_hz"], "periods": s["periods"],
+            "stationarity_change_a1": float(abs(h_last[0] / h_first[0] - 1)),
+            "stationarity_change_a3": float(abs(h_last[1] / h_first[1] - 1)),
+            "effects": str({k: v for k, v in eff.items() if v}),
+            **{f"friction_{k}": v for k, v in zip(("e_f", "k_c", "e_t", "kappa", "mu"), sim.contact.friction)},
+            "preload_n": sim.contact.preload, "normal_static_approach_m": sim.contact.static_approach,
+            "normal_exponent": sim.contact.exponent, "k_t": red.k_t, "k_n": red.k_n,
+            **{f"energy_{k}": v for k, v in energy.items()},
+            **{f"setting_{k}": v for k, v in s.items()},
+        },
+    )
+    return raw, truth

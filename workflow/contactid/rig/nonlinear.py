@@ -1,0 +1,380 @@
+"""Virtual rig, nonlinear part: response-controlled dual-sine tests (Section 3).
+
+Model: the structure of the linear chain reduced to the lowest ``n_modes`` modes
+of the stuck structure plus the static responses to a unit tangential and a
+unit normal contact force (residual flexibility), re-orthogonalised, so the
+basis holds the contact's u and eta when it slips or bounces. The linear
+contact springs are removed again on the right-hand side and replaced by the
+contact laws:
+
+    M q'' + C q' + K_0 q = F f(t) - dxi/dq S + deta/dq (N - P(t))
+
+with xi = xi_lin(q) - q^T G q / 2 (Eq. 9 with the beam shortening, whose
+gradient carries the axial-force term of Eq. 1), eta = eta_lin(q) (Eq. 8),
+S from the modified Valanis law (Eqs. 21-22) with N the total normal force,
+N = N0 ((delta0 - eta) / delta0)^p while in contact (zero when it opens), and
+P(t) the static preload (N0 unless it drifts). The block's dynamics (Eqs. 2-4)
+are in M and K_0.
+
+Time stepping: explicit central differences (velocity Verlet) with the
+diagonal modal damping taken implicitly, at ``oversampling`` times the output
+rate; the friction state is advanced with Heun's method in xi per step.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.linalg
+import scipy.signal
+from numba import njit
+
+from ..beam_model import FEModel, all_modes, shortening_matrix
+from ..friction import valanis_step
+from ..signals import harmonic_amplitudes
+
+
+@dataclass(frozen=True)
+class ReducedModel:
+    """Reduced model in mass-normalised coordinates z (q = basis @ z).
+
+    omega: (n_r,) rad/s of the reduced stuck system; basis: (n_dof, n_r);
+    xi, eta: (n_r,) linear contact coordinates; shortening: (n_r, n_r) G;
+    force: (n_r,) generalized force of a unit force at d_p; drive: (n_r,) w at d_p;
+    sensors: (n_sensors, n_r) w at the sensors; beam_mode: (n_r,) True where
+    the block carries less than half of the kinetic energy; k_t, k_n: the
+    linear springs built into omega (N/m).
+    """
+
+    omega: np.ndarray
+    basis: np.ndarray
+    xi: np.ndarray
+    eta: np.ndarray
+    shortening: np.ndarray
+    force: np.ndarray
+    drive: np.ndarray
+    sensors: np.ndarray
+    beam_mode: np.ndarray
+    k_t: float
+    k_n: float
+
+
+def reduced_model(model: FEModel, n_modes: int, static_correction: bool = True) -> ReducedModel:
+    """Basis of the lowest ``n_modes`` stuck modes (+ the two static contact shapes)."""
+    modes = all_modes(model)
+    phi = modes.shapes[:, :n_modes]
+    if static_correction:
+        K = model.stiffness
+        psi = np.linalg.solve(K, np.column_stack([model.xi_vector, model.eta_vector]))
+        phi = np.column_stack([phi, psi])
+    Kr = phi.T @ model.stiffness @ phi
+    Mr = phi.T @ model.mass @ phi
+    lam, vec = scipy.linalg.eigh(Kr, Mr)
+    basis = phi @ vec
+    p = model.params
+    frac = (p.block_mass * ((model.block_lateral_vector @ basis) ** 2 + (model.block_axial_vector @ basis) ** 2)
+            + p.block_inertia * basis[model.thetas_dof] ** 2)
+    G = shortening_matrix(model)
+    return ReducedModel(
+        omega=np.sqrt(np.clip(lam, 0, None)), basis=basis, xi=model.xi_vector @ basis, eta=model.eta_vector @ basis,
+        shortening=basis.T @ G @ basis, force=basis.T @ model.force_vector, drive=model.force_vector @ basis,
+        sensors=model.sensor_vectors @ basis, beam_mode=frac < 0.5, k_t=p.k_t, k_n=p.k_n,
+    )
+
+
+@dataclass(frozen=True)
+class ContactParameters:
+    """Contact laws of the rig (SI units).
+
+    friction: (e_f, k_c, e_t, kappa, mu) of Eqs. 21-22; preload N0 (N);
+    static_approach delta0 (m) and exponent p of the normal law; hunt_crossley
+    alpha (s/m); viscous sigma_2 (N s/m); iwan_share (0..1) and the Iwan
+    sliders' slip-limit weights (sum 1); preload_drift (relative, over the record).
+    """
+
+    friction: tuple
+    preload: float
+    static_approach: float
+    exponent: float
+    hunt_crossley: float = 0.0
+    viscous: float = 0.0
+    iwan_share: float = 0.0
+    iwan_weights: np.ndarray = field(default_factory=lambda: iwan_slip_weights(16))
+    preload_drift: float = 0.0
+    n_min: float = 1e-6
+
+
+def iwan_slip_weights(n: int, spread: float = 0.8) -> np.ndarray:
+    """Slip limits of n Maxwell-slip sliders as fractions of mu N: thresholds spread
+    uniformly over [1 - spread, 1 + spread] (relative), each slider with stiffness
+    e_0 / n, normalised so that they sum to 1."""
+    w = np.linspace(1 - spread, 1 + spread, n)
+    return w / w.sum()
+
+
+@njit(cache=True)
+def _contact_state(z, v, xi_v, eta_v, G):
+    n = z.size
+    xi_lin = 0.0
+    eta = 0.0
+    deta = 0.0
+    for i in range(n):
+        xi_lin += xi_v[i] * z[i]
+        eta += eta_v[i] * z[i]
+        deta += eta_v[i] * v[i]
+    gz = G @ z
+    short = 0.5 * (z @ gz)
+    dxi_dq = xi_v - gz
+    dxi = dxi_dq @ v
+    return xi_lin, xi_lin - short, dxi_dq, eta, deta, dxi
+
+
+@njit(cache=True)
+def _normal_force(eta, deta, n0, delta0, p, hc):
+    if eta >= delta0:
+        return 0.0
+    nel = n0 * ((delta0 - eta) / delta0) ** p
+    n = nel * (1.0 - hc * deta)
+    return n if n > 0.0 else 0.0
+
+
+@njit(cache=True)
+def _iwan_force(xi, x_sl, weights, e0_total, mu_n):
+    """Maxwell-slip sliders: stiffness e0 w_i, limit mu N w_i; x_sl (slider anchors) updated in place."""
+    total = 0.0
+    for i in range(weights.size):
+        k = e0_total / weights.size
+        lim = mu_n * weights[i]
+        f = k * (xi - x_sl[i])
+        if f > lim:
+            x_sl[i] = xi - lim / k
+            f = lim
+        elif f < -lim:
+            x_sl[i] = xi + lim / k
+            f = -lim
+        total += f
+    return total
+
+
+@njit(cache=True)
+def integrate(z, v, state, t0, n_steps, dt, omega, zeta, xi_v, eta_v, G, bF, k_t, k_n,
+              F1, F3, w, fr, n0, delta0, p, hc, visc, iw_share, iw_w, x_sl, drift_rate, drift_t0,
+              store_from, out_a, out_z, out_v, out_s, out_n, out_xi, out_eta, out_f, out_dxi, out_deta):
+    """Advance the reduced model ``n_steps`` steps of ``dt`` from time ``t0``.
+
+    z, v (n_r,), state = [S_valanis, xi, N] and x_sl (Iwan anchors) are updated
+    in place. From step ``store_from`` on, the acceleration, coordinates,
+    contact forces and motions, velocities and the force are written to the out arrays
+    (row = step - store_from). Returns the time reached.
+    """
+    e_f, k_c, e_t, kappa, mu = fr[0], fr[1], fr[2], fr[3], fr[4]
+    n = z.size
+    c = 2.0 * zeta * omega
+    om2 = omega * omega
+    S_val = state[0]
+    xi_lin, xi, dxi_dq, eta, deta, dxi = _contact_state(z, v, xi_v, eta_v, G)
+    N = _normal_force(eta, deta, n0, delta0, p, hc)
+    P = n0
+    a = np.empty(n)
+    t = t0
+
+    # acceleration at the start
+    e0 = e_f * (1.0 - np.exp(-k_c * max(N, 1e-12) / e_f))
+    s_iw = 0.0
+    if iw_share > 0.0 and N > 0.0:
+        s_iw = _iwan_force(xi, x_sl, iw_w, e0, mu * N)
+    S_tot = (1.0 - iw_share) * S_val + iw_share * s_iw + (visc * dxi if N > 0.0 else 0.0)
+    f = F1 * np.sin(w * t) + F3 * np.sin(3.0 * w * t)
+    for i in range(n):
+        a[i] = bF[i] * f - dxi_dq[i] * S_tot + eta_v[i] * (N - P) + k_t * xi_v[i] * xi_lin + k_n * eta_v[i] * eta \
+            - c[i] * v[i] - om2[i] * z[i]
+    for step in range(n_steps):
+        # half-step velocity, full-step position
+        for i in range(n):
+            v[i] += 0.5 * dt * a[i]
+            z[i] += dt * v[i]
+        t = t0 + (step + 1) * dt
+        xi_old = xi
+        N_old = N
+        xi_lin, xi, dxi_dq, eta, deta, dxi = _contact_state(z, v, xi_v, eta_v, G)
+        N = _normal_force(eta, deta, n0, delta0, p, hc)
+        S_val = valanis_step(S_val, xi_old, xi, N_old, N, e_f, k_c, e_t, kappa, mu, 1e-6)
+        if N > 0.0:
+            e0 = e_f * (1.0 - np.exp(-k_c * N / e_f))
+            s_iw = _iwan_force(xi, x_sl, iw_w, e0, mu * N) if iw_share > 0.0 else 0.0
+            S_tot = (1.0 - iw_share) * S_val + iw_share * s_iw + visc * dxi
+        else:
+            S_tot = 0.0
+            for k in range(x_sl.size):
+                x_sl[k] = xi
+        P = n0 * (1.0 + drift_rate * (t - drift_t0)) if (drift_rate != 0.0 and t > drift_t0) else n0
+        f = F1 * np.sin(w * t) + F3 * np.sin(3.0 * w * t)
+        for i in range(n):
+            g = bF[i] * f - dxi_dq[i] * S_tot + eta_v[i] * (N - P) + k_t * xi_v[i] * xi_lin + k_n * eta_v[i] * eta \
+                - om2[i] * z[i]
+            # implicit diagonal damping: v_new = v_half + dt/2 (g - c v_new)
+            v[i] = (v[i] + 0.5 * dt * g) / (1.0 + 0.5 * dt * c[i])
+            a[i] = g - c[i] * v[i]
+        if step >= store_from:
+            r = step - store_from
+            for i in range(n):
+                out_a[r, i] = a[i]
+                out_z[r, i] = z[i]
+                out_v[r, i] = v[i]
+            out_s[r] = S_tot
+            out_n[r] = N
+            out_xi[r] = xi
+            out_eta[r] = eta
+            out_f[r] = f
+            out_dxi[r] = dxi
+            out_deta[r] = deta
+    state[0] = S_val
+    state[1] = xi
+    state[2] = N
+    return t
+
+
+@dataclass
+class SteadyStateLog:
+    """How steady state was reached: the driving-point harmonic amplitudes
+    A1 (at w) and A3 (at 3w) of each chunk, and the relative change between chunks."""
+
+    a1: list = field(default_factory=list)
+    a3: list = field(default_factory=list)
+    change: list = field(default_factory=list)
+
+
+class DualSineSimulator:
+    """Time integration of the reduced rig model under f = F1 sin(wt) + F3 sin(3wt)."""
+
+    def __init__(self, red: ReducedModel, contact: ContactParameters, zeta: np.ndarray, dt: float):
+        self.red = red
+        self.contact = contact
+        self.zeta = np.asarray(zeta, dtype=float)
+        self.dt = float(dt)
+        self.fr = np.asarray(contact.friction, dtype=float)
+        self.iw_w = np.asarray(contact.iwan_weights, dtype=float)
+        self.reset()
+
+    def reset(self):
+        n = self.red.omega.size
+        self.z = np.zeros(n)
+        self.v = np.zeros(n)
+        self.state = np.zeros(3)
+        self.x_sl = np.zeros(self.iw_w.size)
+        self.t = 0.0
+        self.drift_rate = 0.0
+        self.drift_t0 = 0.0
+
+    def linear_frf(self, w: float) -> complex:
+        """Driving-point accelerance of the stuck linear reduced system at w (m/s^2/N)."""
+        r = self.red
+        x = r.force / (r.omega**2 - w**2 + 2j * self.zeta * r.omega * w)
+        return complex(-(w**2) * (r.drive @ x))
+
+    def start_from_linear(self, F1: float, F3: float, w: float):
+        """Initial state: the stuck linear system's steady state at t = 0."""
+        r = self.red
+        self.reset()
+        for F, h in ((F1, 1), (F3, 3)):
+            X = F * r.force / (r.omega**2 - (h * w) ** 2 + 2j * self.zeta * r.omega * h * w)
+            self.z += X.imag
+            self.v += h * w * X.real
+        self.state[1] = r.xi @ self.z
+        # the friction state starts at the stuck spring force
+        self.state[0] = r.k_t * (r.xi @ self.z)
+
+    def run(self, F1: float, F3: float, w: float, n_steps: int, store_from: int | None = None) -> dict:
+        """Advance n_steps; returns the stored signals (from ``store_from``) at the step rate."""
+        n_store = 0 if store_from is None else n_steps - store_from
+        n_r = self.red.omega.size
+        out = {k: np.empty(n_store) for k in ("S", "N", "xi", "eta", "f", "dxi", "deta")}
+        out_a = np.empty((n_store, n_r))
+        out_z = np.empty((n_store, n_r))
+        out_v = np.empty((n_store, n_r))
+        c = self.contact
+        r = self.red
+        t_start = self.t
+        self.t = integrate(self.z, self.v, self.state, self.t, n_steps, self.dt, r.omega, self.zeta, r.xi, r.eta,
+                           r.shortening, r.force, r.k_t, r.k_n, F1, F3, w, self.fr, c.preload, c.static_approach,
+                           c.exponent, c.hunt_crossley, c.viscous, c.iwan_share, self.iw_w, self.x_sl,
+                           self.drift_rate, self.drift_t0, n_steps if store_from is None else store_from, out_a, out_z, out_v,
+                           out["S"], out["N"], out["xi"], out["eta"], out["f"], out["dxi"], out["deta"])
+        first = 1 + (n_steps if store_from is None else store_from)
+        out["t"] = t_start + self.dt * np.arange(first, first + n_store)
+        out["a"] = out_a
+        out["z"] = out_z
+        out["v"] = out_v
+        return out
+
+    def settle(self, F1: float, F3: float, w: float, chunk_periods: int = 8, tol: float = 1e-4,
+               min_chunks: int = 3, max_chunks: int = 200) -> tuple[np.ndarray, SteadyStateLog, bool]:
+        """Run chunks of ``chunk_periods`` periods until the driving-point harmonics
+        at w and 3w change by less than ``tol`` (relative) from one chunk to the next.
+        Returns ([A1, A3] complex of the last chunk, log, converged)."""
+        n = int(round(chunk_periods * 2 * np.pi / w / self.dt))
+        log = SteadyStateLog()
+        prev = None
+        for k in range(max_chunks):
+            out = self.run(F1, F3, w, n, store_from=0)
+            acc = out["a"] @ self.red.drive
+            c = harmonic_amplitudes(acc, out["t"], w, (1, 3))
+            log.a1.append(abs(c[0]))
+            log.a3.append(abs(c[1]))
+            if prev is not None:
+                ch = float(np.max(np.abs(c - prev) / np.abs(c)))
+                log.change.append(ch)
+                if k + 1 >= min_chunks and ch < tol:
+                    return c, log, True
+            prev = c
+        return prev, log, False
+
+
+@dataclass
+class ControlResult:
+    """Response control: the force amplitudes found, the driving-point harmonic
+    amplitudes they give, and the history of the iteration."""
+
+    F1: float
+    F3: float
+    A1: float
+    A3: float
+    converged: bool
+    history: list
+    steady_state: SteadyStateLog
+
+
+def control_response(sim: DualSineSimulator, target_a1: float, target_a3: float, w: float, tol: float = 1e-3,
+                     max_iter: int = 40) -> ControlResult:
+    """Tune F1, F3 until the driving-point acceleration harmonics at w and 3w
+    equal the targets within ``tol`` (relative): Broyden's method on
+    (F1, F3) -> (|A1|, |A3|), started from the stuck linear system's FRF."""
+    h1, h3 = abs(sim.linear_frf(w)), abs(sim.linear_frf(3 * w))
+    target = np.array([target_a1, target_a3])
+    F = target / np.array([h1, h3])
+    J = np.diag([h1, h3])
+    sim.start_from_linear(F[0], F[1], w)
+    history = []
+    prev = None
+    log = None
+    for it in range(max_iter):
+        c, log, ok = sim.settle(F[0], F[1], w)
+        A = np.abs(c)
+        history.append((float(F[0]), float(F[1]), float(A[0]), float(A[1]), bool(ok)))
+        r = A - target
+        if ok and np.max(np.abs(r) / target) < tol:
+            return ControlResult(float(F[0]), float(F[1]), float(A[0]), float(A[1]), True, history, log)
+        if prev is not None:
+            dF, dA = F - prev[0], A - prev[1]
+            if dF @ dF > 0:
+                J = J + np.outer(dA - J @ dF, dF) / (dF @ dF)
+        prev = (F.copy(), A.copy())
+        try:
+            step = np.linalg.solve(J, -r)
+        except np.linalg.LinAlgError:
+            step = -r / np.diag(J)
+        F_new = F + step
+        F = np.clip(F_new, 0.3 * F, 3.0 * F)  # keep each update within a factor of 3
+    c = history[-1]
+    return ControlResult(c[0], c[1], c[2], c[3], False, history, log)
