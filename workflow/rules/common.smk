@@ -53,6 +53,18 @@ def rig_outputs():
     return out + [f"data/raw/{c}.nc" for c in rig_cases()]
 
 
+def summary_inputs(wildcards):
+    """Everything the headline numbers are read from, named for the summary script."""
+    inputs = {"modal": "results/linear/modal.nc", "stiction": "results/linear/stiction.nc"}
+    if not _is_measured(config.get("random_test")):
+        inputs["truth"] = "data/truth/random_test.nc"
+    for c in load_cases():
+        inputs[f"check_{c}"] = f"results/{c}/raw_check.nc"
+    for c, path in truth_records().items():
+        inputs[f"truth_{c}"] = path
+    return inputs
+
+
 def all_outputs():
     return [
         "results/linear/linear_modes.nc",

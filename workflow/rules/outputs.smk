@@ -54,9 +54,7 @@ rule fig03_frf:
 
 rule summary:
     input:
-        modal="results/linear/modal.nc",
-        stiction="results/linear/stiction.nc",
-        truth=random_test_truth(),
+        unpack(summary_inputs),
     output:
         summary="results/summary.json",
     conda:

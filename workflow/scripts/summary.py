@@ -4,11 +4,15 @@ import json
 
 from contactid.io import load_dataset
 from contactid.logs import setup_logging
-from contactid.reporting import linear_summary
+from contactid.reporting import linear_summary, load_case_summary
 
 log = setup_logging(snakemake.log[0])
-truth = load_dataset(snakemake.input.truth) if snakemake.input.get("truth") else None
-summary = linear_summary(load_dataset(snakemake.input.modal), load_dataset(snakemake.input.stiction), truth)
+inp = snakemake.input
+truth = load_dataset(inp.truth) if "truth" in inp.keys() else None
+summary = linear_summary(load_dataset(inp.modal), load_dataset(inp.stiction), truth)
+checks = {k[len("check_"):]: load_dataset(v) for k, v in inp.items() if k.startswith("check_")}
+truths = {k[len("truth_"):]: load_dataset(v) for k, v in inp.items() if k.startswith("truth_")}
+summary.update(load_case_summary(checks, truths))
 with open(snakemake.output.summary, "w") as fh:
     json.dump(summary, fh, indent=2, sort_keys=True)
 log.info("%s", summary)

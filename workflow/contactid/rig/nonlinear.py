@@ -198,7 +198,7 @@ def integrate(z, v, state, t0, n_steps, dt, omega, zeta, xi_v, eta_v, G, bF, k_t
         xi_old = xi
         N_old = N
         xi_lin, xi, dxi_dq, eta, deta, dxi = _contact_state(z, v, xi_v, eta_v, G)
-        N = _normal_force(eta, deta, n0, delta0, p, hc)
+        N = _normal_force(eta, deta, n0, delta0, p, hc)  # explicit estimate for the friction law
         S_val = valanis_step(S_val, xi_old, xi, N_old, N, e_f, k_c, e_t, kappa, mu, 1e-6)
         if N > 0.0:
             e0 = e_f * (1.0 - np.exp(-k_c * N / e_f))
@@ -210,12 +210,37 @@ def integrate(z, v, state, t0, n_steps, dt, omega, zeta, xi_v, eta_v, G, bF, k_t
                 x_sl[k] = xi
         P = n0 * (1.0 + drift_rate * (t - drift_t0)) if (drift_rate != 0.0 and t > drift_t0) else n0
         f = F1 * np.sin(w * t) + F3 * np.sin(3.0 * w * t)
+        # normal force: elastic part explicit, Hunt-Crossley damping implicit (it is stiff)
+        N_el = _normal_force(eta, 0.0, n0, delta0, p, 0.0)
+        c_n = hc * N_el
+        uDu = 0.0
+        uy = 0.0
         for i in range(n):
-            g = bF[i] * f - dxi_dq[i] * S_tot + eta_v[i] * (N - P) + k_t * xi_v[i] * xi_lin + k_n * eta_v[i] * eta \
-                - om2[i] * z[i]
-            # implicit diagonal damping: v_new = v_half + dt/2 (g - c v_new)
-            v[i] = (v[i] + 0.5 * dt * g) / (1.0 + 0.5 * dt * c[i])
-            a[i] = g - c[i] * v[i]
+            g = bF[i] * f - dxi_dq[i] * S_tot + eta_v[i] * (N_el - P) + k_t * xi_v[i] * xi_lin \
+                + k_n * eta_v[i] * eta - om2[i] * z[i]
+            D = 1.0 + 0.5 * dt * c[i]
+            a[i] = v[i]  # keep v_half
+            v[i] = (v[i] + 0.5 * dt * g) / D  # implicit diagonal damping
+            uDu += eta_v[i] * eta_v[i] / D
+            uy += eta_v[i] * v[i]
+        if c_n > 0.0:
+            beta = 0.5 * dt * c_n
+            corr = beta * uy / (1.0 + beta * uDu)
+            deta_new = 0.0
+            for i in range(n):
+                deta_new += eta_v[i] * (v[i] - corr * eta_v[i] / (1.0 + 0.5 * dt * c[i]))
+            N = N_el * (1.0 - hc * deta_new)
+            if N >= 0.0:
+                for i in range(n):
+                    v[i] -= corr * eta_v[i] / (1.0 + 0.5 * dt * c[i])
+            else:  # the damping cannot pull: the contact force drops to zero
+                N = 0.0
+                for i in range(n):
+                    v[i] -= 0.5 * dt * eta_v[i] * N_el / (1.0 + 0.5 * dt * c[i])
+        else:
+            N = N_el
+        for i in range(n):
+            a[i] = 2.0 * (v[i] - a[i]) / dt
         if step >= store_from:
             r = step - store_from
             for i in range(n):
