@@ -100,3 +100,53 @@ def test_bad_config_fails_before_any_rule(tmp_path, overrides, message):
     assert res.returncode != 0
     assert message in res.stderr + res.stdout
     assert not (proj / "results").exists() and not (proj / "data").exists()
+
+
+def test_rig_target_makes_raw_records_only(tmp_path):
+    proj = make_project(tmp_path)
+    res = snakemake(proj, "rig")
+    assert res.returncode == 0, res.stderr[-3000:]
+    raw = sorted(p.name for p in (proj / "data" / "raw").iterdir())
+    assert raw == ["lc1.nc", "lc2.nc", "lc3.nc", "random_test.nc"]
+    assert not (proj / "results").exists()
+
+
+def test_default_records_meet_table2(default_run):
+    s = json.loads((default_run / "results" / "summary.json").read_text())
+    for case, (a1, a2) in {"lc1": (14, 34), "lc2": (17.5, 42.5), "lc3": (20, 50)}.items():
+        got = s["load_cases"][case]
+        assert abs(got["A1_m_per_s2"] / a1 - 1) < 0.01 and abs(got["A2_m_per_s2"] / a2 - 1) < 0.01
+        tr = s["truth_load_cases"][case]
+        assert tr["N_min_n"] > 0 and tr["max_S_over_mu_N"] > 0.99
+
+
+def test_new_load_case_runs_only_its_jobs(default_run):
+    cfg = yaml.safe_load((default_run / "config" / "config.yaml").read_text())
+    cfg["load_cases"]["lc4"] = {"A1_m_per_s2": 12.0, "A2_m_per_s2": 30.0}
+    alt = default_run / "config" / "with_lc4.yaml"
+    alt.write_text(yaml.safe_dump(cfg))
+    res = snakemake(default_run, "--configfile", str(alt), "-n", "--quiet", "rules")
+    assert res.returncode == 0, res.stderr[-3000:]
+    out = res.stdout + res.stderr
+    jobs = {line.split()[0]: int(line.split()[1]) for line in out.splitlines()
+            if len(line.split()) == 2 and line.split()[1].isdigit()}
+    assert jobs.get("rig_dual_sine") == 1 and jobs.get("raw_check") == 1
+    assert "rig_random_test" not in jobs and "frf" not in jobs and "stiction_stiffness" not in jobs
+
+
+def test_measured_case_with_wrong_unit_names_file(default_run, tmp_path):
+    import xarray as xr
+
+    proj = make_project(tmp_path)
+    ds = xr.load_dataset(default_run / "data" / "raw" / "lc1.nc", engine="netcdf4")
+    ds["acceleration"].attrs["units"] = "g"
+    (proj / "measured").mkdir()
+    ds.to_netcdf(proj / "measured" / "lc7.nc", engine="netcdf4")
+    cfg = yaml.safe_load((proj / "config" / "config.yaml").read_text())
+    cfg["load_cases"] = {"lc7": {"source": "measured", "file": "measured/lc7.nc"}}
+    (proj / "config" / "config.yaml").write_text(yaml.safe_dump(cfg))
+    res = snakemake(proj, "results/lc7/raw_check.nc")
+    assert res.returncode != 0
+    log = (proj / "logs" / "raw_check_lc7.log").read_text() + res.stderr
+    assert "measured/lc7.nc" in log and "convert to 'm/s^2'" in log
+    assert not (proj / "results" / "lc7" / "raw_check.nc").exists()

@@ -8,9 +8,9 @@ relative tangential displacement (Eq. 9). The law is rate independent: S changes
 along the direction sgn(dxi).
 
 Regularisation (documented): where N <= ``n_min`` the contact carries no friction (S = 0, the
-contact is open); and |S| is kept at most mu N, so that a falling normal force makes the contact
-slip back to the friction limit. With |S| <= mu N the denominator stays >= 1 - kappa > 0 for
-kappa < 1.
+contact is open); and |S - e_t xi| is kept at most alpha_0 (1 - kappa e_t / e_0), the law's own
+macro-slip asymptote, so that a falling normal force makes the contact slip back to the
+friction limit. Within that bound the denominator stays >= 1 - kappa > 0 for kappa < 1.
 """
 
 from __future__ import annotations
@@ -31,6 +31,14 @@ def valanis_slope(S, xi, direction, normal_force, e_f, k_c, e_t, kappa, mu):
 
 
 @njit(cache=True)
+def _clamp_to_slip_limit(S, xi, normal_force, e_f, k_c, e_t, kappa, mu):
+    e0 = e_f * (1.0 - np.exp(-k_c * normal_force / e_f))
+    lim = mu * normal_force * (1.0 - kappa * e_t / e0)
+    base = e_t * xi
+    return min(max(S, base - lim), base + lim)
+
+
+@njit(cache=True)
 def valanis_step(S, xi0, xi1, n0, n1, e_f, k_c, e_t, kappa, mu, n_min):
     """Friction force after xi moves from xi0 to xi1 while N moves from n0 to n1
     (Heun's method in xi; N linear over the step). Returns S (N)."""
@@ -40,13 +48,10 @@ def valanis_step(S, xi0, xi1, n0, n1, e_f, k_c, e_t, kappa, mu, n_min):
         return 0.0
     dxi = xi1 - xi0
     if dxi == 0.0:
-        lim = mu * n1
-        return min(max(S, -lim), lim)
+        return _clamp_to_slip_limit(S, xi1, n1, e_f, k_c, e_t, kappa, mu)
     direction = 1.0 if dxi > 0.0 else -1.0
+    S = _clamp_to_slip_limit(S, xi0, n0, e_f, k_c, e_t, kappa, mu)
     k1 = valanis_slope(S, xi0, direction, n0, e_f, k_c, e_t, kappa, mu)
-    s_pred = S + k1 * dxi
-    lim = mu * n1
-    s_pred = min(max(s_pred, -lim), lim)
+    s_pred = _clamp_to_slip_limit(S + k1 * dxi, xi1, n1, e_f, k_c, e_t, kappa, mu)
     k2 = valanis_slope(s_pred, xi1, direction, n1, e_f, k_c, e_t, kappa, mu)
-    s_new = S + 0.5 * (k1 + k2) * dxi
-    return min(max(s_new, -lim), lim)
+    return _clamp_to_slip_limit(S + 0.5 * (k1 + k2) * dxi, xi1, n1, e_f, k_c, e_t, kappa, mu)
