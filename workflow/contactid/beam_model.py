@@ -229,10 +229,18 @@ class Modes:
     block_energy_fraction: np.ndarray
 
 
+def fix_signs(vectors: np.ndarray) -> np.ndarray:
+    """Columns with their largest-magnitude entry made positive, so that eigenvectors (whose sign
+    the solver leaves free, and may flip between processes) are reproducible."""
+    idx = np.argmax(np.abs(vectors), axis=0)
+    return vectors * np.sign(vectors[idx, np.arange(vectors.shape[1])])
+
+
 def all_modes(model: FEModel) -> Modes:
     """All undamped modes, sorted by frequency, mass-normalised."""
     lam, vec = scipy.linalg.eigh(model.stiffness, model.mass)
     lam = np.clip(lam, 0.0, None)
+    vec = fix_signs(vec)
     # share of the (unit, mass-normalised) kinetic energy carried by the block
     p = model.params
     frac = (

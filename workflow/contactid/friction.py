@@ -19,7 +19,7 @@ import numpy as np
 from numba import njit
 
 
-@njit(cache=True)
+@njit
 def valanis_slope(S, xi, direction, normal_force, e_f, k_c, e_t, kappa, mu):
     """dS/dxi (N/m) of Eq. 21 at friction force S (N), displacement xi (m), motion
     direction +-1 and total normal force N (N)."""
@@ -30,7 +30,7 @@ def valanis_slope(S, xi, direction, normal_force, e_f, k_c, e_t, kappa, mu):
     return e0 * (1.0 + d) / (1.0 + kappa * d)
 
 
-@njit(cache=True)
+@njit
 def _clamp_to_slip_limit(S, xi, normal_force, e_f, k_c, e_t, kappa, mu):
     e0 = e_f * (1.0 - np.exp(-k_c * normal_force / e_f))
     lim = mu * normal_force * (1.0 - kappa * e_t / e0)
@@ -38,7 +38,7 @@ def _clamp_to_slip_limit(S, xi, normal_force, e_f, k_c, e_t, kappa, mu):
     return min(max(S, base - lim), base + lim)
 
 
-@njit(cache=True)
+@njit
 def valanis_step(S, xi0, xi1, n0, n1, e_f, k_c, e_t, kappa, mu, n_min):
     """Friction force after xi moves from xi0 to xi1 while N moves from n0 to n1
     (Heun's method in xi; N linear over the step). Returns S (N)."""

@@ -30,7 +30,7 @@ import scipy.linalg
 import scipy.signal
 from numba import njit
 
-from ..beam_model import FEModel, all_modes, shortening_matrix
+from ..beam_model import FEModel, all_modes, fix_signs, shortening_matrix
 from ..friction import valanis_step
 from ..signals import harmonic_amplitudes
 
@@ -71,7 +71,7 @@ def reduced_model(model: FEModel, n_modes: int, static_correction: bool = True) 
     Kr = phi.T @ model.stiffness @ phi
     Mr = phi.T @ model.mass @ phi
     lam, vec = scipy.linalg.eigh(Kr, Mr)
-    basis = phi @ vec
+    basis = fix_signs(phi @ vec)
     p = model.params
     frac = (p.block_mass * ((model.block_lateral_vector @ basis) ** 2 + (model.block_axial_vector @ basis) ** 2)
             + p.block_inertia * basis[model.thetas_dof] ** 2)
@@ -113,7 +113,7 @@ def iwan_slip_weights(n: int, spread: float = 0.8) -> np.ndarray:
     return w / w.sum()
 
 
-@njit(cache=True)
+@njit
 def _contact_state(z, v, xi_v, eta_v, G):
     n = z.size
     xi_lin = 0.0
@@ -130,7 +130,7 @@ def _contact_state(z, v, xi_v, eta_v, G):
     return xi_lin, xi_lin - short, dxi_dq, eta, deta, dxi
 
 
-@njit(cache=True)
+@njit
 def _normal_force(eta, deta, n0, delta0, p, hc):
     if eta >= delta0:
         return 0.0
@@ -139,7 +139,7 @@ def _normal_force(eta, deta, n0, delta0, p, hc):
     return n if n > 0.0 else 0.0
 
 
-@njit(cache=True)
+@njit
 def _iwan_force(xi, x_sl, weights, e0_total, mu_n):
     """Maxwell-slip sliders: stiffness e0 w_i, limit mu N w_i; x_sl (slider anchors) updated in place."""
     total = 0.0
@@ -157,7 +157,7 @@ def _iwan_force(xi, x_sl, weights, e0_total, mu_n):
     return total
 
 
-@njit(cache=True)
+@njit
 def integrate(z, v, state, t0, n_steps, dt, omega, zeta, xi_v, eta_v, G, bF, k_t, k_n,
               F1, F3, w, fr, n0, delta0, p, hc, visc, iw_share, iw_w, x_sl, drift_rate, drift_t0,
               store_from, out_a, out_z, out_v, out_s, out_n, out_xi, out_eta, out_f, out_dxi, out_deta):
