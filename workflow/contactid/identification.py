@@ -86,63 +86,95 @@ class PaperChainResult:
     complex_modes: bool
 
 
-def paper_chain(model: FEModel, n_modes: int, force: np.ndarray, acceleration: np.ndarray, fs: float, f0: float,
-                n_harmonics: int, drive_index: int, phase_limit_deg: float = 10.0) -> PaperChainResult:
-    """The paper's NNM chain on one record (Eqs. 15-20, 10-12)."""
-    j = acceleration.shape[0]
-    if n_modes > j:
-        raise IdentificationError(f"m = {n_modes} linear modes need at least as many sensors (Eq. 15: j >= m); "
+def generalized_coordinates(phi_sensor: np.ndarray, acceleration: np.ndarray, fs: float, f0: float,
+                            n_harmonics: int) -> tuple[np.ndarray, np.ndarray]:
+    """Generalized accelerations p''(t) = Phi^+ w''(t) (Eq. 15) and their K harmonics (Eq. 16).
+
+    phi_sensor: (j, m) linear mode shapes at the j sensors; acceleration: (j, n_t) m/s^2.
+    Returns (p'' raw (m, n_t), coefficients (m, K)). Refuses m > j."""
+    j, m = phi_sensor.shape
+    if m > j:
+        raise IdentificationError(f"m = {m} linear modes need at least as many sensors (Eq. 15: j >= m); "
                                   f"the record has j = {j}: lower nonlinear.n_modes or add sensors")
-    if n_harmonics < 3:
-        raise IdentificationError("the paper's chain needs K >= 3 harmonics (the NNMs use harmonics 1 and 3)")
-    modes = structural_modes(model, n_modes)
-    phi = modes.shapes  # (n_dof, m), mass-normalised
-    Phi_s = model.sensor_vectors @ phi  # (j, m)
-    t = np.arange(acceleration.shape[1]) / fs
-    pdd = np.linalg.pinv(Phi_s) @ acceleration  # Eq. 15
-    p_coef = fourier_series(pdd, fs, f0, n_harmonics)  # Eq. 16, (m, K)
-    # Eq. 20: real NNMs from the amplitudes of harmonics 1 and 3, signed by phase
-    nnm = np.empty((phi.shape[0], 2))
+    pdd = np.linalg.pinv(phi_sensor) @ acceleration
+    return pdd, fourier_series(pdd, fs, f0, n_harmonics)
+
+
+def nonlinear_mode_coefficients(p_coef: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Eq. 20: coefficients (2, m) of the two real NNMs on the linear modes, from the amplitudes
+    of harmonics 1 and 3 of the generalized accelerations, signed by their phase relative to
+    the dominant term; and the largest phase deviation (degrees) from 0 or 180 among the terms of
+    each frequency (the paper's check that the NNMs are real)."""
+    if p_coef.shape[1] < 3:
+        raise IdentificationError("the NNMs use harmonics 1 and 3: K must be at least 3")
+    coef = np.empty((2, p_coef.shape[0]))
     spread = np.empty(2)
-    for col, h in enumerate((1, 3)):
+    for row, h in enumerate((1, 3)):
         c = p_coef[:, h - 1]
         ref = np.angle(c[np.argmax(np.abs(c))])
-        dphi = np.angle(c * np.exp(-1j * ref))  # phase relative to the dominant term, in (-pi, pi]
+        dphi = np.angle(c * np.exp(-1j * ref))
         sign = np.where(np.abs(dphi) <= np.pi / 2, 1.0, -1.0)
-        dev = np.abs(np.angle(np.exp(1j * dphi) * sign))  # distance from 0 or 180 degrees
-        weights = np.abs(c) / np.max(np.abs(c))
-        spread[col] = np.degrees(np.max(dev[weights > 0.01])) if np.any(weights > 0.01) else 0.0
+        dev = np.abs(np.angle(np.exp(1j * dphi) * sign))
+        significant = np.abs(c) > 0.01 * np.max(np.abs(c))
+        spread[row] = float(np.degrees(np.max(dev[significant])))
         A = sign * np.abs(c)
-        nnm[:, col] = phi @ A / np.sqrt(np.sum(A**2))
-    # NNM coordinates: q'' = Psi^+ w'' at the sensors, K harmonics, analytic integration
-    Psi_s = model.sensor_vectors @ nnm
-    qdd_raw = np.linalg.pinv(Psi_s) @ acceleration
-    q_coef = fourier_series(qdd_raw, fs, f0, n_harmonics)
-    qdd = synthesize(q_coef, f0, t, 0)
-    q = synthesize(q_coef, f0, t, -2)
-    reconstruction = (Psi_s @ qdd)[drive_index]
-    # Galerkin reduced model (Eqs. 10-12) without the contact springs
-    k0 = model.stiffness - model.params.k_t * np.outer(model.xi_vector, model.xi_vector) \
-        - model.params.k_n * np.outer(model.eta_vector, model.eta_vector)
+        coef[row] = A / np.sqrt(np.sum(A**2))
+    return coef, spread
+
+
+def nnm_coordinates(psi_sensor: np.ndarray, acceleration: np.ndarray, fs: float, f0: float, n_harmonics: int):
+    """NNM coordinates from the accelerations: q'' = Psi^+ w'' at the sensors, K harmonics,
+    analytic double integration (Eq. 17). Returns (q, q'') on the record's time axis, (2, n_t)."""
+    t = np.arange(acceleration.shape[1]) / fs
+    coef = fourier_series(np.linalg.pinv(psi_sensor) @ acceleration, fs, f0, n_harmonics)
+    return synthesize(coef, f0, t, -2), synthesize(coef, f0, t, 0)
+
+
+def galerkin_contact_forces(model: FEModel, nnm: np.ndarray, q: np.ndarray, qdd: np.ndarray, force: np.ndarray):
+    """S(t), N(t) - N0 by the force-state mapping on the Galerkin reduced model (Eqs. 10-12):
+
+        F_ext - M q'' - K q = [dxi/dq, -deta/dq] [S; N - N0]
+
+    with M = Psi^T M Psi, K = Psi^T K_0 Psi (no contact springs), xi with the shortening term.
+    nnm: (n_dof, n) trial vectors; q, qdd: (n, n_t); force: (n_t,) N.
+    Returns dict of S, N_dyn, xi, eta (n_t,) and the reduced matrices."""
+    k0 = model.stiffness_without_contact
     Mr = nnm.T @ model.mass @ nnm
     Kr = nnm.T @ k0 @ nnm
     Fr = nnm.T @ model.force_vector
     G = nnm.T @ shortening_matrix(model) @ nnm
     xi_r = nnm.T @ model.xi_vector
     eta_r = nnm.T @ model.eta_vector
-    f_coef = fourier_series(force, fs, f0, n_harmonics)
-    f_syn = synthesize(f_coef, f0, t, 0)[0]
-    lhs = np.outer(Fr, f_syn) - Mr @ qdd - Kr @ q  # (2, n_t)
-    S = np.empty(t.size)
-    N = np.empty(t.size)
-    for k in range(t.size):
-        dxi = xi_r - G @ q[:, k]
-        A = np.column_stack([dxi, -eta_r])
-        S[k], N[k] = np.linalg.solve(A, lhs[:, k])
+    lhs = np.outer(Fr, force) - Mr @ qdd - Kr @ q
+    n_t = q.shape[1]
+    S = np.empty(n_t)
+    N = np.empty(n_t)
+    for k in range(n_t):
+        A = np.column_stack([xi_r - G @ q[:, k], -eta_r])
+        S[k], N[k] = np.linalg.lstsq(A, lhs[:, k], rcond=None)[0][:2]
     xi = xi_r @ q - 0.5 * np.einsum("it,ij,jt->t", q, G, q)
     eta = eta_r @ q
-    return PaperChainResult(p_coef, nnm, spread, q, qdd, reconstruction, S - S.mean(), N - N.mean(),
-                            xi - xi.mean(), eta - eta.mean(), Mr, Kr, bool(np.any(spread > phase_limit_deg)))
+    return {"S": S, "N_dyn": N, "xi": xi, "eta": eta, "reduced_mass": Mr, "reduced_stiffness": Kr,
+            "reduced_force": Fr}
+
+
+def paper_chain(model: FEModel, n_modes: int, force: np.ndarray, acceleration: np.ndarray, fs: float, f0: float,
+                n_harmonics: int, drive_index: int, phase_limit_deg: float = 10.0) -> PaperChainResult:
+    """The paper's NNM chain on one record (Eqs. 15-20, 10-12), all steps in one call."""
+    modes = structural_modes(model, n_modes)
+    phi = modes.shapes
+    pdd, p_coef = generalized_coordinates(model.sensor_vectors @ phi, acceleration, fs, f0, n_harmonics)
+    coef, spread = nonlinear_mode_coefficients(p_coef)
+    nnm = phi @ coef.T
+    q, qdd = nnm_coordinates(model.sensor_vectors @ nnm, acceleration, fs, f0, n_harmonics)
+    reconstruction = (model.sensor_vectors @ nnm @ qdd)[drive_index]
+    t = np.arange(acceleration.shape[1]) / fs
+    f_syn = synthesize(fourier_series(force, fs, f0, n_harmonics), f0, t, 0)[0]
+    g = galerkin_contact_forces(model, nnm, q, qdd, f_syn)
+    centre = lambda x: x - x.mean()  # noqa: E731
+    return PaperChainResult(p_coef, nnm, spread, q, qdd, reconstruction, centre(g["S"]), centre(g["N_dyn"]),
+                            centre(g["xi"]), centre(g["eta"]), g["reduced_mass"], g["reduced_stiffness"],
+                            bool(np.any(spread > phase_limit_deg)))
 
 
 # ----------------------------------------------------------------------------------------------

@@ -82,6 +82,9 @@ def write_dataset(ds: xr.Dataset, path: str | os.PathLike) -> None:
     os.close(fd)
     try:
         ds.to_netcdf(tmp, engine=ENGINE)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # mkstemp's 0600 is too private for a shared results tree
         os.replace(tmp, path)
     finally:
         if os.path.exists(tmp):

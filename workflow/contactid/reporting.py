@@ -121,3 +121,107 @@ def plot_fig03(frf: xr.Dataset, modal: xr.Dataset, png: str, pdf: str, f_max_hz:
     fig.savefig(png, dpi=150)
     fig.savefig(pdf)
     plt.close(fig)
+
+
+def _mpl():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _one_period(t: np.ndarray, f0: float, periods: int = 3):
+    return t <= periods / f0
+
+
+def plot_fig04(gc: xr.Dataset, case: str, png: str, pdf: str) -> None:
+    """Fig. 4: generalized coordinates p_i(t) of the linear modes (Eq. 17), three periods."""
+    plt = _mpl()
+    t = gc["time"].values
+    sel = _one_period(t, gc.attrs["excitation_frequency_hz"])
+    fig, ax = plt.subplots(figsize=(6.5, 3.8))
+    for i, m in enumerate(gc["mode"].values):
+        ax.plot(1e3 * t[sel], 1e3 * gc["p"].values[i, sel], lw=1.2, label=f"p$_{m}$")
+    ax.set_xlabel("time (ms)")
+    ax.set_ylabel("generalized coordinate (10$^{-3}$ kg$^{1/2}$ m)")
+    ax.set_title(f"Generalized coordinates of the linear modes, {case}")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(png, dpi=150)
+    fig.savefig(pdf)
+    plt.close(fig)
+
+
+def plot_fig05(nnm: xr.Dataset, case: str, png: str, pdf: str) -> None:
+    """Fig. 5: driving-point acceleration, measured (line) and reconstructed from the NNMs (circles)."""
+    plt = _mpl()
+    t = nnm["time"].values
+    sel = slice(0, int(np.searchsorted(t, 3.0 / nnm.attrs["excitation_frequency_hz"])))
+    fig, ax = plt.subplots(figsize=(6.5, 3.8))
+    ax.plot(1e3 * t[sel], nnm["drive_measured"].values[sel], "-", lw=1.2, color="C0", label="measured")
+    ax.plot(1e3 * t[sel], nnm["drive_reconstructed"].values[sel], "o", ms=3, mfc="none", color="C3",
+            label=f"reconstructed from the NNMs (NRMSE {100 * nnm.attrs['reconstruction_nrmse']:.1f} %)")
+    ax.set_xlabel("time (ms)")
+    ax.set_ylabel("acceleration at d$_p$ (m s$^{-2}$)")
+    ax.set_title(f"Driving-point acceleration, {case}")
+    ax.legend(fontsize=8, loc="lower right")
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(png, dpi=150)
+    fig.savefig(pdf)
+    plt.close(fig)
+
+
+def plot_fig06(forces: Mapping[str, xr.Dataset], png: str, pdf: str) -> None:
+    """Fig. 6: S-xi and N-eta loops per load case: working method (the correction), the paper's
+    chain (the reproduction) and the rig truth where it exists."""
+    plt = _mpl()
+    cases = list(forces)
+    fig, axes = plt.subplots(2, len(cases), figsize=(3.3 * len(cases), 6.2), squeeze=False)
+    for j, case in enumerate(cases):
+        ds = forces[case]
+        for row, (F, X, Fp, Xp, Ft, Xt, xl, yl) in enumerate((
+                ("S", "xi", "S_paper", "xi_paper", "S_truth", "xi_truth", r"$\xi$ ($\mu$m)", "S (N)"),
+                ("N_dyn", "eta", "N_dyn_paper", "eta_paper", "N_dyn_truth", "eta_truth", r"$\eta$ ($\mu$m)",
+                 "N - N$_0$ (N)"))):
+            ax = axes[row, j]
+            if Ft in ds:
+                ax.plot(1e6 * ds[Xt].values, ds[Ft].values, "-", color="0.6", lw=3, label="rig truth")
+            ax.plot(1e6 * ds[X].values, ds[F].values, "-", color="C0", lw=1.0, label="working method")
+            ax.plot(1e6 * ds[Xp].values, ds[Fp].values, ":", color="C3", lw=1.0, label="paper's chain")
+            if row == 1 and Ft in ds:
+                lim = 1.5 * np.max(np.abs(ds[Ft].values))
+                ax.set_ylim(-lim, lim)  # the paper's N leaves the frame; its error is in the summary
+            ax.set_xlabel(xl)
+            ax.set_ylabel(yl)
+            ax.grid(alpha=0.3)
+            if row == 0:
+                ax.set_title(case)
+    axes[0, 0].legend(fontsize=7, loc="upper left")
+    fig.tight_layout()
+    fig.savefig(png, dpi=150)
+    fig.savefig(pdf)
+    plt.close(fig)
+
+
+def contact_force_summary(forces: Mapping[str, xr.Dataset], nnms: Mapping[str, xr.Dataset]) -> dict:
+    """`contact_forces` (working method) and `contact_forces_paper` blocks of summary.json."""
+    work, paper = {}, {}
+    for case, ds in forces.items():
+        a = ds.attrs
+        w = {"eta_observable": bool(a["eta_observable"]), "normal_stiffness_from_n_eta_n_per_m": a["normal_stiffness_from_n_eta_n_per_m"],
+             "normal_hardening_n_per_m2": a["normal_hardening_n_per_m2"], "n_harmonics": a["n_harmonics"]}
+        p = {"nnm_phase_spread_deg": [float(v) for v in nnms[case]["phase_spread"].values],
+             "complex_modes": bool(nnms[case].attrs["complex_modes"]),
+             "reconstruction_nrmse": nnms[case].attrs["reconstruction_nrmse"],
+             "S_decomposition_nrmse": a["paper_S_decomposition_nrmse"],
+             "N_decomposition_nrmse": a["paper_N_decomposition_nrmse"]}
+        for q in ("S", "N", "xi", "eta"):
+            if f"{q}_nrmse" in a:
+                w[f"{q}_nrmse"] = a[f"{q}_nrmse"]
+                p[f"{q}_nrmse"] = a[f"paper_{q}_nrmse"]
+        work[case], paper[case] = w, p
+    return {"contact_forces": work, "contact_forces_paper": paper}

@@ -53,6 +53,25 @@ def rig_outputs():
     return out + [f"data/raw/{c}.nc" for c in rig_cases()]
 
 
+def calibration_case():
+    """The load case the friction law is fitted on (and the harmonic study uses)."""
+    return config.get("nonlinear", {}).get("calibration_case", "lc1")
+
+
+def figure_case():
+    """The load case of Figs. 4 and 5 (the paper shows its largest, load case 3)."""
+    return config.get("nonlinear", {}).get("figure_case") or load_cases()[-1]
+
+
+def contact_forces_inputs(wildcards):
+    inputs = {"raw": raw_record(wildcards.case), "reduced": f"results/{wildcards.case}/reduced_model.nc",
+              "modes": "results/linear/linear_modes.nc", "modal": "results/linear/modal.nc",
+              "stiction": "results/linear/stiction.nc"}
+    if wildcards.case in rig_cases():
+        inputs["truth"] = f"data/truth/{wildcards.case}.nc"
+    return inputs
+
+
 def summary_inputs(wildcards):
     """Everything the headline numbers are read from, named for the summary script."""
     inputs = {"modal": "results/linear/modal.nc", "stiction": "results/linear/stiction.nc"}
@@ -60,6 +79,8 @@ def summary_inputs(wildcards):
         inputs["truth"] = "data/truth/random_test.nc"
     for c in load_cases():
         inputs[f"check_{c}"] = f"results/{c}/raw_check.nc"
+        inputs[f"forces_{c}"] = f"results/{c}/contact_forces.nc"
+        inputs[f"nnm_{c}"] = f"results/{c}/nonlinear_modes.nc"
     for c, path in truth_records().items():
         inputs[f"truth_{c}"] = path
     return inputs
@@ -74,5 +95,9 @@ def all_outputs():
         "results/figures/fig03_frf.png",
         "results/figures/fig03_frf.pdf",
         *[f"results/{c}/raw_check.nc" for c in load_cases()],
+        *[f"results/{c}/contact_forces.nc" for c in load_cases()],
+        *(["results/studies/harmonic_count.csv"] if calibration_case() in rig_cases() else []),
+        *(["results/figures/fig04_generalized_coordinates.png", "results/figures/fig05_reconstruction.png",
+           "results/figures/fig06_contact_forces.png"] if load_cases() else []),
         "results/summary.json",
     ]

@@ -14,3 +14,93 @@ rule raw_check:
         "logs/raw_check_{case}.log",
     script:
         "../scripts/raw_check.py"
+
+
+rule generalized_coordinates:
+    input:
+        raw=lambda wc: raw_record(wc.case),
+        check="results/{case}/raw_check.nc",
+        modes="results/linear/linear_modes.nc",
+    output:
+        gc="results/{case}/generalized_coordinates.nc",
+    params:
+        nonlinear=config.get("nonlinear", {}),
+    conda:
+        "../envs/contactid.yaml"
+    log:
+        "logs/generalized_coordinates_{case}.log",
+    script:
+        "../scripts/generalized_coordinates.py"
+
+
+rule nonlinear_modes:
+    input:
+        raw=lambda wc: raw_record(wc.case),
+        gc="results/{case}/generalized_coordinates.nc",
+        modes="results/linear/linear_modes.nc",
+    output:
+        nnm="results/{case}/nonlinear_modes.nc",
+    params:
+        structure=config["structure"],
+        nonlinear=config.get("nonlinear", {}),
+    conda:
+        "../envs/contactid.yaml"
+    log:
+        "logs/nonlinear_modes_{case}.log",
+    script:
+        "../scripts/nonlinear_modes.py"
+
+
+rule reduced_model:
+    input:
+        raw=lambda wc: raw_record(wc.case),
+        nnm="results/{case}/nonlinear_modes.nc",
+        modes="results/linear/linear_modes.nc",
+    output:
+        reduced="results/{case}/reduced_model.nc",
+    params:
+        structure=config["structure"],
+        nonlinear=config.get("nonlinear", {}),
+    conda:
+        "../envs/contactid.yaml"
+    log:
+        "logs/reduced_model_{case}.log",
+    script:
+        "../scripts/reduced_model.py"
+
+
+rule contact_forces:
+    input:
+        unpack(contact_forces_inputs),
+    output:
+        forces="results/{case}/contact_forces.nc",
+    params:
+        structure=config["structure"],
+        nonlinear=config.get("nonlinear", {}),
+    conda:
+        "../envs/contactid.yaml"
+    log:
+        "logs/contact_forces_{case}.log",
+    benchmark:
+        "benchmarks/rules/contact_forces_{case}.tsv"
+    script:
+        "../scripts/contact_forces.py"
+
+
+rule harmonic_study:
+    input:
+        raw=lambda wc: raw_record(calibration_case()),
+        truth=lambda wc: f"data/truth/{calibration_case()}.nc",
+        modes="results/linear/linear_modes.nc",
+        modal="results/linear/modal.nc",
+    output:
+        table=report("results/studies/harmonic_count.csv", caption="../report/harmonic_study.rst", category="Studies"),
+    params:
+        structure=config["structure"],
+        counts=config.get("nonlinear", {}).get("harmonic_study", [5, 10, 15, 20, 25, 30]),
+    conda:
+        "../envs/contactid.yaml"
+    log:
+        "logs/harmonic_study.log",
+    script:
+        "../scripts/harmonic_study.py"

@@ -63,3 +63,51 @@ rule summary:
         "logs/summary.log",
     script:
         "../scripts/summary.py"
+
+
+rule fig04_generalized_coordinates:
+    input:
+        gc=lambda wc: f"results/{figure_case()}/generalized_coordinates.nc",
+    output:
+        png=report("results/figures/fig04_generalized_coordinates.png", caption="../report/fig04.rst", category="Figures"),
+        pdf="results/figures/fig04_generalized_coordinates.pdf",
+    params:
+        case=figure_case() if load_cases() else None,
+    conda:
+        "../envs/contactid.yaml"
+    log:
+        "logs/fig04.log",
+    script:
+        "../scripts/fig04.py"
+
+
+rule fig05_reconstruction:
+    input:
+        nnm=lambda wc: f"results/{figure_case()}/nonlinear_modes.nc",
+    output:
+        png=report("results/figures/fig05_reconstruction.png", caption="../report/fig05.rst", category="Figures"),
+        pdf="results/figures/fig05_reconstruction.pdf",
+    params:
+        case=figure_case() if load_cases() else None,
+    conda:
+        "../envs/contactid.yaml"
+    log:
+        "logs/fig05.log",
+    script:
+        "../scripts/fig05.py"
+
+
+rule fig06_contact_forces:
+    input:
+        forces=expand("results/{case}/contact_forces.nc", case=load_cases()),
+    output:
+        png=report("results/figures/fig06_contact_forces.png", caption="../report/fig06.rst", category="Figures"),
+        pdf="results/figures/fig06_contact_forces.pdf",
+    params:
+        cases=load_cases(),
+    conda:
+        "../envs/contactid.yaml"
+    log:
+        "logs/fig06.log",
+    script:
+        "../scripts/fig06.py"

@@ -61,12 +61,14 @@ class ReducedModel:
 
 
 def reduced_model(model: FEModel, n_modes: int, static_correction: bool = True) -> ReducedModel:
-    """Basis of the lowest ``n_modes`` stuck modes (+ the two static contact shapes)."""
+    """Basis of the lowest ``n_modes`` stuck modes plus the static responses to a unit tangential
+    and a unit normal contact force and to the excitation (residual flexibility of the truncated
+    modes for every load the model carries)."""
     modes = all_modes(model)
     phi = modes.shapes[:, :n_modes]
     if static_correction:
         K = model.stiffness
-        psi = np.linalg.solve(K, np.column_stack([model.xi_vector, model.eta_vector]))
+        psi = np.linalg.solve(K, np.column_stack([model.xi_vector, model.eta_vector, model.force_vector]))
         phi = np.column_stack([phi, psi])
     Kr = phi.T @ model.stiffness @ phi
     Mr = phi.T @ model.mass @ phi

@@ -1,0 +1,206 @@
+"""The nonlinear chain's datasets, one per step and load case (Sections 4-5):
+generalized coordinates -> nonlinear modes -> reduced model (the paper's S, N) -> contact forces
+(both methods side by side, scored against the rig truth where it exists)."""
+
+from __future__ import annotations
+
+from typing import Mapping
+
+import numpy as np
+import xarray as xr
+
+from .beam_model import FEModel, assemble, structural_modes
+from .identification import (
+    fourier_series,
+    galerkin_contact_forces,
+    generalized_coordinates,
+    inverse_identification,
+    modal_damping_vector,
+    nnm_coordinates,
+    nonlinear_mode_coefficients,
+    nrmse,
+    synthesize,
+)
+from .parameters import structure_from_config
+from .raw_checks import driving_point_index
+
+
+def linear_model(structure_cfg: Mapping, linear_modes: xr.Dataset) -> FEModel:
+    """The identified linear FE model (the stiffnesses the linear chain chose)."""
+    return assemble(structure_from_config(structure_cfg, float(linear_modes["k_t"]), float(linear_modes["k_n"])))
+
+
+def _record(raw: xr.Dataset):
+    return (raw["force"].values, raw["acceleration"].values, float(raw.attrs["sampling_rate_hz"]),
+            float(raw.attrs["excitation_frequency_hz"]))
+
+
+def generalized_coordinates_dataset(raw: xr.Dataset, linear_modes: xr.Dataset, n_harmonics: int) -> xr.Dataset:
+    """Eqs. 15-17: p''(t) from the sensors, its K-harmonic Fourier series and p(t) by analytic integration."""
+    force, acc, fs, f0 = _record(raw)
+    phi_s = linear_modes["phi_sensor"].values
+    pdd, coef = generalized_coordinates(phi_s, acc, fs, f0, n_harmonics)
+    t = raw["time"].values
+    return xr.Dataset(
+        {
+            "p_ddot_measured": (("mode", "time"), pdd, {"units": "kg^1/2 m/s^2", "long_name": "p''(t) = Phi^+ w''(t) (Eq. 15)"}),
+            "p_ddot": (("mode", "time"), synthesize(coef, f0, t, 0), {"units": "kg^1/2 m/s^2", "long_name": "Fourier series of p'' (Eq. 16)"}),
+            "p": (("mode", "time"), synthesize(coef, f0, t, -2), {"units": "kg^1/2 m", "long_name": "p(t) by analytic integration (Eq. 17)"}),
+            "amplitude": (("mode", "harmonic"), np.abs(coef), {"units": "kg^1/2 m/s^2", "long_name": "A_ki of Eq. 16"}),
+            "phase": (("mode", "harmonic"), np.angle(coef), {"units": "rad", "long_name": "psi_ki of Eq. 16 (sine reference)"}),
+        },
+        coords={"mode": linear_modes["mode"].values, "time": ("time", t, {"units": "s"}),
+                "harmonic": np.arange(1, n_harmonics + 1)},
+        attrs={"excitation_frequency_hz": f0, "n_harmonics": n_harmonics},
+    )
+
+
+def nonlinear_modes_dataset(gc: xr.Dataset, linear_modes: xr.Dataset, raw: xr.Dataset, structure_cfg: Mapping,
+                            n_harmonics: int, phase_limit_deg: float) -> xr.Dataset:
+    """Eq. 20's two real NNMs, the phase check, the NNM coordinates and the reconstruction of the
+    driving-point acceleration (Fig. 5)."""
+    force, acc, fs, f0 = _record(raw)
+    coef_c = gc["amplitude"].values * np.exp(1j * gc["phase"].values)
+    coef, spread = nonlinear_mode_coefficients(coef_c)
+    psi_s = linear_modes["phi_sensor"].values @ coef.T
+    q, qdd = nnm_coordinates(psi_s, acc, fs, f0, n_harmonics)
+    i = driving_point_index(raw, float(structure_cfg["excitation_position_m"]), "raw record")
+    recon = (psi_s @ qdd)[i]
+    measured = acc[i]
+    lm = linear_modes
+    return xr.Dataset(
+        {
+            "coefficient": (("nnm", "mode"), coef, {"units": "1", "long_name": "NNM on the linear modes (Eq. 20)"}),
+            "phase_spread": ("nnm", spread, {"units": "deg", "long_name": "largest phase deviation among terms of one frequency"}),
+            "shape": (("x", "nnm"), lm["phi"].values @ coef.T, {"units": "kg^-1/2", "long_name": "NNM lateral shape"}),
+            "u": ("nnm", coef @ lm["u"].values, {"units": "kg^-1/2", "long_name": "NNM axial tip motion"}),
+            "y_s": ("nnm", coef @ lm["y_s"].values, {"units": "kg^-1/2", "long_name": "NNM string stretch"}),
+            "theta_s": ("nnm", coef @ lm["theta_s"].values, {"units": "rad kg^-1/2", "long_name": "NNM pendulum angle"}),
+            "q": (("nnm", "time"), q, {"units": "kg^1/2 m", "long_name": "NNM coordinates (Eq. 19)"}),
+            "q_ddot": (("nnm", "time"), qdd, {"units": "kg^1/2 m/s^2", "long_name": "NNM accelerations"}),
+            "drive_measured": ("time", measured, {"units": "m/s^2", "long_name": "measured driving-point acceleration"}),
+            "drive_reconstructed": ("time", recon, {"units": "m/s^2", "long_name": "driving-point acceleration from the NNMs (Fig. 5)"}),
+        },
+        coords={"nnm": ["w", "3w"], "mode": lm["mode"].values, "x": lm["x"], "time": raw["time"]},
+        attrs={"reconstruction_nrmse": nrmse(recon, measured), "phase_limit_deg": phase_limit_deg,
+               "excitation_frequency_hz": f0,
+               "complex_modes": int(np.any(spread > phase_limit_deg)), "n_harmonics": n_harmonics},
+    )
+
+
+def reduced_model_dataset(nnm: xr.Dataset, linear_modes: xr.Dataset, raw: xr.Dataset, structure_cfg: Mapping,
+                          n_harmonics: int) -> xr.Dataset:
+    """The Galerkin reduced model on the NNMs (Eqs. 10-12) and the paper's S(t), N(t) by force-state mapping."""
+    force, acc, fs, f0 = _record(raw)
+    model = linear_model(structure_cfg, linear_modes)
+    phi = structural_modes(model, linear_modes.sizes["mode"]).shapes
+    vectors = phi @ nnm["coefficient"].values.T
+    t = raw["time"].values
+    f_syn = synthesize(fourier_series(force, fs, f0, n_harmonics), f0, t, 0)[0]
+    g = galerkin_contact_forces(model, vectors, nnm["q"].values, nnm["q_ddot"].values, f_syn)
+    centre = lambda x: x - x.mean()  # noqa: E731
+    return xr.Dataset(
+        {
+            "reduced_mass": (("nnm", "nnm_"), g["reduced_mass"], {"units": "1", "long_name": "generalized mass (Eq. 12)"}),
+            "reduced_stiffness": (("nnm", "nnm_"), g["reduced_stiffness"], {"units": "1/s^2", "long_name": "generalized stiffness without contact springs"}),
+            "reduced_force": ("nnm", g["reduced_force"], {"units": "kg^-1/2", "long_name": "generalized force of a unit force at d_p"}),
+            "S": ("time", centre(g["S"]), {"units": "N", "long_name": "friction force S(t), paper's chain, mean removed"}),
+            "N_dyn": ("time", centre(g["N_dyn"]), {"units": "N", "long_name": "dynamic normal force, paper's chain, mean removed"}),
+            "xi": ("time", centre(g["xi"]), {"units": "m", "long_name": "xi(t) from the NNMs, mean removed"}),
+            "eta": ("time", centre(g["eta"]), {"units": "m", "long_name": "eta(t) from the NNMs, mean removed"}),
+        },
+        coords={"nnm": ["w", "3w"], "nnm_": ["w", "3w"], "time": raw["time"]},
+        attrs={"method": "paper: Galerkin on two NNMs, force-state mapping (Eqs. 10-12, 20)"},
+    )
+
+
+def contact_forces_dataset(raw: xr.Dataset, paper: xr.Dataset, linear_modes: xr.Dataset, modal: xr.Dataset,
+                           stiction: xr.Dataset, structure_cfg: Mapping, n_harmonics: int,
+                           truth: xr.Dataset | None, observability_limit: float = 0.1) -> xr.Dataset:
+    """Both methods side by side: the working method (per-harmonic inverse identification) and the
+    paper's chain; the paper's error decomposed into k_t dxi and k_n deta; the working method's
+    sensitivity to the linear chain's stiffness intervals (eta is called unobservable when it moves
+    by more than ``observability_limit`` NRMSE across them); errors against the truth."""
+    force, acc, fs, f0 = _record(raw)
+    model = linear_model(structure_cfg, linear_modes)
+    zeta = modal_damping_vector(model, modal["damping_ratio"].values)
+    inv = inverse_identification(model, zeta, force, acc, fs, f0, n_harmonics)
+    # sensitivity to the stiffness intervals of the linear chain
+    k_t, k_n = float(linear_modes["k_t"]), float(linear_modes["k_n"])
+    lo_n, hi_n = (float(v) for v in stiction["k_n_interval"].values)
+    hi_n = hi_n if np.isfinite(hi_n) else 10 * max(k_n, lo_n)
+    spreads = {}
+    for name, (a, b) in {"k_n": (lo_n, hi_n), "k_t": tuple(float(v) for v in stiction["k_t_interval"].values)}.items():
+        res = []
+        for val in (a, b):
+            ch = {"k_t": val, "k_n": k_n} if name == "k_t" else {"k_t": k_t, "k_n": val}
+            m2 = assemble(model.params.with_contact(**ch))
+            res.append(inverse_identification(m2, modal_damping_vector(m2, modal["damping_ratio"].values), force, acc,
+                                              fs, f0, n_harmonics))
+        spreads[name] = {q: nrmse(getattr(res[0], q), getattr(res[1], q)) for q in ("S", "N_dyn", "xi", "eta")}
+    eta_spread = max(spreads["k_n"]["eta"], spreads["k_t"]["eta"])
+    eta_observable = eta_spread <= observability_limit
+    # the paper's error explained: S_paper ~ S - k_t dxi, N_paper ~ N_dyn + k_n deta
+    dxi = inv.xi - paper["xi"].values
+    deta = inv.eta - paper["eta"].values
+    S_expl = inv.S - k_t * dxi
+    N_expl = inv.N_dyn + k_n * deta
+    # normal stiffness and hardening from the N-eta relation: N_dyn = -k1 eta + k2 eta^2
+    A = np.column_stack([-inv.eta, inv.eta**2 - np.mean(inv.eta**2)])
+    k1, k2 = np.linalg.lstsq(A, inv.N_dyn, rcond=None)[0]
+    attrs = {
+        "method": "inverse: per-harmonic unknown-input identification with the identified linear model",
+        "n_harmonics": n_harmonics, "eta_observable": int(eta_observable), "eta_spread_over_stiffness_intervals": eta_spread,
+        "normal_stiffness_from_n_eta_n_per_m": float(k1), "normal_hardening_n_per_m2": float(k2),
+        "paper_S_decomposition_nrmse": nrmse(paper["S"].values, S_expl),
+        "paper_N_decomposition_nrmse": nrmse(paper["N_dyn"].values, N_expl),
+        "paper_xi_unrepresented_fraction": nrmse(paper["xi"].values, inv.xi),
+        **{f"spread_{p}_{q}": v for p, d in spreads.items() for q, v in d.items()},
+    }
+    data = {
+        "S": ("time", inv.S, {"units": "N", "long_name": "friction force S(t), working method, mean removed"}),
+        "N_dyn": ("time", inv.N_dyn, {"units": "N", "long_name": "dynamic normal force N(t) - N0, working method, mean removed"}),
+        "xi": ("time", inv.xi, {"units": "m", "long_name": "xi(t), working method, mean removed"}),
+        "eta": ("time", inv.eta, {"units": "m", "long_name": "eta(t), working method, mean removed"}),
+        "xi_dot": ("time", inv.xi_dot, {"units": "m/s", "long_name": "d xi/dt, working method"}),
+        "eta_dot": ("time", inv.eta_dot, {"units": "m/s", "long_name": "d eta/dt, working method"}),
+        "S_paper": ("time", paper["S"].values, {"units": "N", "long_name": "S(t), paper's chain"}),
+        "N_dyn_paper": ("time", paper["N_dyn"].values, {"units": "N", "long_name": "N(t) - N0, paper's chain"}),
+        "xi_paper": ("time", paper["xi"].values, {"units": "m", "long_name": "xi(t), paper's chain"}),
+        "eta_paper": ("time", paper["eta"].values, {"units": "m", "long_name": "eta(t), paper's chain"}),
+        "k_t_dxi": ("time", k_t * dxi, {"units": "N", "long_name": "k_t dxi: the part of S the stuck NNMs miss"}),
+        "k_n_deta": ("time", k_n * deta, {"units": "N", "long_name": "k_n deta: the part of N the stuck NNMs add"}),
+        "residual": ("harmonic", inv.residual, {"units": "1", "long_name": "relative sensor misfit per harmonic"}),
+    }
+    if truth is not None:
+        tS, tN, txi, teta = (truth[k].values for k in ("S", "N", "xi", "eta"))
+        for method, (S, N, xi, eta) in {"": (inv.S, inv.N_dyn, inv.xi, inv.eta),
+                                        "paper_": (paper["S"].values, paper["N_dyn"].values, paper["xi"].values,
+                                                   paper["eta"].values)}.items():
+            attrs.update({f"{method}S_nrmse": nrmse(S, tS), f"{method}N_nrmse": nrmse(N, tN),
+                          f"{method}xi_nrmse": nrmse(xi, txi), f"{method}eta_nrmse": nrmse(eta, teta)})
+        data["S_truth"] = ("time", tS - tS.mean(), {"units": "N", "long_name": "true S, mean removed"})
+        data["N_dyn_truth"] = ("time", tN - tN.mean(), {"units": "N", "long_name": "true N - N0, mean removed"})
+        data["xi_truth"] = ("time", txi - txi.mean(), {"units": "m", "long_name": "true xi, mean removed"})
+        data["eta_truth"] = ("time", teta - teta.mean(), {"units": "m", "long_name": "true eta, mean removed"})
+    return xr.Dataset(data, coords={"time": raw["time"], "harmonic": np.arange(1, n_harmonics + 1)}, attrs=attrs)
+
+
+def harmonic_study(raw: xr.Dataset, truth: xr.Dataset, linear_modes: xr.Dataset, modal: xr.Dataset,
+                   structure_cfg: Mapping, counts) -> "pandas.DataFrame":  # noqa: F821
+    """Errors of the working method against the truth for several harmonic counts K, beside the
+    truth's own truncation floor (its S kept to K harmonics)."""
+    import pandas as pd
+
+    force, acc, fs, f0 = _record(raw)
+    model = linear_model(structure_cfg, linear_modes)
+    zeta = modal_damping_vector(model, modal["damping_ratio"].values)
+    t = raw["time"].values
+    rows = []
+    for K in counts:
+        inv = inverse_identification(model, zeta, force, acc, fs, f0, int(K))
+        S_trunc = synthesize(fourier_series(truth["S"].values, fs, f0, int(K)), f0, t, 0)[0]
+        rows.append({"K": int(K), "S_nrmse": nrmse(inv.S, truth["S"].values), "N_nrmse": nrmse(inv.N_dyn, truth["N"].values),
+                     "xi_nrmse": nrmse(inv.xi, truth["xi"].values), "eta_nrmse": nrmse(inv.eta, truth["eta"].values),
+                     "S_truncation_floor": nrmse(S_trunc, truth["S"].values)})
+    return pd.DataFrame(rows)
