@@ -167,7 +167,9 @@ def plot_fig05(nnm: xr.Dataset, case: str, png: str, pdf: str) -> None:
     ax.set_xlabel("time (ms)")
     ax.set_ylabel("acceleration at d$_p$ (m s$^{-2}$)")
     ax.set_title(f"Driving-point acceleration, {case}")
-    ax.legend(fontsize=8, loc="lower right")
+    lo, hi = ax.get_ylim()
+    ax.set_ylim(lo, hi + 0.35 * (hi - lo))  # room for the legend above the signal
+    ax.legend(fontsize=8, loc="upper right", ncol=2)
     ax.grid(alpha=0.3)
     fig.tight_layout()
     fig.savefig(png, dpi=150)
