@@ -24,6 +24,7 @@ include: "workflow/rules/common.smk"
 include: "workflow/rules/rig.smk"
 include: "workflow/rules/linear.smk"
 include: "workflow/rules/nonlinear.smk"
+include: "workflow/rules/friction.smk"
 include: "workflow/rules/outputs.smk"
 
 

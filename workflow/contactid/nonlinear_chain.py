@@ -150,7 +150,7 @@ def contact_forces_dataset(raw: xr.Dataset, paper: xr.Dataset, linear_modes: xr.
     k1, k2 = np.linalg.lstsq(A, inv.N_dyn, rcond=None)[0]
     attrs = {
         "method": "inverse: per-harmonic unknown-input identification with the identified linear model",
-        "n_harmonics": n_harmonics, "eta_observable": int(eta_observable), "eta_spread_over_stiffness_intervals": eta_spread,
+        "n_harmonics": n_harmonics, "excitation_frequency_hz": f0, "eta_observable": int(eta_observable), "eta_spread_over_stiffness_intervals": eta_spread,
         "normal_stiffness_from_n_eta_n_per_m": float(k1), "normal_hardening_n_per_m2": float(k2),
         "paper_S_decomposition_nrmse": nrmse(paper["S"].values, S_expl),
         "paper_N_decomposition_nrmse": nrmse(paper["N_dyn"].values, N_expl),

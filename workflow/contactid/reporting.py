@@ -227,3 +227,115 @@ def contact_force_summary(forces: Mapping[str, xr.Dataset], nnms: Mapping[str, x
                 p[f"{q}_nrmse"] = a[f"paper_{q}_nrmse"]
         work[case], paper[case] = w, p
     return {"contact_forces": work, "contact_forces_paper": paper}
+
+
+TABLE4 = {"e_f": 3.857e7, "k_c": 2.547e5, "e_t": 0.0, "kappa": 0.284, "mu": 0.397}
+
+
+def table4(fit: xr.Dataset, truth_friction: Mapping | None) -> pd.DataFrame:
+    """Table 4: fitted value and interval (working method), the paper's chain's fit beside it,
+    the paper's value and the rig truth, plus e_0 at the preload."""
+    rows = []
+    keys = {"e_f": "e_f_n_per_m", "k_c": "k_c_per_m", "e_t": "e_t_n_per_m", "kappa": "kappa", "mu": "mu"}
+    for i, name in enumerate(fit["parameter"].values):
+        tr = float(truth_friction[keys[name]]) if truth_friction else np.nan
+        v = float(fit["parameter_value"].values[i])
+        lo, hi = float(fit["interval_low"].values[i]), float(fit["interval_high"].values[i])
+        kind = ("value" if fit["bounded_below"].values[i] and fit["bounded_above"].values[i] else
+                "upper bound" if fit["bounded_above"].values[i] else
+                "lower bound" if fit["bounded_below"].values[i] else "not determined")
+        rows.append({"parameter": name, "identified": v, "interval_low": lo, "interval_high": hi, "reported_as": kind,
+                     "paper_chain_fit": float(fit["paper_parameter_value"].values[i]) if "paper_parameter_value" in fit else np.nan,
+                     "paper_value": TABLE4[name], "truth": tr,
+                     "diff_vs_truth_pct": _pct(v, tr) if name != "e_t" else np.nan,
+                     "truth_inside_interval": bool(lo <= tr <= hi) if np.isfinite(tr) else None})
+    e0 = fit.attrs["e0_at_preload_n_per_m"]
+    e0_paper = float(stiction_shear_stiffness_paper(fit.attrs["preload_n"]))
+    e0_truth = (float(truth_friction["e_f_n_per_m"]) * (1 - np.exp(-float(truth_friction["k_c_per_m"]) * fit.attrs["preload_n"]
+                                                                 / float(truth_friction["e_f_n_per_m"])))
+                if truth_friction else np.nan)
+    rows.append({"parameter": "e0_at_preload", "identified": e0, "interval_low": fit.attrs["e0_interval_low"],
+                 "interval_high": fit.attrs["e0_interval_high"], "reported_as": "value",
+                 "paper_chain_fit": fit.attrs.get("paper_e0_at_preload_n_per_m", np.nan), "paper_value": e0_paper,
+                 "truth": e0_truth, "diff_vs_truth_pct": _pct(e0, e0_truth),
+                 "truth_inside_interval": bool(fit.attrs["e0_interval_low"] <= e0_truth <= fit.attrs["e0_interval_high"])
+                 if np.isfinite(e0_truth) else None})
+    return pd.DataFrame(rows)
+
+
+def stiction_shear_stiffness_paper(preload: float) -> float:
+    return TABLE4["e_f"] * (1 - np.exp(-TABLE4["k_c"] * preload / TABLE4["e_f"]))
+
+
+def friction_summary(fit: xr.Dataset, validations: Mapping[str, xr.Dataset]) -> dict:
+    """`friction` and `validation_nrmse` blocks of summary.json."""
+    p = dict(zip(fit["parameter"].values, (float(v) for v in fit["parameter_value"].values)))
+    intervals = {n: [float(lo), float(hi)] for n, lo, hi in
+                 zip(fit["parameter"].values, fit["interval_low"].values, fit["interval_high"].values)}
+    bounded_only = [n for n, b, a in zip(fit["parameter"].values, fit["bounded_below"].values, fit["bounded_above"].values)
+                    if not (b and a)]
+    out = {"friction": {**p, "e0_at_preload": fit.attrs["e0_at_preload_n_per_m"],
+                        "intervals": {**intervals, "e0_at_preload": [fit.attrs["e0_interval_low"], fit.attrs["e0_interval_high"]]},
+                        "only_bounded": bounded_only, "misfit_nrmse": fit.attrs["misfit_nrmse"],
+                        "correlation_e_f_k_c": float(fit["correlation"].values[0, 1])},
+           "validation_nrmse": {c: v.attrs["nrmse_vs_identified"] for c, v in validations.items()}}
+    if any("nrmse_vs_truth" in v.attrs for v in validations.values()):
+        out["validation_nrmse_vs_truth"] = {c: v.attrs["nrmse_vs_truth"] for c, v in validations.items()
+                                            if "nrmse_vs_truth" in v.attrs}
+    return out
+
+
+def plot_friction_figures(fit: xr.Dataset, validations: Mapping[str, xr.Dataset], truth_friction: Mapping | None,
+                          paths: Mapping[str, str]) -> None:
+    """Fig. 7 (e_0 vs N), Fig. 8 (S vs xi), Fig. 9 (S vs xi'), and the GA convergence."""
+    plt = _mpl()
+    n0 = fit.attrs["preload_n"]
+    N = np.linspace(0, 2.5 * n0, 200)
+    p = dict(zip(fit["parameter"].values, fit["parameter_value"].values))
+    fig, ax = plt.subplots(figsize=(6.0, 4.0))
+    ax.plot(N, 1e-6 * p["e_f"] * (1 - np.exp(-p["k_c"] * N / p["e_f"])), "-", color="C0", label="identified")
+    ax.plot(N, 1e-6 * TABLE4["e_f"] * (1 - np.exp(-TABLE4["k_c"] * N / TABLE4["e_f"])), "--", color="C1", label="paper, Table 4")
+    if truth_friction:
+        ef, kc = float(truth_friction["e_f_n_per_m"]), float(truth_friction["k_c_per_m"])
+        ax.plot(N, 1e-6 * ef * (1 - np.exp(-kc * N / ef)), ":", color="0.3", lw=2, label="rig truth")
+    for k, (case, v) in enumerate(validations.items()):
+        ax.axvspan(v["N"].values.min(), v["N"].values.max(), color=f"C{k + 2}", alpha=0.15, label=f"N range, {case}")
+    ax.set_xlabel("normal force N (N)")
+    ax.set_ylabel("e$_0$ (10$^6$ N/m)")
+    ax.set_title("Contact shear stiffness at stiction, Eq. 22")
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(paths["fig07_png"], dpi=150)
+    fig.savefig(paths["fig07_pdf"])
+    plt.close(fig)
+    for key, xvar, xlabel, scale in (("fig08", "xi", r"$\xi$ ($\mu$m)", 1e6), ("fig09", "xi_dot", r"d$\xi$/dt (mm/s)", 1e3)):
+        cases = list(validations)
+        fig, axes = plt.subplots(1, len(cases), figsize=(3.3 * len(cases), 3.4), squeeze=False)
+        for j, case in enumerate(cases):
+            v = validations[case]
+            ax = axes[0, j]
+            ax.plot(scale * v[xvar].values[::4], v["S_identified"].values[::4], "o", ms=3, mfc="none", color="C0",
+                    label="identified")
+            ax.plot(scale * v[xvar].values, v["S_predicted"].values, "-", color="C3", lw=1.2, label="predicted")
+            ax.set_title(f"{case} (NRMSE {100 * v.attrs['nrmse_vs_identified']:.1f} %)", fontsize=9)
+            ax.set_xlabel(xlabel)
+            ax.set_ylabel("S (N)")
+            ax.grid(alpha=0.3)
+        axes[0, 0].legend(fontsize=7)
+        fig.tight_layout()
+        fig.savefig(paths[f"{key}_png"], dpi=150)
+        fig.savefig(paths[f"{key}_pdf"])
+        plt.close(fig)
+    fig, ax = plt.subplots(figsize=(5.5, 3.5))
+    ax.semilogy(fit["generation"].values, fit["ga_best"].values, label="best")
+    ax.semilogy(fit["generation"].values, fit["ga_mean"].values, label="mean")
+    ax.axhline(fit.attrs["misfit_nrmse"], color="0.4", ls="--", label="after polish")
+    ax.set_xlabel("generation")
+    ax.set_ylabel("misfit (NRMSE of S)")
+    ax.set_title("Genetic algorithm convergence")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3, which="both")
+    fig.tight_layout()
+    fig.savefig(paths["convergence_png"], dpi=150)
+    plt.close(fig)

@@ -72,6 +72,13 @@ def contact_forces_inputs(wildcards):
     return inputs
 
 
+def validate_inputs(wildcards):
+    inputs = {"forces": f"results/{wildcards.case}/contact_forces.nc", "fit": "results/friction/friction_fit.nc"}
+    if wildcards.case in rig_cases():
+        inputs["truth"] = f"data/truth/{wildcards.case}.nc"
+    return inputs
+
+
 def summary_inputs(wildcards):
     """Everything the headline numbers are read from, named for the summary script."""
     inputs = {"modal": "results/linear/modal.nc", "stiction": "results/linear/stiction.nc"}
@@ -81,6 +88,9 @@ def summary_inputs(wildcards):
         inputs[f"check_{c}"] = f"results/{c}/raw_check.nc"
         inputs[f"forces_{c}"] = f"results/{c}/contact_forces.nc"
         inputs[f"nnm_{c}"] = f"results/{c}/nonlinear_modes.nc"
+        inputs[f"validation_{c}"] = f"results/{c}/validation.nc"
+    if load_cases():
+        inputs["fit"] = "results/friction/friction_fit.nc"
     for c, path in truth_records().items():
         inputs[f"truth_{c}"] = path
     return inputs
@@ -96,6 +106,9 @@ def all_outputs():
         "results/figures/fig03_frf.pdf",
         *[f"results/{c}/raw_check.nc" for c in load_cases()],
         *[f"results/{c}/contact_forces.nc" for c in load_cases()],
+        *[f"results/{c}/validation.nc" for c in load_cases()],
+        *(["results/tables/table4.csv", "results/figures/fig07_e0.png", "results/figures/fig08_s_xi.png",
+           "results/figures/fig09_s_xidot.png", "results/figures/friction_convergence.png"] if load_cases() else []),
         *(["results/studies/harmonic_count.csv"] if calibration_case() in rig_cases() else []),
         *(["results/figures/fig04_generalized_coordinates.png", "results/figures/fig05_reconstruction.png",
            "results/figures/fig06_contact_forces.png"] if load_cases() else []),

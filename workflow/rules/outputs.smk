@@ -111,3 +111,28 @@ rule fig06_contact_forces:
         "logs/fig06.log",
     script:
         "../scripts/fig06.py"
+
+
+rule friction_outputs:
+    input:
+        fit="results/friction/friction_fit.nc",
+        validations=expand("results/{case}/validation.nc", case=load_cases()),
+    output:
+        table4=report("results/tables/table4.csv", caption="../report/table4.rst", category="Tables"),
+        fig07_png=report("results/figures/fig07_e0.png", caption="../report/fig07.rst", category="Figures"),
+        fig07_pdf="results/figures/fig07_e0.pdf",
+        fig08_png=report("results/figures/fig08_s_xi.png", caption="../report/fig08.rst", category="Figures"),
+        fig08_pdf="results/figures/fig08_s_xi.pdf",
+        fig09_png=report("results/figures/fig09_s_xidot.png", caption="../report/fig09.rst", category="Figures"),
+        fig09_pdf="results/figures/fig09_s_xidot.pdf",
+        convergence_png=report("results/figures/friction_convergence.png", caption="../report/convergence.rst",
+                               category="Figures"),
+    params:
+        cases=load_cases(),
+        truth_friction=None if _is_measured(config["load_cases"].get(calibration_case())) else config.get("rig", {}).get("truth", {}).get("friction"),
+    conda:
+        "../envs/contactid.yaml"
+    log:
+        "logs/friction_outputs.log",
+    script:
+        "../scripts/friction_outputs.py"

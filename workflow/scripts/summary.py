@@ -4,7 +4,7 @@ import json
 
 from contactid.io import load_dataset
 from contactid.logs import setup_logging
-from contactid.reporting import contact_force_summary, linear_summary, load_case_summary
+from contactid.reporting import contact_force_summary, friction_summary, linear_summary, load_case_summary
 
 log = setup_logging(snakemake.log[0])
 inp = snakemake.input
@@ -16,6 +16,9 @@ summary.update(load_case_summary(checks, truths))
 forces = {k[len("forces_"):]: load_dataset(v) for k, v in inp.items() if k.startswith("forces_")}
 nnms = {k[len("nnm_"):]: load_dataset(v) for k, v in inp.items() if k.startswith("nnm_")}
 summary.update(contact_force_summary(forces, nnms))
+if "fit" in inp.keys():
+    validations = {k[len("validation_"):]: load_dataset(v) for k, v in inp.items() if k.startswith("validation_")}
+    summary.update(friction_summary(load_dataset(inp.fit), validations))
 with open(snakemake.output.summary, "w") as fh:
     json.dump(summary, fh, indent=2, sort_keys=True, default=lambda o: o.item() if hasattr(o, "item") else str(o))
 log.info("%s", summary)

@@ -1,0 +1,363 @@
+"""Fit of the modified Valanis law (Eqs. 21-22) to identified contact forces (Section 5, Table 4):
+a seeded DEAP genetic algorithm over (e_f, k_c, e_t, kappa, mu), a local least-squares polish,
+grid refinement until the fit no longer moves, and profile-likelihood intervals that mark
+parameters the data only bound.
+"""
+
+from __future__ import annotations
+
+import logging
+import random
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import least_squares
+from scipy.stats import chi2 as chi2_dist
+
+from .contact_laws import stiction_shear_stiffness
+from .friction import PARAMETER_NAMES, valanis_friction_force
+from .random_streams import generator
+
+log = logging.getLogger(__name__)
+
+LOG_SCALED = (True, True, False, False, False)  # e_f, k_c on a log scale
+
+
+@dataclass(frozen=True)
+class FitSettings:
+    """Bounds (5 x (low, high)) in the order e_f (N/m), k_c (1/m), e_t (N/m), kappa, mu;
+    GA population, generations, crossover and mutation probabilities; the first grid size and
+    the largest; the relative parameter change that stops the refinement; the confidence level;
+    the relative rms accuracy assumed for the identified S (a floor on the misfit scale of the
+    profile likelihood, since the identification's own error is not noise)."""
+
+    bounds: tuple = ((1e6, 1e9), (1e4, 1e7), (0.0, 1e6), (0.0, 0.95), (0.05, 1.5))
+    population: int = 64
+    generations: int = 40
+    crossover: float = 0.7
+    mutation: float = 0.3
+    grid_points: int = 256
+    max_grid_points: int = 4096
+    refine_tolerance: float = 1e-3
+    confidence: float = 0.95
+    misfit_floor: float = 0.01
+
+
+@dataclass
+class FitResult:
+    params: np.ndarray
+    misfit: float
+    e0_at_preload: float
+    logbook: list
+    grid_history: list
+    intervals: np.ndarray
+    bounded: np.ndarray  # (5, 2): is the interval closed below / above inside the search bounds
+    e0_interval: tuple
+    correlation: np.ndarray
+    grid_points: int
+    profiles: dict = field(default_factory=dict)
+
+
+def periodic_grid(coef: np.ndarray, f0: float, m: int) -> np.ndarray:
+    """Synthesize K-harmonic periodic signals (rows of complex coefficients, x ~ sum Im(c e^{ihwt}))
+    on ``m`` points of one period (Fourier interpolation)."""
+    coef = np.atleast_2d(coef)
+    h = np.arange(1, coef.shape[1] + 1)
+    t = np.arange(m) / (m * f0)
+    return np.imag(coef @ np.exp(1j * np.outer(2 * np.pi * f0 * h, t)))
+
+
+class _Problem:
+    def __init__(self, xi, normal_force, S, bounds):
+        self.xi, self.N = xi, normal_force
+        self.S = S - S.mean()
+        self.scale = np.sqrt(np.mean(self.S**2))
+        self.lo = np.array([np.log10(b[0]) if lg else b[0] for b, lg in zip(bounds, LOG_SCALED)])
+        self.hi = np.array([np.log10(b[1]) if lg else b[1] for b, lg in zip(bounds, LOG_SCALED)])
+
+    def physical(self, u):
+        """Unit-cube coordinates (n, 5) to parameters."""
+        v = self.lo + np.atleast_2d(u) * (self.hi - self.lo)
+        out = v.copy()
+        log_cols = np.array(LOG_SCALED)
+        out[:, log_cols] = 10.0 ** v[:, log_cols]
+        return out
+
+    def unit(self, p):
+        v = np.where(LOG_SCALED, np.log10(np.maximum(np.atleast_2d(p), 1e-300)), np.atleast_2d(p))
+        return (v - self.lo) / (self.hi - self.lo)
+
+    def residuals(self, params):
+        S = valanis_friction_force(self.xi, self.N, params)
+        S = S - S.mean(axis=1, keepdims=True)
+        return (S - self.S) / self.scale
+
+    def misfit(self, params):
+        """NRMSE of the mean-removed S for each parameter set."""
+        return np.sqrt(np.mean(self.residuals(params) ** 2, axis=1))
+
+
+def _ga(problem: _Problem, settings: FitSettings, seed: int):
+    from deap import base, creator, tools
+
+    if not hasattr(creator, "ValanisFitness"):
+        creator.create("ValanisFitness", base.Fitness, weights=(-1.0,))
+        creator.create("ValanisIndividual", list, fitness=creator.ValanisFitness)
+    if settings.population < 2:
+        raise ValueError(f"friction.population = {settings.population}: the genetic algorithm needs at least 2 individuals")
+    py_rng = random.Random(int(generator(seed, "friction/ga").integers(2**31)))
+    state = random.getstate()
+    random.seed(py_rng.random())  # DEAP's operators draw from the module-level generator
+    try:
+        tb = base.Toolbox()
+        tb.register("mate", tools.cxBlend, alpha=0.3)
+        tb.register("mutate", tools.mutGaussian, mu=0.0, sigma=0.1, indpb=0.4)
+        tb.register("select", tools.selTournament, tournsize=3)
+        pop = [creator.ValanisIndividual([py_rng.random() for _ in range(5)]) for _ in range(settings.population)]
+
+        def evaluate(inds):
+            u = np.clip(np.array(inds, dtype=float), 0.0, 1.0)
+            for ind, val in zip(inds, problem.misfit(problem.physical(u))):
+                ind.fitness.values = (float(val),)
+
+        evaluate(pop)
+        hof = tools.HallOfFame(1)
+        hof.update(pop)
+        logbook = []
+        for gen in range(settings.generations):
+            offspring = [creator.ValanisIndividual(list(ind)) for ind in tb.select(pop, len(pop))]
+            for a, b in zip(offspring[::2], offspring[1::2]):
+                if random.random() < settings.crossover:
+                    tb.mate(a, b)
+                    del a.fitness.values, b.fitness.values
+            for ind in offspring:
+                if random.random() < settings.mutation:
+                    tb.mutate(ind)
+                    del ind.fitness.values
+                ind[:] = list(np.clip(ind, 0.0, 1.0))
+            invalid = [ind for ind in offspring if not ind.fitness.valid]
+            if invalid:
+                evaluate(invalid)
+            offspring[0] = creator.ValanisIndividual(list(hof[0]))  # elitism
+            offspring[0].fitness.values = hof[0].fitness.values
+            pop = offspring
+            hof.update(pop)
+            vals = np.array([ind.fitness.values[0] for ind in pop])
+            logbook.append((gen, float(vals.min()), float(vals.mean())))
+        return np.array(hof[0]), logbook
+    finally:
+        random.setstate(state)
+
+
+def _polish(problem: _Problem, u0, fixed: dict | None = None):
+    """Least-squares polish in the unit cube; ``fixed`` {index: unit value} holds parameters."""
+    fixed = fixed or {}
+    free = [i for i in range(5) if i not in fixed]
+
+    def full(x):
+        u = np.empty(5)
+        u[free] = x
+        for i, v in fixed.items():
+            u[i] = v
+        return u
+
+    r = least_squares(lambda x: problem.residuals(problem.physical(full(x)))[0], np.clip(u0[free], 0, 1),
+                      bounds=(0.0, 1.0), x_scale=0.05, xtol=1e-10, ftol=1e-12, diff_step=1e-4)
+    return full(r.x), float(np.sum(r.fun**2)), r
+
+
+def fit_friction_law(coef_xi, coef_n, coef_s, f0: float, preload: float, settings: FitSettings, seed: int,
+                     n_harmonics_data: int | None = None) -> FitResult:
+    """GA + polish on the calibration case's xi, N (total = preload + dynamic) and S harmonics,
+    with the grid refined until the parameters move by less than ``refine_tolerance``."""
+    K = np.atleast_2d(coef_s).shape[1] if n_harmonics_data is None else n_harmonics_data
+    m = settings.grid_points
+    history = []
+    u_best = None
+    logbook = []
+    prev = None
+    while True:
+        xi = periodic_grid(coef_xi, f0, m)[0]
+        n = preload + periodic_grid(coef_n, f0, m)[0]
+        s = periodic_grid(coef_s, f0, m)[0]
+        problem = _Problem(xi, n, s, settings.bounds)
+        if u_best is None:
+            u_ga, logbook = _ga(problem, settings, seed)
+            u_best = u_ga
+        u_best, ssr, res = _polish(problem, u_best)
+        p = problem.physical(u_best)[0]
+        history.append((m, *p, float(np.sqrt(ssr / m))))
+        if prev is not None and np.max(np.abs(p / np.where(prev == 0, 1, prev) - 1)[[0, 1, 3, 4]]) < settings.refine_tolerance:
+            break
+        if 2 * m > settings.max_grid_points:
+            log.warning("friction fit: the grid reached %d points without the parameters settling", m)
+            break
+        prev = p
+        m *= 2
+    # profile likelihood: chi2 = (n_data / M) SSR / sigma^2 with the data's n_data = 2K independent
+    # Fourier coefficients; sigma (relative rms misfit per point) is the larger of the fit's own
+    # residual and the documented floor for the identified forces' accuracy
+    n_data = 2 * K
+    ssr_min = ssr
+    m_pts = problem.S.size
+    sigma2 = max(ssr_min / m_pts * n_data / max(n_data - 5, 1), settings.misfit_floor**2)
+    thr = ssr_min + chi2_dist.ppf(settings.confidence, 1) * sigma2 * m_pts / n_data
+    intervals = np.empty((5, 2))
+    bounded = np.zeros((5, 2), dtype=bool)
+    profiles = {}
+    e0_vals = []
+
+    def profile(i, value, start):
+        u, s_j, _ = _polish(problem, start, {i: value})
+        if s_j <= thr:
+            pp = problem.physical(u)[0]
+            e0_vals.append(float(stiction_shear_stiffness(preload, pp[0], pp[1])))
+        profiles.setdefault(PARAMETER_NAMES[i], []).append((float(problem.physical(u)[0][i]), s_j))
+        return u, s_j
+
+    for i in range(5):
+        for side, direction in ((0, -1.0), (1, +1.0)):
+            edge = 0.0 if direction < 0 else 1.0
+            inside_v, start = u_best[i], u_best.copy()
+            step = 1e-3
+            outside_v = None
+            while True:
+                v = float(np.clip(inside_v + direction * step, 0.0, 1.0))
+                u, s_v = profile(i, v, start)
+                if s_v > thr:
+                    outside_v = v
+                    break
+                inside_v, start = v, u
+                if v == edge:
+                    break
+                step *= 2.0
+            if outside_v is None:
+                bounded[i, side] = False
+                crossing = edge
+            else:
+                bounded[i, side] = True
+                for _ in range(8):  # bisection of the threshold crossing
+                    mid = 0.5 * (inside_v + outside_v)
+                    u, s_m = profile(i, mid, start)
+                    if s_m <= thr:
+                        inside_v, start = mid, u
+                    else:
+                        outside_v = mid
+                crossing = inside_v
+            unit = u_best.copy()
+            unit[i] = crossing
+            intervals[i, side] = problem.physical(unit)[0][i]
+    profiles = {k: np.array(sorted(v)) for k, v in profiles.items()}
+    # correlation from the Jacobian at the optimum (unit-cube coordinates), for sensitive parameters
+    J = res.jac
+    corr = np.full((5, 5), np.nan)
+    sens = np.linalg.norm(J, axis=0) > 1e-8 * np.max(np.linalg.norm(J, axis=0))
+    if sens.sum() >= 2:
+        cov = np.linalg.pinv(J[:, sens].T @ J[:, sens])
+        d = np.sqrt(np.clip(np.diag(cov), 1e-300, None))
+        corr[np.ix_(sens, sens)] = cov / np.outer(d, d)
+    p = problem.physical(u_best)[0]
+    e0 = float(stiction_shear_stiffness(preload, p[0], p[1]))
+    e0_vals.append(e0)
+    return FitResult(p, float(np.sqrt(ssr_min / problem.S.size)), e0, logbook, history, intervals, bounded,
+                     (min(e0_vals), max(e0_vals)), corr, m, profiles)
+
+
+def friction_fit_dataset(forces, preload: float, settings: FitSettings, seed: int, n_harmonics: int,
+                         paper_forces=None):
+    """Dataset of the fit on the calibration case's identified forces (working method), with the
+    paper's chain's forces fitted beside it when given (reproduction)."""
+    import xarray as xr
+
+    from .identification import fourier_series
+
+    fs = 1.0 / float(forces["time"].values[1] - forces["time"].values[0])
+    f0 = float(forces.attrs["excitation_frequency_hz"])
+
+    def run(S, xi, N):
+        c = [fourier_series(x, fs, f0, n_harmonics)[0] for x in (xi, N, S)]
+        return fit_friction_law(*c, f0, preload, settings, seed, n_harmonics)
+
+    res = run(forces["S"].values, forces["xi"].values, forces["N_dyn"].values)
+    data = {
+        "parameter_value": ("parameter", res.params, {"units": "mixed (N/m, 1/m, N/m, 1, 1)", "long_name": "fitted e_f, k_c, e_t, kappa, mu"}),
+        "interval_low": ("parameter", res.intervals[:, 0], {"units": "mixed", "long_name": "profile-likelihood interval, lower end"}),
+        "interval_high": ("parameter", res.intervals[:, 1], {"units": "mixed", "long_name": "profile-likelihood interval, upper end"}),
+        "bounded_below": ("parameter", res.bounded[:, 0].astype(int), {"units": "1", "long_name": "1 if the data bound it from below inside the search range"}),
+        "bounded_above": ("parameter", res.bounded[:, 1].astype(int), {"units": "1", "long_name": "1 if the data bound it from above inside the search range"}),
+        "correlation": (("parameter", "parameter_"), res.correlation, {"units": "1", "long_name": "correlation at the optimum (NaN: insensitive)"}),
+        "ga_best": ("generation", [b for _, b, _ in res.logbook], {"units": "1", "long_name": "best misfit (NRMSE of S) per generation"}),
+        "ga_mean": ("generation", [m for _, _, m in res.logbook], {"units": "1", "long_name": "mean misfit per generation"}),
+        "grid_history": (("refinement", "grid_field"), np.array(res.grid_history),
+                         {"units": "mixed", "long_name": "grid points, e_f, k_c, e_t, kappa, mu, misfit per refinement"}),
+    }
+    attrs = {"e0_at_preload_n_per_m": res.e0_at_preload, "e0_interval_low": res.e0_interval[0],
+             "e0_interval_high": res.e0_interval[1], "misfit_nrmse": res.misfit, "grid_points": res.grid_points,
+             "preload_n": preload, "excitation_frequency_hz": f0, "n_harmonics": n_harmonics, "seed": seed,
+             "population": settings.population, "generations": settings.generations}
+    if paper_forces is not None:
+        try:
+            rp = run(paper_forces["S_paper"].values, paper_forces["xi_paper"].values, paper_forces["N_dyn_paper"].values)
+            data["paper_parameter_value"] = ("parameter", rp.params, {"units": "mixed", "long_name": "fitted to the paper's chain's forces"})
+            data["paper_interval_low"] = ("parameter", rp.intervals[:, 0], {"units": "mixed", "long_name": "paper's chain: interval, lower end"})
+            data["paper_interval_high"] = ("parameter", rp.intervals[:, 1], {"units": "mixed", "long_name": "paper's chain: interval, upper end"})
+            attrs["paper_e0_at_preload_n_per_m"] = rp.e0_at_preload
+            attrs["paper_misfit_nrmse"] = rp.misfit
+        except ValueError as exc:  # e.g. the paper's N reaches zero: the law is not defined there
+            log.warning("the paper's chain's forces cannot be fitted: %s", exc)
+            attrs["paper_fit_error"] = str(exc)
+    return xr.Dataset(data, coords={"parameter": list(PARAMETER_NAMES), "parameter_": list(PARAMETER_NAMES),
+                                    "generation": np.arange(len(res.logbook)),
+                                    "grid_field": ["grid_points", *PARAMETER_NAMES, "misfit"]}, attrs=attrs)
+
+
+def validation_dataset(forces, fit, preload: float, n_harmonics: int, truth=None):
+    """Prediction of S(t) for a load case from its own identified xi(t), N(t) with the fitted law,
+    on a fine periodic grid; NRMSE against the identified S and against the truth."""
+    import xarray as xr
+
+    from .identification import fourier_series, nrmse
+
+    fs = 1.0 / float(forces["time"].values[1] - forces["time"].values[0])
+    f0 = float(forces.attrs["excitation_frequency_hz"])
+    m = int(fit.attrs["grid_points"])
+    c = {v: fourier_series(forces[v].values, fs, f0, n_harmonics)[0] for v in ("xi", "N_dyn", "S", "xi_dot")}
+    xi = periodic_grid(c["xi"], f0, m)[0]
+    N = preload + periodic_grid(c["N_dyn"], f0, m)[0]
+    S_id = periodic_grid(c["S"], f0, m)[0]
+    xi_dot = periodic_grid(c["xi_dot"], f0, m)[0]
+    S_pred = valanis_friction_force(xi, N, fit["parameter_value"].values[None, :])[0]
+    S_pred = S_pred - S_pred.mean()
+    attrs = {"nrmse_vs_identified": nrmse(S_pred, S_id), "excitation_frequency_hz": f0}
+    data = {
+        "xi": ("phase", xi, {"units": "m", "long_name": "identified xi over one period"}),
+        "xi_dot": ("phase", xi_dot, {"units": "m/s", "long_name": "identified d xi/dt over one period"}),
+        "N": ("phase", N, {"units": "N", "long_name": "total normal force (preload + identified dynamic part)"}),
+        "S_identified": ("phase", S_id - S_id.mean(), {"units": "N", "long_name": "identified S, mean removed"}),
+        "S_predicted": ("phase", S_pred, {"units": "N", "long_name": "S predicted by the fitted law, mean removed"}),
+    }
+    if truth is not None:
+        ts = periodic_grid(fourier_series(truth["S"].values, fs, f0, max(n_harmonics, 60))[0], f0, m)[0]
+        attrs["nrmse_vs_truth"] = nrmse(S_pred, ts)
+        data["S_truth"] = ("phase", ts - ts.mean(), {"units": "N", "long_name": "true S, mean removed"})
+    return xr.Dataset(data, coords={"phase": ("phase", np.arange(m) / m, {"units": "1", "long_name": "fraction of the period"})},
+                      attrs=attrs)
+
+
+def settings_from_config(cfg) -> FitSettings:
+    """FitSettings from the ``friction`` config block; bounds that are not (low < high) are refused."""
+    d = FitSettings()
+    b = cfg.get("bounds") or {}
+    names = {"e_f": "e_f_n_per_m", "k_c": "k_c_per_m", "e_t": "e_t_n_per_m", "kappa": "kappa", "mu": "mu"}
+    bounds = []
+    for (name, key), default in zip(names.items(), d.bounds):
+        lo, hi = b.get(key, default)
+        if not lo < hi:
+            raise ValueError(f"friction.bounds.{key} = [{lo}, {hi}]: the lower bound must be below the upper")
+        bounds.append((float(lo), float(hi)))
+    return FitSettings(bounds=tuple(bounds), population=int(cfg.get("population", d.population)),
+                       generations=int(cfg.get("generations", d.generations)),
+                       grid_points=int(cfg.get("grid_points", d.grid_points)),
+                       max_grid_points=int(cfg.get("max_grid_points", d.max_grid_points)),
+                       confidence=float(cfg.get("confidence", d.confidence)),
+                       misfit_floor=float(cfg.get("misfit_floor", d.misfit_floor)))

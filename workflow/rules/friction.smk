@@ -1,0 +1,37 @@
+# The modified Valanis law fitted on the calibration case, and validated on every load case (Section 5).
+
+
+rule friction_fit:
+    input:
+        forces=lambda wc: f"results/{calibration_case()}/contact_forces.nc",
+    output:
+        fit="results/friction/friction_fit.nc",
+    params:
+        friction=config.get("friction", {}),
+        preload=config["structure"]["preload_n"],
+        seed=config["seed"],
+        n_harmonics=config.get("nonlinear", {}).get("n_harmonics", 25),
+    conda:
+        "../envs/contactid.yaml"
+    log:
+        "logs/friction_fit.log",
+    benchmark:
+        "benchmarks/rules/friction_fit.tsv"
+    script:
+        "../scripts/friction_fit.py"
+
+
+rule validate:
+    input:
+        unpack(validate_inputs),
+    output:
+        validation="results/{case}/validation.nc",
+    params:
+        preload=config["structure"]["preload_n"],
+        n_harmonics=config.get("nonlinear", {}).get("n_harmonics", 25),
+    conda:
+        "../envs/contactid.yaml"
+    log:
+        "logs/validate_{case}.log",
+    script:
+        "../scripts/validate.py"

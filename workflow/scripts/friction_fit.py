@@ -1,0 +1,16 @@
+"""Rule friction_fit: GA + polish of the modified Valanis law on the calibration case (Table 4)."""
+
+from contactid.friction_fit import friction_fit_dataset, settings_from_config
+from contactid.io import load_dataset, provenance, write_dataset
+from contactid.logs import setup_logging
+
+log = setup_logging(snakemake.log[0])
+p = snakemake.params
+forces = load_dataset(snakemake.input.forces)
+ds = friction_fit_dataset(forces, float(p.preload), settings_from_config(p.friction), int(p.seed), int(p.n_harmonics),
+                          paper_forces=forces)
+ds.attrs.update(provenance("friction_fit", {"friction": p.friction, "seed": p.seed, "preload": p.preload,
+                                            "n_harmonics": p.n_harmonics}, {"forces": snakemake.input.forces}))
+write_dataset(ds, snakemake.output.fit)
+log.info("fitted %s, e0(N0) = %.5g N/m", dict(zip(ds["parameter"].values, ds["parameter_value"].values)),
+         ds.attrs["e0_at_preload_n_per_m"])
