@@ -182,3 +182,21 @@ def test_tenfold_noise_runs_and_reports_larger_errors(default_run, tmp_path):
     noisy = json.loads((proj / "results" / "summary.json").read_text())["contact_forces"]["lc1"]
     clean = json.loads((default_run / "results" / "summary.json").read_text())["contact_forces"]["lc1"]
     assert noisy["S_nrmse"] > clean["S_nrmse"] and noisy["N_nrmse"] > clean["N_nrmse"]
+
+
+def test_friction_law_recovers_rig_truth_and_validates(default_run):
+    import pandas as pd
+
+    s = json.loads((default_run / "results" / "summary.json").read_text())
+    fr = s["friction"]
+    assert abs(fr["mu"] / 0.397 - 1) < 0.02
+    assert abs(fr["kappa"] / 0.284 - 1) < 0.10
+    e0_true = 3.857e7 * (1 - np.exp(-2.547e5 * 70.0 / 3.857e7))
+    assert abs(fr["e0_at_preload"] / e0_true - 1) < 0.05
+    lo, hi = fr["intervals"]["e_t"]
+    assert lo <= 1.0e4 <= hi and "e_t" in fr["only_bounded"]
+    assert s["validation_nrmse"]["lc2"] <= 0.05 and s["validation_nrmse"]["lc3"] <= 0.05
+    t4 = pd.read_csv(default_run / "results" / "tables" / "table4.csv")
+    assert {"identified", "interval_low", "interval_high", "paper_value", "truth"} <= set(t4.columns)
+    for fig in ("fig07_e0", "fig08_s_xi", "fig09_s_xidot", "friction_convergence"):
+        assert (default_run / "results" / "figures" / f"{fig}.png").stat().st_size > 10000

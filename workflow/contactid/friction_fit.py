@@ -56,6 +56,7 @@ class FitResult:
     correlation: np.ndarray
     grid_points: int
     profiles: dict = field(default_factory=dict)
+    warnings: list = field(default_factory=list)
 
 
 def periodic_grid(coef: np.ndarray, f0: float, m: int) -> np.ndarray:
@@ -259,8 +260,16 @@ def fit_friction_law(coef_xi, coef_n, coef_s, f0: float, preload: float, setting
     p = problem.physical(u_best)[0]
     e0 = float(stiction_shear_stiffness(preload, p[0], p[1]))
     e0_vals.append(e0)
+    warnings = []
+    for i, name in enumerate(PARAMETER_NAMES):
+        for edge, label in ((0.0, "lower"), (1.0, "upper")):
+            if abs(u_best[i] - edge) < 1e-3 and not (name == "e_t" and edge == 0.0 and settings.bounds[2][0] == 0.0):
+                warnings.append(f"{name} = {p[i]:.4g} sits at its {label} search bound {settings.bounds[i][int(edge)]:.4g}: "
+                                f"the bounds may exclude the best value; widen friction.bounds.{name}")
+    for w in warnings:
+        log.warning("friction fit: %s", w)
     return FitResult(p, float(np.sqrt(ssr_min / problem.S.size)), e0, logbook, history, intervals, bounded,
-                     (min(e0_vals), max(e0_vals)), corr, m, profiles)
+                     (min(e0_vals), max(e0_vals)), corr, m, profiles, warnings)
 
 
 def friction_fit_dataset(forces, preload: float, settings: FitSettings, seed: int, n_harmonics: int,
@@ -294,7 +303,8 @@ def friction_fit_dataset(forces, preload: float, settings: FitSettings, seed: in
     attrs = {"e0_at_preload_n_per_m": res.e0_at_preload, "e0_interval_low": res.e0_interval[0],
              "e0_interval_high": res.e0_interval[1], "misfit_nrmse": res.misfit, "grid_points": res.grid_points,
              "preload_n": preload, "excitation_frequency_hz": f0, "n_harmonics": n_harmonics, "seed": seed,
-             "population": settings.population, "generations": settings.generations}
+             "population": settings.population, "generations": settings.generations,
+             "warnings": "; ".join(res.warnings) or "none"}
     if paper_forces is not None:
         try:
             rp = run(paper_forces["S_paper"].values, paper_forces["xi_paper"].values, paper_forces["N_dyn_paper"].values)
