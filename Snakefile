@@ -26,6 +26,7 @@ include: "workflow/rules/linear.smk"
 include: "workflow/rules/nonlinear.smk"
 include: "workflow/rules/friction.smk"
 include: "workflow/rules/outputs.smk"
+include: "workflow/rules/report.smk"
 
 
 rule all:

@@ -113,4 +113,5 @@ def all_outputs():
         *(["results/figures/fig04_generalized_coordinates.png", "results/figures/fig05_reconstruction.png",
            "results/figures/fig06_contact_forces.png"] if load_cases() else []),
         "results/summary.json",
+        *(["results/report/report.pdf"] if load_cases() else []),
     ]

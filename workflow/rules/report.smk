@@ -1,0 +1,52 @@
+# The reproduction report: generated fragments, then LaTeX to PDF.
+
+
+rule report_fragments:
+    input:
+        summary="results/summary.json",
+        table1="results/tables/table1.csv",
+        table3="results/tables/table3.csv",
+        table4="results/tables/table4.csv",
+        consistency="results/tables/paper_consistency.csv",
+    output:
+        numbers="results/report/numbers.tex",
+        setup="results/report/setup.tex",
+        table1="results/report/table1.tex",
+        table3="results/report/table3.tex",
+        table4="results/report/table4.tex",
+        consistency="results/report/consistency.tex",
+        contact="results/report/contact.tex",
+    params:
+        structure=config["structure"],
+    conda:
+        "../envs/contactid.yaml"
+    log:
+        "logs/report_fragments.log",
+    script:
+        "../scripts/report_fragments.py"
+
+
+rule report:
+    input:
+        tex="paper/report.tex",
+        fragments=rules.report_fragments.output,
+        figures=expand(
+            "results/figures/{fig}.pdf",
+            fig=[
+                "fig03_frf",
+                "fig04_generalized_coordinates",
+                "fig05_reconstruction",
+                "fig06_contact_forces",
+                "fig07_e0",
+                "fig08_s_xi",
+                "fig09_s_xidot",
+            ],
+        ),
+    output:
+        pdf="results/report/report.pdf",
+    conda:
+        "../envs/contactid.yaml"
+    log:
+        "logs/report.log",
+    script:
+        "../scripts/report.py"

@@ -1,0 +1,29 @@
+"""Rule report: build the LaTeX report with latexmk; a clear message if TeX is missing."""
+
+import shutil
+import subprocess
+import tempfile
+from pathlib import Path
+
+from contactid.logs import setup_logging
+
+log = setup_logging(snakemake.log[0])
+if shutil.which("latexmk") is None or shutil.which("pdflatex") is None:
+    raise SystemExit("TeX Live is missing, so the report cannot be built (everything else is). Install it with "
+                     "`make env` or `apt-get install texlive-latex-base texlive-latex-recommended "
+                     "texlive-latex-extra latexmk`, then rerun snakemake.")
+out = Path(snakemake.output.pdf)
+figures = Path(snakemake.input.figures[0]).resolve().parent
+with tempfile.TemporaryDirectory(dir=out.parent) as build:
+    build = Path(build)
+    shutil.copy(snakemake.input.tex, build / "report.tex")
+    for frag in snakemake.input.fragments:
+        shutil.copy(frag, build / Path(frag).name)
+    tex = (build / "report.tex").read_text()
+    (build / "report.tex").write_text(tex.replace("\\begin{document}", f"\\graphicspath{{{{{figures}/}}}}\n\\begin{{document}}", 1))
+    res = subprocess.run(["latexmk", "-pdf", "-interaction=nonstopmode", "-halt-on-error", "report.tex"], cwd=build,
+                         capture_output=True, text=True)
+    log.info("%s", res.stdout[-5000:])
+    if res.returncode:
+        raise SystemExit(f"latexmk failed (see {snakemake.log[0]}):\n{res.stdout[-3000:]}")
+    shutil.move(build / "report.pdf", out)
