@@ -18,6 +18,7 @@ pytestmark = pytest.mark.workflow
 def make_project(tmp: Path, overrides: dict | None = None) -> Path:
     shutil.copy(ROOT / "Snakefile", tmp / "Snakefile")
     shutil.copytree(ROOT / "workflow", tmp / "workflow", ignore=shutil.ignore_patterns("__pycache__", "*.egg-info"))
+    shutil.copytree(ROOT / "paper", tmp / "paper")
     (tmp / "config").mkdir()
     cfg = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
     for dotted, value in (overrides or {}).items():
@@ -143,6 +144,7 @@ def test_new_load_case_runs_only_its_jobs(default_run):
             if len(line.split()) == 2 and line.split()[1].isdigit()}
     assert jobs.get("rig_dual_sine") == 1 and jobs.get("raw_check") == 1
     assert "rig_random_test" not in jobs and "frf" not in jobs and "stiction_stiffness" not in jobs
+    assert "friction_fit" not in jobs  # the calibration fit stays; lc4 is validated with it
 
 
 def test_measured_case_with_wrong_unit_names_file(default_run, tmp_path):
@@ -176,11 +178,13 @@ def test_working_method_recovers_contact_forces(default_run):
 
 
 def test_tenfold_noise_runs_and_reports_larger_errors(default_run, tmp_path):
+    import xarray as xr
+
     proj = make_project(tmp_path, {"rig.noise_fraction": 0.05, "load_cases": {"lc1": {"A1_m_per_s2": 14.0, "A2_m_per_s2": 34.0}}})
-    res = snakemake(proj, "results/summary.json")
+    res = snakemake(proj, "results/lc1/contact_forces.nc")
     assert res.returncode == 0, res.stderr[-3000:]
-    noisy = json.loads((proj / "results" / "summary.json").read_text())["contact_forces"]["lc1"]
-    clean = json.loads((default_run / "results" / "summary.json").read_text())["contact_forces"]["lc1"]
+    noisy = xr.load_dataset(proj / "results/lc1/contact_forces.nc", engine="netcdf4").attrs
+    clean = xr.load_dataset(default_run / "results/lc1/contact_forces.nc", engine="netcdf4").attrs
     assert noisy["S_nrmse"] > clean["S_nrmse"] and noisy["N_nrmse"] > clean["N_nrmse"]
 
 
@@ -200,3 +204,40 @@ def test_friction_law_recovers_rig_truth_and_validates(default_run):
     assert {"identified", "interval_low", "interval_high", "paper_value", "truth"} <= set(t4.columns)
     for fig in ("fig07_e0", "fig08_s_xi", "fig09_s_xidot", "friction_convergence"):
         assert (default_run / "results" / "figures" / f"{fig}.png").stat().st_size > 10000
+
+
+def test_report_pdf_and_generated_numbers(default_run):
+    pdf = default_run / "results" / "report" / "report.pdf"
+    assert pdf.stat().st_size > 100000
+    numbers = (default_run / "results" / "report" / "numbers.tex").read_text()
+    for macro in ("\\freqone", "\\kt", "\\fitmu", "\\lconeworkS", "\\consNmaxerr"):
+        assert f"\\newcommand{{{macro}}}" in numbers
+
+
+def test_audit_passes_clean_and_flags_a_hand_edit(default_run, tmp_path):
+    import netCDF4
+
+    from contactid.audit import audit
+
+    clean = audit([default_run / "results", default_run / "data"], root=default_run)
+    assert len(clean) > 20 and (clean["status"] == "ok").all(), clean[clean["status"] != "ok"]
+    edited = tmp_path / "validation.nc"
+    shutil.copy(default_run / "results" / "lc2" / "validation.nc", edited)
+    with netCDF4.Dataset(edited, "a") as nc:
+        nc["S_predicted"][0] = nc["S_predicted"][0] + 1.0
+    row = audit([edited]).iloc[0]
+    assert row["status"] == "flagged" and "edited by hand" in row["problems"]
+
+
+def test_changed_setting_changes_the_pdf_numbers_only_downstream(default_run):
+    cfg = yaml.safe_load((default_run / "config" / "config.yaml").read_text())
+    cfg["friction"]["generations"] = 15
+    alt = default_run / "config" / "fewer_generations.yaml"
+    alt.write_text(yaml.safe_dump(cfg))
+    before = (default_run / "results" / "report" / "numbers.tex").read_text()
+    dry = snakemake(default_run, "--configfile", str(alt), "-n", "--quiet", "rules")
+    assert "friction_fit" in dry.stdout and "rig_dual_sine" not in dry.stdout and "contact_forces" not in dry.stdout
+    res = snakemake(default_run, "--configfile", str(alt))
+    assert res.returncode == 0, res.stderr[-3000:]
+    after = (default_run / "results" / "report" / "numbers.tex").read_text()
+    assert after != before

@@ -294,7 +294,7 @@ def friction_fit_dataset(forces, preload: float, settings: FitSettings, seed: in
         "interval_high": ("parameter", res.intervals[:, 1], {"units": "mixed", "long_name": "profile-likelihood interval, upper end"}),
         "bounded_below": ("parameter", res.bounded[:, 0].astype(int), {"units": "1", "long_name": "1 if the data bound it from below inside the search range"}),
         "bounded_above": ("parameter", res.bounded[:, 1].astype(int), {"units": "1", "long_name": "1 if the data bound it from above inside the search range"}),
-        "correlation": (("parameter", "parameter_"), res.correlation, {"units": "1", "long_name": "correlation at the optimum (NaN: insensitive)"}),
+        "correlation": (("parameter", "parameter_"), res.correlation, {"units": "1", "long_name": "correlation at the optimum", "nonfinite_meaning": "NaN: the parameter is insensitive at the optimum"}),
         "ga_best": ("generation", [b for _, b, _ in res.logbook], {"units": "1", "long_name": "best misfit (NRMSE of S) per generation"}),
         "ga_mean": ("generation", [m for _, _, m in res.logbook], {"units": "1", "long_name": "mean misfit per generation"}),
         "grid_history": (("refinement", "grid_field"), np.array(res.grid_history),

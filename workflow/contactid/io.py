@@ -68,14 +68,32 @@ def provenance(rule: str, config_subset=None, inputs: Mapping[str, str] | None =
     return attrs
 
 
+def content_digest(ds: xr.Dataset) -> str:
+    """sha256 over the data variables' names, dimensions and values (the audit recomputes it to
+    find datasets edited after they were written)."""
+    h = hashlib.sha256()
+    for name in sorted(ds.data_vars):
+        var = ds[name]
+        h.update(name.encode())
+        h.update(repr(var.dims).encode())
+        values = np.asarray(var.values)
+        if values.dtype.kind in "fiub":
+            h.update(np.ascontiguousarray(values, dtype=np.float64).tobytes())
+        else:
+            h.update(repr(values.tolist()).encode())
+    return h.hexdigest()
+
+
 def write_dataset(ds: xr.Dataset, path: str | os.PathLike) -> None:
     """Write ``ds`` whole or not at all: to a temporary file beside ``path``,
     then renamed over it. Every data variable must carry ``units`` and
-    ``long_name``."""
+    ``long_name``; the content digest is stored as the attribute ``content_sha256``."""
     for name, var in ds.data_vars.items():
         missing = [a for a in ("units", "long_name") if a not in var.attrs]
         if missing:
             raise ValueError(f"variable {name!r} lacks attribute(s) {missing}")
+    ds = ds.copy()
+    ds.attrs["content_sha256"] = content_digest(ds)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(suffix=".nc.tmp", dir=path.parent)

@@ -113,10 +113,10 @@ def modal_dataset(frf: xr.Dataset, n_modes: int, band_hz, order: int) -> xr.Data
     return xr.Dataset(
         {
             "natural_frequency": ("mode", est.natural_frequency_hz, {"units": "Hz", "long_name": "undamped natural frequency |s_r|/2pi"}),
-            "natural_frequency_std": ("mode", sf, {"units": "Hz", "long_name": "standard uncertainty of the natural frequency (sub-records)"}),
-            "order_spread": ("mode", order_spread, {"units": "Hz", "long_name": "change of the frequency at model order +-2"}),
+            "natural_frequency_std": ("mode", sf, {"units": "Hz", "long_name": "standard uncertainty of the natural frequency (sub-records)", "nonfinite_meaning": "NaN: fewer than two sub-records could be fitted"}),
+            "order_spread": ("mode", order_spread, {"units": "Hz", "long_name": "change of the frequency at model order +-2", "nonfinite_meaning": "NaN: no neighbouring order could be fitted"}),
             "damping_ratio": ("mode", est.damping_ratio, {"units": "1", "long_name": "modal damping ratio"}),
-            "damping_ratio_std": ("mode", sz, {"units": "1", "long_name": "standard uncertainty of the damping ratio"}),
+            "damping_ratio_std": ("mode", sz, {"units": "1", "long_name": "standard uncertainty of the damping ratio", "nonfinite_meaning": "NaN: fewer than two sub-records could be fitted"}),
             "residue_abs": (("sensor", "mode"), np.abs(est.residues), {"units": "m/s^2/N rad/s", "long_name": "|accelerance residue|"}),
         },
         coords={"mode": np.arange(1, n_modes + 1), "sensor": frf["sensor"].values},
@@ -141,8 +141,8 @@ def stiction_dataset(modal: xr.Dataset, structure_cfg: Mapping, stiction_cfg: Ma
         {
             "k_t": ((), fit.k_t, {"units": "N/m", "long_name": "tangential contact stiffness at stiction (best fit)"}),
             "k_n": ((), fit.k_n, {"units": "N/m", "long_name": "normal contact stiffness (best fit; see k_n_bounded_above)"}),
-            "k_t_interval": ("bound", np.asarray(fit.k_t_interval), {"units": "N/m", "long_name": "confidence interval of k_t"}),
-            "k_n_interval": ("bound", np.asarray(fit.k_n_interval), {"units": "N/m", "long_name": "confidence interval of k_n (inf: unbounded above)"}),
+            "k_t_interval": ("bound", np.asarray(fit.k_t_interval), {"units": "N/m", "long_name": "confidence interval of k_t", "nonfinite_meaning": "inf: the data do not bound k_t from above"}),
+            "k_n_interval": ("bound", np.asarray(fit.k_n_interval), {"units": "N/m", "long_name": "confidence interval of k_n", "nonfinite_meaning": "inf: the data do not bound k_n from above"}),
             "model_frequency": ("mode", fit.model_frequencies_hz, {"units": "Hz", "long_name": "model natural frequency at the best fit"}),
             "identified_frequency": ("mode", f_id, {"units": "Hz", "long_name": "identified natural frequency"}),
             "frequency_sigma": ("mode", sigma, {"units": "Hz", "long_name": "frequency uncertainty used as weight"}),
