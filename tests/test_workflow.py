@@ -241,3 +241,10 @@ def test_changed_setting_changes_the_pdf_numbers_only_downstream(default_run):
     assert res.returncode == 0, res.stderr[-3000:]
     after = (default_run / "results" / "report" / "numbers.tex").read_text()
     assert after != before
+
+
+def test_snakemake_html_report(default_run):
+    res = snakemake(default_run, "--report", "report.html")
+    assert res.returncode == 0, res.stderr[-3000:]
+    html = (default_run / "report.html").read_text(errors="replace")
+    assert len(html) > 100000 and "fig06_contact_forces.png" in html

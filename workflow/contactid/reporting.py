@@ -322,7 +322,7 @@ def plot_friction_figures(fit: xr.Dataset, validations: Mapping[str, xr.Dataset]
             ax.set_xlabel(xlabel)
             ax.set_ylabel("S (N)")
             ax.grid(alpha=0.3)
-        axes[0, 0].legend(fontsize=7)
+        axes[0, 0].legend(fontsize=7, loc="lower right")
         fig.tight_layout()
         fig.savefig(paths[f"{key}_png"], dpi=150)
         fig.savefig(paths[f"{key}_pdf"])
