@@ -20,6 +20,12 @@ configfile: "config/config.yaml"
 validate(config, "workflow/schemas/config.schema.yaml")
 
 
+from contactid.io import package_digest
+
+# every rule takes the package's code digest as a parameter: a changed contactid reruns what it computed
+CODE_DIGEST = package_digest()
+
+
 include: "workflow/rules/common.smk"
 include: "workflow/rules/rig.smk"
 include: "workflow/rules/linear.smk"

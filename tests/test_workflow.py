@@ -248,3 +248,17 @@ def test_snakemake_html_report(default_run):
     assert res.returncode == 0, res.stderr[-3000:]
     html = (default_run / "report.html").read_text(errors="replace")
     assert len(html) > 100000 and "fig06_contact_forces.png" in html
+
+
+def test_changed_package_code_reruns_what_it_computed(default_run):
+    module = default_run / "workflow" / "contactid" / "latex.py"
+    original = module.read_text()
+    try:
+        module.write_text(original + "\n# a change of the package's code\n")
+        dry = snakemake(default_run, "-n", "--quiet", "rules")
+        assert dry.returncode == 0, dry.stderr[-2000:]
+        assert "report_fragments" in dry.stdout and "rig_random_test" in dry.stdout
+    finally:
+        module.write_text(original)
+    again = snakemake(default_run, "-n")
+    assert "Nothing to be done" in again.stdout + again.stderr

@@ -7,6 +7,7 @@ rule friction_fit:
     output:
         fit="results/friction/friction_fit.nc",
     params:
+        code=CODE_DIGEST,
         friction=config.get("friction", {}),
         preload=config["structure"]["preload_n"],
         seed=config["seed"],
@@ -27,6 +28,7 @@ rule validate:
     output:
         validation="results/{case}/validation.nc",
     params:
+        code=CODE_DIGEST,
         preload=config["structure"]["preload_n"],
         n_harmonics=config.get("nonlinear", {}).get("n_harmonics", 25),
     conda:

@@ -7,6 +7,7 @@ rule frf:
     output:
         frf="results/linear/frf.nc",
     params:
+        code=CODE_DIGEST,
         frf=config.get("frf", {}),
         structure=config["structure"],
         blocks=config.get("modal", {}).get("uncertainty_blocks", 4),
@@ -26,6 +27,7 @@ rule modal:
     output:
         modal="results/linear/modal.nc",
     params:
+        code=CODE_DIGEST,
         modal=config.get("modal", {}),
     conda:
         "../envs/contactid.yaml"
@@ -43,6 +45,7 @@ rule stiction_stiffness:
     output:
         stiction="results/linear/stiction.nc",
     params:
+        code=CODE_DIGEST,
         structure=config["structure"],
         stiction=config.get("stiction", {}),
     conda:
@@ -61,6 +64,7 @@ rule linear_modes:
     output:
         modes="results/linear/linear_modes.nc",
     params:
+        code=CODE_DIGEST,
         structure=config["structure"],
         linear_modes=config.get("linear_modes", {}),
         k_n_prior=config.get("stiction", {}).get("k_n_prior_n_per_m", 2.37e7),

@@ -6,6 +6,7 @@ rule raw_check:
     output:
         check="results/{case}/raw_check.nc",
     params:
+        code=CODE_DIGEST,
         structure=config["structure"],
         checks=config.get("raw_checks", {}),
     conda:
@@ -24,6 +25,7 @@ rule generalized_coordinates:
     output:
         gc="results/{case}/generalized_coordinates.nc",
     params:
+        code=CODE_DIGEST,
         nonlinear=config.get("nonlinear", {}),
     conda:
         "../envs/contactid.yaml"
@@ -41,6 +43,7 @@ rule nonlinear_modes:
     output:
         nnm="results/{case}/nonlinear_modes.nc",
     params:
+        code=CODE_DIGEST,
         structure=config["structure"],
         nonlinear=config.get("nonlinear", {}),
     conda:
@@ -59,6 +62,7 @@ rule reduced_model:
     output:
         reduced="results/{case}/reduced_model.nc",
     params:
+        code=CODE_DIGEST,
         structure=config["structure"],
         nonlinear=config.get("nonlinear", {}),
     conda:
@@ -75,6 +79,7 @@ rule contact_forces:
     output:
         forces="results/{case}/contact_forces.nc",
     params:
+        code=CODE_DIGEST,
         structure=config["structure"],
         nonlinear=config.get("nonlinear", {}),
     conda:
@@ -96,6 +101,7 @@ rule harmonic_study:
     output:
         table=report("results/studies/harmonic_count.csv", caption="../report/harmonic_study.rst", category="Studies"),
     params:
+        code=CODE_DIGEST,
         structure=config["structure"],
         counts=config.get("nonlinear", {}).get("harmonic_study", [5, 10, 15, 20, 25, 30]),
     conda:

@@ -9,6 +9,7 @@ rule paper_consistency:
             category="Tables",
         ),
     params:
+        code=CODE_DIGEST,
         structure=config["structure"],
         truth=config.get("rig", {}).get("truth", {}),
     conda:
@@ -29,6 +30,8 @@ rule linear_tables:
     output:
         table1=report("results/tables/table1.csv", caption="../report/table1.rst", category="Tables"),
         table3=report("results/tables/table3.csv", caption="../report/table3.rst", category="Tables"),
+    params:
+        code=CODE_DIGEST,
     conda:
         "../envs/contactid.yaml"
     log:
@@ -44,6 +47,8 @@ rule fig03_frf:
     output:
         png=report("results/figures/fig03_frf.png", caption="../report/fig03.rst", category="Figures"),
         pdf="results/figures/fig03_frf.pdf",
+    params:
+        code=CODE_DIGEST,
     conda:
         "../envs/contactid.yaml"
     log:
@@ -57,6 +62,8 @@ rule summary:
         unpack(summary_inputs),
     output:
         summary="results/summary.json",
+    params:
+        code=CODE_DIGEST,
     conda:
         "../envs/contactid.yaml"
     log:
@@ -72,6 +79,7 @@ rule fig04_generalized_coordinates:
         png=report("results/figures/fig04_generalized_coordinates.png", caption="../report/fig04.rst", category="Figures"),
         pdf="results/figures/fig04_generalized_coordinates.pdf",
     params:
+        code=CODE_DIGEST,
         case=figure_case() if load_cases() else None,
     conda:
         "../envs/contactid.yaml"
@@ -88,6 +96,7 @@ rule fig05_reconstruction:
         png=report("results/figures/fig05_reconstruction.png", caption="../report/fig05.rst", category="Figures"),
         pdf="results/figures/fig05_reconstruction.pdf",
     params:
+        code=CODE_DIGEST,
         case=figure_case() if load_cases() else None,
     conda:
         "../envs/contactid.yaml"
@@ -104,6 +113,7 @@ rule fig06_contact_forces:
         png=report("results/figures/fig06_contact_forces.png", caption="../report/fig06.rst", category="Figures"),
         pdf="results/figures/fig06_contact_forces.pdf",
     params:
+        code=CODE_DIGEST,
         cases=load_cases(),
     conda:
         "../envs/contactid.yaml"
@@ -128,6 +138,7 @@ rule friction_outputs:
         convergence_png=report("results/figures/friction_convergence.png", caption="../report/convergence.rst",
                                category="Figures"),
     params:
+        code=CODE_DIGEST,
         cases=load_cases(),
         truth_friction=None if _is_measured(config["load_cases"].get(calibration_case())) else config.get("rig", {}).get("truth", {}).get("friction"),
     conda:

@@ -17,6 +17,7 @@ rule report_fragments:
         consistency="results/report/consistency.tex",
         contact="results/report/contact.tex",
     params:
+        code=CODE_DIGEST,
         structure=config["structure"],
     conda:
         "../envs/contactid.yaml"
@@ -44,6 +45,8 @@ rule report:
         ),
     output:
         pdf="results/report/report.pdf",
+    params:
+        code=CODE_DIGEST,
     conda:
         "../envs/contactid.yaml"
     log:

@@ -11,6 +11,7 @@ rule rig_random_test:
         raw="data/raw/random_test.nc",
         truth="data/truth/random_test.nc",
     params:
+        code=CODE_DIGEST,
         seed=config["seed"],
         structure=config["structure"],
         rig=random_test_rig_config(config.get("rig", {})),
@@ -32,6 +33,7 @@ rule rig_dual_sine:
     wildcard_constraints:
         case=rig_case_pattern(),
     params:
+        code=CODE_DIGEST,
         seed=config["seed"],
         structure=config["structure"],
         rig=config.get("rig", {}),
