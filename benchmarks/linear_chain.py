@@ -8,10 +8,7 @@ the stiffness fit evaluates it, so machine speed can be factored out.
 Usage: .venv/bin/python benchmarks/linear_chain.py
 """
 
-import shutil
-import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -23,22 +20,13 @@ sys.path.insert(0, str(ROOT / "workflow"))
 from contactid.beam_model import assemble  # noqa: E402
 from contactid.parameters import StructureParameters  # noqa: E402
 
+sys.path.insert(0, str(ROOT / "benchmarks"))
+from common import timed_clean_run  # noqa: E402
+
 
 def main():
-    with tempfile.TemporaryDirectory() as tmp:
-        tmp = Path(tmp)
-        shutil.copy(ROOT / "Snakefile", tmp)
-        shutil.copytree(ROOT / "workflow", tmp / "workflow", ignore=shutil.ignore_patterns("__pycache__"))
-        shutil.copytree(ROOT / "config", tmp / "config")
-        t0 = time.perf_counter()
-        res = subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", "results/summary.json",
-                              "results/linear/linear_modes.nc", "results/figures/fig03_frf.png",
-                              "results/tables/table1.csv", "results/tables/paper_consistency.csv"],
-                             cwd=tmp, capture_output=True, text=True)
-        wall = time.perf_counter() - t0
-        if res.returncode:
-            print(res.stderr[-2000:])
-            raise SystemExit(1)
+    wall = timed_clean_run("results/linear/linear_modes.nc", "results/figures/fig03_frf.png",
+                           "results/tables/table1.csv", "results/tables/paper_consistency.csv")
     m = assemble(StructureParameters())
     t0 = time.perf_counter()
     for _ in range(500):

@@ -9,10 +9,7 @@ numba integrator; the ratio is printed.
 Usage: .venv/bin/python benchmarks/rig_dual_sine.py
 """
 
-import shutil
-import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -25,6 +22,9 @@ sys.path.insert(0, str(ROOT / "workflow"))
 
 from contactid.friction import valanis_slope  # noqa: E402
 from contactid.rig.dual_sine import build_simulator, dual_sine_settings, dual_sine_test  # noqa: E402
+
+sys.path.insert(0, str(ROOT / "benchmarks"))
+from common import timed_clean_run  # noqa: E402
 
 
 def solve_ivp_baseline(sim, F1, F3, w, t_end):
@@ -85,18 +85,7 @@ def main():
     print(f"8 periods of lc1: numba central differences {t_numba * 1e3:.1f} ms, solve_ivp RK45 {t_ivp:.2f} s "
           f"({sol.t.size} steps); speed-up {t_ivp / t_numba:.0f}x")
 
-    with tempfile.TemporaryDirectory() as tmp:
-        tmp = Path(tmp)
-        shutil.copy(ROOT / "Snakefile", tmp)
-        shutil.copytree(ROOT / "workflow", tmp / "workflow", ignore=shutil.ignore_patterns("__pycache__"))
-        shutil.copytree(ROOT / "config", tmp / "config")
-        t0 = time.perf_counter()
-        res = subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", "rig"], cwd=tmp, capture_output=True,
-                             text=True)
-        wall = time.perf_counter() - t0
-        if res.returncode:
-            print(res.stderr[-2000:])
-            raise SystemExit(1)
+    wall = timed_clean_run("rig")
     print(f"whole default rig data set (snakemake rig, from clean, 2 cores): {wall:.1f} s (goal < 40 s)")
 
 
