@@ -62,6 +62,7 @@ def test_snapped_frequency_gives_whole_periods():
 def test_time_step_and_mode_convergence(default_config):
     c = default_config
     df = convergence_study(c["structure"], c["rig"], c["load_cases"]["lc1"], FS)
+    assert df["change_pct"].notna().all() and np.isfinite(df["amplitude_m_per_s2"]).all()
     main = df[df["harmonic"].isin([1, 3])]
     assert main["change_pct"].max() < 0.5
     assert df["change_pct"].max() < 1.0

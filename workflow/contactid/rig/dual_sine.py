@@ -67,7 +67,11 @@ def build_simulator(structure_cfg: Mapping, rig_cfg: Mapping, settings: Mapping,
     zeta = np.full(red.omega.size, float(rig_cfg.get("modal_damping_ratio", 0.005)))
     zeta[red.beam_mode] += eff["structural_damping"]
     q = int(oversampling or settings["oversampling"])
-    return DualSineSimulator(red, contact_parameters(structure_cfg, rig_cfg), zeta, 1.0 / (q * settings["sampling_rate_hz"]))
+    # explicit central differences are stable for omega_max dt < 2: keep a margin (1.6) by oversampling more
+    q = max(q, int(np.ceil(red.omega.max() / (1.6 * settings["sampling_rate_hz"]))))
+    sim = DualSineSimulator(red, contact_parameters(structure_cfg, rig_cfg), zeta, 1.0 / (q * settings["sampling_rate_hz"]))
+    sim.oversampling = q
+    return sim
 
 
 def energy_balance(out: dict, sim: DualSineSimulator) -> dict:
@@ -104,7 +108,7 @@ def dual_sine_test(structure_cfg: Mapping, rig_cfg: Mapping, case_cfg: Mapping, 
     ctl = control_response(sim, target[0], target[1], w, tol=float(s["control_tolerance"]))
     if not ctl.converged:
         log.warning("%s: response control did not converge: %s", case, ctl.history[-1])
-    q = int(s["oversampling"])
+    q = sim.oversampling
     n_rec = int(s["record_samples"]) * q
     margin = 64 * q * 8
     # preload drift (effect) runs over the recorded window
