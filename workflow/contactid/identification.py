@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .beam_model import FEModel, all_modes, shortening_matrix, structural_modes
+from .beam_model import FEModel, all_modes, shortening_matrix
 from .signals import harmonic_content
 
 
@@ -61,29 +61,6 @@ def nrmse(estimate: np.ndarray, truth: np.ndarray) -> float:
 # ----------------------------------------------------------------------------------------------
 # the paper's chain
 # ----------------------------------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class PaperChainResult:
-    """Outputs of the paper's chain (SI units). p_coef: (m, K) harmonics of p''_i; nnm: (n_dof, 2)
-    NNM vectors for w and 3w; phase_spread_deg: (2,) largest phase difference between the terms of
-    the same frequency (Eq. 18); q, qdd: (2, n_t) NNM coordinates; reconstruction: driving-point
-    acceleration from the NNM expansion (Fig. 5); S, N_dyn, xi, eta: (n_t,) mean-removed;
-    reduced_mass, reduced_stiffness: (2, 2)."""
-
-    p_coef: np.ndarray
-    nnm: np.ndarray
-    phase_spread_deg: np.ndarray
-    q: np.ndarray
-    qdd: np.ndarray
-    reconstruction: np.ndarray
-    S: np.ndarray
-    N_dyn: np.ndarray
-    xi: np.ndarray
-    eta: np.ndarray
-    reduced_mass: np.ndarray
-    reduced_stiffness: np.ndarray
-    complex_modes: bool
 
 
 def generalized_coordinates(phi_sensor: np.ndarray, acceleration: np.ndarray, fs: float, f0: float,
@@ -156,25 +133,6 @@ def galerkin_contact_forces(model: FEModel, nnm: np.ndarray, q: np.ndarray, qdd:
     eta = eta_r @ q
     return {"S": S, "N_dyn": N, "xi": xi, "eta": eta, "reduced_mass": Mr, "reduced_stiffness": Kr,
             "reduced_force": Fr}
-
-
-def paper_chain(model: FEModel, n_modes: int, force: np.ndarray, acceleration: np.ndarray, fs: float, f0: float,
-                n_harmonics: int, drive_index: int, phase_limit_deg: float = 10.0) -> PaperChainResult:
-    """The paper's NNM chain on one record (Eqs. 15-20, 10-12), all steps in one call."""
-    modes = structural_modes(model, n_modes)
-    phi = modes.shapes
-    pdd, p_coef = generalized_coordinates(model.sensor_vectors @ phi, acceleration, fs, f0, n_harmonics)
-    coef, spread = nonlinear_mode_coefficients(p_coef)
-    nnm = phi @ coef.T
-    q, qdd = nnm_coordinates(model.sensor_vectors @ nnm, acceleration, fs, f0, n_harmonics)
-    reconstruction = (model.sensor_vectors @ nnm @ qdd)[drive_index]
-    t = np.arange(acceleration.shape[1]) / fs
-    f_syn = synthesize(fourier_series(force, fs, f0, n_harmonics), f0, t, 0)[0]
-    g = galerkin_contact_forces(model, nnm, q, qdd, f_syn)
-    centre = lambda x: x - x.mean()  # noqa: E731
-    return PaperChainResult(p_coef, nnm, spread, q, qdd, reconstruction, centre(g["S"]), centre(g["N_dyn"]),
-                            centre(g["xi"]), centre(g["eta"]), g["reduced_mass"], g["reduced_stiffness"],
-                            bool(np.any(spread > phase_limit_deg)))
 
 
 # ----------------------------------------------------------------------------------------------
