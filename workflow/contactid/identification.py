@@ -179,20 +179,35 @@ def period_coefficients(x_grid: np.ndarray, n_harmonics: int) -> np.ndarray:
     return 2j * X / M
 
 
-def inverse_identification(model: FEModel, zeta: np.ndarray, force: np.ndarray, acceleration: np.ndarray,
-                           fs: float, f0: float, n_harmonics: int, n_iterations: int = 8) -> InverseResult:
-    """Contact forces as unknown inputs, harmonic by harmonic, with the stuck linear model.
+@dataclass(frozen=True)
+class InverseHarmonics:
+    """Harmonic-level result of the inverse identification (complex, h = 1..K): S, N_dyn, xi
+    (with the beam shortening's harmonics), eta, their rates, the stuck-system coordinates q
+    (n_dof, K), the unknown inputs r = (S - k_t xi_lin, N_dyn + k_n eta) and the relative sensor
+    misfit per harmonic."""
 
-    The axial-force term of Eq. 1 (the gradient of the beam shortening in xi, G q S) mixes
-    harmonics; it is moved to the known side and updated by fixed-point iteration."""
+    S: np.ndarray
+    N_dyn: np.ndarray
+    xi: np.ndarray
+    eta: np.ndarray
+    xi_dot: np.ndarray
+    eta_dot: np.ndarray
+    q: np.ndarray
+    r: np.ndarray
+    residual: np.ndarray
+
+
+def inverse_harmonics(model: FEModel, zeta: np.ndarray, F_coef: np.ndarray, A_coef: np.ndarray, f0: float,
+                      n_iterations: int = 8) -> InverseHarmonics:
+    """Per-harmonic inverse identification from the force harmonics F_coef (K,) and the sensor
+    acceleration harmonics A_coef (j, K) (convention of Eq. 16). The axial-force term of Eq. 1
+    (G q S) mixes harmonics; it is moved to the known side and updated by fixed-point iteration."""
     modes = all_modes(model)
     phi = modes.shapes
     wn = 2 * np.pi * modes.frequencies_hz
     p = model.params
     w0 = 2 * np.pi * f0
-    K = n_harmonics
-    A_coef = fourier_series(acceleration, fs, f0, K)  # (j, K)
-    F_coef = fourier_series(force, fs, f0, K)[0]  # (K,)
+    K = A_coef.shape[1]
     b_f = phi.T @ model.force_vector
     b_xi = phi.T @ model.xi_vector
     b_eta = phi.T @ model.eta_vector
@@ -229,6 +244,28 @@ def inverse_identification(model: FEModel, zeta: np.ndarray, force: np.ndarray, 
         geo_coef = new
         if change < 1e-8:
             break
+    qg = synthesize(q_coef, f0, t_grid, 0)
+    qdg = synthesize(q_coef, f0, t_grid, 1)
+    xi_lin = model.xi_vector @ q_coef
+    xi = xi_lin - 0.5 * period_coefficients(np.einsum("it,ij,jt->t", qg, G, qg), K)
+    xi_dot = period_coefficients(model.xi_vector @ qdg - np.einsum("it,ij,jt->t", qg, G, qdg), K)
+    eta = model.eta_vector @ q_coef
+    h = np.arange(1, K + 1)
+    return InverseHarmonics(S=r_coef[0] + p.k_t * xi_lin, N_dyn=r_coef[1] - p.k_n * eta, xi=xi, eta=eta,
+                            xi_dot=xi_dot, eta_dot=1j * h * w0 * eta, q=q_coef, r=r_coef, residual=residual)
+
+
+def inverse_identification(model: FEModel, zeta: np.ndarray, force: np.ndarray, acceleration: np.ndarray,
+                           fs: float, f0: float, n_harmonics: int, n_iterations: int = 8) -> InverseResult:
+    """Contact forces as unknown inputs, harmonic by harmonic, with the stuck linear model
+    (:func:`inverse_harmonics` on the record's K harmonics, then the time signals)."""
+    p = model.params
+    K = n_harmonics
+    A_coef = fourier_series(acceleration, fs, f0, K)  # (j, K)
+    F_coef = fourier_series(force, fs, f0, K)[0]  # (K,)
+    res = inverse_harmonics(model, zeta, F_coef, A_coef, f0, n_iterations)
+    q_coef, r_coef = res.q, res.r
+    G = shortening_matrix(model)
     t = np.arange(acceleration.shape[1]) / fs
     q = synthesize(q_coef, f0, t, 0)  # (n_dof, n_t)
     qd = synthesize(q_coef, f0, t, 1)
@@ -245,4 +282,4 @@ def inverse_identification(model: FEModel, zeta: np.ndarray, force: np.ndarray, 
     S_coef = r_coef[0] + p.k_t * xi_coef
     N_coef = r_coef[1] - p.k_n * eta_coef
     return InverseResult(S - S.mean(), N_dyn - N_dyn.mean(), xi - xi.mean(), eta - eta.mean(), xi_dot, eta_dot,
-                         S_coef, N_coef, xi_coef, eta_coef, residual)
+                         S_coef, N_coef, xi_coef, eta_coef, res.residual)

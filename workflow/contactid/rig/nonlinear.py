@@ -105,6 +105,7 @@ class ContactParameters:
     iwan_weights: np.ndarray = field(default_factory=lambda: iwan_slip_weights(16))
     preload_drift: float = 0.0
     n_min: float = 1e-6
+    unilateral: bool = True
 
 
 def iwan_slip_weights(n: int, spread: float = 0.8) -> np.ndarray:
@@ -133,12 +134,28 @@ def _contact_state(z, v, xi_v, eta_v, G):
 
 
 @njit
-def _normal_force(eta, deta, n0, delta0, p, hc):
+def _normal_force(eta, deta, n0, delta0, p, hc, unilateral):
+    """N = N0 ((delta0 - eta)/delta0)^p (1 - hc deta/dt), zero once the contact opens; a
+    bilateral law (``unilateral`` False, p = 1) is the linear spring of Eq. 13 and may pull."""
+    if not unilateral:
+        return n0 * (delta0 - eta) / delta0 * (1.0 - hc * deta)
     if eta >= delta0:
         return 0.0
     nel = n0 * ((delta0 - eta) / delta0) ** p
     n = nel * (1.0 - hc * deta)
     return n if n > 0.0 else 0.0
+
+
+@njit
+def _excitation(f_sin, f_cos, w, t):
+    """f(t) = sum_h f_sin[h-1] sin(h w t) + f_cos[h-1] cos(h w t) (N)."""
+    f = 0.0
+    for k in range(f_sin.size):
+        if f_sin[k] != 0.0:
+            f += f_sin[k] * np.sin((k + 1.0) * w * t)
+        if f_cos[k] != 0.0:
+            f += f_cos[k] * np.cos((k + 1.0) * w * t)
+    return f
 
 
 @njit
@@ -161,7 +178,7 @@ def _iwan_force(xi, x_sl, weights, e0_total, mu_n):
 
 @njit
 def integrate(z, v, state, t0, n_steps, dt, omega, zeta, xi_v, eta_v, G, bF, k_t, k_n,
-              F1, F3, w, fr, n0, delta0, p, hc, visc, iw_share, iw_w, x_sl, drift_rate, drift_t0,
+              f_sin, f_cos, w, fr, n0, delta0, p, hc, unilateral, visc, iw_share, iw_w, x_sl, drift_rate, drift_t0,
               store_from, out_a, out_z, out_v, out_s, out_n, out_xi, out_eta, out_f, out_dxi, out_deta):
     """Advance the reduced model ``n_steps`` steps of ``dt`` from time ``t0``.
 
@@ -176,7 +193,7 @@ def integrate(z, v, state, t0, n_steps, dt, omega, zeta, xi_v, eta_v, G, bF, k_t
     om2 = omega * omega
     S_val = state[0]
     xi_lin, xi, dxi_dq, eta, deta, dxi = _contact_state(z, v, xi_v, eta_v, G)
-    N = _normal_force(eta, deta, n0, delta0, p, hc)
+    N = _normal_force(eta, deta, n0, delta0, p, hc, unilateral)
     P = n0
     a = np.empty(n)
     t = t0
@@ -187,7 +204,7 @@ def integrate(z, v, state, t0, n_steps, dt, omega, zeta, xi_v, eta_v, G, bF, k_t
     if iw_share > 0.0 and N > 0.0:
         s_iw = _iwan_force(xi, x_sl, iw_w, e0, mu * N)
     S_tot = (1.0 - iw_share) * S_val + iw_share * s_iw + (visc * dxi if N > 0.0 else 0.0)
-    f = F1 * np.sin(w * t) + F3 * np.sin(3.0 * w * t)
+    f = _excitation(f_sin, f_cos, w, t)
     for i in range(n):
         a[i] = bF[i] * f - dxi_dq[i] * S_tot + eta_v[i] * (N - P) + k_t * xi_v[i] * xi_lin + k_n * eta_v[i] * eta \
             - c[i] * v[i] - om2[i] * z[i]
@@ -200,7 +217,7 @@ def integrate(z, v, state, t0, n_steps, dt, omega, zeta, xi_v, eta_v, G, bF, k_t
         xi_old = xi
         N_old = N
         xi_lin, xi, dxi_dq, eta, deta, dxi = _contact_state(z, v, xi_v, eta_v, G)
-        N = _normal_force(eta, deta, n0, delta0, p, hc)  # explicit estimate for the friction law
+        N = _normal_force(eta, deta, n0, delta0, p, hc, unilateral)  # explicit estimate for the friction law
         S_val = valanis_step(S_val, xi_old, xi, N_old, N, e_f, k_c, e_t, kappa, mu, 1e-6)
         if N > 0.0:
             e0 = e_f * (1.0 - np.exp(-k_c * N / e_f))
@@ -211,9 +228,9 @@ def integrate(z, v, state, t0, n_steps, dt, omega, zeta, xi_v, eta_v, G, bF, k_t
             for k in range(x_sl.size):
                 x_sl[k] = xi
         P = n0 * (1.0 + drift_rate * (t - drift_t0)) if (drift_rate != 0.0 and t > drift_t0) else n0
-        f = F1 * np.sin(w * t) + F3 * np.sin(3.0 * w * t)
+        f = _excitation(f_sin, f_cos, w, t)
         # normal force: elastic part explicit, Hunt-Crossley damping implicit (it is stiff)
-        N_el = _normal_force(eta, 0.0, n0, delta0, p, 0.0)
+        N_el = _normal_force(eta, 0.0, n0, delta0, p, 0.0, unilateral)
         c_n = hc * N_el
         uDu = 0.0
         uy = 0.0
@@ -232,7 +249,7 @@ def integrate(z, v, state, t0, n_steps, dt, omega, zeta, xi_v, eta_v, G, bF, k_t
             for i in range(n):
                 deta_new += eta_v[i] * (v[i] - corr * eta_v[i] / (1.0 + 0.5 * dt * c[i]))
             N = N_el * (1.0 - hc * deta_new)
-            if N >= 0.0:
+            if N >= 0.0 or not unilateral:
                 for i in range(n):
                     v[i] -= corr * eta_v[i] / (1.0 + 0.5 * dt * c[i])
             else:  # the damping cannot pull: the contact force drops to zero
@@ -272,8 +289,17 @@ class SteadyStateLog:
     change: list = field(default_factory=list)
 
 
+def force_coefficients(F1, F3) -> np.ndarray:
+    """Complex harmonics c_h (h = 1..H) of the excitation, f = sum_h Im(c_h e^{i h w t}) (N):
+    [F1, 0, F3] for two amplitudes, or F1 itself (an array) when F3 is None."""
+    if F3 is None:
+        return np.atleast_1d(np.asarray(F1, dtype=complex))
+    return np.array([F1, 0.0, F3], dtype=complex)
+
+
 class DualSineSimulator:
-    """Time integration of the reduced rig model under f = F1 sin(wt) + F3 sin(3wt)."""
+    """Time integration of the reduced rig model under f = F1 sin(wt) + F3 sin(3wt)
+    (or any periodic force given by its harmonics)."""
 
     def __init__(self, red: ReducedModel, contact: ContactParameters, zeta: np.ndarray, dt: float):
         self.red = red
@@ -300,11 +326,14 @@ class DualSineSimulator:
         x = r.force / (r.omega**2 - w**2 + 2j * self.zeta * r.omega * w)
         return complex(-(w**2) * (r.drive @ x))
 
-    def start_from_linear(self, F1: float, F3: float, w: float):
-        """Initial state: the stuck linear system's steady state at t = 0."""
+    def start_from_linear(self, F1, F3, w: float):
+        """Initial state: the stuck linear system's steady state at t = 0 (force as in ``run``)."""
         r = self.red
         self.reset()
-        for F, h in ((F1, 1), (F3, 3)):
+        for k, F in enumerate(force_coefficients(F1, F3)):
+            if F == 0:
+                continue
+            h = k + 1
             X = F * r.force / (r.omega**2 - (h * w) ** 2 + 2j * self.zeta * r.omega * h * w)
             self.z += X.imag
             self.v += h * w * X.real
@@ -312,8 +341,11 @@ class DualSineSimulator:
         # the friction state starts at the stuck spring force
         self.state[0] = r.k_t * (r.xi @ self.z)
 
-    def run(self, F1: float, F3: float, w: float, n_steps: int, store_from: int | None = None) -> dict:
-        """Advance n_steps; returns the stored signals (from ``store_from``) at the step rate."""
+    def run(self, F1, F3, w: float, n_steps: int, store_from: int | None = None) -> dict:
+        """Advance n_steps under f = F1 sin(wt) + F3 sin(3wt) (N), or, with F3 None, under
+        f = sum_h Im(F1[h-1] e^{i h w t}) for a complex coefficient array F1; returns the stored
+        signals (from ``store_from``) at the step rate."""
+        coef = force_coefficients(F1, F3)
         n_store = 0 if store_from is None else n_steps - store_from
         n_r = self.red.omega.size
         out = {k: np.empty(n_store) for k in ("S", "N", "xi", "eta", "f", "dxi", "deta")}
@@ -324,8 +356,9 @@ class DualSineSimulator:
         r = self.red
         t_start = self.t
         self.t = integrate(self.z, self.v, self.state, self.t, n_steps, self.dt, r.omega, self.zeta, r.xi, r.eta,
-                           r.shortening, r.force, r.k_t, r.k_n, F1, F3, w, self.fr, c.preload, c.static_approach,
-                           c.exponent, c.hunt_crossley, c.viscous, c.iwan_share, self.iw_w, self.x_sl,
+                           r.shortening, r.force, r.k_t, r.k_n, np.ascontiguousarray(coef.real),
+                           np.ascontiguousarray(coef.imag), w, self.fr, c.preload, c.static_approach,
+                           c.exponent, c.hunt_crossley, bool(c.unilateral), c.viscous, c.iwan_share, self.iw_w, self.x_sl,
                            self.drift_rate, self.drift_t0, n_steps if store_from is None else store_from, out_a, out_z, out_v,
                            out["S"], out["N"], out["xi"], out["eta"], out["f"], out["dxi"], out["deta"])
         first = 1 + (n_steps if store_from is None else store_from)
@@ -335,7 +368,7 @@ class DualSineSimulator:
         out["v"] = out_v
         return out
 
-    def settle(self, F1: float, F3: float, w: float, chunk_periods: int = 8, tol: float = 1e-4,
+    def settle(self, F1, F3, w: float, chunk_periods: int = 8, tol: float = 1e-4,
                min_chunks: int = 3, max_chunks: int = 200) -> tuple[np.ndarray, SteadyStateLog, bool]:
         """Run chunks of ``chunk_periods`` periods until the driving-point harmonics
         at w and 3w change by less than ``tol`` (relative) from one chunk to the next.

@@ -1,0 +1,199 @@
+"""The identified model (the "sim") and its forward simulation under a record's measured force.
+
+The identified model is the chain's own result: the structure of ``structure`` with the linear
+chain's k_t and k_n and its modal damping ratios, the friction law fitted by the chain
+(Eqs. 21-22) and the normal law of Eq. 13 with the sign of our derivation, N = N0 - k_n eta
+(linear and bilateral, as the paper identifies it). It is reduced and integrated exactly as the
+virtual rig is (``rig.nonlinear``), so a disagreement is the model's, not the integrator's.
+
+An augmentation (``Augmentation``) adds one or more physical effects to it; the candidate
+library (``candidates``) maps an effect's few parameters onto these fields.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+from functools import lru_cache
+from typing import Mapping
+
+import numpy as np
+import xarray as xr
+
+from ..beam_model import assemble
+from ..parameters import StructureParameters, structure_from_config
+from ..rig.nonlinear import ContactParameters, DualSineSimulator, reduced_model
+from ..signals import harmonic_amplitudes
+from .records import RecordHarmonics
+
+
+@dataclass(frozen=True)
+class Augmentation:
+    """Effects added to the identified model (all off by default; SI units).
+
+    extra_damping: modal damping ratio added to the beam's modes; hunt_crossley: alpha (s/m) of
+    N (1 - alpha deta/dt); viscous: sigma_2 (N s/m) of S + sigma_2 dxi/dt; iwan_share: share of the
+    tangential contact carried by a Maxwell-slip (Iwan) element; mass_error: relative error of
+    every transducer mass; delays: (j,) s, acceleration channels late on the force;
+    unilateral_exponent: 0 = the linear bilateral spring N0 - k_n eta, p >= 1 = the unilateral
+    power law N0 ((delta0 - eta)/delta0)^p with delta0 = p N0 / k_n (the contact may open);
+    preload_drift: relative change of the preload over the record.
+    """
+
+    extra_damping: float = 0.0
+    hunt_crossley: float = 0.0
+    viscous: float = 0.0
+    iwan_share: float = 0.0
+    mass_error: float = 0.0
+    delays: tuple = ()
+    unilateral_exponent: float = 0.0
+    preload_drift: float = 0.0
+
+    def merge(self, other: "Augmentation") -> "Augmentation":
+        """Both augmentations' effects (other's non-default fields win)."""
+        changes = {f.name: getattr(other, f.name) for f in dataclasses.fields(other)
+                   if getattr(other, f.name) != f.default}
+        return dataclasses.replace(self, **changes)
+
+
+NONE = Augmentation()
+
+
+@dataclass(frozen=True)
+class IdentifiedModel:
+    """The chain's identified model: structure (with identified k_t, k_n), damping ratios of the
+    identified structural modes (by order), friction parameters (e_f, k_c, e_t, kappa, mu), preload
+    N0 (N), the number of stuck modes kept and the integration oversampling."""
+
+    structure: StructureParameters
+    damping: tuple
+    friction: tuple
+    preload: float
+    n_modes: int = 8
+    oversampling: int = 8
+
+    def structure_with(self, aug: Augmentation) -> StructureParameters:
+        p = self.structure
+        if aug.mass_error:
+            m = 1.0 + aug.mass_error
+            p = p.replace(sensor_masses=tuple(m * x for x in p.sensor_masses),
+                          force_transducer_mass=m * p.force_transducer_mass)
+        return p
+
+    def with_friction(self, friction) -> "IdentifiedModel":
+        return dataclasses.replace(self, friction=tuple(float(x) for x in friction))
+
+
+def identified_model(structure_cfg: Mapping, linear_modes: xr.Dataset, modal: xr.Dataset, friction_fit: xr.Dataset,
+                     n_modes: int = 8, oversampling: int = 8) -> IdentifiedModel:
+    """The identified model from the chain's datasets (linear_modes.nc, modal.nc, friction_fit.nc)."""
+    k_t, k_n = float(linear_modes["k_t"]), float(linear_modes["k_n"])
+    params = structure_from_config(structure_cfg, k_t, k_n)
+    return IdentifiedModel(params, tuple(float(z) for z in modal["damping_ratio"].values),
+                           tuple(float(x) for x in friction_fit["parameter_value"].values),
+                           float(structure_cfg["preload_n"]), int(n_modes), int(oversampling))
+
+
+@lru_cache(maxsize=32)
+def _reduced(params: StructureParameters, n_modes: int):
+    model = assemble(params)
+    return model, reduced_model(model, n_modes)
+
+
+def fe_model(model: IdentifiedModel, aug: Augmentation = NONE):
+    """The FE model (with the augmentation's structural changes)."""
+    return _reduced(model.structure_with(aug), model.n_modes)[0]
+
+
+def simulator(model: IdentifiedModel, aug: Augmentation, fs: float) -> DualSineSimulator:
+    """The reduced identified model with the augmentation, ready to integrate (step as the rig's)."""
+    red = _reduced(model.structure_with(aug), model.n_modes)[1]
+    zeta = np.empty(red.omega.size)
+    beam = np.flatnonzero(red.beam_mode)
+    zeta[:] = model.damping[0]
+    for k, idx in enumerate(beam):
+        zeta[idx] = model.damping[min(k, len(model.damping) - 1)]
+    zeta[red.beam_mode] += aug.extra_damping
+    k_n = red.k_n
+    p = aug.unilateral_exponent if aug.unilateral_exponent >= 1.0 else 1.0
+    contact = ContactParameters(friction=tuple(model.friction), preload=model.preload,
+                                static_approach=p * model.preload / k_n, exponent=p,
+                                hunt_crossley=aug.hunt_crossley, viscous=aug.viscous, iwan_share=aug.iwan_share,
+                                preload_drift=aug.preload_drift, unilateral=aug.unilateral_exponent >= 1.0)
+    q = max(int(model.oversampling), int(np.ceil(red.omega.max() / (1.6 * fs))))
+    sim = DualSineSimulator(red, contact, zeta, 1.0 / (q * fs))
+    sim.oversampling = q
+    return sim
+
+
+@dataclass
+class SimResult:
+    """A forward simulation's harmonics (same convention and time origin as RecordHarmonics):
+    acceleration (j, H); contact signals S, N (total), xi, eta (H,) complex and their means;
+    one period of each on ``grid`` points (for force-state maps and cycle energies); the energy
+    dissipated per cycle by friction (tangential) and by the normal contact (J); whether the
+    response settled; the first- and last-third accelerations for a drifting record."""
+
+    acceleration: np.ndarray
+    contact: dict
+    grid: dict
+    energy: dict
+    settled: bool
+    first: np.ndarray | None = None
+    last: np.ndarray | None = None
+    extra: dict = field(default_factory=dict)
+
+
+def _delay(coef: np.ndarray, delays, w: float) -> np.ndarray:
+    if not len(delays):
+        return coef
+    h = np.arange(1, coef.shape[-1] + 1)
+    return coef * np.exp(-1j * np.outer(np.asarray(delays, dtype=float), h * w))
+
+
+def simulate(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, record_periods: int = 16,
+             force_harmonics: int = 5, tol: float = 2e-5, grid: int = 256) -> SimResult:
+    """Steady-state response of the (augmented) identified model to the record's measured force
+    (its first ``force_harmonics`` harmonics), in the record's harmonics. With a preload drift the
+    whole record's length is simulated, as measured."""
+    sim = simulator(model, aug, rec.fs)
+    w = 2 * np.pi * rec.f0
+    H = rec.acceleration.shape[1]
+    coef = rec.force[:force_harmonics].copy()
+    sim.start_from_linear(coef, None, w)
+    _, _, settled = sim.settle(coef, None, w, tol=tol, max_chunks=60)
+    n_per = 2 * np.pi / w / sim.dt
+    first = last = None
+    if aug.preload_drift:
+        n_rec = int(round(rec.periods * n_per))
+        sim.drift_t0 = sim.t
+        sim.drift_rate = aug.preload_drift / (n_rec * sim.dt)
+        out = sim.run(coef, None, w, n_rec, store_from=0)
+        acc = out["a"] @ sim.red.sensors.T
+        third = int(round((rec.periods // 3) * n_per))
+        first = np.array([harmonic_amplitudes(a, out["t"][:third], w, range(1, H + 1)) for a in acc[:third].T])
+        last = np.array([harmonic_amplitudes(a, out["t"][-third:], w, range(1, H + 1)) for a in acc[-third:].T])
+        first, last = _delay(first, aug.delays, w), _delay(last, aug.delays, w)
+        cyc = slice(n_rec - int(round(n_per)), n_rec)  # last period for the cycle views
+    else:
+        n_rec = int(round(record_periods * n_per))
+        out = sim.run(coef, None, w, n_rec, store_from=0)
+        acc = out["a"] @ sim.red.sensors.T
+        cyc = slice(0, n_rec)
+    t = out["t"]
+    A = np.array([harmonic_amplitudes(a, t, w, range(1, H + 1)) for a in acc.T])
+    A = _delay(A, aug.delays, w)
+    contact, means = {}, {}
+    for key, name in (("S", "S"), ("N", "N"), ("xi", "xi"), ("eta", "eta"), ("dxi", "xi_dot"), ("deta", "eta_dot")):
+        contact[name] = harmonic_amplitudes(out[key], t, w, range(1, H + 1))
+        means[name] = float(np.mean(out[key]))
+    # one period on a uniform grid (Fourier synthesis of the harmonics + mean)
+    tg = np.arange(grid) / (grid * rec.f0)
+    E = np.exp(1j * np.outer(np.arange(1, H + 1) * w, tg))
+    grids = {k: means[k] + np.imag(c @ E) for k, c in contact.items()}
+    grids["t"] = tg
+    periods_sim = (t[cyc][-1] - t[cyc][0] + sim.dt) * rec.f0
+    e_t = float(np.sum(out["S"][cyc] * out["dxi"][cyc]) * sim.dt / periods_sim)
+    e_n = float(-np.sum((out["N"][cyc] - model.preload) * out["deta"][cyc]) * sim.dt / periods_sim)
+    return SimResult(A, contact, grids, {"tangential_j": e_t, "normal_j": e_n}, bool(settled), first, last,
+                     {"means": means})

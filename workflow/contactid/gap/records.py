@@ -1,0 +1,87 @@
+"""Harmonics of the measured dual-sine records, the quantities every comparison uses.
+
+A record x(t) is summarised by its complex harmonics c_h (h = 1..H) of the test frequency,
+x ~ mean + sum_h Im(c_h e^{i h w t}) (as in Eq. 16), estimated over whole periods. Time zero is
+moved to the force's fundamental's zero crossing (phase of c_1 of the force = 0), so records
+and simulations share one time origin; a common delay of all channels (anti-alias filter)
+drops out. Block estimates (the record cut into whole-period blocks) give the spread for the
+bootstrap, and the first and last thirds show drift.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import xarray as xr
+
+from ..signals import harmonic_amplitudes
+
+
+@dataclass(frozen=True)
+class RecordHarmonics:
+    """One load case's record in harmonics (force in N, accelerations in m/s^2).
+
+    force: (H,) complex; acceleration: (j, H) complex; block_force (B, H) and block_acceleration
+    (B, j, H): the same per block of whole periods; first/last: (j, H) of the first and last thirds;
+    f0 (Hz), fs (Hz), periods (whole periods in the record), sensors (names)."""
+
+    case: str
+    f0: float
+    fs: float
+    periods: int
+    force: np.ndarray
+    acceleration: np.ndarray
+    block_force: np.ndarray
+    block_acceleration: np.ndarray
+    first: np.ndarray
+    last: np.ndarray
+    sensors: tuple
+    sensor_positions: np.ndarray
+
+
+def _aligned(force_coef: np.ndarray, coefs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Shift time so that the force's fundamental has phase 0: c_h -> c_h e^{-i h phi_1}."""
+    h = np.arange(1, force_coef.shape[-1] + 1)
+    rot = np.exp(-1j * h * np.angle(force_coef[..., :1]))
+    return force_coef * rot, coefs * rot[..., None, :] if coefs.ndim == force_coef.ndim + 1 else coefs * rot
+
+
+def _harmonics(x: np.ndarray, t: np.ndarray, w: float, H: int) -> np.ndarray:
+    return np.array([harmonic_amplitudes(row, t, w, range(1, H + 1)) for row in np.atleast_2d(x)])
+
+
+def record_harmonics(raw: xr.Dataset, case: str, n_harmonics: int, n_blocks: int = 8) -> RecordHarmonics:
+    """Harmonics 1..n_harmonics of the force and every accelerometer of a dual-sine record."""
+    fs = float(raw.attrs["sampling_rate_hz"])
+    f0 = float(raw.attrs["excitation_frequency_hz"])
+    force = raw["force"].values
+    acc = raw["acceleration"].values
+    n = force.size
+    per = fs / f0
+    periods = int(np.floor(n / per + 1e-9))
+    n_use = int(round(periods * per)) if periods * per <= n + 1e-6 else n
+    t = np.arange(n_use) / fs
+    w = 2 * np.pi * f0
+    H = int(n_harmonics)
+    F = _harmonics(force[:n_use], t, w, H)[0]
+    A = _harmonics(acc[:, :n_use], t, w, H)
+    F_al, A_al = _aligned(F, A)
+    n_blocks = max(2, min(int(n_blocks), periods))
+    edges = np.round(np.arange(n_blocks + 1) * (periods // n_blocks) * per).astype(int)
+    bf, ba = [], []
+    for a, b in zip(edges[:-1], edges[1:]):
+        fb = _harmonics(force[a:b], t[a:b], w, H)[0]
+        ab = _harmonics(acc[:, a:b], t[a:b], w, H)
+        fb, ab = _aligned(fb, ab)
+        bf.append(fb)
+        ba.append(ab)
+    third = int(round((periods // 3) * per))
+    thirds = []
+    for sl in (slice(0, third), slice(n_use - third, n_use)):
+        ft = _harmonics(force[sl], t[sl], w, H)[0]
+        at = _harmonics(acc[:, sl], t[sl], w, H)
+        thirds.append(_aligned(ft, at)[1])
+    return RecordHarmonics(case, f0, fs, periods, F_al, A_al, np.array(bf), np.array(ba), thirds[0], thirds[1],
+                           tuple(str(s) for s in raw["sensor"].values),
+                           np.asarray(raw["sensor_position"].values if "sensor_position" in raw else [], dtype=float))
