@@ -33,6 +33,7 @@ include: "workflow/rules/nonlinear.smk"
 include: "workflow/rules/friction.smk"
 include: "workflow/rules/outputs.smk"
 include: "workflow/rules/report.smk"
+include: "workflow/rules/gap.smk"
 
 
 rule all:

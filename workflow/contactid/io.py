@@ -120,6 +120,19 @@ def write_dataset(ds: xr.Dataset, path: str | os.PathLike) -> None:
             os.remove(tmp)
 
 
+def write_text(path: str | os.PathLike, text: str) -> None:
+    """Write a text file whole or not at all (temporary file, then renamed over ``path``)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.name + ".tmp")
+    try:
+        tmp.write_text(text)
+        os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+
+
 def load_dataset(path: str | os.PathLike) -> xr.Dataset:
     """Eagerly load a dataset (the file is closed on return)."""
     return xr.load_dataset(path, engine=ENGINE)

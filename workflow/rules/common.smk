@@ -115,3 +115,28 @@ def all_outputs():
         "results/summary.json",
         *(["results/report/report.pdf"] if load_cases() else []),
     ]
+
+
+def gap_inputs(wildcards):
+    """The diagnosis reads the raw records of every load case and the chain's identified model."""
+    inputs = {"modes": "results/linear/linear_modes.nc", "modal": "results/linear/modal.nc",
+              "frf": "results/linear/frf.nc", "fit": "results/friction/friction_fit.nc"}
+    inputs["raw"] = [raw_record(c) for c in load_cases()]
+    return inputs
+
+
+def gap_outputs():
+    return ["results/gap/diagnosis.json", "results/gap/gap.nc"] + [
+        f"results/gap/gap_{v}.png" for v in ("stages", "harmonics", "cycle", "force_state", "ranking")]
+
+
+def benchmark_base_config():
+    """What a benchmark item depends on: the config without the benchmark's own block."""
+    return {k: v for k, v in config.items() if k != "gap_benchmark"}
+
+
+def benchmark_items():
+    """{item name: spec} of the blind gap benchmark (see config/README.md, gap_benchmark)."""
+    from contactid.gap.benchmark import benchmark_items as items
+
+    return items(config.get("gap_benchmark", {}), int(config["seed"]))

@@ -23,7 +23,6 @@ import xarray as xr
 from ..beam_model import assemble
 from ..parameters import StructureParameters, structure_from_config
 from ..rig.nonlinear import ContactParameters, DualSineSimulator, reduced_model
-from ..signals import harmonic_amplitudes
 from .records import RecordHarmonics
 
 
@@ -71,13 +70,18 @@ class IdentifiedModel:
     preload: float
     n_modes: int = 8
     oversampling: int = 8
+    frequencies: tuple = ()
 
     def structure_with(self, aug: Augmentation) -> StructureParameters:
+        """The structure with the augmentation's changes; changed masses re-fit k_t and k_n to the identified
+        natural frequencies (the linear chain redone with the effect in the model)."""
         p = self.structure
         if aug.mass_error:
             m = 1.0 + aug.mass_error
             p = p.replace(sensor_masses=tuple(m * x for x in p.sensor_masses),
                           force_transducer_mass=m * p.force_transducer_mass)
+            if self.frequencies:
+                p = _refit_contact(p, self.frequencies)
         return p
 
     def with_friction(self, friction) -> "IdentifiedModel":
@@ -91,7 +95,24 @@ def identified_model(structure_cfg: Mapping, linear_modes: xr.Dataset, modal: xr
     params = structure_from_config(structure_cfg, k_t, k_n)
     return IdentifiedModel(params, tuple(float(z) for z in modal["damping_ratio"].values),
                            tuple(float(x) for x in friction_fit["parameter_value"].values),
-                           float(structure_cfg["preload_n"]), int(n_modes), int(oversampling))
+                           float(structure_cfg["preload_n"]), int(n_modes), int(oversampling),
+                           tuple(float(f) for f in modal["natural_frequency"].values))
+
+
+@lru_cache(maxsize=64)
+def _refit_contact(params: StructureParameters, frequencies: tuple) -> StructureParameters:
+    """k_t and k_n that best fit the identified natural frequencies (relative least squares on a
+    log scale, from the current values): the stiction fit of the linear chain, redone."""
+    from scipy.optimize import least_squares
+
+    from ..beam_model import ContactFrequencyMap
+
+    f_id = np.asarray(frequencies)
+    fmap = ContactFrequencyMap(params, len(f_id))
+    x0 = np.log10([params.k_t, params.k_n])
+    res = least_squares(lambda x: fmap(10.0 ** x[0], 10.0 ** x[1]) / f_id - 1, x0, bounds=(x0 - 2, x0 + 2),
+                        x_scale=0.1, xtol=1e-10, ftol=1e-12)
+    return params.with_contact(float(10.0 ** res.x[0]), float(10.0 ** res.x[1]))
 
 
 @lru_cache(maxsize=32)
@@ -105,8 +126,9 @@ def fe_model(model: IdentifiedModel, aug: Augmentation = NONE):
     return _reduced(model.structure_with(aug), model.n_modes)[0]
 
 
-def simulator(model: IdentifiedModel, aug: Augmentation, fs: float) -> DualSineSimulator:
-    """The reduced identified model with the augmentation, ready to integrate (step as the rig's)."""
+def simulator(model: IdentifiedModel, aug: Augmentation, fs: float, f0: float | None = None) -> DualSineSimulator:
+    """The reduced identified model with the augmentation, ready to integrate (step as the rig's,
+    shortened to a whole number of steps per period of ``f0`` when given)."""
     red = _reduced(model.structure_with(aug), model.n_modes)[1]
     zeta = np.empty(red.omega.size)
     beam = np.flatnonzero(red.beam_mode)
@@ -121,9 +143,23 @@ def simulator(model: IdentifiedModel, aug: Augmentation, fs: float) -> DualSineS
                                 hunt_crossley=aug.hunt_crossley, viscous=aug.viscous, iwan_share=aug.iwan_share,
                                 preload_drift=aug.preload_drift, unilateral=aug.unilateral_exponent >= 1.0)
     q = max(int(model.oversampling), int(np.ceil(red.omega.max() / (1.6 * fs))))
-    sim = DualSineSimulator(red, contact, zeta, 1.0 / (q * fs))
+    dt = 1.0 / (q * fs)
+    if f0:
+        dt = 1.0 / f0 / np.ceil(1.0 / (f0 * dt))
+    sim = DualSineSimulator(red, contact, zeta, dt)
     sim.oversampling = q
     return sim
+
+
+def periodic_harmonics(x: np.ndarray, t_first: float, w: float, n_per: int, H: int) -> np.ndarray:
+    """Harmonics 1..H (x ~ mean + sum Im(c_h e^{i h w t})) of rows sampled uniformly over a whole
+    number of periods of n_per samples each, the first at t_first (exact, by FFT of the period mean)."""
+    x = np.atleast_2d(x)
+    periods = x.shape[1] // n_per
+    mean_period = x[:, : periods * n_per].reshape(x.shape[0], periods, n_per).mean(axis=1)
+    X = np.fft.fft(mean_period, axis=1)[:, 1:H + 1]
+    h = np.arange(1, H + 1)
+    return 2j * X / n_per * np.exp(-1j * h * w * t_first)
 
 
 @dataclass
@@ -156,44 +192,40 @@ def simulate(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, re
     """Steady-state response of the (augmented) identified model to the record's measured force
     (its first ``force_harmonics`` harmonics), in the record's harmonics. With a preload drift the
     whole record's length is simulated, as measured."""
-    sim = simulator(model, aug, rec.fs)
+    sim = simulator(model, aug, rec.fs, rec.f0)
     w = 2 * np.pi * rec.f0
     H = rec.acceleration.shape[1]
     coef = rec.force[:force_harmonics].copy()
     sim.start_from_linear(coef, None, w)
     _, _, settled = sim.settle(coef, None, w, tol=tol, max_chunks=60)
-    n_per = 2 * np.pi / w / sim.dt
+    n_per = int(round(2 * np.pi / w / sim.dt))
     first = last = None
     if aug.preload_drift:
-        n_rec = int(round(rec.periods * n_per))
+        n_rec = rec.periods * n_per
         sim.drift_t0 = sim.t
         sim.drift_rate = aug.preload_drift / (n_rec * sim.dt)
-        out = sim.run(coef, None, w, n_rec, store_from=0)
-        acc = out["a"] @ sim.red.sensors.T
-        third = int(round((rec.periods // 3) * n_per))
-        first = np.array([harmonic_amplitudes(a, out["t"][:third], w, range(1, H + 1)) for a in acc[:third].T])
-        last = np.array([harmonic_amplitudes(a, out["t"][-third:], w, range(1, H + 1)) for a in acc[-third:].T])
-        first, last = _delay(first, aug.delays, w), _delay(last, aug.delays, w)
-        cyc = slice(n_rec - int(round(n_per)), n_rec)  # last period for the cycle views
     else:
-        n_rec = int(round(record_periods * n_per))
-        out = sim.run(coef, None, w, n_rec, store_from=0)
-        acc = out["a"] @ sim.red.sensors.T
-        cyc = slice(0, n_rec)
-    t = out["t"]
-    A = np.array([harmonic_amplitudes(a, t, w, range(1, H + 1)) for a in acc.T])
-    A = _delay(A, aug.delays, w)
-    contact, means = {}, {}
-    for key, name in (("S", "S"), ("N", "N"), ("xi", "xi"), ("eta", "eta"), ("dxi", "xi_dot"), ("deta", "eta_dot")):
-        contact[name] = harmonic_amplitudes(out[key], t, w, range(1, H + 1))
-        means[name] = float(np.mean(out[key]))
+        n_rec = int(record_periods) * n_per
+    out = sim.run(coef, None, w, n_rec, store_from=0)
+    acc = (out["a"] @ sim.red.sensors.T).T
+    t1 = out["t"][0]
+    if aug.preload_drift:
+        third = (rec.periods // 3) * n_per
+        first = _delay(periodic_harmonics(acc[:, :third], t1, w, n_per, H), aug.delays, w)
+        last = _delay(periodic_harmonics(acc[:, -third:], out["t"][n_rec - third], w, n_per, H), aug.delays, w)
+    A = _delay(periodic_harmonics(acc, t1, w, n_per, H), aug.delays, w)
+    keys = (("S", "S"), ("N", "N"), ("xi", "xi"), ("eta", "eta"), ("dxi", "xi_dot"), ("deta", "eta_dot"))
+    sig = np.array([out[k] for k, _ in keys])
+    C = periodic_harmonics(sig, t1, w, n_per, H)
+    contact = {name: C[i] for i, (_, name) in enumerate(keys)}
+    means = {name: float(np.mean(sig[i])) for i, (_, name) in enumerate(keys)}
     # one period on a uniform grid (Fourier synthesis of the harmonics + mean)
     tg = np.arange(grid) / (grid * rec.f0)
     E = np.exp(1j * np.outer(np.arange(1, H + 1) * w, tg))
     grids = {k: means[k] + np.imag(c @ E) for k, c in contact.items()}
     grids["t"] = tg
-    periods_sim = (t[cyc][-1] - t[cyc][0] + sim.dt) * rec.f0
-    e_t = float(np.sum(out["S"][cyc] * out["dxi"][cyc]) * sim.dt / periods_sim)
-    e_n = float(-np.sum((out["N"][cyc] - model.preload) * out["deta"][cyc]) * sim.dt / periods_sim)
+    cyc = slice(n_rec - n_per, n_rec)  # the last period for the cycle energies
+    e_t = float(np.sum(out["S"][cyc] * out["dxi"][cyc]) * sim.dt)
+    e_n = float(-np.sum((out["N"][cyc] - model.preload) * out["deta"][cyc]) * sim.dt)
     return SimResult(A, contact, grids, {"tangential_j": e_t, "normal_j": e_n}, bool(settled), first, last,
                      {"means": means})

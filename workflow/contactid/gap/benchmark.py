@@ -1,0 +1,170 @@
+"""The blind check of the diagnosis: rig data sets with one effect on at a random (seeded)
+magnitude, diagnosed from their raw records alone, and scored.
+
+Items (config ``gap_benchmark``): for every effect, ``magnitudes`` random magnitudes in its
+benchmark range for every seed in ``seeds``; one effect-free data set per seed (false alarms);
+and, with ``leave_out``, for every effect one data set at mid-range diagnosed with a library that
+lacks that effect (the verdict must be "none", the localisation must point at the right place).
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Mapping
+
+import numpy as np
+
+from ..random_streams import generator
+from ..rig.effects import EFFECTS
+
+# magnitudes the benchmark draws from (rig units, see rig.effects): large enough to matter,
+# within the range where the rig's response stays periodic
+RANGES = {
+    "structural_damping": (0.002, 0.01),
+    "normal_contact_damping": (150.0, 600.0),
+    "viscous_friction": (150.0, 600.0),
+    "multi_asperity_friction": (0.5, 1.0),
+    "transducer_mass_error": (0.15, 0.5),
+    "channel_time_skew": (1.0e-5, 4.0e-5),
+    "contact_separation": (7.2, 7.5),
+    "preload_drift": (0.05, 0.2),
+}
+
+# where the localisation should point when the effect is missing from the library
+EXPECTED_PLACE = {
+    "structural_damping": ("direction", "tangential"),
+    "normal_contact_damping": ("direction", "normal"),
+    "viscous_friction": ("direction", "tangential"),
+    "multi_asperity_friction": ("direction", "tangential"),
+    "transducer_mass_error": ("direction", "tangential"),
+    "channel_time_skew": ("direction", "tangential"),
+    "contact_separation": ("direction", "normal"),
+    "preload_drift": ("direction", "normal"),
+}
+
+
+def benchmark_items(cfg: Mapping, seed: int) -> dict:
+    """{name: spec} with spec = {effect, magnitude, seed, library (None = all), kind}."""
+    cfg = dict(cfg or {})
+    effects = cfg.get("effects") or list(EFFECTS)
+    unknown = [e for e in effects if e not in EFFECTS]
+    if unknown:
+        raise ValueError(f"gap_benchmark.effects: unknown {unknown}; known: {', '.join(EFFECTS)}")
+    ranges = {**RANGES, **{k: tuple(v) for k, v in (cfg.get("ranges") or {}).items()}}
+    n_mag = int(cfg.get("magnitudes", 3))
+    seeds = [int(s) for s in cfg.get("seeds", [1, 2])]
+    items = {}
+    for e in effects:
+        lo, hi = ranges[e]
+        for s in seeds:
+            for k in range(n_mag):
+                m = float(generator(seed, f"gap_benchmark/{e}/{k}/{s}").uniform(lo, hi))
+                items[f"{e}-{k}-s{s}"] = {"effect": e, "magnitude": m, "seed": s, "library": None, "kind": "blind"}
+    for s in seeds[: int(cfg.get("effect_free", len(seeds)))]:
+        items[f"none-0-s{s}"] = {"effect": None, "magnitude": 0.0, "seed": s, "library": None, "kind": "effect_free"}
+    if cfg.get("leave_out", True):
+        for e in effects:
+            lo, hi = ranges[e]
+            lib = [x for x in EFFECTS if x != e]
+            items[f"lo_{e}-0-s{seeds[0]}"] = {"effect": e, "magnitude": 0.5 * (lo + hi), "seed": seeds[0],
+                                              "library": lib, "kind": "leave_out"}
+    return items
+
+
+def run_item(spec: Mapping, cfg: Mapping) -> dict:
+    """Generate the item's rig records, identify the model from them, diagnose; the result row."""
+    from ..friction_fit import settings_from_config
+    from .diagnosis import GapSettings, diagnose, linear_stage
+    from .pipeline import identify, rig_records
+    from .records import record_harmonics
+
+    t0 = time.perf_counter()
+    effects = {spec["effect"]: spec["magnitude"]} if spec["effect"] else {}
+    cases = sorted(cfg["load_cases"], key=lambda c: int(c[2:]))
+    cal = cfg.get("nonlinear", {}).get("calibration_case", "lc1")
+    recs = rig_records(cfg, effects, int(spec["seed"]), cases)
+    t_rig = time.perf_counter() - t0
+    model, modes, modal, frf = identify(cfg, recs["random_test"], recs[cal])
+    K = int(cfg.get("nonlinear", {}).get("n_harmonics", 25))
+    fit_settings = settings_from_config(cfg.get("friction", {}))
+    records = {c: record_harmonics(recs[c], c, K) for c in cases}
+    t_id = time.perf_counter() - t0 - t_rig
+    gap_cfg = dict(cfg.get("gap", {}))
+    if spec.get("library") is not None:
+        gap_cfg["candidates"] = list(spec["library"])
+    settings = GapSettings.from_config(gap_cfg, int(cfg["seed"]), K)
+    t1 = time.perf_counter()
+    diag = diagnose(model, records, cal, settings, fit_settings, linear_stage(model, frf, modal))
+    t_diag = time.perf_counter() - t1
+    by = {r["effect"]: r for r in diag.ranking}
+    true = spec["effect"]
+    return {**dict(spec), "verdict": diag.verdict, "reason": diag.reason, "correct": (diag.verdict == (true or "none"))
+            if spec["kind"] != "leave_out" else diag.verdict == "none",
+            "heldout_gap_before": diag.where["heldout_gap_before"],
+            "heldout_gap_after_true": by[true]["heldout_gap_after"] if true in by else None,
+            "shrink_true": by[true]["reduction"] if true in by else None,
+            "ranking": [{k: r[k] for k in ("effect", "heldout_gap_before", "heldout_gap_after", "score", "reduction")}
+                        for r in diag.ranking],
+            "where": diag.where, "control_converged": {c: int(recs[c].attrs.get("control_converged", 1)) for c in cases},
+            "seconds": {"rig": t_rig, "identification": t_id, "diagnosis": t_diag}}
+
+
+def score(rows: list) -> dict:
+    """Top-1 accuracy, confusion matrix, false alarms, shrink and the leave-out results."""
+    blind = [r for r in rows if r["kind"] == "blind"]
+    free = [r for r in rows if r["kind"] == "effect_free"]
+    lo = [r for r in rows if r["kind"] == "leave_out"]
+    labels = sorted({r["effect"] for r in blind}) + ["none"]
+    conf = {t: {p: 0 for p in labels + sorted({r["verdict"] for r in rows} - set(labels))} for t in labels}
+    for r in blind + free:
+        conf[r["effect"] or "none"][r["verdict"]] = conf[r["effect"] or "none"].get(r["verdict"], 0) + 1
+    correct = [r for r in blind if r["verdict"] == r["effect"]]
+    shrink = [r["shrink_true"] for r in correct]
+    place_ok = []
+    for r in lo:
+        key, want = EXPECTED_PLACE[r["effect"]]
+        place_ok.append(r["where"].get(key) == want)
+    return {
+        "n_blind": len(blind), "top1_accuracy": len(correct) / max(len(blind), 1),
+        "n_effect_free": len(free), "false_alarms": sum(r["verdict"] != "none" for r in free),
+        "shrink_of_correct": {"min": float(np.min(shrink)) if shrink else None,
+                              "median": float(np.median(shrink)) if shrink else None,
+                              "all_at_least_half": bool(shrink) and all(s >= 0.5 for s in shrink)},
+        "leave_out": {"n": len(lo), "verdict_none": sum(r["verdict"] == "none" for r in lo),
+                      "place_right": int(sum(place_ok)),
+                      "items": [{"effect": r["effect"], "verdict": r["verdict"], "direction": r["where"].get("direction"),
+                                 "largest_stage": r["where"].get("largest_stage"),
+                                 "harmonic_class": r["where"].get("harmonic_class")} for r in lo]},
+        "confusion": conf,
+        "per_effect_accuracy": {e: float(np.mean([r["verdict"] == e for r in blind if r["effect"] == e]))
+                                for e in labels if e != "none"},
+        "diagnosis_seconds": {"median": float(np.median([r["seconds"]["diagnosis"] for r in rows])) if rows else None,
+                              "max": float(np.max([r["seconds"]["diagnosis"] for r in rows])) if rows else None},
+    }
+
+
+def confusion_figure(result: dict, path: str) -> None:
+    """Heat map of the confusion matrix (rows: true effect, columns: verdict)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    rows = list(result["confusion"])
+    cols = sorted({c for r in result["confusion"].values() for c in r}, key=lambda c: (c == "none", c))
+    M = np.array([[result["confusion"][r].get(c, 0) for c in cols] for r in rows])
+    fig, ax = plt.subplots(figsize=(7.5, 6))
+    ax.imshow(M, cmap="Blues")
+    for i in range(M.shape[0]):
+        for j in range(M.shape[1]):
+            if M[i, j]:
+                ax.text(j, i, str(M[i, j]), ha="center", va="center", color="k")
+    ax.set_xticks(range(len(cols)), cols, rotation=60, ha="right")
+    ax.set_yticks(range(len(rows)), rows)
+    ax.set_xlabel("verdict")
+    ax.set_ylabel("effect on in the rig")
+    ax.set_title(f"Blind benchmark: top-1 {result['top1_accuracy']:.0%} of {result['n_blind']}, "
+                 f"false alarms {result['false_alarms']}/{result['n_effect_free']}")
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)

@@ -1,0 +1,104 @@
+"""The library of candidate effects that can be added to the identified model.
+
+Each candidate is a physical effect with few parameters, mapped onto an ``Augmentation`` of the
+identified model. The built-in library covers every effect the virtual rig can switch on (under
+the same names), so the blind benchmark can score the diagnosis; the candidate's parametrisation
+is generic, not the rig's (for example one delay per accelerometer channel, not the rig's skew
+pattern).
+
+Adding your own: write a module that builds a ``Candidate`` and calls ``register(candidate)``,
+and list the module in ``gap.plugins`` (config); the rule imports it before the diagnosis. A
+candidate maps its parameter vector theta onto any combination of the Augmentation fields.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from .model import Augmentation
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """One parameter of a candidate: name, unit, search range [low, high]."""
+
+    name: str
+    unit: str
+    low: float
+    high: float
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """A candidate effect: name, what it models, its parameters and theta -> Augmentation.
+    ``per_channel``: the one parameter is repeated for every accelerometer channel."""
+
+    name: str
+    meaning: str
+    parameters: tuple
+    augmentation: Callable[[np.ndarray], Augmentation]
+    per_channel: bool = False
+
+    def n_parameters(self, n_channels: int) -> int:
+        return n_channels if self.per_channel else len(self.parameters)
+
+
+LIBRARY: dict[str, Candidate] = {}
+
+
+def register(candidate: Candidate) -> Candidate:
+    """Add a candidate to the library (a user's plugin calls this); names must be unique."""
+    if candidate.name in LIBRARY or candidate.name == "none":
+        raise ValueError(f"gap candidate {candidate.name!r}: the name is taken; choose another")
+    if not candidate.parameters:
+        raise ValueError(f"gap candidate {candidate.name!r}: give at least one parameter")
+    for p in candidate.parameters:
+        if not p.low < p.high:
+            raise ValueError(f"gap candidate {candidate.name!r}, parameter {p.name}: low must be below high")
+    LIBRARY[candidate.name] = candidate
+    return candidate
+
+
+register(Candidate("structural_damping", "extra modal damping of the beam's modes at test level",
+                   (Parameter("extra_damping_ratio", "1", 0.0, 0.05),),
+                   lambda th: Augmentation(extra_damping=float(th[0]))))
+register(Candidate("normal_contact_damping", "Hunt-Crossley damping of the normal contact, N (1 - alpha deta/dt)",
+                   (Parameter("alpha", "s/m", 0.0, 3000.0),),
+                   lambda th: Augmentation(hunt_crossley=float(th[0]))))
+register(Candidate("viscous_friction", "velocity-dependent friction, S + sigma_2 dxi/dt",
+                   (Parameter("sigma_2", "N s/m", 0.0, 3000.0),),
+                   lambda th: Augmentation(viscous=float(th[0]))))
+register(Candidate("multi_asperity_friction", "share of the tangential contact carried by a 16-slider Iwan element "
+                   "(internal hysteresis loops)",
+                   (Parameter("iwan_share", "1", 0.0, 1.0),),
+                   lambda th: Augmentation(iwan_share=float(th[0]))))
+register(Candidate("transducer_mass_error", "every transducer mass wrong by the same factor 1 + m",
+                   (Parameter("mass_error", "1", -0.9, 3.0),),
+                   lambda th: Augmentation(mass_error=float(th[0]))))
+register(Candidate("channel_time_skew", "each accelerometer channel late on the force by its own delay",
+                   (Parameter("delay", "s", -2.0e-4, 2.0e-4),),
+                   lambda th: Augmentation(delays=tuple(float(x) for x in th)), per_channel=True))
+register(Candidate("contact_separation", "unilateral hardening normal contact N0 ((delta0 - eta)/delta0)^p that opens "
+                   "(instead of Eq. 13's linear spring)",
+                   (Parameter("exponent", "1", 1.0, 3.0),),
+                   lambda th: Augmentation(unilateral_exponent=float(th[0]))))
+register(Candidate("preload_drift", "static normal preload drifting linearly over each record",
+                   (Parameter("relative_drift", "1", -0.5, 0.5),),
+                   lambda th: Augmentation(preload_drift=float(th[0]))))
+
+BUILTIN = tuple(LIBRARY)
+
+
+def load_plugins(modules) -> None:
+    """Import the users' candidate modules (``gap.plugins``); each calls ``register``."""
+    import importlib
+
+    for name in modules or ():
+        try:
+            importlib.import_module(name)
+        except ImportError as exc:
+            raise ValueError(f"gap.plugins: cannot import {name!r} ({exc}); put the module on PYTHONPATH "
+                             "or under workflow/") from None

@@ -1,0 +1,345 @@
+"""The diagnosis: the gap measured at every level of the chain, localised, explained by the
+candidate library, and its shrinkage with uncertainty.
+
+Settings (config ``gap``): the harmonics compared, the candidates, the thresholds of the verdict
+and the bootstrap. The verdict names the best candidate only when (1) the held-out gap before is
+above the records' own scatter, (2) the candidate shrinks the held-out gap by at least
+``min_reduction`` with the bootstrap's lower bound above zero, and (3) it beats the runner-up's
+held-out gap by the factor ``separation``; otherwise the verdict is "none" and the localisation
+says where the gap lies.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass, field
+from typing import Mapping
+
+import numpy as np
+import xarray as xr
+
+from ..beam_model import all_modes, structural_modes
+from ..friction_fit import FitSettings, periodic_grid
+from ..random_streams import generator
+from .candidates import LIBRARY
+from .model import NONE, IdentifiedModel, SimResult, fe_model
+from .records import RecordHarmonics
+from .refit import (augmented_zeta, baseline, calibrate, contact_grids, evaluate, gap_residual, gap_value,
+                    identified_forces, law_friction_force)
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class GapSettings:
+    """n_harmonics: harmonics compared (gap); identification_harmonics: K of the inverse
+    identification; candidates: names (None = the whole library); min_reduction: the held-out gap
+    must shrink at least this much (relative) for a verdict; separation: the winner's held-out gap
+    must be at least this factor below the runner-up's; noise_factor: the gap before must exceed this
+    many bootstrap standard deviations of the records' scatter; n_bootstrap: resamples of the
+    record blocks; seed."""
+
+    n_harmonics: int = 9
+    identification_harmonics: int = 25
+    candidates: tuple | None = None
+    min_reduction: float = 0.3
+    separation: float = 1.5
+    noise_factor: float = 3.0
+    n_bootstrap: int = 200
+    seed: int = 0
+    max_evaluations: int = 10
+
+    @classmethod
+    def from_config(cls, gap_cfg: Mapping | None, seed: int, n_harmonics_id: int) -> "GapSettings":
+        g = dict(gap_cfg or {})
+        d = cls()
+        cands = g.get("candidates")
+        if cands is not None:
+            unknown = [c for c in cands if c not in LIBRARY]
+            if unknown:
+                raise ValueError(f"gap.candidates: unknown {unknown}; the library has {', '.join(LIBRARY)}")
+        s = cls(n_harmonics=int(g.get("n_harmonics", d.n_harmonics)), identification_harmonics=int(n_harmonics_id),
+                candidates=tuple(cands) if cands is not None else None,
+                min_reduction=float(g.get("min_reduction", d.min_reduction)),
+                separation=float(g.get("separation", d.separation)), noise_factor=float(g.get("noise_factor", d.noise_factor)),
+                n_bootstrap=int(g.get("n_bootstrap", d.n_bootstrap)), seed=int(seed),
+                max_evaluations=int(g.get("max_evaluations", d.max_evaluations)))
+        if not 0.0 < s.min_reduction < 1.0:
+            raise ValueError(f"gap.min_reduction = {s.min_reduction}: give a fraction in (0, 1)")
+        if s.separation < 1.0:
+            raise ValueError(f"gap.separation = {s.separation}: give a factor >= 1")
+        if s.n_harmonics < 3 or s.n_harmonics > s.identification_harmonics:
+            raise ValueError(f"gap.n_harmonics = {s.n_harmonics}: give 3 .. nonlinear.n_harmonics "
+                             f"({s.identification_harmonics})")
+        return s
+
+
+# ------------------------------------------------------------------------------------------
+# localisation
+# ------------------------------------------------------------------------------------------
+
+def _rel(a, b) -> float:
+    return float(np.linalg.norm(np.asarray(a) - np.asarray(b)) / max(np.linalg.norm(b), 1e-300))
+
+
+def cycle_parts(g: dict, k_t: float) -> dict:
+    """Masks of one period (identified motion and forces): velocity reversal (within 4 % of the
+    period of a sign change of dxi/dt), peak compression (N in the top 10 % of its range), slip
+    (tangent stiffness dS/dxi below half of k_t) and stick (the rest)."""
+    m = g["xi"].size
+    xd = g["xi_dot"]
+    rev_idx = np.flatnonzero(np.sign(xd) != np.sign(np.roll(xd, 1)))
+    reversal = np.zeros(m, bool)
+    width = max(1, int(0.04 * m))
+    for i in rev_idx:
+        reversal[(np.arange(-width, width + 1) + i) % m] = True
+    N = g["N"]
+    peak = N >= N.max() - 0.1 * (N.max() - N.min())
+    dS = np.gradient(g["S"]) / np.where(np.abs(np.gradient(g["xi"])) > 0, np.gradient(g["xi"]), np.nan)
+    slip = (np.abs(dS) < 0.5 * k_t) & ~reversal
+    stick = ~(reversal | slip)
+    return {"stick": stick, "slip": slip, "velocity_reversal": reversal, "peak_compression": peak}
+
+
+def localise(model: IdentifiedModel, records: dict, sims: dict, n_harmonics: int, linear: dict | None = None) -> tuple[dict, dict]:
+    """The gap by stage, sensor, harmonic, part of the cycle and load level (the identified model
+    as the chain left it). Returns (summary for diagnosis.json, arrays for gap.nc)."""
+    H = n_harmonics
+    fe = fe_model(model)
+    cases = list(records)
+    arrays = {}
+    stage = {}
+    # accelerations and generalized coordinates
+    phi_s = fe.sensor_vectors @ structural_modes(fe, min(3, len(records[cases[0]].sensors))).shapes
+    pinv = np.linalg.pinv(phi_s)
+    acc_gap, gc_gap, per_sensor, per_harm = [], [], [], []
+    for c in cases:
+        A, As = records[c].acceleration[:, :H], sims[c].acceleration[:, :H]
+        acc_gap.append(_rel(As, A))
+        gc_gap.append(_rel(pinv @ As, pinv @ A))
+        per_sensor.append(np.linalg.norm(As - A, axis=1) / np.linalg.norm(A, axis=1))
+        per_harm.append(np.linalg.norm(As - A, axis=0) / np.linalg.norm(A))
+    arrays["gap_by_sensor"] = np.array(per_sensor)
+    arrays["gap_by_harmonic"] = np.array(per_harm)
+    stage["accelerations"] = float(np.sqrt(np.mean(np.square(acc_gap))))
+    stage["generalized_coordinates"] = float(np.sqrt(np.mean(np.square(gc_gap))))
+    # contact forces: identified (inverse, from the record) against the laws at the identified motion
+    s_res, n_res, e_t, e_n, parts_rms = [], [], [], [], []
+    maps = []
+    part_names = ("stick", "slip", "velocity_reversal", "peak_compression")
+    for c in cases:
+        rec = records[c]
+        forces = identified_forces(model, NONE, rec)
+        g = contact_grids(forces, rec.f0, model.preload, 256)
+        S_law = law_friction_force(g["xi"], g["xi_dot"], g["N"], np.asarray(model.friction), NONE)[0]
+        S_law -= S_law.mean()
+        N_law = -model.structure.k_n * g["eta"]
+        N_id = g["N"] - model.preload
+        s_res.append(_rel(S_law, g["S"]))
+        n_res.append(_rel(N_law, N_id))
+        # energy per cycle (J): identified from the record vs the simulation
+        T = 1.0 / rec.f0
+        et_id = float(np.mean(g["S"] * g["xi_dot"]) * T)
+        en_id = float(-np.mean(N_id * g["eta_dot"]) * T)
+        e_t.append((et_id, sims[c].energy["tangential_j"]))
+        e_n.append((en_id, sims[c].energy["normal_j"]))
+        # part of the cycle: driving-point acceleration residual over one period
+        t = np.arange(256) / (256 * rec.f0)
+        E = np.exp(1j * np.outer(np.arange(1, H + 1) * 2 * np.pi * rec.f0, t))
+        r_t = np.imag((sims[c].acceleration[0, :H] - rec.acceleration[0, :H]) @ E)
+        a_rms = np.sqrt(np.mean(np.imag(rec.acceleration[0, :H] @ E) ** 2))
+        parts = cycle_parts(g, model.structure.k_t)
+        parts_rms.append([float(np.sqrt(np.mean(r_t[parts[p]] ** 2)) / a_rms) if parts[p].any() else 0.0
+                          for p in part_names])
+        maps.append(np.array([g["xi"], g["xi_dot"], g["S"] - S_law, g["eta"], g["eta_dot"], N_id - N_law]))
+    stage["contact_force_S"] = float(np.sqrt(np.mean(np.square(s_res))))
+    stage["contact_force_N"] = float(np.sqrt(np.mean(np.square(n_res))))
+    e_t, e_n = np.array(e_t), np.array(e_n)
+    scale_e = np.abs(e_t[:, 0])
+    stage["energy_tangential"] = float(np.sqrt(np.mean(((e_t[:, 1] - e_t[:, 0]) / scale_e) ** 2)))
+    stage["energy_normal"] = float(np.sqrt(np.mean(((e_n[:, 1] - e_n[:, 0]) / scale_e) ** 2)))
+    if linear is not None:
+        stage.update(linear)
+    arrays["energy_tangential"] = e_t
+    arrays["energy_normal"] = e_n
+    arrays["gap_by_cycle_part"] = np.array(parts_rms)
+    arrays["force_state_map"] = np.array(maps)
+    ph = np.mean(arrays["gap_by_harmonic"] ** 2, axis=0)
+    odd = float(np.sum(ph[0::2]))
+    even = float(np.sum(ph[1::2]))
+    worst_h = int(np.argmax(ph)) + 1
+    part_mean = np.mean(arrays["gap_by_cycle_part"], axis=0)
+    sensors = records[cases[0]].sensors
+    amps = [float(np.abs(records[c].acceleration[0, 0])) for c in cases]
+    slope = float(np.polyfit(np.log(amps), np.log(np.maximum(acc_gap, 1e-12)), 1)[0]) if len(cases) > 1 else float("nan")
+    # direction: unexplained dissipation or force mismatch in the normal vs the tangential direction
+    normal_score = max(stage["energy_normal"], stage["contact_force_N"] - np.median(n_res) * 0 - 0.0)
+    direction = "normal" if stage["energy_normal"] > 0.5 * stage["energy_tangential"] and stage["energy_normal"] > 0.02 \
+        else "tangential"
+    summary = {
+        "stage": stage,
+        "largest_stage": max(("accelerations", "generalized_coordinates", "contact_force_S", "contact_force_N",
+                              "energy_tangential", "energy_normal"), key=lambda k: stage[k]),
+        "direction": direction,
+        "by_sensor": {s: float(v) for s, v in zip(sensors, np.sqrt(np.mean(arrays["gap_by_sensor"] ** 2, axis=0)))},
+        "worst_sensor": sensors[int(np.argmax(np.mean(arrays["gap_by_sensor"] ** 2, axis=0)))],
+        "by_harmonic": {int(h): float(np.sqrt(v)) for h, v in enumerate(ph, start=1)},
+        "worst_harmonic": worst_h,
+        "even_share": even / max(odd + even, 1e-300),
+        "harmonic_class": "even" if even > odd else "odd",
+        "by_cycle_part": {p: float(v) for p, v in zip(part_names, part_mean)},
+        "worst_cycle_part": part_names[int(np.argmax(part_mean))],
+        "by_load_case": {c: float(g) for c, g in zip(cases, acc_gap)},
+        "load_exponent": slope,
+        "drift": {c: _rel(records[c].last[:, :H], records[c].first[:, :H]) for c in cases},
+    }
+    del normal_score
+    return summary, arrays
+
+
+def linear_stage(model: IdentifiedModel, frf: xr.Dataset, modal: xr.Dataset) -> dict:
+    """The random test's FRF against the identified model: natural frequencies (relative error) and
+    the driving-point |H1| at the identified peaks (relative error of the model's accelerance)."""
+    fe = fe_model(model)
+    modes = all_modes(fe)
+    zeta = augmented_zeta(fe, model.damping, 0.0)
+    wn = 2 * np.pi * modes.frequencies_hz
+    b = modes.shapes.T @ fe.force_vector
+    d = fe.sensor_vectors[0] @ modes.shapes
+    f_id = modal["natural_frequency"].values
+    freq = frf["frequency"].values
+    H1 = frf["h1_real"].values[0] + 1j * frf["h1_imag"].values[0]
+    f_model = structural_modes(fe, len(f_id)).frequencies_hz
+    peak_err = []
+    for f in f_id:
+        i = int(np.argmin(np.abs(freq - f)))
+        W = 2 * np.pi * freq[i]
+        Hm = -(W**2) * np.sum(d * b / (wn**2 - W**2 + 2j * zeta * wn * W))
+        peak_err.append(abs(Hm) / abs(H1[i]) - 1)
+    return {"frf_frequency": float(np.sqrt(np.mean((f_model / f_id - 1) ** 2))),
+            "frf_peak_amplitude": float(np.sqrt(np.mean(np.square(peak_err))))}
+
+
+# ------------------------------------------------------------------------------------------
+# ranking and verdict
+# ------------------------------------------------------------------------------------------
+
+@dataclass
+class Diagnosis:
+    verdict: str
+    reason: str
+    ranking: list
+    where: dict
+    calibration_case: str
+    heldout_cases: list
+    arrays: dict = field(default_factory=dict)
+    sims: dict = field(default_factory=dict)
+
+    def summary(self) -> dict:
+        return {"verdict": self.verdict, "reason": self.reason, "ranking": self.ranking, "where": self.where,
+                "calibration_case": self.calibration_case, "heldout_cases": self.heldout_cases}
+
+
+def _bootstrap_records(rec: RecordHarmonics, rng, n: int, H: int) -> np.ndarray:
+    """(n, j, H) resampled record harmonics: means of blocks drawn with replacement."""
+    B = rec.block_acceleration.shape[0]
+    idx = rng.integers(0, B, size=(n, B))
+    return rec.block_acceleration[idx][:, :, :, :H].mean(axis=1)
+
+
+def diagnose(model: IdentifiedModel, records: Mapping[str, RecordHarmonics], calibration_case: str,
+             settings: GapSettings, fit_settings: FitSettings, linear: dict | None = None) -> Diagnosis:
+    """Run the whole diagnosis on the load cases' records (``calibration_case`` for the refits,
+    the others held out)."""
+    H = settings.n_harmonics
+    if calibration_case not in records:
+        raise ValueError(f"gap: the calibration case {calibration_case!r} is not among the load cases {list(records)}")
+    cases = list(records)
+    held = [c for c in cases if c != calibration_case]
+    score_cases = held or [calibration_case]
+    base_sims = {}
+    base_res = {}
+    for c in cases:
+        g, sim = baseline(model, records[c], H)
+        base_sims[c] = sim
+        base_res[c] = gap_residual(sim, records[c], H)
+    where, arrays = localise(model, dict(records), base_sims, H, linear)
+    # candidates: calibrate, predict the held-out cases
+    names = settings.candidates or tuple(LIBRARY)
+    results = {}
+    for name in names:
+        cand = LIBRARY[name]
+        cal = calibrate(model, cand, records[calibration_case], fit_settings, H, settings.max_evaluations)
+        sims = {calibration_case: None}
+        res = {}
+        for c in score_cases:
+            _, _, sim, _ = evaluate(cal.model, cal.augmentation, records[c], None, H, refit=False)
+            sims[c] = sim
+            res[c] = gap_residual(sim, records[c], H)
+        results[name] = (cal, sims, res)
+        log.info("candidate %s: theta %s, calibration gap %.4g, held-out %s", name, cal.theta, cal.gap,
+                 {c: round(gap_value(r), 5) for c, r in res.items()})
+    # bootstrap over record blocks: the sims are fixed, the records resampled
+    rng = generator(settings.seed, "gap/bootstrap")
+    boot = {c: _bootstrap_records(records[c], rng, settings.n_bootstrap, H) for c in score_cases}
+
+    def heldout_gap(sims_by_case, boot_index=None):
+        vals = []
+        for c in score_cases:
+            rec = records[c]
+            A = rec.acceleration[:, :H] if boot_index is None else boot[c][boot_index]
+            As = sims_by_case[c].acceleration[:, :H]
+            d_meas = (rec.last - rec.first)[:, :H]
+            sim = sims_by_case[c]
+            d_sim = (sim.last - sim.first)[:, :H] if sim.first is not None else np.zeros_like(d_meas)
+            r = np.concatenate([(As - A).ravel(), (d_sim - d_meas).ravel()]) / np.linalg.norm(A)
+            vals.append(np.sum(np.abs(r) ** 2))
+        return float(np.sqrt(np.mean(vals)))
+
+    before = heldout_gap(base_sims)
+    before_b = np.array([heldout_gap(base_sims, b) for b in range(settings.n_bootstrap)])
+    n_data = 2 * sum(base_res[c].size for c in score_cases)
+    rows = []
+    boots = {}
+    for name, (cal, sims, res) in results.items():
+        after = heldout_gap(sims)
+        after_b = np.array([heldout_gap(sims, b) for b in range(settings.n_bootstrap)])
+        boots[name] = after_b
+        k = LIBRARY[name].n_parameters(len(records[cases[0]].sensors))
+        score = n_data * np.log(after**2 / before**2) + 2 * k
+        red_b = 1 - after_b / before_b
+        rows.append({"effect": name, "heldout_gap_before": before, "heldout_gap_after": after, "score": float(score),
+                     "reduction": 1 - after / before, "reduction_interval": [float(np.percentile(red_b, 2.5)),
+                                                                            float(np.percentile(red_b, 97.5))],
+                     "heldout_gap_after_interval": [float(np.percentile(after_b, 2.5)), float(np.percentile(after_b, 97.5))],
+                     "n_parameters": k, "parameters": {p.name if not LIBRARY[name].per_channel else f"{p.name}_{i}": float(v)
+                                                       for i, (p, v) in enumerate(zip(LIBRARY[name].parameters * len(cal.theta), cal.theta))},
+                     "calibration_gap": cal.gap, "friction": [float(x) for x in cal.friction],
+                     "heldout_gap_after_by_case": {c: gap_value(r) for c, r in res.items()},
+                     "evaluations": cal.evaluations})
+    rows.sort(key=lambda r: r["score"])
+    scatter = float(np.std(before_b))
+    verdict, reason = "none", ""
+    if rows:
+        best = rows[0]
+        second = rows[1] if len(rows) > 1 else None
+        if before < settings.noise_factor * scatter:
+            reason = f"the held-out gap {before:.3g} is within {settings.noise_factor} x the records' scatter {scatter:.2g}"
+        elif best["reduction"] < settings.min_reduction or best["reduction_interval"][0] <= 0:
+            reason = (f"no candidate shrinks the held-out gap by {settings.min_reduction:.0%} (best: {best['effect']}, "
+                      f"{best['reduction']:.1%})")
+        elif second is not None and second["heldout_gap_after"] < settings.separation * best["heldout_gap_after"]:
+            reason = (f"{best['effect']} and {second['effect']} explain the gap about equally (held-out gaps "
+                      f"{best['heldout_gap_after']:.3g}, {second['heldout_gap_after']:.3g}; separation {settings.separation})")
+        else:
+            verdict = best["effect"]
+            p_better = float(np.mean(boots[best["effect"]] < boots[second["effect"]])) if second else 1.0
+            reason = (f"{best['effect']} shrinks the held-out gap from {before:.3g} to {best['heldout_gap_after']:.3g} "
+                      f"({best['reduction']:.1%}); runner-up {second['effect'] if second else '-'} "
+                      f"{second['heldout_gap_after'] if second else float('nan'):.3g}; bootstrap P(better) {p_better:.2f}")
+    where["heldout_gap_before"] = before
+    where["heldout_gap_before_interval"] = [float(np.percentile(before_b, 2.5)), float(np.percentile(before_b, 97.5))]
+    where["record_scatter"] = scatter
+    diag = Diagnosis(verdict, reason, rows, where, calibration_case, held, arrays,
+                     {"base": base_sims, **{n: r[1] for n, r in results.items()}})
+    return diag

@@ -1,0 +1,66 @@
+"""The identification chain run in one process from raw records to the identified model, for
+data sets that do not go through the workflow's rules one by one (the blind benchmark). It calls
+the same package functions as the rules, with the same settings from the config."""
+
+from __future__ import annotations
+
+import copy
+from typing import Mapping
+
+import numpy as np
+import xarray as xr
+
+from ..friction_fit import fit_friction_law, settings_from_config
+from ..linear_chain import frf_dataset, linear_modes_dataset, modal_dataset, stiction_dataset
+from .model import identified_model
+from .records import record_harmonics
+from .refit import identified_forces
+
+
+def linear_chain(cfg: Mapping, raw_random: xr.Dataset, return_frf: bool = False):
+    """random test -> FRF -> modal -> stiction -> linear modes; returns (linear_modes, modal[, frf])."""
+    f, m, st, lm = (cfg.get(k, {}) for k in ("frf", "modal", "stiction", "linear_modes"))
+    frf = frf_dataset(raw_random, int(f.get("segment_length", 16384)), float(f.get("overlap", 0.5)),
+                      f.get("window", "hann"), int(m.get("uncertainty_blocks", 4)))
+    modal = modal_dataset(frf, int(m.get("n_modes", 3)), m.get("band_hz", [20.0, 450.0]), int(m.get("order", 16)))
+    stiction = stiction_dataset(modal, cfg["structure"], st)
+    modes = linear_modes_dataset(stiction, cfg["structure"], int(lm.get("n_modes", 3)), int(lm.get("grid_points", 301)),
+                                 float(st.get("k_n_prior_n_per_m", 2.37e7)))
+    return (modes, modal, frf) if return_frf else (modes, modal)
+
+
+def identify(cfg: Mapping, raw_random: xr.Dataset, raw_calibration: xr.Dataset, n_modes: int = 8):
+    """The identified model from a random test and the calibration case's dual-sine record
+    (linear chain, inverse identification, GA fit of the friction law); returns
+    (model, linear_modes, modal, frf)."""
+    from .model import NONE
+
+    modes, modal, frf = linear_chain(cfg, raw_random, return_frf=True)
+    K = int(cfg.get("nonlinear", {}).get("n_harmonics", 25))
+    settings = settings_from_config(cfg.get("friction", {}))
+    unfitted = xr.Dataset({"parameter_value": ("parameter", np.ones(5))})
+    model = identified_model(cfg["structure"], modes, modal, unfitted, n_modes=n_modes)
+    rec = record_harmonics(raw_calibration, "calibration", K)
+    forces = identified_forces(model, NONE, rec)
+    fit = fit_friction_law(forces.xi, forces.N_dyn, forces.S, rec.f0, model.preload, settings, int(cfg["seed"]), K)
+    return model.with_friction(fit.params), modes, modal, frf
+
+
+def rig_records(cfg: Mapping, effects: Mapping, seed: int, cases, random_test: bool = True) -> dict:
+    """Raw records of the virtual rig with ``effects`` on: {'random_test': ds, case: ds, ...}."""
+    from ..rig.dual_sine import dual_sine_test
+    from ..rig.random_test import random_test_datasets
+    from ..rig.structure import random_test_rig_config
+
+    rig = copy.deepcopy(dict(cfg["rig"]))
+    rig["effects"] = dict(effects)
+    out = {}
+    if random_test:
+        out["random_test"] = random_test_datasets(cfg["structure"], random_test_rig_config(rig), cfg["random_test"], seed)[0]
+    fs = float(cfg["random_test"].get("sampling_rate_hz", 5120.0))
+    for case in cases:
+        raw, truth = dual_sine_test(cfg["structure"], rig, cfg["load_cases"][case], fs, float(rig.get("noise_fraction", 0.005)),
+                                    seed, case, cfg["structure"]["sensors"]["names"])
+        raw.attrs["control_converged"] = truth.attrs["control_converged"]  # kept apart from what the diagnosis reads
+        out[case] = raw
+    return out

@@ -1,0 +1,247 @@
+"""Calibration refit of a candidate effect, and the gap between a simulation and a record.
+
+For a candidate with parameters theta the whole identification is redone with the effect in the
+model, on the calibration case only: the contact forces by inverse identification with the
+augmented structure (extra damping, transducer masses) on the augmented record (channel delays
+removed), the friction law polished from the chain's fit with the augmented law (viscous term,
+Iwan share), then the forward simulation. theta minimises the calibration gap. The held-out load
+cases are then predicted with theta and the refitted friction law, never fitted.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+from scipy.optimize import minimize_scalar
+
+from ..beam_model import all_modes
+from ..friction import valanis_friction_force
+from ..friction_fit import FitSettings, _polish, _Problem, periodic_grid
+from ..identification import InverseHarmonics, inverse_harmonics
+from ..rig.nonlinear import iwan_slip_weights
+from .candidates import Candidate
+from .model import NONE, Augmentation, IdentifiedModel, SimResult, fe_model, simulate
+from .records import RecordHarmonics
+
+log = logging.getLogger(__name__)
+
+
+# ------------------------------------------------------------------------------------------
+# the gap
+# ------------------------------------------------------------------------------------------
+
+def gap_residual(sim: SimResult, rec: RecordHarmonics, n_harmonics: int) -> np.ndarray:
+    """Residual (complex, scaled by the record's rms acceleration harmonic norm): the sensors'
+    harmonics 1..H of the whole record, and the change from the first to the last third (drift)."""
+    H = n_harmonics
+    scale = np.linalg.norm(rec.acceleration[:, :H])
+    r = [(sim.acceleration[:, :H] - rec.acceleration[:, :H]).ravel()]
+    d_meas = (rec.last - rec.first)[:, :H]
+    d_sim = (sim.last - sim.first)[:, :H] if sim.first is not None else np.zeros_like(d_meas)
+    r.append((d_sim - d_meas).ravel())
+    return np.concatenate(r) / scale
+
+
+def gap_value(residual: np.ndarray) -> float:
+    """The gap: rms of the scaled residual over its entries' norm, i.e. ||A_sim - A_rec|| / ||A_rec||
+    (with the drift part added in quadrature)."""
+    return float(np.linalg.norm(residual))
+
+
+# ------------------------------------------------------------------------------------------
+# identification with an augmented model
+# ------------------------------------------------------------------------------------------
+
+def augmented_zeta(fe, damping, extra: float) -> np.ndarray:
+    """Damping ratio of every FE mode: the identified ratios on the structural modes (by order),
+    the first elsewhere, plus ``extra`` on the structural (beam) modes."""
+    modes = all_modes(fe)
+    zeta = np.full(modes.frequencies_hz.size, damping[0])
+    structural = np.flatnonzero(modes.block_energy_fraction < 0.5)
+    for k, idx in enumerate(structural):
+        zeta[idx] = damping[min(k, len(damping) - 1)]
+    zeta[structural] += extra
+    return zeta
+
+
+def deskewed(rec: RecordHarmonics, delays) -> np.ndarray:
+    """The record's acceleration harmonics with per-channel delays removed."""
+    if not len(delays):
+        return rec.acceleration
+    h = np.arange(1, rec.acceleration.shape[1] + 1)
+    return rec.acceleration * np.exp(1j * np.outer(np.asarray(delays, float), 2 * np.pi * rec.f0 * h))
+
+
+def identified_forces(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics) -> InverseHarmonics:
+    """Contact forces of a record by inverse identification with the augmented model."""
+    fe = fe_model(model, aug)
+    zeta = augmented_zeta(fe, model.damping, aug.extra_damping)
+    return inverse_harmonics(fe, zeta, rec.force, deskewed(rec, aug.delays), rec.f0)
+
+
+@njit
+def _iwan_periodic(xi, N, e_f, k_c, mu, weights, periods):
+    n = weights.size
+    x_sl = np.zeros(n)
+    out = np.zeros(xi.size)
+    for _ in range(periods):
+        for t in range(xi.size):
+            if N[t] <= 0.0:
+                for i in range(n):
+                    x_sl[i] = xi[t]
+                out[t] = 0.0
+                continue
+            e0 = e_f * (1.0 - np.exp(-k_c * N[t] / e_f))
+            total = 0.0
+            for i in range(n):
+                k = e0 / n
+                lim = mu * N[t] * weights[i]
+                f = k * (xi[t] - x_sl[i])
+                if f > lim:
+                    x_sl[i] = xi[t] - lim / k
+                    f = lim
+                elif f < -lim:
+                    x_sl[i] = xi[t] + lim / k
+                    f = -lim
+                total += f
+            out[t] = total
+    return out
+
+
+def law_friction_force(xi, xi_dot, N, params, aug: Augmentation) -> np.ndarray:
+    """S (N) of the (augmented) friction law over one period: (1 - s) Valanis + s Iwan + sigma_2 dxi/dt
+    (params: e_f, k_c, e_t, kappa, mu; N total, clipped at 1 mN where the contact would open)."""
+    Nc = np.maximum(N, 1e-3)
+    S = valanis_friction_force(xi, Nc, np.atleast_2d(params))
+    if aug.iwan_share:
+        p = np.atleast_2d(params)
+        iw = np.array([_iwan_periodic(xi, N, q[0], q[1], q[4], iwan_slip_weights(16), 3) for q in p])
+        S = (1 - aug.iwan_share) * S + aug.iwan_share * iw
+    if aug.viscous:
+        S = S + aug.viscous * np.where(N > 0, xi_dot, 0.0)[None, :]
+    return S
+
+
+class _AugmentedProblem(_Problem):
+    def __init__(self, xi, xi_dot, N, S, bounds, aug):
+        super().__init__(xi, N, S, bounds)
+        self.xi_dot, self.aug = xi_dot, aug
+
+    def residuals(self, params):
+        S = law_friction_force(self.xi, self.xi_dot, self.N, params, self.aug)
+        S = S - S.mean(axis=1, keepdims=True)
+        return (S - self.S) / self.scale
+
+
+def contact_grids(forces: InverseHarmonics, f0: float, preload: float, m: int) -> dict:
+    """One period of the identified xi, xi_dot, N (total) and S (mean removed) on m points."""
+    return {"xi": periodic_grid(forces.xi, f0, m)[0], "xi_dot": periodic_grid(forces.xi_dot, f0, m)[0],
+            "N": preload + periodic_grid(forces.N_dyn, f0, m)[0], "S": periodic_grid(forces.S, f0, m)[0],
+            "eta": periodic_grid(forces.eta, f0, m)[0], "eta_dot": periodic_grid(forces.eta_dot, f0, m)[0]}
+
+
+def refit_friction(model: IdentifiedModel, aug: Augmentation, forces: InverseHarmonics, f0: float,
+                   bounds, grid: int = 512) -> tuple[np.ndarray, float]:
+    """The friction law (with the augmentation's terms) polished from the chain's fit to the
+    identified forces; returns (e_f, k_c, e_t, kappa, mu) and the NRMSE of S."""
+    # a drifting preload: the record's harmonics see the mean preload over the record
+    g = contact_grids(forces, f0, model.preload * (1.0 + 0.5 * aug.preload_drift), grid)
+    prob = _AugmentedProblem(g["xi"], g["xi_dot"], g["N"], g["S"], bounds, aug)
+    u0 = np.clip(prob.unit(np.asarray(model.friction))[0], 1e-6, 1 - 1e-6)
+    u, ssr, _ = _polish(prob, u0)
+    return prob.physical(u)[0], float(np.sqrt(ssr / grid))
+
+
+# ------------------------------------------------------------------------------------------
+# calibration of a candidate
+# ------------------------------------------------------------------------------------------
+
+@dataclass
+class Calibration:
+    """A candidate calibrated on the calibration case: theta, the refitted friction law, the
+    calibration gap, the model and augmentation to predict with, and the number of simulations."""
+
+    candidate: str
+    theta: np.ndarray
+    friction: np.ndarray
+    gap: float
+    model: IdentifiedModel
+    augmentation: Augmentation
+    evaluations: int
+    friction_misfit: float
+
+
+def evaluate(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, bounds, n_harmonics: int,
+             refit: bool = True):
+    """Redo the chain with ``aug`` on one record: (gap, model with refitted friction, simulation, misfit)."""
+    misfit = float("nan")
+    if refit:
+        forces = identified_forces(model, aug, rec)
+        fr, misfit = refit_friction(model, aug, forces, rec.f0, bounds)
+        model = model.with_friction(fr)
+    sim = simulate(model, aug, rec)
+    return gap_value(gap_residual(sim, rec, n_harmonics)), model, sim, misfit
+
+
+def calibrate(model: IdentifiedModel, cand: Candidate, rec: RecordHarmonics, settings: FitSettings,
+              n_harmonics: int, max_evaluations: int = 12) -> Calibration:
+    """theta of ``cand`` minimising the calibration case's gap (friction law refitted at each theta)."""
+    bounds = settings.bounds
+    n_eval = 0
+    cache = {}
+
+    def run(theta):
+        nonlocal n_eval
+        key = tuple(np.round(np.atleast_1d(theta), 12))
+        if key not in cache:
+            n_eval += 1
+            aug = cand.augmentation(np.atleast_1d(theta))
+            try:
+                cache[key] = (*evaluate(model, aug, rec, bounds, n_harmonics), aug)
+            except (ValueError, FloatingPointError) as exc:  # e.g. the law is undefined there
+                log.info("%s at %s: %s", cand.name, theta, exc)
+                cache[key] = (np.inf, model, None, np.nan, aug)
+        return cache[key]
+
+    if cand.per_channel:
+        # one parameter per accelerometer channel: Nelder-Mead from zero, simplex steps of 10 % of the range
+        from scipy.optimize import minimize
+
+        j = rec.acceleration.shape[0]
+        p = cand.parameters[0]
+        step = 0.1 * (p.high - p.low)
+        simplex = np.vstack([np.zeros(j), step * np.eye(j)])
+        res = minimize(lambda x: run(np.clip(x, p.low, p.high))[0], np.zeros(j), method="Nelder-Mead",
+                       options={"initial_simplex": simplex, "maxfev": 3 * max_evaluations,
+                                "xatol": 1e-3 * (p.high - p.low), "fatol": 1e-6})
+        theta = np.clip(res.x, p.low, p.high)
+        if run(np.zeros(j))[0] <= run(theta)[0]:
+            theta = np.zeros(j)
+    elif len(cand.parameters) == 1:
+        p = cand.parameters[0]
+        res = minimize_scalar(lambda x: run(np.array([x]))[0], bounds=(p.low, p.high), method="bounded",
+                              options={"xatol": 1e-3 * (p.high - p.low), "maxiter": max_evaluations})
+        theta = np.array([res.x])
+        # the bounded search never tries the ends: compare with "off" (the low end or zero)
+        off = np.array([0.0 if p.low <= 0.0 <= p.high else p.low])
+        if run(off)[0] < run(theta)[0]:
+            theta = off
+    else:
+        from scipy.optimize import minimize
+
+        lo = np.array([p.low for p in cand.parameters])
+        hi = np.array([p.high for p in cand.parameters])
+        res = minimize(lambda x: run(lo + x * (hi - lo))[0], np.full(lo.size, 0.5), method="Nelder-Mead",
+                       options={"maxfev": max_evaluations * lo.size, "xatol": 1e-3})
+        theta = lo + np.clip(res.x, 0, 1) * (hi - lo)
+    g, m2, sim, misfit, aug = run(theta)
+    return Calibration(cand.name, np.atleast_1d(theta), np.asarray(m2.friction), g, m2, aug, n_eval, misfit)
+
+
+def baseline(model: IdentifiedModel, rec: RecordHarmonics, n_harmonics: int) -> tuple[float, SimResult]:
+    """The identified model as the chain left it (no effect, no refit) on one record."""
+    g, _, sim, _ = evaluate(model, NONE, rec, None, n_harmonics, refit=False)
+    return g, sim

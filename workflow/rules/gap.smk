@@ -1,0 +1,94 @@
+# Sim-to-real gap diagnosis (issue 7): the identified model against the records, localised,
+# explained by the candidate library; and its blind check on rig data with a hidden effect.
+
+
+rule gap:
+    input:
+        gap_outputs(),
+
+
+rule gap_diagnosis:
+    input:
+        unpack(gap_inputs),
+    output:
+        diagnosis="results/gap/diagnosis.json",
+        dataset="results/gap/gap.nc",
+    params:
+        code=CODE_DIGEST,
+        structure=config["structure"],
+        gap=config.get("gap", {}),
+        friction=config.get("friction", {}),
+        seed=config["seed"],
+        n_harmonics=config.get("nonlinear", {}).get("n_harmonics", 25),
+        calibration_case=calibration_case(),
+        cases=load_cases(),
+    threads: 2
+    resources:
+        runtime=20,
+        mem_mb=2000,
+    conda:
+        "../envs/contactid.yaml"
+    log:
+        "logs/gap_diagnosis.log",
+    benchmark:
+        "benchmarks/rules/gap_diagnosis.tsv"
+    script:
+        "../scripts/gap_diagnosis.py"
+
+
+rule gap_figures:
+    input:
+        diagnosis="results/gap/diagnosis.json",
+        dataset="results/gap/gap.nc",
+    output:
+        stages=report("results/gap/gap_stages.png", caption="../report/gap.rst", category="Gap diagnosis"),
+        harmonics=report("results/gap/gap_harmonics.png", caption="../report/gap.rst", category="Gap diagnosis"),
+        cycle=report("results/gap/gap_cycle.png", caption="../report/gap.rst", category="Gap diagnosis"),
+        force_state=report("results/gap/gap_force_state.png", caption="../report/gap.rst", category="Gap diagnosis"),
+        ranking=report("results/gap/gap_ranking.png", caption="../report/gap.rst", category="Gap diagnosis"),
+    params:
+        code=CODE_DIGEST,
+    conda:
+        "../envs/contactid.yaml"
+    log:
+        "logs/gap_figures.log",
+    script:
+        "../scripts/gap_figures.py"
+
+
+rule gap_benchmark_item:
+    output:
+        item="results/gap_benchmark/items/{item}.json",
+    params:
+        code=CODE_DIGEST,
+        spec=lambda wc: benchmark_items()[wc.item],
+        config=benchmark_base_config(),
+    wildcard_constraints:
+        item=r"[a-z_]+-[0-9]+-s[0-9]+",
+    threads: 1
+    resources:
+        runtime=20,
+        mem_mb=2000,
+    conda:
+        "../envs/contactid.yaml"
+    log:
+        "logs/gap_benchmark/{item}.log",
+    script:
+        "../scripts/gap_benchmark_item.py"
+
+
+rule gap_benchmark:
+    input:
+        rows=expand("results/gap_benchmark/items/{item}.json", item=list(benchmark_items())),
+    output:
+        summary="results/gap_benchmark/benchmark.json",
+        confusion=report("results/gap_benchmark/confusion.csv", caption="../report/gap_benchmark.rst", category="Gap diagnosis"),
+        figure=report("results/gap_benchmark/confusion.png", caption="../report/gap_benchmark.rst", category="Gap diagnosis"),
+    params:
+        code=CODE_DIGEST,
+    conda:
+        "../envs/contactid.yaml"
+    log:
+        "logs/gap_benchmark.log",
+    script:
+        "../scripts/gap_benchmark.py"

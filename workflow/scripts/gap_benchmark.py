@@ -1,0 +1,23 @@
+"""Rule gap_benchmark: gather the blind items into accuracy, confusion matrix, false alarms, shrink."""
+
+import json
+
+from contactid.gap.benchmark import confusion_figure, score
+from contactid.gap.output import _clean
+from contactid.io import write_text
+from contactid.logs import setup_logging
+
+log = setup_logging(snakemake.log[0])
+rows = [json.load(open(path)) for path in snakemake.input.rows]
+result = score(rows)
+result["items"] = [{k: r[k] for k in ("item", "effect", "magnitude", "seed", "kind", "verdict", "shrink_true",
+                                      "heldout_gap_before", "seconds")} for r in rows]
+write_text(snakemake.output.summary, json.dumps(_clean(result), indent=2))
+labels = list(result["confusion"])
+cols = sorted({c for row in result["confusion"].values() for c in row}, key=lambda c: (c == "none", c))
+lines = ["true," + ",".join(cols)]
+lines += [t + "," + ",".join(str(result["confusion"][t].get(c, 0)) for c in cols) for t in labels]
+write_text(snakemake.output.confusion, "\n".join(lines) + "\n")
+confusion_figure(result, snakemake.output.figure)
+log.info("top-1 accuracy %.3f over %d, false alarms %d of %d", result["top1_accuracy"], result["n_blind"],
+         result["false_alarms"], result["n_effect_free"])

@@ -1,0 +1,14 @@
+"""Rule gap_benchmark_item: one blind data set: rig records with a hidden effect -> chain -> diagnosis."""
+
+import json
+
+from contactid.gap.benchmark import run_item
+from contactid.gap.output import _clean
+from contactid.io import write_text
+from contactid.logs import setup_logging
+
+log = setup_logging(snakemake.log[0])
+row = run_item(snakemake.params.spec, snakemake.params.config)
+row["item"] = snakemake.wildcards.item
+write_text(snakemake.output.item, json.dumps(_clean(row), indent=2))
+log.info("%s: effect %s (%.4g) -> verdict %s", row["item"], row["effect"], row["magnitude"], row["verdict"])

@@ -1,0 +1,11 @@
+"""Rule gap_figures: one figure per view of the diagnosis."""
+
+from contactid.gap.figures import all_figures
+from contactid.logs import setup_logging
+
+log = setup_logging(snakemake.log[0])
+o = snakemake.output
+all_figures(snakemake.input.diagnosis, snakemake.input.dataset,
+            {"stages": o.stages, "harmonics": o.harmonics, "cycle": o.cycle, "force_state": o.force_state,
+             "ranking": o.ranking})
+log.info("gap figures written")
