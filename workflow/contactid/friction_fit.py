@@ -68,9 +68,14 @@ def periodic_grid(coef: np.ndarray, f0: float, m: int) -> np.ndarray:
     return np.imag(coef @ np.exp(1j * np.outer(2 * np.pi * f0 * h, t)))
 
 
+N_OPEN = 1.0e-3  # N: where the identified normal force is lower, the contact is taken as open (S = 0)
+
+
 class _Problem:
     def __init__(self, xi, normal_force, S, bounds):
-        self.xi, self.N = xi, normal_force
+        # where the identified N falls to zero the contact opens and carries no friction: the law is
+        # evaluated there with a vanishing normal force (the kernel refuses N <= 0)
+        self.xi, self.N = xi, np.maximum(normal_force, N_OPEN)
         self.S = S - S.mean()
         self.scale = np.sqrt(np.mean(self.S**2))
         self.lo = np.array([np.log10(b[0]) if lg else b[0] for b, lg in zip(bounds, LOG_SCALED)])
@@ -168,9 +173,10 @@ def _polish(problem: _Problem, u0, fixed: dict | None = None):
 
 
 def fit_friction_law(coef_xi, coef_n, coef_s, f0: float, preload: float, settings: FitSettings, seed: int,
-                     n_harmonics_data: int | None = None) -> FitResult:
+                     n_harmonics_data: int | None = None, intervals: bool = True) -> FitResult:
     """GA + polish on the calibration case's xi, N (total = preload + dynamic) and S harmonics,
-    with the grid refined until the parameters move by less than ``refine_tolerance``."""
+    with the grid refined until the parameters move by less than ``refine_tolerance``; then the
+    profile-likelihood intervals (skipped with ``intervals`` False: NaN intervals)."""
     K = np.atleast_2d(coef_s).shape[1] if n_harmonics_data is None else n_harmonics_data
     m = settings.grid_points
     history = []
@@ -203,7 +209,8 @@ def fit_friction_law(coef_xi, coef_n, coef_s, f0: float, preload: float, setting
     m_pts = problem.S.size
     sigma2 = max(ssr_min / m_pts * n_data / max(n_data - 5, 1), settings.misfit_floor**2)
     thr = ssr_min + chi2_dist.ppf(settings.confidence, 1) * sigma2 * m_pts / n_data
-    intervals = np.empty((5, 2))
+    want_intervals = intervals
+    intervals = np.full((5, 2), np.nan)
     bounded = np.zeros((5, 2), dtype=bool)
     profiles = {}
     e0_vals = []
@@ -216,7 +223,7 @@ def fit_friction_law(coef_xi, coef_n, coef_s, f0: float, preload: float, setting
         profiles.setdefault(PARAMETER_NAMES[i], []).append((float(problem.physical(u)[0][i]), s_j))
         return u, s_j
 
-    for i in range(5):
+    for i in range(5 if want_intervals else 0):
         for side, direction in ((0, -1.0), (1, +1.0)):
             edge = 0.0 if direction < 0 else 1.0
             inside_v, start = u_best[i], u_best.copy()
@@ -305,8 +312,14 @@ def friction_fit_dataset(forces, preload: float, settings: FitSettings, seed: in
              "preload_n": preload, "excitation_frequency_hz": f0, "n_harmonics": n_harmonics, "seed": seed,
              "population": settings.population, "generations": settings.generations,
              "warnings": "; ".join(res.warnings) or "none"}
+    n_total = preload + forces["N_dyn"].values
+    attrs["open_fraction"] = float(np.mean(n_total <= N_OPEN))  # share of the record with the contact open
     if paper_forces is not None:
         try:
+            n_paper = preload + paper_forces["N_dyn_paper"].values
+            if np.min(n_paper) <= 0:  # not a separation the working method sees: the paper's N is wrong
+                raise ValueError(f"the normal force reaches {np.min(n_paper):.3g} N <= 0 N, where the working "
+                                 "method's contact stays closed: the paper's N is not a physical normal force")
             rp = run(paper_forces["S_paper"].values, paper_forces["xi_paper"].values, paper_forces["N_dyn_paper"].values)
             data["paper_parameter_value"] = ("parameter", rp.params, {"units": "mixed", "long_name": "fitted to the paper's chain's forces"})
             data["paper_interval_low"] = ("parameter", rp.intervals[:, 0], {"units": "mixed", "long_name": "paper's chain: interval, lower end"})

@@ -113,6 +113,7 @@ def all_outputs():
         *(["results/figures/fig04_generalized_coordinates.png", "results/figures/fig05_reconstruction.png",
            "results/figures/fig06_contact_forces.png"] if load_cases() else []),
         "results/summary.json",
+        *(gap_outputs() if load_cases() else []),
         *(["results/report/report.pdf"] if load_cases() else []),
     ]
 
@@ -140,3 +141,11 @@ def benchmark_items():
     from contactid.gap.benchmark import benchmark_items as items
 
     return items(config.get("gap_benchmark", {}), int(config["seed"]))
+
+
+def gap_report_inputs(wildcards):
+    """The report's gap section: the diagnosis, and the blind benchmark when gap_benchmark.in_report."""
+    inputs = {"diagnosis": "results/gap/diagnosis.json"}
+    if config.get("gap_benchmark", {}).get("in_report", True):
+        inputs["benchmark"] = "results/gap_benchmark/benchmark.json"
+    return inputs

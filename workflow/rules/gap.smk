@@ -92,3 +92,18 @@ rule gap_benchmark:
         "logs/gap_benchmark.log",
     script:
         "../scripts/gap_benchmark.py"
+
+
+rule gap_report_fragment:
+    input:
+        unpack(gap_report_inputs),
+    output:
+        tex="results/report/gap.tex",
+    params:
+        code=CODE_DIGEST,
+    conda:
+        "../envs/contactid.yaml"
+    log:
+        "logs/gap_report_fragment.log",
+    script:
+        "../scripts/gap_report_fragment.py"

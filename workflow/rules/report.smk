@@ -31,6 +31,13 @@ rule report:
     input:
         tex="paper/report.tex",
         fragments=rules.report_fragments.output,
+        gap="results/report/gap.tex",
+        gap_figures=[f"results/gap/gap_{v}.png" for v in ("stages", "harmonics", "cycle", "ranking")],
+        benchmark_figure=(
+            ["results/gap_benchmark/confusion.png"]
+            if config.get("gap_benchmark", {}).get("in_report", True)
+            else []
+        ),
         figures=expand(
             "results/figures/{fig}.pdf",
             fig=[

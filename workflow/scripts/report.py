@@ -13,14 +13,16 @@ if shutil.which("latexmk") is None or shutil.which("pdflatex") is None:
                      "`make env` or `apt-get install texlive-latex-base texlive-latex-recommended "
                      "texlive-latex-extra latexmk`, then rerun snakemake.")
 out = Path(snakemake.output.pdf)
-figures = Path(snakemake.input.figures[0]).resolve().parent
+dirs = {Path(f).resolve().parent for f in [snakemake.input.figures[0], *snakemake.input.gap_figures,
+                                           *snakemake.input.benchmark_figure]}
+graphicspath = "".join(f"{{{d}/}}" for d in sorted(dirs))
 with tempfile.TemporaryDirectory(dir=out.parent) as build:
     build = Path(build)
     shutil.copy(snakemake.input.tex, build / "report.tex")
-    for frag in snakemake.input.fragments:
+    for frag in [*snakemake.input.fragments, snakemake.input.gap]:
         shutil.copy(frag, build / Path(frag).name)
     tex = (build / "report.tex").read_text()
-    (build / "report.tex").write_text(tex.replace("\\begin{document}", f"\\graphicspath{{{{{figures}/}}}}\n\\begin{{document}}", 1))
+    (build / "report.tex").write_text(tex.replace("\\begin{document}", f"\\graphicspath{{{graphicspath}}}\n\\begin{{document}}", 1))
     res = subprocess.run(["latexmk", "-pdf", "-interaction=nonstopmode", "-halt-on-error", "report.tex"], cwd=build,
                          capture_output=True, text=True)
     log.info("%s", res.stdout[-5000:])

@@ -32,14 +32,14 @@ RANGES = {
 
 # where the localisation should point when the effect is missing from the library
 EXPECTED_PLACE = {
-    "structural_damping": ("direction", "tangential"),
-    "normal_contact_damping": ("direction", "normal"),
-    "viscous_friction": ("direction", "tangential"),
-    "multi_asperity_friction": ("direction", "tangential"),
-    "transducer_mass_error": ("direction", "tangential"),
-    "channel_time_skew": ("direction", "tangential"),
-    "contact_separation": ("direction", "normal"),
-    "preload_drift": ("direction", "normal"),
+    "structural_damping": "structure_or_measurement",
+    "transducer_mass_error": "structure_or_measurement",
+    "channel_time_skew": "structure_or_measurement",
+    "normal_contact_damping": "normal_contact",
+    "contact_separation": "normal_contact",
+    "viscous_friction": "tangential_contact",
+    "multi_asperity_friction": "tangential_contact",
+    "preload_drift": "non_stationary",
 }
 
 
@@ -122,8 +122,7 @@ def score(rows: list) -> dict:
     shrink = [r["shrink_true"] for r in correct]
     place_ok = []
     for r in lo:
-        key, want = EXPECTED_PLACE[r["effect"]]
-        place_ok.append(r["where"].get(key) == want)
+        place_ok.append(r["where"].get("place") == EXPECTED_PLACE[r["effect"]])
     return {
         "n_blind": len(blind), "top1_accuracy": len(correct) / max(len(blind), 1),
         "n_effect_free": len(free), "false_alarms": sum(r["verdict"] != "none" for r in free),
@@ -132,7 +131,8 @@ def score(rows: list) -> dict:
                               "all_at_least_half": bool(shrink) and all(s >= 0.5 for s in shrink)},
         "leave_out": {"n": len(lo), "verdict_none": sum(r["verdict"] == "none" for r in lo),
                       "place_right": int(sum(place_ok)),
-                      "items": [{"effect": r["effect"], "verdict": r["verdict"], "direction": r["where"].get("direction"),
+                      "items": [{"effect": r["effect"], "verdict": r["verdict"], "place": r["where"].get("place"),
+                                 "expected_place": EXPECTED_PLACE[r["effect"]], "direction": r["where"].get("direction"),
                                  "largest_stage": r["where"].get("largest_stage"),
                                  "harmonic_class": r["where"].get("harmonic_class")} for r in lo]},
         "confusion": conf,

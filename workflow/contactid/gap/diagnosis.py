@@ -124,19 +124,27 @@ def localise(model: IdentifiedModel, records: dict, sims: dict, n_harmonics: int
     stage["accelerations"] = float(np.sqrt(np.mean(np.square(acc_gap))))
     stage["generalized_coordinates"] = float(np.sqrt(np.mean(np.square(gc_gap))))
     # contact forces: identified (inverse, from the record) against the laws at the identified motion
-    s_res, n_res, e_t, e_n, parts_rms = [], [], [], [], []
+    s_res, n_res, e_t, e_n, parts_rms, id_res, scatter, open_frac = [], [], [], [], [], [], [], []
     maps = []
     part_names = ("stick", "slip", "velocity_reversal", "peak_compression")
     for c in cases:
         rec = records[c]
         forces = identified_forces(model, NONE, rec)
+        # the sensors' misfit of the inverse identification at the driven harmonics (1 and 3): the
+        # structure and sensor model's consistency with the records, whatever the contact does
+        id_res.append(float(np.sqrt(np.mean(forces.residual[[0, 2]] ** 2))))
+        scatter.append(identification_noise(model, rec))
         g = contact_grids(forces, rec.f0, model.preload, 256)
         S_law = law_friction_force(g["xi"], g["xi_dot"], g["N"], np.asarray(model.friction), NONE)[0]
         S_law -= S_law.mean()
-        N_law = -model.structure.k_n * g["eta"]
         N_id = g["N"] - model.preload
+        # the best elastic normal law at the identified motion (stiffness + hardening): what it leaves
+        # is dissipation or opening in the normal direction
+        A_el = np.column_stack([-g["eta"], g["eta"] ** 2 - np.mean(g["eta"] ** 2)])
+        N_law = A_el @ np.linalg.lstsq(A_el, N_id, rcond=None)[0]
         s_res.append(_rel(S_law, g["S"]))
         n_res.append(_rel(N_law, N_id))
+        open_frac.append(float(np.mean(g["N"] <= OPEN_LIMIT * model.preload)))
         # energy per cycle (J): identified from the record vs the simulation
         T = 1.0 / rec.f0
         et_id = float(np.mean(g["S"] * g["xi_dot"]) * T)
@@ -152,6 +160,8 @@ def localise(model: IdentifiedModel, records: dict, sims: dict, n_harmonics: int
         parts_rms.append([float(np.sqrt(np.mean(r_t[parts[p]] ** 2)) / a_rms) if parts[p].any() else 0.0
                           for p in part_names])
         maps.append(np.array([g["xi"], g["xi_dot"], g["S"] - S_law, g["eta"], g["eta_dot"], N_id - N_law]))
+    stage["identification_residual"] = float(np.sqrt(np.mean(np.square(id_res))))
+    stage["open_fraction"] = float(np.max(open_frac))
     stage["contact_force_S"] = float(np.sqrt(np.mean(np.square(s_res))))
     stage["contact_force_N"] = float(np.sqrt(np.mean(np.square(n_res))))
     e_t, e_n = np.array(e_t), np.array(e_n)
@@ -172,10 +182,7 @@ def localise(model: IdentifiedModel, records: dict, sims: dict, n_harmonics: int
     sensors = records[cases[0]].sensors
     amps = [float(np.abs(records[c].acceleration[0, 0])) for c in cases]
     slope = float(np.polyfit(np.log(amps), np.log(np.maximum(acc_gap, 1e-12)), 1)[0]) if len(cases) > 1 else float("nan")
-    # direction: unexplained dissipation or force mismatch in the normal vs the tangential direction
-    normal_score = max(stage["energy_normal"], stage["contact_force_N"] - np.median(n_res) * 0 - 0.0)
-    direction = "normal" if stage["energy_normal"] > 0.5 * stage["energy_tangential"] and stage["energy_normal"] > 0.02 \
-        else "tangential"
+    direction = "normal" if stage["contact_force_N"] > NORMAL_LIMIT or stage["open_fraction"] > 0 else "tangential"
     summary = {
         "stage": stage,
         "largest_stage": max(("accelerations", "generalized_coordinates", "contact_force_S", "contact_force_N",
@@ -191,10 +198,72 @@ def localise(model: IdentifiedModel, records: dict, sims: dict, n_harmonics: int
         "worst_cycle_part": part_names[int(np.argmax(part_mean))],
         "by_load_case": {c: float(g) for c, g in zip(cases, acc_gap)},
         "load_exponent": slope,
-        "drift": {c: _rel(records[c].last[:, :H], records[c].first[:, :H]) for c in cases},
+        "drift": {c: dict(zip(("change", "z"), record_drift(records[c], H))) for c in cases},
     }
-    del normal_score
+    summary["place"], summary["place_reason"] = _place(summary, stage, np.array(id_res), np.array(scatter),
+                                                       records, H)
     return summary, arrays
+
+
+def record_scatter(rec: RecordHarmonics, H: int) -> float:
+    """Relative standard error of the record's harmonics 1..H from its blocks: the level a gap or a
+    residual must exceed to be more than the records' own noise."""
+    B = rec.block_acceleration.shape[0]
+    d = rec.block_acceleration[:, :, :H] - rec.acceleration[None, :, :H]
+    return float(np.sqrt(np.mean(np.sum(np.abs(d) ** 2, axis=(1, 2)))) / np.linalg.norm(rec.acceleration[:, :H]) / np.sqrt(B))
+
+
+def record_drift(rec: RecordHarmonics, H: int) -> tuple[float, float]:
+    """Linear trend of the block harmonics over the record: (relative change over the record, its size in
+    units of its own standard error from the scatter about the trend; about 1 for a stationary record)."""
+    A = rec.block_acceleration[:, :, :H].reshape(rec.block_acceleration.shape[0], -1)
+    b = np.arange(A.shape[0]) - 0.5 * (A.shape[0] - 1)
+    slope = (b @ A) / (b @ b)
+    resid = A - A.mean(axis=0) - np.outer(b, slope)
+    sigma = np.sqrt(np.mean(np.sum(np.abs(resid) ** 2, axis=1)) * A.shape[0] / max(A.shape[0] - 2, 1))
+    change = float(np.linalg.norm(slope) * (A.shape[0] - 1) / np.linalg.norm(rec.acceleration[:, :H]))
+    return change, float(np.linalg.norm(slope) * np.sqrt(b @ b) / max(sigma, 1e-300))
+
+
+def identification_noise(model: IdentifiedModel, rec: RecordHarmonics) -> float:
+    """Standard error of the inverse identification's sensor misfit (w and 3w) from the record's blocks."""
+    import dataclasses
+
+    r = []
+    for k in range(rec.block_acceleration.shape[0]):
+        blk = dataclasses.replace(rec, acceleration=rec.block_acceleration[k], force=rec.block_force[k])
+        r.append(float(np.sqrt(np.mean(identified_forces(model, NONE, blk).residual[[0, 2]] ** 2))))
+    return float(np.std(r) / np.sqrt(len(r)))
+
+
+# thresholds of the place (measured on rig data with each effect; see README): the records drift when
+# their trend exceeds DRIFT_FACTOR standard errors; the structure and sensor model disagrees with the
+# records when the inverse identification's sensor misfit exceeds RESIDUAL_FACTOR standard errors; the
+# normal contact is not elastic when the best elastic normal law leaves more than NORMAL_LIMIT of N
+DRIFT_FACTOR = 8.0
+RESIDUAL_FACTOR = 20.0
+NORMAL_LIMIT = 0.35
+OPEN_LIMIT = 0.02  # the contact is taken as open where the identified N is below this fraction of N0
+
+
+def _place(summary, stage, id_res, scatter, records, H) -> tuple[str, str]:
+    drift = np.array([v["z"] for v in summary["drift"].values()])
+    if np.median(drift) > DRIFT_FACTOR:
+        change = np.median([v["change"] for v in summary["drift"].values()])
+        return "non_stationary", (f"the records' harmonics drift by {change:.2g} over a record "
+                                  f"({np.median(drift):.0f} standard errors)")
+    if np.median(id_res / scatter) > RESIDUAL_FACTOR:
+        return "structure_or_measurement", (f"the linear structure and sensor model cannot fit the records at w "
+                                            f"and 3w (sensor misfit {np.median(id_res):.2g}, "
+                                            f"{np.median(id_res / scatter):.0f} x the scatter)")
+    if stage["open_fraction"] > 0:
+        return "normal_contact", (f"the identified normal force falls to zero over {stage['open_fraction']:.0%} of the "
+                                  "cycle in the hardest load case: the contact opens")
+    if stage["contact_force_N"] > NORMAL_LIMIT:
+        return "normal_contact", (f"no elastic normal law fits the identified N(eta): {stage['contact_force_N']:.0%} "
+                                  "of N is left (dissipation or opening in the normal direction)")
+    return "tangential_contact", (f"structure, sensors and normal contact are consistent with the records; the "
+                                  f"friction law leaves {stage['contact_force_S']:.1%} of S")
 
 
 def linear_stage(model: IdentifiedModel, frf: xr.Dataset, modal: xr.Dataset) -> dict:

@@ -42,7 +42,8 @@ def identify(cfg: Mapping, raw_random: xr.Dataset, raw_calibration: xr.Dataset, 
     model = identified_model(cfg["structure"], modes, modal, unfitted, n_modes=n_modes)
     rec = record_harmonics(raw_calibration, "calibration", K)
     forces = identified_forces(model, NONE, rec)
-    fit = fit_friction_law(forces.xi, forces.N_dyn, forces.S, rec.f0, model.preload, settings, int(cfg["seed"]), K)
+    fit = fit_friction_law(forces.xi, forces.N_dyn, forces.S, rec.f0, model.preload, settings, int(cfg["seed"]), K,
+                           intervals=False)
     return model.with_friction(fit.params), modes, modal, frf
 
 
