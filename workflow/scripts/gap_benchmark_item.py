@@ -2,12 +2,15 @@
 
 import json
 
+import numba
+
 from contactid.gap.benchmark import run_item
 from contactid.gap.output import _clean
 from contactid.io import write_text
 from contactid.logs import setup_logging
 
 log = setup_logging(snakemake.log[0])
+numba.set_num_threads(max(1, min(int(snakemake.threads), numba.config.NUMBA_NUM_THREADS)))
 row = run_item(snakemake.params.spec, snakemake.params.config)
 row["item"] = snakemake.wildcards.item
 write_text(snakemake.output.item, json.dumps(_clean(row), indent=2))
