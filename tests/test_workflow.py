@@ -21,6 +21,8 @@ def make_project(tmp: Path, overrides: dict | None = None) -> Path:
     shutil.copytree(ROOT / "paper", tmp / "paper")
     (tmp / "config").mkdir()
     cfg = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
+    # the blind gap benchmark (about 45 min) stays out of the tests' report; tests/test_gap.py checks the diagnosis
+    cfg["gap_benchmark"]["in_report"] = False
     for dotted, value in (overrides or {}).items():
         d = cfg
         *head, last = dotted.split(".")
@@ -263,3 +265,36 @@ def test_changed_package_code_reruns_what_it_computed(default_run):
     again = snakemake(default_run, "-n", "--quiet", "rules")
     # with the code restored, nothing upstream of the fit is planned (an earlier test changed a fit setting)
     assert "rig_random_test" not in again.stdout and "contact_forces" not in again.stdout
+
+
+def test_gap_diagnosis_of_default_data_names_no_effect(default_run):
+    d = json.loads((default_run / "results" / "gap" / "diagnosis.json").read_text())
+    assert d["verdict"] == "none", d["reason"]  # effect-free rig data: no false alarm
+    assert {"verdict", "ranking", "where"} <= set(d)
+    assert {r["effect"] for r in d["ranking"]} == {"structural_damping", "normal_contact_damping", "viscous_friction",
+                                                   "multi_asperity_friction", "transducer_mass_error",
+                                                   "channel_time_skew", "contact_separation", "preload_drift"}
+    for r in d["ranking"]:
+        assert {"effect", "heldout_gap_before", "heldout_gap_after", "score"} <= set(r)
+        assert r["heldout_gap_after"] > 0.5 * r["heldout_gap_before"]  # nothing explains what is not there
+    assert d["where"]["heldout_gap_before"] < 0.01  # the identified model reproduces the held-out records
+    assert d["where"]["place"] == "tangential_contact"
+    for view in ("stages", "harmonics", "cycle", "force_state", "ranking"):
+        assert (default_run / "results" / "gap" / f"gap_{view}.png").stat().st_size > 10000
+    tex = (default_run / "results" / "report" / "gap.tex").read_text()
+    assert "Verdict" in tex and "not built with this report" in tex
+
+
+def test_gap_runs_on_a_directory_of_raw_files_alone(default_run, tmp_path):
+    (tmp_path / "measured").mkdir()
+    for f in ("random_test", "lc1", "lc2", "lc3"):
+        shutil.copy(default_run / "data" / "raw" / f"{f}.nc", tmp_path / "measured" / f"{f}.nc")
+    proj = make_project(tmp_path / "proj" if (tmp_path / "proj").mkdir() is None else None, {
+        "random_test.source": "measured", "random_test.file": str(tmp_path / "measured" / "random_test.nc"),
+        "load_cases": {c: {"source": "measured", "file": str(tmp_path / "measured" / f"{c}.nc")} for c in ("lc1", "lc2", "lc3")},
+        "gap.candidates": ["viscous_friction"]})
+    res = snakemake(proj, "gap")
+    assert res.returncode == 0, res.stderr[-3000:]
+    assert not (proj / "data").exists()  # nothing from the rig
+    d = json.loads((proj / "results" / "gap" / "diagnosis.json").read_text())
+    assert d["verdict"] == "none" and [r["effect"] for r in d["ranking"]] == ["viscous_friction"]

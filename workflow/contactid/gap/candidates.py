@@ -82,9 +82,9 @@ register(Candidate("channel_time_skew", "each accelerometer channel late on the 
                    (Parameter("delay", "s", -2.0e-4, 2.0e-4),),
                    lambda th: Augmentation(delays=tuple(float(x) for x in th)), per_channel=True))
 register(Candidate("contact_separation", "unilateral hardening normal contact N0 ((delta0 - eta)/delta0)^p that opens "
-                   "(instead of Eq. 13's linear spring)",
-                   (Parameter("exponent", "1", 1.0, 3.0),),
-                   lambda th: Augmentation(unilateral_exponent=float(th[0]))))
+                   "(instead of Eq. 13's linear spring), delta0 = p N0 / (c k_n)",
+                   (Parameter("exponent", "1", 1.0, 3.0), Parameter("stiffness_factor", "1", 0.3, 3.0)),
+                   lambda th: Augmentation(unilateral_exponent=float(th[0]), normal_stiffness_factor=float(th[1]))))
 register(Candidate("preload_drift", "static normal preload drifting linearly over each record",
                    (Parameter("relative_drift", "1", -0.5, 0.5),),
                    lambda th: Augmentation(preload_drift=float(th[0]))))

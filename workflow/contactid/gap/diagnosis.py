@@ -3,7 +3,7 @@ candidate library, and its shrinkage with uncertainty.
 
 Settings (config ``gap``): the harmonics compared, the candidates, the thresholds of the verdict
 and the bootstrap. The verdict names the best candidate only when (1) the held-out gap before is
-above the records' own scatter, (2) the candidate shrinks the held-out gap by at least
+above ``min_gap`` and the records' own scatter, (2) the candidate shrinks the held-out gap by at least
 ``min_reduction`` with the bootstrap's lower bound above zero, and (3) it beats the runner-up's
 held-out gap by the factor ``separation``; otherwise the verdict is "none" and the localisation
 says where the gap lies.
@@ -33,7 +33,8 @@ log = logging.getLogger(__name__)
 @dataclass(frozen=True)
 class GapSettings:
     """n_harmonics: harmonics compared (gap); identification_harmonics: K of the inverse
-    identification; candidates: names (None = the whole library); min_reduction: the held-out gap
+    identification; candidates: names (None = the whole library); min_gap: a held-out gap below this
+    (relative) is what the chain's own identification leaves and is not explained; min_reduction: the held-out gap
     must shrink at least this much (relative) for a verdict; separation: the winner's held-out gap
     must be at least this factor below the runner-up's; noise_factor: the gap before must exceed this
     many bootstrap standard deviations of the records' scatter; n_bootstrap: resamples of the
@@ -42,6 +43,7 @@ class GapSettings:
     n_harmonics: int = 9
     identification_harmonics: int = 25
     candidates: tuple | None = None
+    min_gap: float = 0.006
     min_reduction: float = 0.3
     separation: float = 1.5
     noise_factor: float = 3.0
@@ -60,6 +62,7 @@ class GapSettings:
                 raise ValueError(f"gap.candidates: unknown {unknown}; the library has {', '.join(LIBRARY)}")
         s = cls(n_harmonics=int(g.get("n_harmonics", d.n_harmonics)), identification_harmonics=int(n_harmonics_id),
                 candidates=tuple(cands) if cands is not None else None,
+                min_gap=float(g.get("min_gap", d.min_gap)),
                 min_reduction=float(g.get("min_reduction", d.min_reduction)),
                 separation=float(g.get("separation", d.separation)), noise_factor=float(g.get("noise_factor", d.noise_factor)),
                 n_bootstrap=int(g.get("n_bootstrap", d.n_bootstrap)), seed=int(seed),
@@ -373,12 +376,14 @@ def diagnose(model: IdentifiedModel, records: Mapping[str, RecordHarmonics], cal
     for name, (cal, sims, res) in results.items():
         after = heldout_gap(sims)
         after_b = np.array([heldout_gap(sims, b) for b in range(settings.n_bootstrap)])
+        if not np.isfinite(after):  # a held-out prediction diverged: the candidate explains nothing
+            after, after_b = np.inf, np.full(settings.n_bootstrap, np.inf)
         boots[name] = after_b
         k = LIBRARY[name].n_parameters(len(records[cases[0]].sensors))
-        score = n_data * np.log(after**2 / before**2) + 2 * k
+        score = n_data * np.log(after**2 / before**2) + 2 * k if np.isfinite(after) else np.inf
         red_b = 1 - after_b / before_b
         rows.append({"effect": name, "heldout_gap_before": before, "heldout_gap_after": after, "score": float(score),
-                     "reduction": 1 - after / before, "reduction_interval": [float(np.percentile(red_b, 2.5)),
+                     "reduction": 1 - after / before if np.isfinite(after) else -np.inf, "reduction_interval": [float(np.percentile(red_b, 2.5)),
                                                                             float(np.percentile(red_b, 97.5))],
                      "heldout_gap_after_interval": [float(np.percentile(after_b, 2.5)), float(np.percentile(after_b, 97.5))],
                      "n_parameters": k, "parameters": {p.name if not LIBRARY[name].per_channel else f"{p.name}_{i}": float(v)
@@ -392,7 +397,11 @@ def diagnose(model: IdentifiedModel, records: Mapping[str, RecordHarmonics], cal
     if rows:
         best = rows[0]
         second = rows[1] if len(rows) > 1 else None
-        if before < settings.noise_factor * scatter:
+        if before < settings.min_gap:
+            reason = (f"the held-out gap {before:.3g} is below gap.min_gap = {settings.min_gap:g}: the identified model "
+                      f"reproduces the records as well as the chain's own identification allows (best candidate "
+                      f"{best['effect']}: {best['reduction']:.1%})")
+        elif before < settings.noise_factor * scatter:
             reason = f"the held-out gap {before:.3g} is within {settings.noise_factor} x the records' scatter {scatter:.2g}"
         elif best["reduction"] < settings.min_reduction or best["reduction_interval"][0] <= 0:
             reason = (f"no candidate shrinks the held-out gap by {settings.min_reduction:.0%} (best: {best['effect']}, "

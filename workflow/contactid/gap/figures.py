@@ -96,7 +96,7 @@ def ranking(diag: dict, path: str):
         ax.axvline(100 * rows[0]["heldout_gap_before"], color="k", ls="--", label="identified model (before)")
     ax.set_yticks(y, names)
     ax.invert_yaxis()
-    ax.set_xscale("log")
+    ax.set_xlim(0, 1.15 * max(hi.max() if len(hi) else 1.0, 100 * rows[0]["heldout_gap_before"] if rows else 1.0))
     ax.set_xlabel("held-out gap (%)")
     ax.set_title(f"Candidates ranked; verdict: {diag['verdict']}")
     ax.legend(fontsize=7)

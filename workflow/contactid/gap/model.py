@@ -35,7 +35,8 @@ class Augmentation:
     tangential contact carried by a Maxwell-slip (Iwan) element; mass_error: relative error of
     every transducer mass; delays: (j,) s, acceleration channels late on the force;
     unilateral_exponent: 0 = the linear bilateral spring N0 - k_n eta, p >= 1 = the unilateral
-    power law N0 ((delta0 - eta)/delta0)^p with delta0 = p N0 / k_n (the contact may open);
+    power law N0 ((delta0 - eta)/delta0)^p with delta0 = p N0 / (c k_n) (the contact may open), c the
+    normal_stiffness_factor on the linear chain's k_n (poorly determined by frequencies);
     preload_drift: relative change of the preload over the record.
     """
 
@@ -46,6 +47,7 @@ class Augmentation:
     mass_error: float = 0.0
     delays: tuple = ()
     unilateral_exponent: float = 0.0
+    normal_stiffness_factor: float = 1.0
     preload_drift: float = 0.0
 
     def merge(self, other: "Augmentation") -> "Augmentation":
@@ -136,7 +138,7 @@ def simulator(model: IdentifiedModel, aug: Augmentation, fs: float, f0: float | 
     for k, idx in enumerate(beam):
         zeta[idx] = model.damping[min(k, len(model.damping) - 1)]
     zeta[red.beam_mode] += aug.extra_damping
-    k_n = red.k_n
+    k_n = red.k_n * aug.normal_stiffness_factor
     p = aug.unilateral_exponent if aug.unilateral_exponent >= 1.0 else 1.0
     contact = ContactParameters(friction=tuple(model.friction), preload=model.preload,
                                 static_approach=p * model.preload / k_n, exponent=p,
@@ -197,9 +199,13 @@ def simulate(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, re
     H = rec.acceleration.shape[1]
     coef = rec.force[:force_harmonics].copy()
     sim.start_from_linear(coef, None, w)
-    _, _, settled = sim.settle(coef, None, w, tol=tol, max_chunks=60)
+    _, _, settled = sim.settle(coef, None, w, tol=tol, max_chunks=30)
     n_per = int(round(2 * np.pi / w / sim.dt))
     first = last = None
+    if not settled and not aug.preload_drift:
+        # the motion does not settle (impacts): average over as many periods as the record holds, as the
+        # record's harmonics do
+        record_periods = max(int(record_periods), rec.periods)
     if aug.preload_drift:
         n_rec = rec.periods * n_per
         sim.drift_t0 = sim.t

@@ -200,7 +200,10 @@ def calibrate(model: IdentifiedModel, cand: Candidate, rec: RecordHarmonics, set
             n_eval += 1
             aug = cand.augmentation(np.atleast_1d(theta))
             try:
-                cache[key] = (*evaluate(model, aug, rec, bounds, n_harmonics), aug)
+                out = evaluate(model, aug, rec, bounds, n_harmonics)
+                if not np.isfinite(out[0]):
+                    raise FloatingPointError("the simulation diverged")
+                cache[key] = (*out, aug)
             except (ValueError, FloatingPointError) as exc:  # e.g. the law is undefined there
                 log.info("%s at %s: %s", cand.name, theta, exc)
                 cache[key] = (np.inf, model, None, np.nan, aug)
@@ -234,10 +237,17 @@ def calibrate(model: IdentifiedModel, cand: Candidate, rec: RecordHarmonics, set
 
         lo = np.array([p.low for p in cand.parameters])
         hi = np.array([p.high for p in cand.parameters])
-        res = minimize(lambda x: run(lo + x * (hi - lo))[0], np.full(lo.size, 0.5), method="Nelder-Mead",
-                       options={"maxfev": max_evaluations * lo.size, "xatol": 1e-3})
+        x0 = np.full(lo.size, 0.5)
+        simplex = np.vstack([x0, x0 + 0.25 * np.eye(lo.size)])
+        res = minimize(lambda x: run(lo + np.clip(x, 0, 1) * (hi - lo))[0], x0, method="Nelder-Mead",
+                       options={"initial_simplex": simplex, "maxfev": max_evaluations * lo.size, "xatol": 1e-3,
+                                "fatol": 1e-6})
         theta = lo + np.clip(res.x, 0, 1) * (hi - lo)
     g, m2, sim, misfit, aug = run(theta)
+    if not np.isfinite(g):  # nothing in the range could be simulated: the effect off
+        theta = np.array([0.0 if p.low <= 0.0 <= p.high else p.low for p in cand.parameters]) \
+            if not cand.per_channel else np.zeros_like(np.atleast_1d(theta))
+        g, m2, sim, misfit, aug = run(theta)
     return Calibration(cand.name, np.atleast_1d(theta), np.asarray(m2.friction), g, m2, aug, n_eval, misfit)
 
 
