@@ -279,7 +279,7 @@ def test_gap_diagnosis_of_default_data_names_no_effect(default_run):
         assert r["heldout_gap_after"] > 0.5 * r["heldout_gap_before"]  # nothing explains what is not there
     assert d["where"]["heldout_gap_before"] < 0.01  # the identified model reproduces the held-out records
     assert d["where"]["place"] == "tangential_contact"
-    for view in ("stages", "harmonics", "cycle", "force_state", "ranking"):
+    for view in ("stages", "harmonics", "cycle", "force_state", "ranking", "shrink"):
         assert (default_run / "results" / "gap" / f"gap_{view}.png").stat().st_size > 10000
     tex = (default_run / "results" / "report" / "gap.tex").read_text()
     assert "Verdict" in tex and "not built with this report" in tex

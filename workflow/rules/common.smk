@@ -128,7 +128,7 @@ def gap_inputs(wildcards):
 
 def gap_outputs():
     return ["results/gap/diagnosis.json", "results/gap/gap.nc"] + [
-        f"results/gap/gap_{v}.png" for v in ("stages", "harmonics", "cycle", "force_state", "ranking")]
+        f"results/gap/gap_{v}.png" for v in ("stages", "harmonics", "cycle", "force_state", "ranking", "shrink")]
 
 
 def benchmark_base_config():

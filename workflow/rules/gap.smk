@@ -46,6 +46,7 @@ rule gap_figures:
         cycle=report("results/gap/gap_cycle.png", caption="../report/gap.rst", category="Gap diagnosis"),
         force_state=report("results/gap/gap_force_state.png", caption="../report/gap.rst", category="Gap diagnosis"),
         ranking=report("results/gap/gap_ranking.png", caption="../report/gap.rst", category="Gap diagnosis"),
+        shrink=report("results/gap/gap_shrink.png", caption="../report/gap.rst", category="Gap diagnosis"),
     params:
         code=CODE_DIGEST,
     conda:

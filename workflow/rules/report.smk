@@ -32,7 +32,10 @@ rule report:
         tex="paper/report.tex",
         fragments=rules.report_fragments.output,
         gap="results/report/gap.tex",
-        gap_figures=[f"results/gap/gap_{v}.png" for v in ("stages", "harmonics", "cycle", "ranking")],
+        gap_figures=[
+            f"results/gap/gap_{v}.png"
+            for v in ("stages", "harmonics", "cycle", "ranking", "shrink", "force_state")
+        ],
         benchmark_figure=(
             ["results/gap_benchmark/confusion.png"]
             if config.get("gap_benchmark", {}).get("in_report", True)

@@ -203,6 +203,8 @@ def localise(model: IdentifiedModel, records: dict, sims: dict, n_harmonics: int
         "load_exponent": slope,
         "drift": {c: dict(zip(("change", "z"), record_drift(records[c], H))) for c in cases},
     }
+    summary["identification_residual"] = {c: v for c, v in zip(cases, id_res)}
+    summary["identification_noise"] = {c: v for c, v in zip(cases, scatter)}
     summary["place"], summary["place_reason"] = _place(summary, stage, np.array(id_res), np.array(scatter),
                                                        records, H)
     return summary, arrays
@@ -306,10 +308,42 @@ class Diagnosis:
     heldout_cases: list
     arrays: dict = field(default_factory=dict)
     sims: dict = field(default_factory=dict)
+    shrink: dict = field(default_factory=dict)
 
     def summary(self) -> dict:
         return {"verdict": self.verdict, "reason": self.reason, "ranking": self.ranking, "where": self.where,
-                "calibration_case": self.calibration_case, "heldout_cases": self.heldout_cases}
+                "shrink": self.shrink, "calibration_case": self.calibration_case, "heldout_cases": self.heldout_cases}
+
+
+def shrink_views(records, cases, before_sims, after_sims, boot, H) -> dict:
+    """Held-out gap before and after, per load case (with bootstrap 95 % intervals over record blocks),
+    per harmonic and per sensor."""
+    out = {"by_case": {}, "by_harmonic": {}, "by_sensor": {}}
+    num_h = {"before": 0.0, "after": 0.0}
+    sensors = records[cases[0]].sensors
+    by_h = {k: np.zeros(H) for k in ("before", "after")}
+    by_s = {k: np.zeros(len(sensors)) for k in ("before", "after")}
+    den_h, den_s = np.zeros(H), np.zeros(len(sensors))
+    for c in cases:
+        A = records[c].acceleration[:, :H]
+        row = {}
+        for key, sims in (("before", before_sims), ("after", after_sims)):
+            As = sims[c].acceleration[:, :H]
+            row[key] = _rel(As, A)
+            Ab = boot[c]
+            vals = np.linalg.norm((As[None] - Ab).reshape(Ab.shape[0], -1), axis=1) / np.linalg.norm(A)
+            row[f"{key}_interval"] = [float(np.percentile(vals, 2.5)), float(np.percentile(vals, 97.5))]
+            by_h[key] += np.sum(np.abs(As - A) ** 2, axis=0)
+            by_s[key] += np.sum(np.abs(As - A) ** 2, axis=1)
+            num_h[key] += 1
+        den_h += np.sum(np.abs(A) ** 2, axis=0)
+        den_s += np.sum(np.abs(A) ** 2, axis=1)
+        out["by_case"][c] = row
+    total = np.sum(den_h)
+    for key in ("before", "after"):
+        out["by_harmonic"][key] = [float(np.sqrt(v / total)) for v in by_h[key]]
+        out["by_sensor"][key] = {s: float(np.sqrt(v / d)) for s, v, d in zip(sensors, by_s[key], den_s)}
+    return out
 
 
 def _bootstrap_records(rec: RecordHarmonics, rng, n: int, H: int) -> np.ndarray:
@@ -380,6 +414,11 @@ def diagnose(model: IdentifiedModel, records: Mapping[str, RecordHarmonics], cal
             after, after_b = np.inf, np.full(settings.n_bootstrap, np.inf)
         boots[name] = after_b
         k = LIBRARY[name].n_parameters(len(records[cases[0]].sensors))
+        # does the candidate make the structure and sensor model consistent with the calibration record?
+        res_after = float(np.sqrt(np.mean(identified_forces(cal.model, cal.augmentation,
+                                                            records[calibration_case]).residual[[0, 2]] ** 2)))
+        noise = where["identification_noise"][calibration_case]
+        consistent = where["place"] != "structure_or_measurement" or res_after < RESIDUAL_FACTOR * noise
         score = n_data * np.log(after**2 / before**2) + 2 * k if np.isfinite(after) else np.inf
         red_b = 1 - after_b / before_b
         rows.append({"effect": name, "heldout_gap_before": before, "heldout_gap_after": after, "score": float(score),
@@ -390,13 +429,18 @@ def diagnose(model: IdentifiedModel, records: Mapping[str, RecordHarmonics], cal
                                                        for i, (p, v) in enumerate(zip(LIBRARY[name].parameters * len(cal.theta), cal.theta))},
                      "calibration_gap": cal.gap, "friction": [float(x) for x in cal.friction],
                      "heldout_gap_after_by_case": {c: gap_value(r) for c, r in res.items()},
+                     "identification_residual_after": res_after, "consistent": bool(consistent),
                      "evaluations": cal.evaluations})
     rows.sort(key=lambda r: r["score"])
     scatter = float(np.std(before_b))
     verdict, reason = "none", ""
-    if rows:
-        best = rows[0]
-        second = rows[1] if len(rows) > 1 else None
+    eligible = [r for r in rows if r["consistent"]]
+    if rows and not eligible:
+        reason = (f"the records disagree with the structure and sensor model (place {where['place']}) and no candidate "
+                  f"removes that misfit (best by score: {rows[0]['effect']}, {rows[0]['reduction']:.1%})")
+    elif rows:
+        best = eligible[0]
+        second = next((r for r in rows if r is not best), None)
         if before < settings.min_gap:
             reason = (f"the held-out gap {before:.3g} is below gap.min_gap = {settings.min_gap:g}: the identified model "
                       f"reproduces the records as well as the chain's own identification allows (best candidate "
@@ -415,9 +459,13 @@ def diagnose(model: IdentifiedModel, records: Mapping[str, RecordHarmonics], cal
             reason = (f"{best['effect']} shrinks the held-out gap from {before:.3g} to {best['heldout_gap_after']:.3g} "
                       f"({best['reduction']:.1%}); runner-up {second['effect'] if second else '-'} "
                       f"{second['heldout_gap_after'] if second else float('nan'):.3g}; bootstrap P(better) {p_better:.2f}")
+    shrink = {}
+    for label, r in zip(("winner", "runner_up"), rows[:2]):
+        shrink[label] = {"effect": r["effect"],
+                         **shrink_views(records, score_cases, base_sims, results[r["effect"]][1], boot, H)}
     where["heldout_gap_before"] = before
     where["heldout_gap_before_interval"] = [float(np.percentile(before_b, 2.5)), float(np.percentile(before_b, 97.5))]
     where["record_scatter"] = scatter
     diag = Diagnosis(verdict, reason, rows, where, calibration_case, held, arrays,
-                     {"base": base_sims, **{n: r[1] for n, r in results.items()}})
+                     {"base": base_sims, **{n: r[1] for n, r in results.items()}}, shrink)
     return diag

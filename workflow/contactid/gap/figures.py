@@ -103,6 +103,41 @@ def ranking(diag: dict, path: str):
     _save(fig, path)
 
 
+def shrink(diag: dict, path: str):
+    """Held-out gap before and after for the winner and the runner-up, per load case and per harmonic."""
+    fig, axes = plt.subplots(1, 2, figsize=(9, 3.4))
+    sh = diag.get("shrink", {})
+    cases = list(next(iter(sh.values()))["by_case"]) if sh else []
+    x = np.arange(len(cases))
+    first = True
+    for i, (label, v) in enumerate(sh.items()):
+        bc = v["by_case"]
+        if first:
+            b = np.array([100 * bc[c]["before"] for c in cases])
+            axes[0].bar(x - 0.27, b, 0.27, color="0.6", label="identified model")
+            first = False
+        a = np.array([100 * bc[c]["after"] for c in cases])
+        lo = np.array([100 * bc[c]["after_interval"][0] for c in cases])
+        hi = np.array([100 * bc[c]["after_interval"][1] for c in cases])
+        axes[0].bar(x + 0.27 * i, a, 0.27, yerr=[np.maximum(a - lo, 0), np.maximum(hi - a, 0)],
+                    label=f"+ {v['effect']} ({label.replace('_', '-')})")
+        axes[1].semilogy(np.arange(1, len(v["by_harmonic"]["after"]) + 1), 100 * np.array(v["by_harmonic"]["after"]),
+                         "o-", label=f"+ {v['effect']}")
+    if sh:
+        v = next(iter(sh.values()))
+        axes[1].semilogy(np.arange(1, len(v["by_harmonic"]["before"]) + 1), 100 * np.array(v["by_harmonic"]["before"]),
+                         "s--", color="0.4", label="identified model")
+    axes[0].set_xticks(x, cases)
+    axes[0].set_ylabel("held-out gap (%)")
+    axes[0].set_title("before and after, per held-out case (95 % bootstrap)")
+    axes[0].legend(fontsize=7)
+    axes[1].set_xlabel("harmonic")
+    axes[1].set_ylabel("residual / |A| (%)")
+    axes[1].set_title("per harmonic (held-out cases)")
+    axes[1].legend(fontsize=7)
+    _save(fig, path)
+
+
 def all_figures(diagnosis_path: str, gap_path: str, out: dict):
     diag = json.load(open(diagnosis_path))
     ds = xr.open_dataset(gap_path, engine="netcdf4")
@@ -111,4 +146,5 @@ def all_figures(diagnosis_path: str, gap_path: str, out: dict):
     cycle(ds, out["cycle"])
     force_state(ds, out["force_state"])
     ranking(diag, out["ranking"])
+    shrink(diag, out["shrink"])
     ds.close()

@@ -55,8 +55,11 @@ def gap_section(diag: dict, bench: dict | None) -> str:
             "\\includegraphics[width=0.49\\textwidth]{gap_ranking.png}\n"
             "\\includegraphics[width=0.49\\textwidth]{gap_harmonics.png}"
             "\\includegraphics[width=0.49\\textwidth]{gap_cycle.png}\n"
+            "\\includegraphics[width=0.49\\textwidth]{gap_shrink.png}"
+            "\\includegraphics[width=0.49\\textwidth]{gap_force_state.png}\n"
             "\\caption{The gap by stage, the candidates ranked, by harmonic and sensor, by part of the cycle and "
-            "dissipation in each direction.}\\label{fig:gap}\\end{figure}\n")
+            "dissipation in each direction, the held-out gap before and after the two best candidates, and the residual "
+            "force-state maps.}\\label{fig:gap}\\end{figure}\n")
     if bench is None:
         out += ("\n\\paragraph{Blind benchmark.} Not built with this report (\\texttt{gap\\_benchmark.in\\_report: "
                 "false}); run \\texttt{snakemake gap\\_benchmark}.\n")
