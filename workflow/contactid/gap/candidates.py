@@ -34,18 +34,22 @@ class Parameter:
 @dataclass(frozen=True)
 class Candidate:
     """A candidate effect: name, what it models, its parameters and theta -> Augmentation.
-    ``per_channel``: the one parameter is repeated for every accelerometer channel."""
+    ``per_channel``: the one parameter is repeated for every accelerometer channel. ``acts_on``: the
+    place of the gap it can explain (one of PLACES, or "any"): a winner must act where the
+    localisation puts the gap."""
 
     name: str
     meaning: str
     parameters: tuple
     augmentation: Callable[[np.ndarray], Augmentation]
     per_channel: bool = False
+    acts_on: str = "any"
 
     def n_parameters(self, n_channels: int) -> int:
         return n_channels if self.per_channel else len(self.parameters)
 
 
+PLACES = ("structure_or_measurement", "normal_contact", "tangential_contact", "non_stationary")
 LIBRARY: dict[str, Candidate] = {}
 
 
@@ -55,6 +59,9 @@ def register(candidate: Candidate) -> Candidate:
         raise ValueError(f"gap candidate {candidate.name!r}: the name is taken; choose another")
     if not candidate.parameters:
         raise ValueError(f"gap candidate {candidate.name!r}: give at least one parameter")
+    if candidate.acts_on not in (*PLACES, "any"):
+        raise ValueError(f"gap candidate {candidate.name!r}: acts_on = {candidate.acts_on!r}; give one of "
+                         f"{', '.join(PLACES)} or 'any'")
     for p in candidate.parameters:
         if not p.low < p.high:
             raise ValueError(f"gap candidate {candidate.name!r}, parameter {p.name}: low must be below high")
@@ -64,30 +71,32 @@ def register(candidate: Candidate) -> Candidate:
 
 register(Candidate("structural_damping", "extra modal damping of the beam's modes at test level",
                    (Parameter("extra_damping_ratio", "1", 0.0, 0.05),),
-                   lambda th: Augmentation(extra_damping=float(th[0]))))
+                   lambda th: Augmentation(extra_damping=float(th[0])), acts_on="structure_or_measurement"))
 register(Candidate("normal_contact_damping", "Hunt-Crossley damping of the normal contact, N (1 - alpha deta/dt)",
                    (Parameter("alpha", "s/m", 0.0, 3000.0),),
-                   lambda th: Augmentation(hunt_crossley=float(th[0]))))
+                   lambda th: Augmentation(hunt_crossley=float(th[0])), acts_on="normal_contact"))
 register(Candidate("viscous_friction", "velocity-dependent friction, S + sigma_2 dxi/dt",
                    (Parameter("sigma_2", "N s/m", 0.0, 3000.0),),
-                   lambda th: Augmentation(viscous=float(th[0]))))
+                   lambda th: Augmentation(viscous=float(th[0])), acts_on="tangential_contact"))
 register(Candidate("multi_asperity_friction", "share of the tangential contact carried by a 16-slider Iwan element "
                    "(internal hysteresis loops)",
                    (Parameter("iwan_share", "1", 0.0, 1.0),),
-                   lambda th: Augmentation(iwan_share=float(th[0]))))
+                   lambda th: Augmentation(iwan_share=float(th[0])), acts_on="tangential_contact"))
 register(Candidate("transducer_mass_error", "every transducer mass wrong by the same factor 1 + m",
                    (Parameter("mass_error", "1", -0.9, 3.0),),
-                   lambda th: Augmentation(mass_error=float(th[0]))))
+                   lambda th: Augmentation(mass_error=float(th[0])), acts_on="structure_or_measurement"))
 register(Candidate("channel_time_skew", "each accelerometer channel late on the force by its own delay",
                    (Parameter("delay", "s", -2.0e-4, 2.0e-4),),
-                   lambda th: Augmentation(delays=tuple(float(x) for x in th)), per_channel=True))
+                   lambda th: Augmentation(delays=tuple(float(x) for x in th)), per_channel=True,
+                   acts_on="structure_or_measurement"))
 register(Candidate("contact_separation", "unilateral hardening normal contact N0 ((delta0 - eta)/delta0)^p that opens "
                    "(instead of Eq. 13's linear spring), delta0 = p N0 / (c k_n)",
                    (Parameter("exponent", "1", 1.0, 3.0), Parameter("stiffness_factor", "1", 0.3, 3.0)),
-                   lambda th: Augmentation(unilateral_exponent=float(th[0]), normal_stiffness_factor=float(th[1]))))
+                   lambda th: Augmentation(unilateral_exponent=float(th[0]), normal_stiffness_factor=float(th[1])),
+                   acts_on="normal_contact"))
 register(Candidate("preload_drift", "static normal preload drifting linearly over each record",
                    (Parameter("relative_drift", "1", -0.5, 0.5),),
-                   lambda th: Augmentation(preload_drift=float(th[0]))))
+                   lambda th: Augmentation(preload_drift=float(th[0])), acts_on="non_stationary"))
 
 BUILTIN = tuple(LIBRARY)
 

@@ -247,7 +247,7 @@ def identification_noise(model: IdentifiedModel, rec: RecordHarmonics) -> float:
 # normal contact is not elastic when the best elastic normal law leaves more than NORMAL_LIMIT of N
 DRIFT_FACTOR = 8.0
 RESIDUAL_FACTOR = 20.0
-NORMAL_LIMIT = 0.35
+NORMAL_LIMIT = 0.25
 OPEN_LIMIT = 0.02  # the contact is taken as open where the identified N is below this fraction of N0
 
 
@@ -418,7 +418,9 @@ def diagnose(model: IdentifiedModel, records: Mapping[str, RecordHarmonics], cal
         res_after = float(np.sqrt(np.mean(identified_forces(cal.model, cal.augmentation,
                                                             records[calibration_case]).residual[[0, 2]] ** 2)))
         noise = where["identification_noise"][calibration_case]
-        consistent = where["place"] != "structure_or_measurement" or res_after < RESIDUAL_FACTOR * noise
+        acts_on = LIBRARY[name].acts_on
+        consistent = (acts_on in ("any", where["place"])
+                      and (where["place"] != "structure_or_measurement" or res_after < RESIDUAL_FACTOR * noise))
         score = n_data * np.log(after**2 / before**2) + 2 * k if np.isfinite(after) else np.inf
         red_b = 1 - after_b / before_b
         rows.append({"effect": name, "heldout_gap_before": before, "heldout_gap_after": after, "score": float(score),
@@ -429,15 +431,15 @@ def diagnose(model: IdentifiedModel, records: Mapping[str, RecordHarmonics], cal
                                                        for i, (p, v) in enumerate(zip(LIBRARY[name].parameters * len(cal.theta), cal.theta))},
                      "calibration_gap": cal.gap, "friction": [float(x) for x in cal.friction],
                      "heldout_gap_after_by_case": {c: gap_value(r) for c, r in res.items()},
-                     "identification_residual_after": res_after, "consistent": bool(consistent),
+                     "identification_residual_after": res_after, "acts_on": acts_on, "consistent": bool(consistent),
                      "evaluations": cal.evaluations})
     rows.sort(key=lambda r: r["score"])
     scatter = float(np.std(before_b))
     verdict, reason = "none", ""
     eligible = [r for r in rows if r["consistent"]]
     if rows and not eligible:
-        reason = (f"the records disagree with the structure and sensor model (place {where['place']}) and no candidate "
-                  f"removes that misfit (best by score: {rows[0]['effect']}, {rows[0]['reduction']:.1%})")
+        reason = (f"the gap lies in {where['place']} and no candidate of the library acts there and explains it "
+                  f"(best by score: {rows[0]['effect']}, acting on {rows[0]['acts_on']}, {rows[0]['reduction']:.1%})")
     elif rows:
         best = eligible[0]
         second = next((r for r in rows if r is not best), None)
