@@ -50,6 +50,8 @@ def test_register_refuses_taken_names_and_bad_ranges():
         register(Candidate("viscous_friction", "dup", (Parameter("x", "1", 0, 1),), lambda th: Augmentation()))
     with pytest.raises(ValueError, match="low must be below high"):
         register(Candidate("my_effect", "bad", (Parameter("x", "1", 1, 0),), lambda th: Augmentation()))
+    with pytest.raises(ValueError, match="acts_on"):
+        register(Candidate("my_effect", "bad", (Parameter("x", "1", 0, 1),), lambda th: Augmentation(), acts_on="rotor"))
     assert "my_effect" not in LIBRARY
 
 
@@ -96,5 +98,6 @@ def test_diagnosis_names_the_hidden_effect_and_the_gap_shrinks(hc_data):
 def test_effect_missing_from_library_gives_none_and_points_at_the_normal_direction(hc_data):
     d = _diagnose(hc_data, ["viscous_friction", "structural_damping"])
     assert d.verdict == "none", d.reason
-    assert d.where["direction"] == "normal"
+    assert d.where["direction"] == "normal" and d.where["place"] == "normal_contact"
+    assert d.ranking[0]["effect"] == "viscous_friction" and d.ranking[0]["reduction"] > 0.3  # helps, acts elsewhere
     assert d.where["heldout_gap_before"] > 0.01  # a real gap, left unexplained

@@ -419,8 +419,11 @@ def diagnose(model: IdentifiedModel, records: Mapping[str, RecordHarmonics], cal
                                                             records[calibration_case]).residual[[0, 2]] ** 2)))
         noise = where["identification_noise"][calibration_case]
         acts_on = LIBRARY[name].acts_on
+        # where the records misfit the structure and sensor model, a winner must at least halve that misfit
+        res_before = where["identification_residual"][calibration_case]
         consistent = (acts_on in ("any", where["place"])
-                      and (where["place"] != "structure_or_measurement" or res_after < RESIDUAL_FACTOR * noise))
+                      and (where["place"] != "structure_or_measurement"
+                           or res_after < max(RESIDUAL_FACTOR * noise, 0.5 * res_before)))
         score = n_data * np.log(after**2 / before**2) + 2 * k if np.isfinite(after) else np.inf
         red_b = 1 - after_b / before_b
         rows.append({"effect": name, "heldout_gap_before": before, "heldout_gap_after": after, "score": float(score),
