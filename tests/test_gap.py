@@ -86,7 +86,7 @@ def _diagnose(data, candidates):
 
 
 def test_diagnosis_names_the_hidden_effect_and_the_gap_shrinks(hc_data):
-    d = _diagnose(hc_data, ["normal_contact_damping", "viscous_friction", "structural_damping"])
+    d = _diagnose(hc_data, ["normal_contact_damping", "viscous_friction"])
     assert d.verdict == "normal_contact_damping", d.reason
     best = d.ranking[0]
     assert best["reduction"] > 0.5
@@ -96,7 +96,7 @@ def test_diagnosis_names_the_hidden_effect_and_the_gap_shrinks(hc_data):
 
 
 def test_effect_missing_from_library_gives_none_and_points_at_the_normal_direction(hc_data):
-    d = _diagnose(hc_data, ["viscous_friction", "structural_damping"])
+    d = _diagnose(hc_data, ["viscous_friction"])
     assert d.verdict == "none", d.reason
     assert d.where["direction"] == "normal" and d.where["place"] == "normal_contact"
     assert d.ranking[0]["effect"] == "viscous_friction" and d.ranking[0]["reduction"] > 0.3  # helps, acts elsewhere
