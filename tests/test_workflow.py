@@ -231,6 +231,24 @@ def test_audit_passes_clean_and_flags_a_hand_edit(default_run, tmp_path):
     assert row["status"] == "flagged" and "edited by hand" in row["problems"]
 
 
+def test_gap_diagnosis_of_default_data_names_no_effect(default_run):
+    d = json.loads((default_run / "results" / "gap" / "diagnosis.json").read_text())
+    assert d["verdict"] == "none", d["reason"]  # effect-free rig data: no false alarm
+    assert {"verdict", "ranking", "where"} <= set(d)
+    assert {r["effect"] for r in d["ranking"]} == {"structural_damping", "normal_contact_damping", "viscous_friction",
+                                                   "multi_asperity_friction", "transducer_mass_error",
+                                                   "channel_time_skew", "contact_separation", "preload_drift"}
+    for r in d["ranking"]:
+        assert {"effect", "heldout_gap_before", "heldout_gap_after", "score"} <= set(r)
+        assert r["heldout_gap_after"] > 0.5 * r["heldout_gap_before"]  # nothing explains what is not there
+    assert d["where"]["heldout_gap_before"] < 0.01  # the identified model reproduces the held-out records
+    assert d["where"]["place"] == "tangential_contact"
+    for view in ("stages", "harmonics", "cycle", "force_state", "ranking", "shrink"):
+        assert (default_run / "results" / "gap" / f"gap_{view}.png").stat().st_size > 10000
+    tex = (default_run / "results" / "report" / "gap.tex").read_text()
+    assert "Verdict" in tex and "Not built with this report" in tex
+
+
 def test_changed_setting_changes_the_pdf_numbers_only_downstream(default_run):
     cfg = yaml.safe_load((default_run / "config" / "config.yaml").read_text())
     cfg["friction"]["generations"] = 15
@@ -266,24 +284,6 @@ def test_changed_package_code_reruns_what_it_computed(default_run):
     again = snakemake(default_run, "-n", "--quiet", "rules")
     # with the code restored, nothing upstream of the fit is planned (an earlier test changed a fit setting)
     assert "rig_random_test" not in again.stdout and "contact_forces" not in again.stdout
-
-
-def test_gap_diagnosis_of_default_data_names_no_effect(default_run):
-    d = json.loads((default_run / "results" / "gap" / "diagnosis.json").read_text())
-    assert d["verdict"] == "none", d["reason"]  # effect-free rig data: no false alarm
-    assert {"verdict", "ranking", "where"} <= set(d)
-    assert {r["effect"] for r in d["ranking"]} == {"structural_damping", "normal_contact_damping", "viscous_friction",
-                                                   "multi_asperity_friction", "transducer_mass_error",
-                                                   "channel_time_skew", "contact_separation", "preload_drift"}
-    for r in d["ranking"]:
-        assert {"effect", "heldout_gap_before", "heldout_gap_after", "score"} <= set(r)
-        assert r["heldout_gap_after"] > 0.5 * r["heldout_gap_before"]  # nothing explains what is not there
-    assert d["where"]["heldout_gap_before"] < 0.01  # the identified model reproduces the held-out records
-    assert d["where"]["place"] == "tangential_contact"
-    for view in ("stages", "harmonics", "cycle", "force_state", "ranking", "shrink"):
-        assert (default_run / "results" / "gap" / f"gap_{view}.png").stat().st_size > 10000
-    tex = (default_run / "results" / "report" / "gap.tex").read_text()
-    assert "Verdict" in tex and "Not built with this report" in tex
 
 
 def test_gap_runs_on_a_directory_of_raw_files_alone(default_run, tmp_path):
