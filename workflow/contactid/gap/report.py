@@ -73,7 +73,7 @@ def gap_section(diag: dict, bench: dict | None) -> str:
             r". With the effect left out of the library (" + str(lo["n"]) + r" data sets) the verdict was ``none'' in " +
             str(lo["verdict_none"]) + r" and the localisation named the right place in " + str(lo["place_right"]) +
             r". Diagnosis time per data set (three load cases): median " + f"${bench['diagnosis_seconds']['median']:.0f}$" +
-            r"\,s.\n")
+            "\\,s.\n")
     acc = pd.DataFrame([{"effect": e, "accuracy": 100 * a} for e, a in bench["per_effect_accuracy"].items()])
     out += tabular(acc, {"effect": "effect", "accuracy": "top-1 (\\%)"}, "Blind benchmark: accuracy per effect.",
                    "tab:bench")
