@@ -101,3 +101,22 @@ def test_effect_missing_from_library_gives_none_and_points_at_the_normal_directi
     assert d.where["direction"] == "normal" and d.where["place"] == "normal_contact"
     assert d.ranking[0]["effect"] == "viscous_friction" and d.ranking[0]["reduction"] > 0.3  # helps, acts elsewhere
     assert d.where["heldout_gap_before"] > 0.01  # a real gap, left unexplained
+
+
+def test_report_section_is_plain_latex_with_and_without_the_benchmark():
+    from contactid.gap.report import gap_section
+
+    stage = {k: 0.01 for k in ("accelerations", "generalized_coordinates", "identification_residual", "contact_force_S",
+                               "contact_force_N", "energy_tangential", "frf_peak_amplitude")}
+    diag = {"calibration_case": "lc1", "verdict": "none", "reason": "no candidate shrinks it by 30%", "ranking": [],
+            "where": {"stage": stage, "heldout_gap_before": 0.02, "heldout_gap_before_interval": [0.019, 0.021],
+                      "record_scatter": 1e-4, "by_harmonic": {1: 0.01, 2: 0.0}, "worst_sensor": "a1", "worst_harmonic": 3,
+                      "even_share": 0.1, "worst_cycle_part": "slip", "place": "tangential_contact",
+                      "place_reason": "the friction law leaves 1% of S"}}
+    bench = {"n_blind": 48, "top1_accuracy": 0.9375, "false_alarms": 0, "n_effect_free": 2,
+             "shrink_of_correct": {"min": 0.83, "median": 0.94}, "leave_out": {"n": 8, "verdict_none": 7, "place_right": 8},
+             "diagnosis_seconds": {"median": 53.0}, "per_effect_accuracy": {"viscous_friction": 1.0}}
+    for text in (gap_section(diag, None), gap_section(diag, bench)):
+        assert "\\n" not in text.replace("\\newcommand", "")  # no literal backslash-n reaches LaTeX
+        assert "30\\%" in text and "tangential\\_contact" in text
+    assert "93.8" in gap_section(diag, bench) and "Not built" in gap_section(diag, None)
