@@ -277,9 +277,5 @@ def inverse_identification(model: FEModel, zeta: np.ndarray, force: np.ndarray, 
     N_dyn = r[1] - p.k_n * eta
     xi_dot = model.xi_vector @ qd - np.einsum("it,ij,jt->t", q, G, qd)
     eta_dot = model.eta_vector @ qd
-    xi_coef = model.xi_vector @ q_coef
-    eta_coef = model.eta_vector @ q_coef
-    S_coef = r_coef[0] + p.k_t * xi_coef
-    N_coef = r_coef[1] - p.k_n * eta_coef
     return InverseResult(S - S.mean(), N_dyn - N_dyn.mean(), xi - xi.mean(), eta - eta.mean(), xi_dot, eta_dot,
-                         S_coef, N_coef, xi_coef, eta_coef, res.residual)
+                         res.S, res.N_dyn, model.xi_vector @ q_coef, res.eta, res.residual)

@@ -19,12 +19,13 @@ import numpy as np
 import xarray as xr
 
 from ..beam_model import all_modes, structural_modes
-from ..friction_fit import FitSettings, periodic_grid
+from ..identification import modal_damping_vector
+from ..friction_fit import FitSettings
 from ..random_streams import generator
 from .candidates import LIBRARY
-from .model import NONE, IdentifiedModel, SimResult, fe_model
+from .model import NONE, IdentifiedModel, fe_model
 from .records import RecordHarmonics
-from .refit import (augmented_zeta, baseline, calibrate, contact_grids, evaluate, gap_residual, gap_value,
+from .refit import (baseline, calibrate, contact_grids, evaluate, gap_residual, gap_value,
                     identified_forces, law_friction_force)
 
 log = logging.getLogger(__name__)
@@ -210,14 +211,6 @@ def localise(model: IdentifiedModel, records: dict, sims: dict, n_harmonics: int
     return summary, arrays
 
 
-def record_scatter(rec: RecordHarmonics, H: int) -> float:
-    """Relative standard error of the record's harmonics 1..H from its blocks: the level a gap or a
-    residual must exceed to be more than the records' own noise."""
-    B = rec.block_acceleration.shape[0]
-    d = rec.block_acceleration[:, :, :H] - rec.acceleration[None, :, :H]
-    return float(np.sqrt(np.mean(np.sum(np.abs(d) ** 2, axis=(1, 2)))) / np.linalg.norm(rec.acceleration[:, :H]) / np.sqrt(B))
-
-
 def record_drift(rec: RecordHarmonics, H: int) -> tuple[float, float]:
     """Linear trend of the block harmonics over the record: (relative change over the record, its size in
     units of its own standard error from the scatter about the trend; about 1 for a stationary record)."""
@@ -276,7 +269,7 @@ def linear_stage(model: IdentifiedModel, frf: xr.Dataset, modal: xr.Dataset) -> 
     the driving-point |H1| at the identified peaks (relative error of the model's accelerance)."""
     fe = fe_model(model)
     modes = all_modes(fe)
-    zeta = augmented_zeta(fe, model.damping, 0.0)
+    zeta = modal_damping_vector(fe, np.asarray(model.damping))
     wn = 2 * np.pi * modes.frequencies_hz
     b = modes.shapes.T @ fe.force_vector
     d = fe.sensor_vectors[0] @ modes.shapes

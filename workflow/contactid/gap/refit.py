@@ -20,7 +20,7 @@ from scipy.optimize import minimize_scalar
 from ..beam_model import all_modes
 from ..friction import valanis_friction_force
 from ..friction_fit import FitSettings, _polish, _Problem, periodic_grid
-from ..identification import InverseHarmonics, inverse_harmonics
+from ..identification import InverseHarmonics, inverse_harmonics, modal_damping_vector
 from ..rig.nonlinear import iwan_slip_weights
 from .candidates import Candidate
 from .model import NONE, Augmentation, IdentifiedModel, SimResult, fe_model, simulate
@@ -56,14 +56,10 @@ def gap_value(residual: np.ndarray) -> float:
 # ------------------------------------------------------------------------------------------
 
 def augmented_zeta(fe, damping, extra: float) -> np.ndarray:
-    """Damping ratio of every FE mode: the identified ratios on the structural modes (by order),
-    the first elsewhere, plus ``extra`` on the structural (beam) modes."""
-    modes = all_modes(fe)
-    zeta = np.full(modes.frequencies_hz.size, damping[0])
-    structural = np.flatnonzero(modes.block_energy_fraction < 0.5)
-    for k, idx in enumerate(structural):
-        zeta[idx] = damping[min(k, len(damping) - 1)]
-    zeta[structural] += extra
+    """Damping ratio of every FE mode (``modal_damping_vector``) plus ``extra`` on the structural (beam) modes."""
+    zeta = modal_damping_vector(fe, np.asarray(damping))
+    if extra:
+        zeta[all_modes(fe).block_energy_fraction < 0.5] += extra
     return zeta
 
 
