@@ -8,7 +8,7 @@ import pytest
 
 from contactid.gap.candidates import LIBRARY, Candidate, Parameter, register
 from contactid.gap.diagnosis import GapSettings, diagnose, linear_stage
-from contactid.gap.model import Augmentation, periodic_harmonics, simulate
+from contactid.gap.model import Augmentation, periodic_harmonics
 from contactid.gap.pipeline import identify, rig_records
 from contactid.gap.records import record_harmonics
 from contactid.io import raw_dataset
@@ -73,7 +73,7 @@ CASES = ["lc1", "lc2", "lc3"]
 def hc_data(default_config):
     """Rig records with Hunt-Crossley normal damping (alpha = 400 s/m), identified by the chain."""
     cfg = copy.deepcopy(default_config)
-    recs = rig_records(cfg, {"normal_contact_damping": 400.0}, 3, CASES)
+    recs, _ = rig_records(cfg, {"normal_contact_damping": 400.0}, 3, CASES)
     model, modes, modal, frf = identify(cfg, recs["random_test"], recs["lc1"])
     records = {c: record_harmonics(recs[c], c, 25) for c in CASES}
     return cfg, model, records, linear_stage(model, frf, modal)

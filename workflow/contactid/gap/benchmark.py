@@ -82,7 +82,7 @@ def run_item(spec: Mapping, cfg: Mapping) -> dict:
     effects = {spec["effect"]: spec["magnitude"]} if spec["effect"] else {}
     cases = sorted(cfg["load_cases"], key=lambda c: int(c[2:]))
     cal = cfg.get("nonlinear", {}).get("calibration_case", "lc1")
-    recs = rig_records(cfg, effects, int(spec["seed"]), cases)
+    recs, converged = rig_records(cfg, effects, int(spec["seed"]), cases)
     t_rig = time.perf_counter() - t0
     model, modes, modal, frf = identify(cfg, recs["random_test"], recs[cal])
     K = int(cfg.get("nonlinear", {}).get("n_harmonics", 25))
@@ -105,7 +105,7 @@ def run_item(spec: Mapping, cfg: Mapping) -> dict:
             "shrink_true": by[true]["reduction"] if true in by else None,
             "ranking": [{k: r[k] for k in ("effect", "heldout_gap_before", "heldout_gap_after", "score", "reduction")}
                         for r in diag.ranking],
-            "where": diag.where, "control_converged": {c: int(recs[c].attrs.get("control_converged", 1)) for c in cases},
+            "where": diag.where, "control_converged": converged,
             "seconds": {"rig": t_rig, "identification": t_id, "diagnosis": t_diag}}
 
 
