@@ -79,9 +79,9 @@ def hc_data(default_config):
     return cfg, model, records, linear_stage(model, frf, modal)
 
 
-def _diagnose(data, candidates):
+def _diagnose(data, candidates, **gap):
     cfg, model, records, linear = data
-    settings = GapSettings.from_config({**cfg["gap"], "candidates": candidates, "n_bootstrap": 50}, 1, 25)
+    settings = GapSettings.from_config({**cfg["gap"], "candidates": candidates, "n_bootstrap": 50, **gap}, 1, 25)
     return diagnose(model, records, "lc1", settings, settings_from_config(cfg["friction"]), linear)
 
 
@@ -93,6 +93,13 @@ def test_diagnosis_names_the_hidden_effect_and_the_gap_shrinks(hc_data):
     assert best["parameters"]["alpha"] == pytest.approx(400.0, rel=0.1)  # the rig's alpha, recovered
     assert best["reduction_interval"][0] > 0.5
     assert d.where["direction"] == "normal"
+
+
+def test_a_candidate_removing_less_than_min_reduction_is_not_named(hc_data):
+    # the right effect removes ~96 % of this gap; asking for more than it removes leaves the verdict open
+    d = _diagnose(hc_data, ["normal_contact_damping"], min_reduction=0.99)
+    assert d.ranking[0]["effect"] == "normal_contact_damping" and 0.5 < d.ranking[0]["reduction"] < 0.99
+    assert d.verdict == "none" and "no candidate shrinks the held-out gap by 99%" in d.reason
 
 
 def test_effect_missing_from_library_gives_none_and_points_at_the_normal_direction(hc_data):

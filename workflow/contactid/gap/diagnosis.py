@@ -45,7 +45,7 @@ class GapSettings:
     identification_harmonics: int = 25
     candidates: tuple | None = None
     min_gap: float = 0.006
-    min_reduction: float = 0.3
+    min_reduction: float = 0.5
     separation: float = 1.5
     noise_factor: float = 3.0
     n_bootstrap: int = 200
