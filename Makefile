@@ -33,4 +33,4 @@ test: env
 	$(PY) -m pytest -q
 
 clean-results:
-	rm -rf results data/raw data/truth logs benchmarks/rules .snakemake/metadata
+	rm -rf results data/raw data/truth data/imported logs benchmarks/rules .snakemake/metadata

@@ -28,6 +28,7 @@ CODE_DIGEST = package_digest()
 
 include: "workflow/rules/common.smk"
 include: "workflow/rules/rig.smk"
+include: "workflow/rules/import.smk"
 include: "workflow/rules/linear.smk"
 include: "workflow/rules/nonlinear.smk"
 include: "workflow/rules/friction.smk"

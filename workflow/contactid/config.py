@@ -71,6 +71,17 @@ def check_config(cfg: Mapping, source: str = "config/config.yaml") -> None:
                 if key not in lc:
                     errors.append(f"load_cases.{case}.{key} is missing: a rig load case needs its target "
                                   "driving-point harmonic amplitudes (Table 2)")
+    for where, block in [("random_test", rt)] + [(f"load_cases.{c}", lc) for c, lc in (cfg.get("load_cases") or {}).items()]:
+        if block.get("source", "rig") == "measured" and block.get("format", "netcdf") != "netcdf" and block.get("file"):
+            from .importers import record_spec
+            from .io import RawDataError
+
+            try:
+                record_spec(block, where)  # the channel map (and a CSV's sidecar) is complete and consistent
+            except RawDataError as exc:
+                errors.append(str(exc))
+        elif block.get("format", "netcdf") != "netcdf" and block.get("source", "rig") != "measured":
+            errors.append(f"{where}.format = {block['format']!r} applies to measured files only; set source: measured")
     try:
         from .rig.effects import effect_magnitudes
 

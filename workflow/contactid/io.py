@@ -199,9 +199,20 @@ def read_raw(path: str | os.PathLike, dual_sine: bool = False, min_samples: int 
     units_a = ds["acceleration"].attrs.get("units")
     if units_a not in _ACC_UNITS:
         fail(f"'acceleration' has units {units_a!r}; convert to 'm/s^2' (1 g = 9.80665 m/s^2)")
+    if ds["position"].dtype.kind not in "fiu" or not np.all(np.isfinite(ds["position"].values)):
+        fail("coordinate 'position' must hold finite numbers (m from the clamp)")
+    try:
+        fs_attr = float(ds.attrs["sampling_rate_hz"])
+        f0_attr = float(ds.attrs.get("excitation_frequency_hz", 1.0))
+    except (TypeError, ValueError):
+        fail("global attributes 'sampling_rate_hz' and 'excitation_frequency_hz' must be numbers (Hz)")
+    if not (np.isfinite(fs_attr) and np.isfinite(f0_attr)):
+        fail("global attributes 'sampling_rate_hz' and 'excitation_frequency_hz' must be finite numbers (Hz)")
     if ds.sizes["time"] < min_samples:
         fail(f"only {ds.sizes['time']} samples; at least {min_samples} are needed")
     for var in ("force", "acceleration"):
+        if ds[var].dtype.kind not in "fiu":
+            fail(f"'{var}' holds values of type {ds[var].dtype}; write real floating-point numbers")
         bad = ~np.isfinite(ds[var].values)
         if bad.any():
             fail(f"'{var}' holds {int(bad.sum())} NaN or infinite samples")

@@ -141,3 +141,27 @@ def setup_table(structure_cfg: Mapping) -> str:
         lines.append(f"{r['quantity'].replace('_', chr(92) + '_')} & {val} & {r['source']} \\\\")
     lines += [r"\bottomrule", r"\end{tabular}", r"\end{table}"]
     return "\n".join(lines) + "\n"
+
+
+def data_checks_text(summary: Mapping) -> str:
+    """The report's paragraph on the raw records' validation: the checks, and each warning by record."""
+    warnings = summary.get("data_warnings") or {}
+    lines = [r"\paragraph{Data checks.} Every raw record passed the validation before identification (format, "
+             r"finite samples, length and sampling rate for the harmonics and the FRF resolution, clipping, the "
+             r"excitation frequency recovered from the force, stationarity of first against last third, the random "
+             r"test's coherence in the modal band; thresholds in \texttt{raw\_checks})."]
+    items = [(rec, w) for rec, ws in sorted(warnings.items()) for w in ws]
+    if not items:
+        lines.append("No check came within a factor of two of its limit.")
+    else:
+        lines.append(r"Warnings (a value beyond half its limit):\begin{itemize}")
+        lines += [rf"\item {_tex(rec)}: {_tex(w)}" for rec, w in items]
+        lines.append(r"\end{itemize}")
+    return "\n".join(lines) + "\n"
+
+
+def _tex(text: str) -> str:
+    """Plain text safe in LaTeX."""
+    repl = {"\\": r"\textbackslash{}", "_": r"\_", "%": r"\%", "&": r"\&", "#": r"\#", "$": r"\$",
+            "{": r"\{", "}": r"\}", "^": r"\^{}", "~": r"\~{}"}
+    return "".join(repl.get(ch, ch) for ch in str(text))

@@ -49,3 +49,149 @@ def dual_sine_check_dataset(raw: xr.Dataset, structure_cfg: Mapping, path: str, 
         attrs={"A1_m_per_s2": float(np.abs(c_acc[i, 0])), "A2_m_per_s2": float(np.abs(c_acc[i, 2])) if max_harmonic >= 3 else np.nan,
                "excitation_frequency_hz": f0, "periods": float(acc.shape[1] / fs * f0), "driving_point_sensor": str(raw["sensor"].values[i])},
     )
+
+
+# ------------------------------------------------------------------------------------------
+# validation of raw records before identification (config raw_checks); a failure stops the
+# record with a message naming the file, the channel, the check and the measured value; a value
+# beyond half its limit is a warning stored in the check dataset and shown in the report
+# ------------------------------------------------------------------------------------------
+
+CHECK_DEFAULTS = {"clip_samples": 8, "frequency_tolerance_cycles": 0.02, "stationarity_tolerance": 0.05,
+                  "min_coherence": 0.5, "coherence_fraction": 0.5, "max_frf_resolution_hz": 0.5}
+
+
+def check_settings(checks: Mapping | None) -> dict:
+    """raw_checks with defaults filled in."""
+    return {**CHECK_DEFAULTS, **{k: v for k, v in dict(checks or {}).items() if v is not None}}
+
+
+def _channels(raw: xr.Dataset):
+    yield "force", np.asarray(raw["force"].values, float)
+    for s, a in zip(raw["sensor"].values, np.asarray(raw["acceleration"].values, float)):
+        yield str(s), a
+
+
+def samples_at_limit(x: np.ndarray) -> int:
+    """How many samples sit at the channel's largest or smallest value (a flat top: clipping)."""
+    span = float(np.ptp(x))
+    if span == 0.0:
+        return x.size
+    tol = 1e-9 * span
+    return int(max(np.sum(x >= x.max() - tol), np.sum(x <= x.min() + tol)))
+
+
+def recovered_frequency(x: np.ndarray, fs: float, declared_hz: float) -> tuple[float, int]:
+    """The excitation frequency found in a record: the strongest spectral line of ``x`` (Hann
+    window), refined by maximising the windowed DFT magnitude, divided by its harmonic number h of
+    the declared frequency. Returns (frequency in Hz, h)."""
+    from scipy.optimize import minimize_scalar
+
+    n = x.size
+    w = np.hanning(n)
+    y = (x - x.mean()) * w
+    spec = np.abs(np.fft.rfft(y))
+    spec[0] = 0.0
+    k = int(np.argmax(spec))
+    t = np.arange(n) / fs
+    df = fs / n
+
+    def neg_mag(f):
+        return -abs(np.dot(y, np.exp(-2j * np.pi * f * t)))
+
+    res = minimize_scalar(neg_mag, bounds=(max((k - 1) * df, 0.0), (k + 1) * df), method="bounded",
+                          options={"xatol": 1e-7 * max(k, 1) * df})
+    h = max(1, int(round(res.x / declared_hz)))
+    return float(res.x / h), h
+
+
+def validate_dual_sine(raw: xr.Dataset, path: str, checks: Mapping) -> list[str]:
+    """Clipping, excitation frequency and stationarity of a dual-sine record; raises RawDataError on
+    the first failure, returns the warnings."""
+    c = check_settings(checks)
+    fs = float(raw.attrs["sampling_rate_hz"])
+    f0 = float(raw.attrs["excitation_frequency_hz"])
+    n = raw.sizes["time"]
+    duration = n / fs
+    warnings = []
+    for name, x in _channels(raw):
+        at = samples_at_limit(x)
+        if at >= c["clip_samples"]:
+            raise RawDataError(f"{path}: channel {name}: clipping check failed: {at} samples sit at the range limit "
+                               f"({x.max():.6g} / {x.min():.6g}); raw_checks.clip_samples = {c['clip_samples']}. "
+                               "Lower the input range's gain or the excitation and record again")
+        if at >= max(2, c["clip_samples"] // 2):
+            warnings.append(f"{name}: {at} samples at the range limit (clipping check: {c['clip_samples']})")
+    f_rec, h = recovered_frequency(np.asarray(raw["force"].values, float), fs, f0)
+    drift_cycles = abs(f_rec - f0) * duration
+    if h not in (1, 2, 3) or drift_cycles > c["frequency_tolerance_cycles"]:
+        raise RawDataError(f"{path}: channel force: excitation frequency check failed: the record's excitation is at "
+                           f"{f_rec:.6g} Hz (strongest line at harmonic {h}), the file declares {f0:.6g} Hz, "
+                           f"{drift_cycles:.3g} cycles apart over the record (raw_checks.frequency_tolerance_cycles = "
+                           f"{c['frequency_tolerance_cycles']}); correct excitation_frequency_hz")
+    if drift_cycles > 0.5 * c["frequency_tolerance_cycles"]:
+        warnings.append(f"force: excitation at {f_rec:.6g} Hz against {f0:.6g} Hz declared ({drift_cycles:.3g} cycles "
+                        "over the record)")
+    third = n // 3
+    for name, x in _channels(raw):
+        whole = np.abs(harmonic_content(x, fs, f0, (1, 3)))
+        first = np.abs(harmonic_content(x[:third], fs, f0, (1, 3)))
+        last = np.abs(harmonic_content(x[-third:], fs, f0, (1, 3)))
+        change = np.abs(last - first) / np.maximum(whole, 0.05 * whole.max())
+        worst = int(np.argmax(change))
+        if change[worst] > c["stationarity_tolerance"]:
+            raise RawDataError(f"{path}: channel {name}: stationarity check failed: the amplitude at {(1, 3)[worst]} w "
+                               f"changes by {change[worst]:.3g} between the record's first and last thirds "
+                               f"(raw_checks.stationarity_tolerance = {c['stationarity_tolerance']}); record after the "
+                               "transient has died out, or raise the tolerance to accept a drifting test (the gap "
+                               "diagnosis can model a drifting preload)")
+        if change[worst] > 0.5 * c["stationarity_tolerance"]:
+            warnings.append(f"{name}: amplitude at {(1, 3)[worst]} w changes by {change[worst]:.3g} over the record")
+    return warnings
+
+
+def validate_random_test(raw: xr.Dataset, path: str, checks: Mapping, segment_length: int, blocks: int) -> list[str]:
+    """Clipping, record length and frequency resolution of the random test (before the FRF)."""
+    c = check_settings(checks)
+    fs = float(raw.attrs["sampling_rate_hz"])
+    n = raw.sizes["time"]
+    warnings = []
+    for name, x in _channels(raw):
+        at = samples_at_limit(x)
+        if at >= c["clip_samples"]:
+            raise RawDataError(f"{path}: channel {name}: clipping check failed: {at} samples sit at the range limit "
+                               f"({x.max():.6g} / {x.min():.6g}); raw_checks.clip_samples = {c['clip_samples']}. "
+                               "Lower the input range's gain or the force level and record again")
+        if at >= max(2, c["clip_samples"] // 2):
+            warnings.append(f"{name}: {at} samples at the range limit (clipping check: {c['clip_samples']})")
+    need = 2 * segment_length * blocks
+    if n < need:
+        raise RawDataError(f"{path}: record length check failed: {n} samples, fewer than 2 x frf.segment_length x "
+                           f"modal.uncertainty_blocks = {need}; record {need / fs:.1f} s or more, or lower "
+                           "frf.segment_length")
+    df = fs / segment_length
+    if df > c["max_frf_resolution_hz"]:
+        raise RawDataError(f"{path}: FRF resolution check failed: {fs:g} Hz / frf.segment_length {segment_length} = "
+                           f"{df:.3g} Hz between lines, coarser than raw_checks.max_frf_resolution_hz = "
+                           f"{c['max_frf_resolution_hz']}; raise frf.segment_length (and the record length)")
+    return warnings
+
+
+def validate_coherence(frf: xr.Dataset, band_hz, path: str, checks: Mapping) -> tuple[dict, list[str]]:
+    """Share of the FRF lines in ``band_hz`` whose coherence reaches raw_checks.min_coherence, per
+    channel; raises RawDataError when a channel's share is below raw_checks.coherence_fraction."""
+    c = check_settings(checks)
+    f = frf["frequency"].values
+    band = (f >= band_hz[0]) & (f <= band_hz[1])
+    shares, warnings = {}, []
+    for s, coh in zip(frf["sensor"].values, frf["coherence"].values):
+        share = float(np.mean(coh[band] >= c["min_coherence"]))
+        shares[str(s)] = share
+        if share < c["coherence_fraction"]:
+            raise RawDataError(f"{path}: channel {s}: coherence check failed: only {share:.1%} of the lines in "
+                               f"{band_hz[0]:g}-{band_hz[1]:g} Hz reach coherence {c['min_coherence']} "
+                               f"(raw_checks.coherence_fraction = {c['coherence_fraction']}); raise the force level, "
+                               "average longer, or check the sensor and its cable")
+        if share < 0.5 * (1.0 + c["coherence_fraction"]):
+            warnings.append(f"{s}: {share:.1%} of the band's lines reach coherence {c['min_coherence']}")
+    return shares, warnings

@@ -70,12 +70,15 @@ def linear_summary(modal: xr.Dataset, stiction: xr.Dataset, truth: xr.Dataset | 
 
 
 def load_case_summary(checks: Mapping[str, xr.Dataset], truths: Mapping[str, xr.Dataset]) -> dict:
-    """Per load case: the driving-point harmonics read off the raw record, and (rig
-    cases) the truth's force amplitudes and contact extremes."""
-    out = {"load_cases": {}}
+    """Per load case: the driving-point harmonics read off the raw record and the validation's
+    warnings (``data_warnings``), and (rig cases) the truth's force amplitudes and contact extremes."""
+    import json
+
+    out = {"load_cases": {}, "data_warnings": {}}
     for case, ds in checks.items():
         out["load_cases"][case] = {"A1_m_per_s2": ds.attrs["A1_m_per_s2"], "A2_m_per_s2": ds.attrs["A2_m_per_s2"],
                                    "excitation_frequency_hz": ds.attrs["excitation_frequency_hz"]}
+        out["data_warnings"][case] = json.loads(ds.attrs.get("warnings", "[]"))
     if truths:
         out["truth_load_cases"] = {}
         for case, tr in truths.items():

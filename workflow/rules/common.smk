@@ -10,6 +10,44 @@ def _is_measured(block):
     return (block or {}).get("source", "rig") == "measured"
 
 
+def _import_format(block):
+    """The importer a measured record needs (uff58, tdms, csv), or None (rig, or a raw netCDF file)."""
+    fmt = (block or {}).get("format", "netcdf")
+    return fmt if _is_measured(block) and fmt != "netcdf" else None
+
+
+def record_block(record):
+    """The config block of a record: a load case, or the random test."""
+    return config.get("random_test", {}) if record == "random_test" else config["load_cases"][record]
+
+
+def imported_records(fmt):
+    """Records (load cases, random_test) that the importer of ``fmt`` converts."""
+    names = ["random_test"] + list(config.get("load_cases") or {})
+    return [r for r in names if (r != "random_test" or "random_test" in config) and _import_format(record_block(r)) == fmt]
+
+
+def import_pattern(fmt):
+    """Wildcard constraint matching exactly the records imported from ``fmt`` (or nothing)."""
+    return "|".join(imported_records(fmt)) or "(?!)"
+
+
+def import_inputs(wildcards):
+    """The measured file, and for CSV its sidecar YAML."""
+    from contactid.importers import sidecar_path
+
+    block = record_block(wildcards.record)
+    inputs = {"file": block["file"]}
+    if block.get("format") == "csv":
+        inputs["sidecar"] = sidecar_path(block["file"], block.get("sidecar"))
+    return inputs
+
+
+def _measured_path(record):
+    block = record_block(record)
+    return f"data/imported/{record}.nc" if _import_format(block) else block["file"]
+
+
 def load_cases():
     """Names of every configured load case."""
     return sorted(config.get("load_cases") or {}, key=lambda c: int(c[2:]))
@@ -28,7 +66,7 @@ def rig_case_pattern():
 def random_test_raw():
     """The random-test record: the rig's output or the user's measured file."""
     rt = config.get("random_test", {})
-    return rt["file"] if _is_measured(rt) else "data/raw/random_test.nc"
+    return _measured_path("random_test") if _is_measured(rt) else "data/raw/random_test.nc"
 
 
 def random_test_truth():
@@ -39,7 +77,7 @@ def random_test_truth():
 def raw_record(case):
     """The dual-sine record of a load case: the rig's output or the user's measured file."""
     lc = config["load_cases"][case]
-    return lc["file"] if _is_measured(lc) else f"data/raw/{case}.nc"
+    return _measured_path(case) if _is_measured(lc) else f"data/raw/{case}.nc"
 
 
 def truth_records():
@@ -81,7 +119,7 @@ def validate_inputs(wildcards):
 
 def summary_inputs(wildcards):
     """Everything the headline numbers are read from, named for the summary script."""
-    inputs = {"modal": "results/linear/modal.nc", "stiction": "results/linear/stiction.nc"}
+    inputs = {"modal": "results/linear/modal.nc", "stiction": "results/linear/stiction.nc", "frf": "results/linear/frf.nc"}
     if not _is_measured(config.get("random_test")):
         inputs["truth"] = "data/truth/random_test.nc"
     for c in load_cases():
@@ -123,6 +161,7 @@ def gap_inputs(wildcards):
     inputs = {"modes": "results/linear/linear_modes.nc", "modal": "results/linear/modal.nc",
               "frf": "results/linear/frf.nc", "fit": "results/friction/friction_fit.nc"}
     inputs["raw"] = [raw_record(c) for c in load_cases()]
+    inputs["checks"] = [f"results/{c}/raw_check.nc" for c in load_cases()]  # a record that fails validation stops the gap
     return inputs
 
 

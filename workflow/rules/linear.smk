@@ -11,6 +11,8 @@ rule frf:
         frf=config.get("frf", {}),
         structure=config["structure"],
         blocks=config.get("modal", {}).get("uncertainty_blocks", 4),
+        band_hz=config.get("modal", {}).get("band_hz", [20.0, 450.0]),
+        checks=config.get("raw_checks", {}),
     conda:
         "../envs/contactid.yaml"
     log:

@@ -9,6 +9,7 @@ rule raw_check:
         code=CODE_DIGEST,
         structure=config["structure"],
         checks=config.get("raw_checks", {}),
+        n_harmonics=config.get("nonlinear", {}).get("n_harmonics", 25),
     conda:
         "../envs/contactid.yaml"
     log:

@@ -16,6 +16,7 @@ rule report_fragments:
         table4="results/report/table4.tex",
         consistency="results/report/consistency.tex",
         contact="results/report/contact.tex",
+        datachecks="results/report/datachecks.tex",
     params:
         code=CODE_DIGEST,
         structure=config["structure"],

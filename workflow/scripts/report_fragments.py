@@ -5,7 +5,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from contactid.latex import macros, report_values, setup_table, tabular
+from contactid.latex import data_checks_text, macros, report_values, setup_table, tabular
 from contactid.logs import setup_logging
 
 setup_logging(snakemake.log[0])
@@ -14,6 +14,7 @@ summary = json.loads(Path(inp.summary).read_text())
 cons = pd.read_csv(inp.consistency)
 Path(out.numbers).write_text(macros(report_values(summary, cons)))
 Path(out.setup).write_text(setup_table(snakemake.params.structure))
+Path(out.datachecks).write_text(data_checks_text(summary))
 Path(out.table1).write_text(tabular(pd.read_csv(inp.table1), {
     "mode": "mode", "identified_hz": "identified (Hz)", "paper_hz": "paper (Hz)", "truth_hz": "rig truth (Hz)",
     "diff_vs_paper_pct": "vs paper (\\%)", "diff_vs_truth_pct": "vs truth (\\%)", "damping_ratio": "damping"},

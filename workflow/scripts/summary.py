@@ -13,6 +13,7 @@ summary = linear_summary(load_dataset(inp.modal), load_dataset(inp.stiction), tr
 checks = {k[len("check_"):]: load_dataset(v) for k, v in inp.items() if k.startswith("check_")}
 truths = {k[len("truth_"):]: load_dataset(v) for k, v in inp.items() if k.startswith("truth_")}
 summary.update(load_case_summary(checks, truths))
+summary["data_warnings"]["random_test"] = json.loads(load_dataset(inp.frf).attrs.get("warnings", "[]"))
 forces = {k[len("forces_"):]: load_dataset(v) for k, v in inp.items() if k.startswith("forces_")}
 nnms = {k[len("nnm_"):]: load_dataset(v) for k, v in inp.items() if k.startswith("nnm_")}
 summary.update(contact_force_summary(forces, nnms))

@@ -1,0 +1,148 @@
+"""Readers of the files test rigs write: universal file format dataset 58 (pyuff), LabVIEW
+TDMS (nptdms) and CSV (pandas). Each returns, for every mapped channel, its samples (float64,
+as stored) and the sampling interval the file states (or None), after checking the file's own
+unit labels against the channel map. Every failure names the file and the channel."""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..io import RawDataError
+from .channels import ImportSpec, check_file_unit
+
+
+@dataclass
+class Samples:
+    """One channel as read: samples (file units) and the sampling interval stated by the file (s)."""
+
+    values: np.ndarray
+    dt: float | None
+
+
+def _as_samples(values, path: str, channel: str) -> np.ndarray:
+    try:
+        arr = np.asarray(values, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise RawDataError(f"{path}: channel {channel!r} does not hold numbers ({exc})") from None
+    if arr.ndim != 1:
+        raise RawDataError(f"{path}: channel {channel!r} holds an array of shape {arr.shape}; a time history is 1-D")
+    return arr
+
+
+def _missing(path, what, channel, available):
+    avail = ", ".join(repr(a) for a in available[:20]) or "none"
+    return RawDataError(f"{path}: {what} {channel!r} not found; the file has {avail}. Correct the channel map")
+
+
+def read_uff58(spec: ImportSpec) -> dict:
+    """Time histories from a universal file (datasets 58, function type 1 = time response,
+    even abscissa), each channel selected by its ID line 1 (``id1``)."""
+    import pyuff
+
+    path = spec.file
+    try:
+        sets = pyuff.UFF(path).read_sets()
+    except Exception as exc:  # noqa: BLE001 - pyuff raises anything on a malformed file
+        raise RawDataError(f"{path}: cannot be read as a universal file ({type(exc).__name__}: {exc}); "
+                           "write the time histories as datasets 58") from None
+    if isinstance(sets, dict):
+        sets = [sets]
+    by_id = {}
+    for s in sets:
+        if isinstance(s, dict) and s.get("type") == 58:
+            by_id.setdefault(str(s.get("id1", "")).strip(), s)
+    out = {}
+    for ch in spec.channels:
+        s = by_id.get(ch.channel.strip())
+        if s is None:
+            raise _missing(path, "dataset 58 with id1", ch.channel, list(by_id))
+        if s.get("func_type") != 1:
+            raise RawDataError(f"{path}: dataset 58 {ch.channel!r} has function type {s.get('func_type')}, not 1 "
+                               "(time response); export the time histories, not spectra or FRFs")
+        if s.get("abscissa_spacing") not in (1, None):
+            raise RawDataError(f"{path}: dataset 58 {ch.channel!r} has an uneven abscissa; export evenly sampled data")
+        check_file_unit(ch, s.get("ordinate_axis_units_lab"), path)
+        data = s.get("data")
+        if data is None:
+            raise RawDataError(f"{path}: dataset 58 {ch.channel!r} holds no data")
+        if np.iscomplexobj(data):
+            raise RawDataError(f"{path}: dataset 58 {ch.channel!r} holds complex numbers; a time history is real")
+        dt = s.get("abscissa_inc")
+        out[ch.role] = Samples(_as_samples(data, path, ch.channel), float(dt) if dt else None)
+    return out
+
+
+def read_tdms(spec: ImportSpec) -> dict:
+    """Channels of a TDMS file, each selected as "group/channel"; the sampling interval from the
+    channel's ``wf_increment`` property, the unit from ``unit_string``."""
+    from nptdms import TdmsFile
+
+    path = spec.file
+    try:
+        f = TdmsFile.read(path)
+        chans = {f"{g.name}/{c.name}": c for g in f.groups() for c in g.channels()}
+    except Exception as exc:  # noqa: BLE001 - nptdms raises anything on a malformed file
+        raise RawDataError(f"{path}: cannot be read as a TDMS file ({type(exc).__name__}: {exc})") from None
+    out = {}
+    for ch in spec.channels:
+        c = chans.get(ch.channel)
+        if c is None:
+            raise _missing(path, "channel", ch.channel, list(chans))
+        check_file_unit(ch, c.properties.get("unit_string"), path)
+        try:
+            data = c[:]
+        except Exception as exc:  # noqa: BLE001
+            raise RawDataError(f"{path}: channel {ch.channel!r} cannot be read ({type(exc).__name__}: {exc})") from None
+        dt = c.properties.get("wf_increment")
+        out[ch.role] = Samples(_as_samples(data, path, ch.channel), float(dt) if dt else None)
+    return out
+
+
+def read_csv(spec: ImportSpec) -> dict:
+    """Columns of a CSV file with a header row, each selected by its header; the sampling interval
+    from the time column when the sidecar names one."""
+    import pandas as pd
+
+    path = spec.file
+    try:
+        df = pd.read_csv(path)
+    except Exception as exc:  # noqa: BLE001 - empty file, bad quoting, binary junk...
+        raise RawDataError(f"{path}: cannot be read as CSV with a header row ({type(exc).__name__}: {exc})") from None
+    cols = [str(c) for c in df.columns]
+    df.columns = cols
+
+    def column(name):
+        if name not in cols:
+            raise _missing(path, "column", name, cols)
+        v = pd.to_numeric(df[name], errors="coerce")
+        bad = np.flatnonzero(v.isna().to_numpy())
+        if bad.size:
+            raise RawDataError(f"{path}: column {name!r} line {int(bad[0]) + 2} holds {df[name].iloc[bad[0]]!r}, "
+                               "not a number (an empty cell, text, or a truncated line)")
+        return _as_samples(v.to_numpy(), path, name)
+
+    dt = None
+    if spec.time_column:
+        t = column(spec.time_column)
+        if t.size >= 2:
+            steps = np.diff(t)
+            dt = float(np.mean(steps))
+            if not (dt > 0 and np.allclose(steps, dt, rtol=1e-4, atol=1e-9 * abs(dt))):
+                raise RawDataError(f"{path}: time column {spec.time_column!r} is not evenly spaced and increasing "
+                                   f"(steps from {steps.min():g} to {steps.max():g} s)")
+    return {ch.role: Samples(column(ch.channel), dt) for ch in spec.channels}
+
+
+READERS = {"uff58": read_uff58, "tdms": read_tdms, "csv": read_csv}
+
+
+def read_channels(spec: ImportSpec) -> dict:
+    """{role: Samples} of the file, by the reader of ``spec.format``."""
+    if not os.path.exists(spec.file):
+        raise RawDataError(f"{spec.where}: file {spec.file!r} not found; correct 'file:'")
+    if os.path.getsize(spec.file) == 0:
+        raise RawDataError(f"{spec.file}: the file is empty (zero bytes)")
+    return READERS[spec.format](spec)
