@@ -299,3 +299,47 @@ def test_gap_runs_on_a_directory_of_raw_files_alone(default_run, tmp_path):
     assert not (proj / "data").exists()  # nothing from the rig
     d = json.loads((proj / "results" / "gap" / "diagnosis.json").read_text())
     assert d["verdict"] == "none" and [r["effect"] for r in d["ranking"]] == ["viscous_friction"]
+
+
+def test_no_rule_writes_to_its_own_inputs(default_run):
+    res = snakemake(default_run, "--detailed-summary")
+    assert res.returncode == 0, res.stderr[-3000:]
+    rows = [line.split("\t") for line in res.stdout.splitlines()[1:] if "\t" in line]
+    assert len(rows) > 30
+    for out, _, rule, logs, inputs, *_ in rows:
+        assert out not in inputs.split(","), f"rule {rule} reads its own output {out}"
+        assert out not in logs.split(","), f"rule {rule} logs into its output {out}"
+
+
+def test_imported_uff58_tdms_csv_give_the_same_contact_forces(default_run, tmp_path):
+    """lc1's rig record written as a UFF58 file (accelerations in g), a TDMS file (voltages with
+    sensitivities) and a CSV + sidecar YAML, imported by their rules, identify the same S(t)."""
+    import xarray as xr
+
+    from contactid.importers.export import export_record
+
+    proj = make_project(tmp_path)
+    (proj / "measured").mkdir()
+    shutil.copy(default_run / "data/raw/random_test.nc", proj / "measured/random_test.nc")
+    raw = xr.load_dataset(default_run / "data/raw/lc1.nc", engine="netcdf4")
+    storages = {"uff58": {"acceleration": ("g", None, None)},
+                "tdms": {"force": ("mV", 2.25, "mV/N"), "acceleration": ("mV", 10.2, "mV/g")}, "csv": None}
+    cfg = yaml.safe_load((proj / "config" / "config.yaml").read_text())
+    cfg["random_test"] = {**cfg["random_test"], "source": "measured", "file": "measured/random_test.nc"}
+    cfg["load_cases"] = {}
+    for case, fmt in zip(("lc1", "lc2", "lc3"), storages):
+        block = export_record(raw, proj / "measured" / f"{case}.{fmt}", fmt, storages[fmt])
+        block["file"] = f"measured/{case}.{fmt}"
+        cfg["load_cases"][case] = block
+    (proj / "config" / "config.yaml").write_text(yaml.safe_dump(cfg))
+    res = snakemake(proj, *[f"results/{c}/contact_forces.nc" for c in ("lc1", "lc2", "lc3")])
+    assert res.returncode == 0, res.stderr[-3000:]
+    for rule in ("import_uff58", "import_tdms", "import_csv"):
+        assert rule in res.stdout + res.stderr
+    S0 = xr.load_dataset(default_run / "results/lc1/contact_forces.nc", engine="netcdf4")["S"].values
+    for c in ("lc1", "lc2", "lc3"):
+        S = xr.load_dataset(proj / f"results/{c}/contact_forces.nc", engine="netcdf4")["S"].values
+        nrmse = np.sqrt(np.mean((S - S0) ** 2)) / np.std(S0)
+        print(f"{c} ({cfg['load_cases'][c]['format']}): S NRMSE against the netCDF original {nrmse:.2e}")
+        assert nrmse < 1e-3
+    assert not (proj / "data" / "truth").exists()  # nothing of the rig's truth for measured records
