@@ -167,6 +167,33 @@ def test_measured_case_with_wrong_unit_names_file(default_run, tmp_path):
     assert not (proj / "results" / "lc7" / "raw_check.nc").exists()
 
 
+def test_invalid_measured_records_stop_only_their_case_and_say_why(tmp_path):
+    from test_importers import dual_sine
+
+    proj = make_project(tmp_path)
+    ds = dual_sine()  # a valid synthetic record on the model's sensor layout
+    (proj / "measured").mkdir()
+    clipped = ds.copy(deep=True)
+    a = clipped["acceleration"].values
+    a[2] = np.clip(a[2], None, 0.7 * a[2].max())
+    clipped.to_netcdf(proj / "measured" / "lc7.nc", engine="netcdf4")
+    wrong_f = ds.copy(deep=True)
+    wrong_f.attrs["excitation_frequency_hz"] = 55.0
+    wrong_f.to_netcdf(proj / "measured" / "lc8.nc", engine="netcdf4")
+    ds.to_netcdf(proj / "measured" / "lc9.nc", engine="netcdf4")
+    cfg = yaml.safe_load((proj / "config" / "config.yaml").read_text())
+    cfg["load_cases"] = {c: {"source": "measured", "file": f"measured/{c}.nc"} for c in ("lc7", "lc8", "lc9")}
+    (proj / "config" / "config.yaml").write_text(yaml.safe_dump(cfg))
+    res = snakemake(proj, "--keep-going", *[f"results/{c}/raw_check.nc" for c in ("lc7", "lc8", "lc9")])
+    assert res.returncode != 0
+    log7 = (proj / "logs" / "raw_check_lc7.log").read_text()  # the rule's log says it, not only stderr
+    assert "measured/lc7.nc: channel a3: clipping check failed" in log7
+    log8 = (proj / "logs" / "raw_check_lc8.log").read_text()
+    assert "measured/lc8.nc: channel force: excitation frequency check failed" in log8 and "declares 55 Hz" in log8
+    assert not (proj / "results/lc7/raw_check.nc").exists() and not (proj / "results/lc8/raw_check.nc").exists()
+    assert (proj / "results/lc9/raw_check.nc").exists()  # the valid case went on
+
+
 def test_working_method_recovers_contact_forces(default_run):
     s = json.loads((default_run / "results" / "summary.json").read_text())
     for case in ("lc1", "lc2", "lc3"):
