@@ -167,6 +167,10 @@ def test_clipping_frequency_and_stationarity_failures_name_channel_check_and_val
     ramp["acceleration"].values[0] *= np.linspace(1.0, 1.2, N)
     with pytest.raises(RawDataError, match=r"channel a1: stationarity check failed: .* changes by 0\.1"):
         validate_dual_sine(ramp, "r.nc", {})
+    huge = raw.copy(deep=True)
+    huge["force"].values[5] = 1e308  # a scaling error, not a clipped channel
+    with pytest.raises(RawDataError, match=r"channel force: magnitude check failed: \|value\| reaches 1e\+308"):
+        validate_dual_sine(huge, "r.nc", {})
     # a drift within the tolerance is a warning, kept in the dataset and the report
     mild = raw.copy(deep=True)
     mild["acceleration"].values[0] *= np.linspace(1.0, 1.04, N)

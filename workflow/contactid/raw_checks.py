@@ -66,10 +66,19 @@ def check_settings(checks: Mapping | None) -> dict:
     return {**CHECK_DEFAULTS, **{k: v for k, v in dict(checks or {}).items() if v is not None}}
 
 
-def _channels(raw: xr.Dataset):
-    yield "force", np.asarray(raw["force"].values, float)
-    for s, a in zip(raw["sensor"].values, np.asarray(raw["acceleration"].values, float)):
-        yield str(s), a
+# no force (N) or acceleration (m/s^2) of a vibration test comes near this: a larger value is a scaling error
+PHYSICAL_LIMIT = 1.0e9
+
+
+def _channels(raw: xr.Dataset, path: str = "record"):
+    chans = [("force", np.asarray(raw["force"].values, float))]
+    chans += [(str(s), a) for s, a in zip(raw["sensor"].values, np.asarray(raw["acceleration"].values, float))]
+    for name, x in chans:
+        big = float(np.max(np.abs(x))) if x.size else 0.0
+        if big > PHYSICAL_LIMIT:
+            raise RawDataError(f"{path}: channel {name}: magnitude check failed: |value| reaches {big:.3g} (N or m/s^2), "
+                               f"beyond any vibration test ({PHYSICAL_LIMIT:g}); check the channel's units and sensitivity")
+    yield from chans
 
 
 def samples_at_limit(x: np.ndarray) -> int:
@@ -114,7 +123,7 @@ def validate_dual_sine(raw: xr.Dataset, path: str, checks: Mapping) -> list[str]
     n = raw.sizes["time"]
     duration = n / fs
     warnings = []
-    for name, x in _channels(raw):
+    for name, x in _channels(raw, path):
         at = samples_at_limit(x)
         if at >= c["clip_samples"]:
             raise RawDataError(f"{path}: channel {name}: clipping check failed: {at} samples sit at the range limit "
@@ -133,7 +142,7 @@ def validate_dual_sine(raw: xr.Dataset, path: str, checks: Mapping) -> list[str]
         warnings.append(f"force: excitation at {f_rec:.6g} Hz against {f0:.6g} Hz declared ({drift_cycles:.3g} cycles "
                         "over the record)")
     third = n // 3
-    for name, x in _channels(raw):
+    for name, x in _channels(raw, path):
         whole = np.abs(harmonic_content(x, fs, f0, (1, 3)))
         first = np.abs(harmonic_content(x[:third], fs, f0, (1, 3)))
         last = np.abs(harmonic_content(x[-third:], fs, f0, (1, 3)))
@@ -156,7 +165,7 @@ def validate_random_test(raw: xr.Dataset, path: str, checks: Mapping, segment_le
     fs = float(raw.attrs["sampling_rate_hz"])
     n = raw.sizes["time"]
     warnings = []
-    for name, x in _channels(raw):
+    for name, x in _channels(raw, path):
         at = samples_at_limit(x)
         if at >= c["clip_samples"]:
             raise RawDataError(f"{path}: channel {name}: clipping check failed: {at} samples sit at the range limit "

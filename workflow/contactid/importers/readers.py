@@ -120,8 +120,10 @@ def read_csv(spec: ImportSpec) -> dict:
         v = pd.to_numeric(df[name], errors="coerce")
         bad = np.flatnonzero(v.isna().to_numpy())
         if bad.size:
-            raise RawDataError(f"{path}: column {name!r} line {int(bad[0]) + 2} holds {df[name].iloc[bad[0]]!r}, "
-                               "not a number (an empty cell, text, or a truncated line)")
+            cell = df[name].iloc[bad[0]]
+            what = "an empty cell" if pd.isna(cell) else f"{str(cell)!r}"
+            raise RawDataError(f"{path}: column {name!r} line {int(bad[0]) + 2} holds {what}, not a number "
+                               "(text, a gap, or a truncated line)")
         return _as_samples(v.to_numpy(), path, name)
 
     dt = None
