@@ -35,6 +35,7 @@ include: "workflow/rules/friction.smk"
 include: "workflow/rules/outputs.smk"
 include: "workflow/rules/report.smk"
 include: "workflow/rules/gap.smk"
+include: "workflow/rules/studies.smk"
 
 
 rule all:

@@ -152,6 +152,8 @@ def all_outputs():
            "results/figures/fig06_contact_forces.png"] if load_cases() else []),
         "results/summary.json",
         *(gap_outputs() if load_cases() else []),
+        *(["results/studies/noise_study.nc", "results/figures/noise_study.png"]
+          if config.get("noise_study", {}).get("in_report", True) else []),
         *(["results/report/report.pdf"] if load_cases() else []),
     ]
 

@@ -19,7 +19,7 @@ graphicspath = "".join(f"{{{d}/}}" for d in sorted(dirs))
 with tempfile.TemporaryDirectory(dir=out.parent) as build:
     build = Path(build)
     shutil.copy(snakemake.input.tex, build / "report.tex")
-    for frag in [*snakemake.input.fragments, snakemake.input.gap]:
+    for frag in [*snakemake.input.fragments, snakemake.input.gap, snakemake.input.noise]:
         shutil.copy(frag, build / Path(frag).name)
     tex = (build / "report.tex").read_text()
     (build / "report.tex").write_text(tex.replace("\\begin{document}", f"\\graphicspath{{{graphicspath}}}\n\\begin{{document}}", 1))

@@ -1,0 +1,51 @@
+"""The noise / record-length study: its parameter table, the e_0 formula, and the sweep as Snakemake jobs."""
+
+import json
+
+import numpy as np
+import pytest
+import xarray as xr
+import yaml
+
+from contactid.studies import e0_at, noise_study_table
+from test_workflow import make_project, snakemake
+
+
+def test_parameter_table_is_the_full_product_and_refuses_empty_or_bad_axes():
+    t = noise_study_table({"noise_fractions": [0.001, 0.01], "record_samples": [8192], "seeds": [1, 2, 3]})
+    assert list(t.columns) == ["noise_fraction", "record_samples", "seed"] and len(t) == 6
+    assert t.iloc[0].tolist() == [0.001, 8192, 1] and t.iloc[-1].tolist() == [0.01, 8192, 3]
+    assert len(noise_study_table(None)) == 5 * 2 * 3  # the defaults
+    with pytest.raises(ValueError, match="noise_study.seeds is empty"):
+        noise_study_table({"seeds": []})
+    with pytest.raises(ValueError, match="at least 1024 samples"):
+        noise_study_table({"record_samples": [100]})
+
+
+def test_e0_is_eq22_and_tends_to_k_c_n_at_low_load():
+    assert e0_at(3.857e7, 2.547e5, 70.0) == pytest.approx(3.857e7 * (1 - np.exp(-2.547e5 * 70.0 / 3.857e7)), rel=1e-14)
+    assert e0_at(1e12, 2.0e5, 10.0) == pytest.approx(2.0e6, rel=1e-5)  # k_c N << e_f: e_0 -> k_c N
+
+
+@pytest.mark.workflow
+def test_sweep_runs_one_job_per_point_and_errors_grow_with_noise(tmp_path):
+    proj = make_project(tmp_path, {"noise_study": {"noise_fractions": [0.001, 0.05], "record_samples": [8192],
+                                                   "seeds": [1], "in_report": False}})
+    res = snakemake(proj, "noise_study")
+    assert res.returncode == 0, res.stderr[-3000:]
+    points = sorted((proj / "results/studies/noise").glob("*.json"))
+    assert [p.name for p in points] == ["noise_fraction~0.001_record_samples~8192_seed~1.json",
+                                        "noise_fraction~0.05_record_samples~8192_seed~1.json"]
+    ds = xr.load_dataset(proj / "results/studies/noise_study.nc", engine="netcdf4")
+    assert dict(ds.sizes) == {"noise_fraction": 2, "record_samples": 1, "seed": 1}
+    low, high = (json.loads(p.read_text()) for p in points)
+    for q in ("mu", "e0", "k_t"):
+        assert ds[f"error_{q}"].sel(noise_fraction=0.05).item() == pytest.approx(high[f"error_{q}"])
+        assert abs(high[f"error_{q}"]) > abs(low[f"error_{q}"]), q  # ten times... fifty times the noise, larger errors
+    assert abs(low["error_mu"]) < 0.02 and abs(low["error_k_t"]) < 1e-3  # near the truth at low noise
+    assert (proj / "results/figures/noise_study.png").stat().st_size > 10000
+    # the study's jobs declare what a scheduler needs
+    cfg = yaml.safe_load((proj / "config/config.yaml").read_text())
+    assert cfg["noise_study"]["seeds"] == [1]
+    dry = snakemake(proj, "-n", "--forceall", "noise_study")
+    assert "noise_study_point" in dry.stdout and "runtime=15" in dry.stdout.replace(" ", "")

@@ -1,0 +1,159 @@
+"""Monte Carlo study of identification accuracy against sensor noise and record length.
+
+Each point of the parameter table (noise fraction, dual-sine record length, seed) is one small,
+independent job: the virtual rig records a random test and the calibration case at that noise and
+length, the chain identifies k_t and the friction law from them in one process (the same package
+functions as the rules, ``gap.pipeline.identify``), and the errors against the rig's truth are
+returned. The gathering step stacks the points into a dataset and draws the errors against noise.
+"""
+
+from __future__ import annotations
+
+import copy
+import itertools
+import time
+from typing import Mapping
+
+import numpy as np
+import pandas as pd
+import xarray as xr
+
+DEFAULTS = {"noise_fractions": [0.0025, 0.005, 0.01, 0.02, 0.04], "record_samples": [8192, 16384], "seeds": [1, 2, 3]}
+QUANTITIES = ("mu", "e0", "k_t")
+
+
+def noise_study_table(study_cfg: Mapping | None) -> pd.DataFrame:
+    """The parameter table: one row per (noise_fraction, record_samples, seed), in that order."""
+    c = {**DEFAULTS, **{k: v for k, v in dict(study_cfg or {}).items() if k in DEFAULTS}}
+    for key in DEFAULTS:
+        if not c[key]:
+            raise ValueError(f"noise_study.{key} is empty; give at least one value")
+    if min(c["noise_fractions"]) < 0:
+        raise ValueError(f"noise_study.noise_fractions = {c['noise_fractions']}: noise fractions are >= 0")
+    if min(c["record_samples"]) < 1024:
+        raise ValueError(f"noise_study.record_samples = {c['record_samples']}: give at least 1024 samples per record")
+    rows = [{"noise_fraction": float(n), "record_samples": int(r), "seed": int(s)}
+            for n, r, s in itertools.product(c["noise_fractions"], c["record_samples"], c["seeds"])]
+    return pd.DataFrame(rows, columns=["noise_fraction", "record_samples", "seed"])
+
+
+def e0_at(e_f: float, k_c: float, normal_force: float) -> float:
+    """Tangential stiffness e_0 (N/m) of the modified Valanis law at the normal force N (N): e_f (1 - exp(-k_c N / e_f)) (Eq. 22)."""
+    return float(e_f * (1.0 - np.exp(-k_c * normal_force / e_f)))
+
+
+def run_point(cfg: Mapping, noise_fraction: float, record_samples: int, seed: int) -> dict:
+    """One point: rig records at this noise and length (rig seed = config seed + ``seed``), the
+    identification, and the relative errors of mu, e_0 (at the preload) and k_t against the rig's truth."""
+    from .gap.pipeline import identify
+    from .rig.dual_sine import dual_sine_test
+    from .rig.random_test import random_test_datasets
+    from .rig.structure import random_test_rig_config
+
+    t0 = time.perf_counter()
+    cfg = copy.deepcopy(dict(cfg))
+    rig = cfg["rig"]
+    rig["noise_fraction"] = float(noise_fraction)
+    rig.setdefault("dual_sine", {})["record_samples"] = int(record_samples)
+    rig["effects"] = {}
+    rig_seed = int(cfg["seed"]) + int(seed)
+    cal = cfg.get("nonlinear", {}).get("calibration_case", "lc1")
+    raw_rt, truth_rt = random_test_datasets(cfg["structure"], random_test_rig_config(rig), cfg["random_test"], rig_seed)
+    fs = float(cfg["random_test"].get("sampling_rate_hz", 5120.0))
+    raw_cal, truth_cal = dual_sine_test(cfg["structure"], rig, cfg["load_cases"][cal], fs, float(noise_fraction), rig_seed,
+                                        cal, cfg["structure"]["sensors"]["names"])
+    t_rig = time.perf_counter() - t0
+    model, modes, _, _ = identify(cfg, raw_rt, raw_cal)
+    tf = rig["truth"]["friction"]
+    N0 = float(truth_cal.attrs["preload_n"])
+    e_f, k_c, _, _, mu = (float(x) for x in model.friction)
+    e0, e0_true = e0_at(e_f, k_c, N0), e0_at(tf["e_f_n_per_m"], tf["k_c_per_m"], N0)
+    k_t, k_t_true = float(modes["k_t"]), float(truth_rt["k_t"])
+    return {"noise_fraction": float(noise_fraction), "record_samples": int(record_samples), "seed": int(seed),
+            "mu": mu, "mu_true": float(tf["mu"]), "e0": e0, "e0_true": e0_true, "k_t": k_t, "k_t_true": k_t_true,
+            "error_mu": mu / float(tf["mu"]) - 1.0, "error_e0": e0 / e0_true - 1.0, "error_k_t": k_t / k_t_true - 1.0,
+            "seconds": {"rig": t_rig, "identification": time.perf_counter() - t0 - t_rig}}
+
+
+def gather(rows: list) -> xr.Dataset:
+    """The points stacked on (noise_fraction, record_samples, seed): identified values, truths and
+    relative errors of mu, e_0 and k_t."""
+    df = pd.DataFrame([{k: v for k, v in r.items() if k != "seconds"} for r in rows])
+    df = df.set_index(["noise_fraction", "record_samples", "seed"]).sort_index()
+    ds = xr.Dataset.from_dataframe(df)
+    meaning = {"mu": ("1", "friction coefficient mu"), "e0": ("N/m", "tangential stiffness e_0 at the preload (Eq. 22)"),
+               "k_t": ("N/m", "contact stiffness at stiction k_t")}
+    for q, (unit, name) in meaning.items():
+        ds[q].attrs.update(units=unit, long_name=f"identified {name}")
+        ds[f"{q}_true"].attrs.update(units=unit, long_name=f"rig truth: {name}")
+        ds[f"error_{q}"].attrs.update(units="1", long_name=f"relative error of {name} (identified / truth - 1)")
+    ds["noise_fraction"].attrs.update(units="1", long_name="sensor noise rms over signal rms")
+    ds["record_samples"].attrs.update(units="1", long_name="dual-sine record length (samples)")
+    ds["seed"].attrs.update(units="1", long_name="seed offset of the point's rig records")
+    ds["seconds"] = (("noise_fraction", "record_samples", "seed"),
+                     np.array([sum(r["seconds"].values()) for r in sorted(rows, key=lambda r: (r["noise_fraction"], r["record_samples"], r["seed"]))]).reshape(
+                         ds.sizes["noise_fraction"], ds.sizes["record_samples"], ds.sizes["seed"]),
+                     {"units": "s", "long_name": "wall time of the point's job"})
+    return ds
+
+
+def plot_noise_study(ds: xr.Dataset, default_noise: float, png: str, pdf: str | None = None) -> None:
+    """|error| of mu, e_0 and k_t against the noise fraction: every seed as a dot, the median as a line
+    per record length; the default noise marked."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    noise = ds["noise_fraction"].values
+    fig, axes = plt.subplots(1, len(QUANTITIES), figsize=(11, 3.4), sharex=True)
+    labels = {"mu": r"$\mu$", "e0": r"$e_0$ at $N_0$", "k_t": r"$k_t$"}
+    for ax, q in zip(axes, QUANTITIES):
+        err = 100 * np.abs(ds[f"error_{q}"].values)  # (noise, length, seed)
+        for j, n in enumerate(ds["record_samples"].values):
+            line, = ax.plot(noise, np.median(err[:, j, :], axis=1), "-o", ms=3, label=f"{int(n)} samples")
+            for s in range(err.shape[2]):
+                ax.plot(noise, err[:, j, s], ".", color=line.get_color(), alpha=0.4)
+        ax.axvline(default_noise, color="k", ls="--", lw=0.8)
+        ax.text(default_noise, ax.get_ylim()[1] * 0.95 if ax.get_yscale() == "linear" else 1, " default",
+                va="top", fontsize=8)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("sensor noise (rms fraction)")
+        ax.set_title(f"|error| of {labels[q]} (%)")
+    axes[0].legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(png, dpi=130)
+    if pdf:
+        fig.savefig(pdf)
+    plt.close(fig)
+
+
+def report_section(ds: xr.Dataset | None) -> str:
+    """The report's section on the study: medians over seeds at the default noise and at the largest, and
+    the figure; without the study (noise_study.in_report: false) a sentence saying how to run it."""
+    head = "\\section{Identification accuracy against sensor noise and record length}\n"
+    if ds is None:
+        return head + ("The Monte Carlo study is not part of this report (\\texttt{noise\\_study.in\\_report: false}); "
+                       "\\texttt{snakemake noise\\_study} runs it.\n")
+    noise = ds["noise_fraction"].values
+    longest = int(ds["record_samples"].values.max())
+    default = float(ds.attrs.get("default_noise_fraction", noise[len(noise) // 2]))
+    i_def = int(np.argmin(np.abs(noise - default)))
+
+    def med(q, i):
+        return 100 * float(np.median(np.abs(ds[f"error_{q}"].sel(record_samples=longest).values[i])))
+
+    n_points = ds.sizes["noise_fraction"] * ds.sizes["record_samples"] * ds.sizes["seed"]
+    text = (f"Each of the {n_points} points of the parameter table (noise fractions "
+            f"{', '.join(f'{x:g}' for x in noise)}; records of {', '.join(str(int(r)) for r in ds['record_samples'].values)} "
+            f"samples; {ds.sizes['seed']} seeds) is one Snakemake job: the rig records a random test and the calibration "
+            f"case, the chain identifies $k_t$ and the friction law, and the errors against the rig's truth are gathered "
+            f"(Fig.~\\ref{{fig:noise}}). With {longest}-sample records the median error of $\\mu$ is "
+            f"{med('mu', i_def):.2g}\\,\\% at the default noise ({noise[i_def]:g}) and {med('mu', -1):.2g}\\,\\% at "
+            f"{noise[-1]:g}; of $e_0$ {med('e0', i_def):.2g}\\,\\% and {med('e0', -1):.2g}\\,\\%; of $k_t$ "
+            f"{med('k_t', i_def):.2g}\\,\\% and {med('k_t', -1):.2g}\\,\\%.\n")
+    fig = ("\\begin{figure}[H]\\centering\\includegraphics[width=\\textwidth]{noise_study.pdf}\n"
+           "\\caption{Relative error of $\\mu$, $e_0$ at the preload and $k_t$ against the sensor noise: dots are seeds, "
+           "lines the medians per record length; the dashed line marks the default noise.}\\label{fig:noise}\\end{figure}\n")
+    return head + text + fig

@@ -1,0 +1,77 @@
+# Parameter studies as Snakemake jobs: one small, independent job per point of a parameter table
+# (snakemake.utils.Paramspace), with declared resources, and a gathering rule. Run them on one
+# machine or through a cluster executor (profiles/default, profiles/slurm; README "Running on a cluster").
+
+from snakemake.utils import Paramspace
+
+from contactid.studies import noise_study_table
+
+NOISE_SPACE = Paramspace(noise_study_table(config.get("noise_study")), filename_params="*", param_sep="~")
+
+
+def study_base_config():
+    """What a study point depends on: the rig, the structure and the identification settings."""
+    keys = ("seed", "structure", "random_test", "rig", "frf", "modal", "stiction", "linear_modes", "nonlinear",
+            "friction", "load_cases")
+    return {k: config[k] for k in keys if k in config}
+
+
+rule noise_study_point:
+    output:
+        point=f"results/studies/noise/{NOISE_SPACE.wildcard_pattern}.json",
+    params:
+        code=CODE_DIGEST,
+        point=NOISE_SPACE.instance,
+        config=study_base_config(),
+    threads: 1
+    resources:
+        runtime=15,
+        mem_mb=2000,
+    conda:
+        "../envs/contactid.yaml"
+    log:
+        f"logs/noise_study/{NOISE_SPACE.wildcard_pattern}.log",
+    script:
+        "../scripts/noise_study_point.py"
+
+
+rule noise_study:
+    input:
+        points=expand("results/studies/noise/{params}.json", params=NOISE_SPACE.instance_patterns),
+    output:
+        dataset="results/studies/noise_study.nc",
+        table="results/studies/noise_study.csv",
+        png="results/figures/noise_study.png",
+        pdf="results/figures/noise_study.pdf",
+    params:
+        code=CODE_DIGEST,
+        default_noise=config.get("rig", {}).get("noise_fraction", 0.005),
+    resources:
+        runtime=5,
+        mem_mb=1000,
+    conda:
+        "../envs/contactid.yaml"
+    log:
+        "logs/noise_study.log",
+    script:
+        "../scripts/noise_study.py"
+
+
+def noise_report_inputs(wildcards):
+    """The study's dataset when it is part of the report (noise_study.in_report), else nothing."""
+    return {"dataset": "results/studies/noise_study.nc"} if config.get("noise_study", {}).get("in_report", True) else {}
+
+
+rule noise_report_fragment:
+    input:
+        unpack(noise_report_inputs),
+    output:
+        tex="results/report/noise.tex",
+    params:
+        code=CODE_DIGEST,
+    conda:
+        "../envs/contactid.yaml"
+    log:
+        "logs/noise_report_fragment.log",
+    script:
+        "../scripts/noise_report_fragment.py"
