@@ -7,7 +7,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 CORES ?= 2
 
-.PHONY: env reproduce test clean-results tex
+.PHONY: env reproduce test slurm-test clean-results tex
 
 env: $(VENV)/.installed tex
 
@@ -31,6 +31,10 @@ reproduce: env
 
 test: env
 	$(PY) -m pytest -q
+
+# optional (not in CI by default): the noise-study sweep through a local single-node SLURM against -c2 here
+slurm-test: env
+	.ci/slurm/run
 
 clean-results:
 	rm -rf results data/raw data/truth data/imported logs benchmarks/rules .snakemake/metadata
