@@ -49,3 +49,21 @@ def test_sweep_runs_one_job_per_point_and_errors_grow_with_noise(tmp_path):
     assert cfg["noise_study"]["seeds"] == [1]
     dry = snakemake(proj, "-n", "--forceall", "noise_study")
     assert "noise_study_point" in dry.stdout and "runtime=15" in dry.stdout.replace(" ", "")
+
+
+@pytest.mark.workflow
+@pytest.mark.parametrize("profile", ["default", "slurm"])
+def test_profiles_plan_the_sweep_and_comment_every_entry(tmp_path, profile):
+    import shutil
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    proj = make_project(tmp_path)
+    shutil.copytree(root / "profiles", proj / "profiles")
+    lines = (proj / "profiles" / profile / "config.yaml").read_text().splitlines()
+    for i, line in enumerate(lines):  # every top-level entry has a comment line right above it
+        if line and not line.startswith((" ", "#")):
+            assert lines[i - 1].startswith("#"), f"profiles/{profile}: '{line}' has no comment"
+    res = snakemake(proj, "--profile", f"profiles/{profile}", "-n", "noise_study")
+    assert res.returncode == 0, res.stderr[-3000:]
+    assert "noise_study_point" in res.stdout
