@@ -58,7 +58,8 @@ def read_uff58(spec: ImportSpec) -> dict:
     for ch in spec.channels:
         s = by_id.get(ch.channel.strip())
         if s is None:
-            raise _missing(path, "dataset 58 with id1", ch.channel, list(by_id))
+            err = _missing(path, "dataset 58 with id1", ch.channel, list(by_id))
+            raise RawDataError(f"{err} (or the file was cut short: it holds {len(by_id)} time histories)")
         if s.get("func_type") != 1:
             raise RawDataError(f"{path}: dataset 58 {ch.channel!r} has function type {s.get('func_type')}, not 1 "
                                "(time response); export the time histories, not spectra or FRFs")
