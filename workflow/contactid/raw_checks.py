@@ -90,6 +90,20 @@ def samples_at_limit(x: np.ndarray) -> int:
     return int(max(np.sum(x >= x.max() - tol), np.sum(x <= x.min() + tol)))
 
 
+def clipping_warnings(raw: xr.Dataset, path: str, clip_samples: int, drive: str) -> list[str]:
+    """Refuse a clipped channel (``clip_samples`` samples at its extreme value); warn from half that many."""
+    warnings = []
+    for name, x in _channels(raw, path):
+        at = samples_at_limit(x)
+        if at >= clip_samples:
+            raise RawDataError(f"{path}: channel {name}: clipping check failed: {at} samples sit at the range limit "
+                               f"({x.max():.6g} / {x.min():.6g}); raw_checks.clip_samples = {clip_samples}. "
+                               f"Lower the input range's gain or the {drive} and record again")
+        if at >= max(2, clip_samples // 2):
+            warnings.append(f"{name}: {at} samples at the range limit (clipping check: {clip_samples})")
+    return warnings
+
+
 def recovered_frequency(x: np.ndarray, fs: float, declared_hz: float) -> tuple[float, int]:
     """The excitation frequency found in a record: the strongest spectral line of ``x`` (Hann
     window), refined by maximising the windowed DFT magnitude, divided by its harmonic number h of
@@ -122,15 +136,7 @@ def validate_dual_sine(raw: xr.Dataset, path: str, checks: Mapping) -> list[str]
     f0 = float(raw.attrs["excitation_frequency_hz"])
     n = raw.sizes["time"]
     duration = n / fs
-    warnings = []
-    for name, x in _channels(raw, path):
-        at = samples_at_limit(x)
-        if at >= c["clip_samples"]:
-            raise RawDataError(f"{path}: channel {name}: clipping check failed: {at} samples sit at the range limit "
-                               f"({x.max():.6g} / {x.min():.6g}); raw_checks.clip_samples = {c['clip_samples']}. "
-                               "Lower the input range's gain or the excitation and record again")
-        if at >= max(2, c["clip_samples"] // 2):
-            warnings.append(f"{name}: {at} samples at the range limit (clipping check: {c['clip_samples']})")
+    warnings = clipping_warnings(raw, path, c["clip_samples"], "excitation")
     f_rec, h = recovered_frequency(np.asarray(raw["force"].values, float), fs, f0)
     drift_cycles = abs(f_rec - f0) * duration
     if h not in (1, 2, 3) or drift_cycles > c["frequency_tolerance_cycles"]:
@@ -164,15 +170,7 @@ def validate_random_test(raw: xr.Dataset, path: str, checks: Mapping, segment_le
     c = check_settings(checks)
     fs = float(raw.attrs["sampling_rate_hz"])
     n = raw.sizes["time"]
-    warnings = []
-    for name, x in _channels(raw, path):
-        at = samples_at_limit(x)
-        if at >= c["clip_samples"]:
-            raise RawDataError(f"{path}: channel {name}: clipping check failed: {at} samples sit at the range limit "
-                               f"({x.max():.6g} / {x.min():.6g}); raw_checks.clip_samples = {c['clip_samples']}. "
-                               "Lower the input range's gain or the force level and record again")
-        if at >= max(2, c["clip_samples"] // 2):
-            warnings.append(f"{name}: {at} samples at the range limit (clipping check: {c['clip_samples']})")
+    warnings = clipping_warnings(raw, path, c["clip_samples"], "force level")
     need = 2 * segment_length * blocks
     if n < need:
         raise RawDataError(f"{path}: record length check failed: {n} samples, fewer than 2 x frf.segment_length x "
