@@ -1,6 +1,9 @@
 # Shared helpers: config checks and path functions, so that rules stay declarative.
 
+from snakemake.utils import Paramspace
+
 from contactid.config import check_config
+from contactid.studies import noise_study_table
 from contactid.rig.structure import random_test_rig_config
 
 check_config(config)
@@ -190,3 +193,20 @@ def gap_report_inputs(wildcards):
     if config.get("gap_benchmark", {}).get("in_report", True):
         inputs["benchmark"] = "results/gap_benchmark/benchmark.json"
     return inputs
+
+
+# ---- parameter studies (workflow/rules/studies.smk) ----
+
+NOISE_SPACE = Paramspace(noise_study_table(config.get("noise_study")), filename_params="*", param_sep="~")
+
+
+def study_base_config():
+    """What a study point depends on: the rig, the structure and the identification settings."""
+    keys = ("seed", "structure", "random_test", "rig", "frf", "modal", "stiction", "linear_modes", "nonlinear",
+            "friction", "load_cases")
+    return {k: config[k] for k in keys if k in config}
+
+
+def noise_report_inputs(wildcards):
+    """The study's dataset when it is part of the report (noise_study.in_report), else nothing."""
+    return {"dataset": "results/studies/noise_study.nc"} if config.get("noise_study", {}).get("in_report", True) else {}

@@ -2,20 +2,6 @@
 # (snakemake.utils.Paramspace), with declared resources, and a gathering rule. Run them on one
 # machine or through a cluster executor (profiles/default, profiles/slurm; README "Running on a cluster").
 
-from snakemake.utils import Paramspace
-
-from contactid.studies import noise_study_table
-
-NOISE_SPACE = Paramspace(noise_study_table(config.get("noise_study")), filename_params="*", param_sep="~")
-
-
-def study_base_config():
-    """What a study point depends on: the rig, the structure and the identification settings."""
-    keys = ("seed", "structure", "random_test", "rig", "frf", "modal", "stiction", "linear_modes", "nonlinear",
-            "friction", "load_cases")
-    return {k: config[k] for k in keys if k in config}
-
-
 rule noise_study_point:
     output:
         point=f"results/studies/noise/{NOISE_SPACE.wildcard_pattern}.json",
@@ -55,11 +41,6 @@ rule noise_study:
         "logs/noise_study.log",
     script:
         "../scripts/noise_study.py"
-
-
-def noise_report_inputs(wildcards):
-    """The study's dataset when it is part of the report (noise_study.in_report), else nothing."""
-    return {"dataset": "results/studies/noise_study.nc"} if config.get("noise_study", {}).get("in_report", True) else {}
 
 
 rule noise_report_fragment:
