@@ -31,16 +31,31 @@ def _finish(p: subprocess.Popen, timeout=900) -> str:
     return out
 
 
-def _interrupt_when(p: subprocess.Popen, started: Path, sig, timeout=600) -> None:
-    """Send ``sig`` to the whole run (snakemake and its job) once ``started`` exists (the job's log)."""
+def _job_running(proj: Path, rule: str) -> bool:
+    """Is the Python process of ``rule``'s script (written by Snakemake into proj/.snakemake/scripts) running?"""
+    mark = f"{proj}/.snakemake/scripts/"
+    for cmd in Path("/proc").glob("[0-9]*/cmdline"):
+        try:
+            text = cmd.read_bytes().decode(errors="replace")
+        except OSError:
+            continue
+        if mark in text and f".{rule}.py" in text:
+            return True
+    return False
+
+
+def _interrupt_during(p: subprocess.Popen, proj: Path, rule: str, sig, timeout=600) -> str:
+    """Send ``sig`` to the whole run (snakemake and its job) while ``rule``'s script is running; its output."""
     t0 = time.time()
-    while not started.exists():
+    while not _job_running(proj, rule):
         assert p.poll() is None, "the run ended before the job to interrupt started"
-        assert time.time() - t0 < timeout, f"{started} never appeared"
+        assert time.time() - t0 < timeout, f"{rule} never started"
         time.sleep(0.05)
-    time.sleep(0.5)  # inside the job's computation
+    time.sleep(1.0)  # inside the job's computation
+    assert _job_running(proj, rule), f"{rule} ended within a second; nothing was interrupted"
     os.killpg(p.pid, sig)
-    p.communicate(timeout=120)
+    out, _ = p.communicate(timeout=120)
+    return out
 
 
 def _datasets(proj: Path) -> dict:
@@ -55,14 +70,14 @@ def test_killed_runs_resume_to_bit_identical_results(tmp_path):
     reference = _start(ref, TARGET)  # uninterrupted, at the same time in another directory
     # 1. SIGKILL in the middle of the rig (no chance to clean up: the lock and the incomplete marker stay)
     first = _start(run, TARGET)
-    _interrupt_when(first, run / "logs" / "rig_dual_sine_lc1.log", signal.SIGKILL)
+    _interrupt_during(first, run, "rig_dual_sine", signal.SIGKILL)
     for f in _datasets(run).values():  # whatever exists is whole: it loads
         xr.load_dataset(f, engine="netcdf4")
     _finish(_start(run, "--unlock"))
     # 2. resume, then SIGINT in the middle of the friction fit
     second = _start(run, "--rerun-incomplete", TARGET)
-    _interrupt_when(second, run / "logs" / "friction_fit.log", signal.SIGINT)
-    assert not (run / TARGET).exists()
+    out = _interrupt_during(second, run, "friction_fit", signal.SIGINT)
+    assert not (run / TARGET).exists(), out[-3000:]  # the interrupted job left no output
     # 3. resume to the end
     _finish(_start(run, "--rerun-incomplete", TARGET))
     _finish(reference)
