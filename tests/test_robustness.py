@@ -21,8 +21,11 @@ TARGET = "results/friction/friction_fit.nc"
 
 def _start(proj: Path, *args) -> subprocess.Popen:
     env = {**os.environ, "PYTHONPATH": str(proj / "workflow"), "NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
+    # as from a terminal: a run started in the background (CI, nohup ... &) inherits SIGINT ignored, and
+    # Python then never turns Ctrl-C into KeyboardInterrupt; restore the default disposition
     return subprocess.Popen([sys.executable, "-m", "snakemake", "--cores", "1", *args], cwd=proj, env=env,
-                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, start_new_session=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, start_new_session=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
 
 
 def _finish(p: subprocess.Popen, timeout=900) -> str:
