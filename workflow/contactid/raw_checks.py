@@ -71,6 +71,7 @@ PHYSICAL_LIMIT = 1.0e9
 
 
 def _channels(raw: xr.Dataset, path: str = "record"):
+    """(name, samples) of the force and every accelerometer, after the magnitude check."""
     chans = [("force", np.asarray(raw["force"].values, float))]
     chans += [(str(s), a) for s, a in zip(raw["sensor"].values, np.asarray(raw["acceleration"].values, float))]
     for name, x in chans:
@@ -90,10 +91,11 @@ def samples_at_limit(x: np.ndarray) -> int:
     return int(max(np.sum(x >= x.max() - tol), np.sum(x <= x.min() + tol)))
 
 
-def clipping_warnings(raw: xr.Dataset, path: str, clip_samples: int, drive: str) -> list[str]:
-    """Refuse a clipped channel (``clip_samples`` samples at its extreme value); warn from half that many."""
+def clipping_warnings(channels, path: str, clip_samples: int, drive: str) -> list[str]:
+    """Refuse a clipped channel of ``channels`` ([(name, samples)], from ``_channels``) when
+    ``clip_samples`` samples sit at its extreme value; warn from half that many."""
     warnings = []
-    for name, x in _channels(raw, path):
+    for name, x in channels:
         at = samples_at_limit(x)
         if at >= clip_samples:
             raise RawDataError(f"{path}: channel {name}: clipping check failed: {at} samples sit at the range limit "
@@ -136,7 +138,8 @@ def validate_dual_sine(raw: xr.Dataset, path: str, checks: Mapping) -> list[str]
     f0 = float(raw.attrs["excitation_frequency_hz"])
     n = raw.sizes["time"]
     duration = n / fs
-    warnings = clipping_warnings(raw, path, c["clip_samples"], "excitation")
+    channels = list(_channels(raw, path))
+    warnings = clipping_warnings(channels, path, c["clip_samples"], "excitation")
     f_rec, h = recovered_frequency(np.asarray(raw["force"].values, float), fs, f0)
     drift_cycles = abs(f_rec - f0) * duration
     if h not in (1, 2, 3) or drift_cycles > c["frequency_tolerance_cycles"]:
@@ -148,7 +151,7 @@ def validate_dual_sine(raw: xr.Dataset, path: str, checks: Mapping) -> list[str]
         warnings.append(f"force: excitation at {f_rec:.6g} Hz against {f0:.6g} Hz declared ({drift_cycles:.3g} cycles "
                         "over the record)")
     third = n // 3
-    for name, x in _channels(raw, path):
+    for name, x in channels:
         whole = np.abs(harmonic_content(x, fs, f0, (1, 3)))
         first = np.abs(harmonic_content(x[:third], fs, f0, (1, 3)))
         last = np.abs(harmonic_content(x[-third:], fs, f0, (1, 3)))
@@ -170,7 +173,7 @@ def validate_random_test(raw: xr.Dataset, path: str, checks: Mapping, segment_le
     c = check_settings(checks)
     fs = float(raw.attrs["sampling_rate_hz"])
     n = raw.sizes["time"]
-    warnings = clipping_warnings(raw, path, c["clip_samples"], "force level")
+    warnings = clipping_warnings(list(_channels(raw, path)), path, c["clip_samples"], "force level")
     need = 2 * segment_length * blocks
     if n < need:
         raise RawDataError(f"{path}: record length check failed: {n} samples, fewer than 2 x frf.segment_length x "
