@@ -155,13 +155,13 @@ def data_checks_text(summary: Mapping) -> str:
         lines.append("No check came within a factor of two of its limit.")
     else:
         lines.append(r"Warnings (a value beyond half its limit):\begin{itemize}")
-        lines += [rf"\item {_tex(rec)}: {_tex(w)}" for rec, w in items]
+        lines += [rf"\item {plain_text(rec)}: {plain_text(w)}" for rec, w in items]
         lines.append(r"\end{itemize}")
     return "\n".join(lines) + "\n"
 
 
-def _tex(text: str) -> str:
-    """Plain text safe in LaTeX."""
+def plain_text(text: str) -> str:
+    """Plain text (messages, names) safe in LaTeX: its special characters escaped."""
     repl = {"\\": r"\textbackslash{}", "_": r"\_", "%": r"\%", "&": r"\&", "#": r"\#", "$": r"\$",
             "{": r"\{", "}": r"\}", "^": r"\^{}", "~": r"\~{}"}
     return "".join(repl.get(ch, ch) for ch in str(text))

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 from typing import Mapping
 
@@ -72,8 +73,6 @@ def linear_summary(modal: xr.Dataset, stiction: xr.Dataset, truth: xr.Dataset | 
 def load_case_summary(checks: Mapping[str, xr.Dataset], truths: Mapping[str, xr.Dataset]) -> dict:
     """Per load case: the driving-point harmonics read off the raw record and the validation's
     warnings (``data_warnings``), and (rig cases) the truth's force amplitudes and contact extremes."""
-    import json
-
     out = {"load_cases": {}, "data_warnings": {}}
     for case, ds in checks.items():
         out["load_cases"][case] = {"A1_m_per_s2": ds.attrs["A1_m_per_s2"], "A2_m_per_s2": ds.attrs["A2_m_per_s2"],

@@ -5,11 +5,7 @@ from __future__ import annotations
 
 import pandas as pd
 
-from ..latex import _fmt, tabular
-
-
-def _t(x: str) -> str:
-    return str(x).replace("_", r"\_").replace("%", r"\%")
+from ..latex import _fmt, plain_text as _t, tabular
 
 
 def _pct(x) -> str:
