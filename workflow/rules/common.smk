@@ -27,7 +27,7 @@ def record_block(record):
 def imported_records(fmt):
     """Records (load cases, random_test) that the importer of ``fmt`` converts."""
     names = ["random_test"] + list(config.get("load_cases") or {})
-    return [r for r in names if (r != "random_test" or "random_test" in config) and _import_format(record_block(r)) == fmt]
+    return [r for r in names if _import_format(record_block(r)) == fmt]
 
 
 def import_pattern(fmt):
@@ -155,8 +155,7 @@ def all_outputs():
            "results/figures/fig06_contact_forces.png"] if load_cases() else []),
         "results/summary.json",
         *(gap_outputs() if load_cases() else []),
-        *(["results/studies/noise_study.nc", "results/figures/noise_study.png"]
-          if config.get("noise_study", {}).get("in_report", True) else []),
+        *(["results/studies/noise_study.nc", "results/figures/noise_study.png"] if noise_study_in_report() else []),
         *(["results/report/report.pdf"] if load_cases() else []),
     ]
 
@@ -207,6 +206,11 @@ def study_base_config():
     return {k: config[k] for k in keys if k in config}
 
 
+def noise_study_in_report():
+    """Is the noise study part of the default target and the report (noise_study.in_report)?"""
+    return config.get("noise_study", {}).get("in_report", True)
+
+
 def noise_report_inputs(wildcards):
-    """The study's dataset when it is part of the report (noise_study.in_report), else nothing."""
-    return {"dataset": "results/studies/noise_study.nc"} if config.get("noise_study", {}).get("in_report", True) else {}
+    """The study's dataset when it is part of the report, else nothing."""
+    return {"dataset": "results/studies/noise_study.nc"} if noise_study_in_report() else {}

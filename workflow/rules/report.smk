@@ -34,9 +34,7 @@ rule report:
         fragments=rules.report_fragments.output,
         gap="results/report/gap.tex",
         noise="results/report/noise.tex",
-        noise_figure=(
-            ["results/figures/noise_study.pdf"] if config.get("noise_study", {}).get("in_report", True) else []
-        ),
+        noise_figure=["results/figures/noise_study.pdf"] if noise_study_in_report() else [],
         gap_figures=[
             f"results/gap/gap_{v}.png"
             for v in ("stages", "harmonics", "cycle", "ranking", "shrink", "force_state")
