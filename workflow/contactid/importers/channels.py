@@ -100,12 +100,7 @@ def _channel(entry, role: str, where: str) -> ChannelSpec:
         if sens is None or sens_units is None:
             raise RawDataError(f"{where}: {role} is stored in {units}: give sensitivity and sensitivity_units "
                                f"(for example sensitivity: 10.2, sensitivity_units: mV/{'N' if quantity == 'force' else 'g'})")
-        try:
-            sens = float(sens)
-        except (TypeError, ValueError):
-            raise RawDataError(f"{where}: {role}.sensitivity = {sens!r}: give a positive number") from None
-        if not sens > 0 or sens != sens or sens == float("inf"):
-            raise RawDataError(f"{where}: {role}.sensitivity = {sens!r}: give a positive finite number")
+        sens = _positive_or_none(entry, "sensitivity", f"{where}: {role}")
         parts = str(sens_units).split("/", 1)
         den = parts[1].strip().strip("()") if len(parts) == 2 else ""
         if len(parts) != 2 or parts[0].strip() not in ELECTRICAL or den not in PHYSICAL[quantity]:
