@@ -189,7 +189,7 @@ def benchmark_items():
 def gap_report_inputs(wildcards):
     """The report's gap section: the diagnosis, and the blind benchmark when gap_benchmark.in_report."""
     inputs = {"diagnosis": "results/gap/diagnosis.json"}
-    if config.get("gap_benchmark", {}).get("in_report", True):
+    if gap_benchmark_in_report():
         inputs["benchmark"] = "results/gap_benchmark/benchmark.json"
     return inputs
 
@@ -208,7 +208,12 @@ def study_base_config():
 
 def noise_study_in_report():
     """Is the noise study part of the default target and the report (noise_study.in_report)?"""
-    return config.get("noise_study", {}).get("in_report", True)
+    return config["noise_study"]["in_report"]
+
+
+def gap_benchmark_in_report():
+    """Is the blind benchmark part of the default target and the report (gap_benchmark.in_report)?"""
+    return config["gap_benchmark"]["in_report"]
 
 
 def noise_report_inputs(wildcards):

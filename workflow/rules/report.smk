@@ -41,7 +41,7 @@ rule report:
         ],
         benchmark_figure=(
             ["results/gap_benchmark/confusion.png"]
-            if config.get("gap_benchmark", {}).get("in_report", True)
+            if gap_benchmark_in_report()
             else []
         ),
         figures=expand(
