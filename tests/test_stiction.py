@@ -28,3 +28,38 @@ def test_rigid_normal_contact_gives_only_a_lower_bound():
     assert math.isinf(fit.k_n_interval[1])
     assert 1e5 < fit.k_n_lower_bound < 1e10
     assert fit.k_t == pytest.approx(1e7, rel=5e-3)
+
+
+# identified frequencies and their standard errors of the blind benchmark's item transducer_mass_error-0-s1
+# (transducers 47 % heavier than the model; single-threaded BLAS), on which the joint fit stopped in a second
+# minimum and the k_t interval's bracket had no sign change (brentq raised)
+ITEM_FREQUENCIES = [54.549283495121216, 166.05550692977624, 334.62758784106103]
+ITEM_SIGMA = [0.0006693521432435572, 0.0004573431763065356, 0.00023251057083377834]
+
+
+def test_second_minimum_restarts_the_joint_fit_and_every_interval_holds_it(default_config):
+    from contactid.parameters import structure_from_config
+
+    p = structure_from_config(default_config["structure"], 1e7, 1e8)
+    fit = stiction_stiffness(p, ITEM_FREQUENCIES, frequency_sigma(ITEM_FREQUENCIES, ITEM_SIGMA, 1e-3))
+    # the joint fit is the lowest point of both profiles, and each interval holds its best value
+    assert fit.chi2_min == pytest.approx(min(fit.profiles["k_t"][1].min(), fit.profiles["k_n"][1].min()), abs=1e-6)
+    assert fit.k_t_interval[0] < fit.k_t < fit.k_t_interval[1]
+    assert fit.k_n_interval[0] < fit.k_n < fit.k_n_interval[1]
+    # the heavier transducers lower the frequencies: the fit trades that for a stiffer k_t and a softer k_n
+    assert 1.2e7 < fit.k_t < 1.5e7 and 4e6 < fit.k_n < 6e6
+    assert np.allclose(fit.model_frequencies_hz, ITEM_FREQUENCIES, rtol=2e-3)
+
+
+def test_an_edge_that_cannot_be_bracketed_is_unbounded_with_the_reason():
+    from contactid.stiction import interval_edge
+
+    grid = np.linspace(0.0, 1.0, 11)
+    chi2_grid = 10.0 * (grid - 0.5) ** 2
+    # a profile that re-evaluates higher than its stored grid values (a refit that stops elsewhere): no sign change
+    edge, why = interval_edge(lambda x: 10.0 * (x - 0.5) ** 2 + 5.0, grid, chi2_grid, 5, +1, 0.0, 1.0)
+    assert edge is None and "does not cross the threshold" in why
+    edge, why = interval_edge(lambda x: 10.0 * (x - 0.5) ** 2, grid, chi2_grid, 5, -1, 0.0, 1.0)
+    assert edge == pytest.approx(0.5 - np.sqrt(0.1), abs=1e-6) and why == ""
+    edge, why = interval_edge(lambda x: 0.1 * x, grid, 0.1 * grid, 0, +1, 0.0, 1.0)
+    assert edge is None and "search bound" in why

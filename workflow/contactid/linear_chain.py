@@ -153,7 +153,8 @@ def stiction_dataset(modal: xr.Dataset, structure_cfg: Mapping, stiction_cfg: Ma
                 "k_t_grid": ("k_t_grid", gt, {"units": "N/m"}), "k_n_grid": ("k_n_grid", gn, {"units": "N/m"})},
         attrs={"chi2_min": fit.chi2_min, "confidence": fit.confidence,
                "k_t_bounded": int(fit.k_t_bounded), "k_n_bounded_above": int(fit.k_n_bounded_above),
-               "k_n_bounded_below": int(fit.k_n_bounded_below)},
+               "k_n_bounded_below": int(fit.k_n_bounded_below),
+               "k_t_interval_note": "; ".join(fit.notes["k_t"]), "k_n_interval_note": "; ".join(fit.notes["k_n"])},
     )
 
 

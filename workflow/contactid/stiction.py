@@ -25,7 +25,8 @@ class StiffnessFit:
     the data do not bound the parameter; k_n_bounded_above: False when the
     data only give a lower bound on k_n (then ``k_n_lower_bound`` holds it);
     model_frequencies_hz: frequencies at the best fit; chi2_min: minimum of the
-    weighted misfit; profiles: dict of (grid, chi2) arrays per parameter.
+    weighted misfit; profiles: dict of (grid, chi2) arrays per parameter;
+    notes: {parameter: why a side is not bounded} (empty where both are).
     """
 
     k_t: float
@@ -39,6 +40,7 @@ class StiffnessFit:
     chi2_min: float
     confidence: float
     profiles: dict
+    notes: dict
 
     @property
     def k_n_lower_bound(self) -> float:
@@ -65,6 +67,47 @@ def _fit_one(params, f_id, sigma, fixed_name, fixed_log, start, bounds):
     return r.x[0], float(2 * r.cost)
 
 
+def _joint_fit(params, f_id, sigma, x0, lt, ln):
+    """Least-squares fit of (log10 k_t, log10 k_n) from x0; returns (x, chi2)."""
+    r = least_squares(lambda x: _residuals(params, f_id, sigma, x[0], x[1]), x0,
+                      bounds=([lt[0], ln[0]], [lt[1], ln[1]]), x_scale=[0.1, 1.0], xtol=1e-12, ftol=1e-14)
+    return r.x, float(2 * r.cost)
+
+
+def _profiles(params, f_id, sigma, best, lt, ln, n_profile):
+    """Profile misfit of each parameter on a log grid (the other refitted from the joint best):
+    {name: (log grid, chi2, the other parameter's fitted log value)}."""
+    out = {}
+    for name, rng, idx, other_rng in (("k_n", ln, 1, lt), ("k_t", lt, 0, ln)):
+        grid = np.unique(np.concatenate([np.linspace(rng[0], rng[1], n_profile), [best[idx]]]))
+        fits = [_fit_one(params, f_id, sigma, name, x, best[1 - idx], other_rng) for x in grid]
+        out[name] = (grid, np.array([c for _, c in fits]), np.array([o for o, _ in fits]))
+    return out
+
+
+def interval_edge(profile, grid, chi2_prof, i_min, direction, chi2_min, threshold):
+    """One edge (log10) of a profile-likelihood interval: where the profiled chi2 crosses
+    ``chi2_min + threshold``, walking from grid point ``i_min`` in ``direction`` (-1 or +1).
+
+    Returns (edge, reason): edge None with the reason where the data do not bound the parameter
+    on that side, either because the crossing lies beyond the search range or because no
+    crossing can be bracketed (the profile does not come down to the threshold there)."""
+    j = i_min
+    while 0 <= j + direction < len(grid) and chi2_prof[j + direction] - chi2_min <= threshold:
+        j += direction
+    if not 0 <= j + direction < len(grid):
+        return None, "the interval reaches the search bound"
+    a, b = sorted((grid[j], grid[j + direction]))
+    fa, fb = profile(a) - chi2_min - threshold, profile(b) - chi2_min - threshold
+    if not (np.isfinite(fa) and np.isfinite(fb)) or fa * fb > 0:
+        return None, (f"the profile misfit does not cross the threshold between 10^{a:.3f} and 10^{b:.3f} "
+                      f"({fa + threshold:.3g} and {fb + threshold:.3g} above the minimum, threshold {threshold:.3g}): "
+                      "the data do not bound this side")
+    if fa == 0.0 or fb == 0.0:
+        return (a if fa == 0.0 else b), ""
+    return brentq(lambda x: profile(x) - chi2_min - threshold, a, b, xtol=1e-6), ""
+
+
 def stiction_stiffness(params: StructureParameters, f_id_hz, sigma_hz, k_t_bounds=(1e5, 1e9),
                        k_n_bounds=(1e5, 1e11), confidence: float = 0.95, n_profile: int = 25) -> StiffnessFit:
     """Fit k_t and k_n (N/m) of Eq. (13) to the identified natural frequencies.
@@ -72,8 +115,10 @@ def stiction_stiffness(params: StructureParameters, f_id_hz, sigma_hz, k_t_bound
     Misfit chi2 = sum_i ((f_i(k_t, k_n) - f_id,i) / sigma_i)^2 over the first
     len(f_id) structural modes. A parameter's confidence interval is the set
     of values whose profiled chi2 lies within chi2_1(confidence) of the
-    minimum; an interval reaching a search bound means the data do not bound
-    the parameter on that side.
+    minimum; an interval reaching a search bound, or one whose edge cannot be
+    bracketed, means the data do not bound the parameter on that side (the
+    reason is in ``notes``). Where a profile finds a lower misfit than the joint
+    fit (a second minimum), the joint fit is restarted from there.
     """
     f_id = np.asarray(f_id_hz, dtype=float)
     sigma = np.asarray(sigma_hz, dtype=float)
@@ -82,43 +127,37 @@ def stiction_stiffness(params: StructureParameters, f_id_hz, sigma_hz, k_t_bound
     # start: a coarse scan in k_t with k_n at the geometric mid of its range
     grid_t = np.linspace(lt[0], lt[1], 17)
     c0 = [np.sum(_residuals(params, f_id, sigma, g, ln.mean()) ** 2) for g in grid_t]
-    x0 = [grid_t[int(np.argmin(c0))], ln.mean()]
-    r = least_squares(lambda x: _residuals(params, f_id, sigma, x[0], x[1]), x0,
-                      bounds=([lt[0], ln[0]], [lt[1], ln[1]]), x_scale=[0.1, 1.0], xtol=1e-12, ftol=1e-14)
-    best = r.x
-    chi2_min = float(2 * r.cost)
+    best, chi2_min = _joint_fit(params, f_id, sigma, [grid_t[int(np.argmin(c0))], ln.mean()], lt, ln)
+    prof = _profiles(params, f_id, sigma, best, lt, ln, n_profile)
+    # a profile below the joint fit: the joint fit stopped in a second minimum; restart from the lowest point
+    name, (grid, chi2_p, other) = min(prof.items(), key=lambda kv: kv[1][1].min())
+    i = int(np.argmin(chi2_p))
+    if chi2_p[i] < chi2_min - 1e-9 * (1.0 + chi2_min):
+        x0 = [other[i], grid[i]] if name == "k_n" else [grid[i], other[i]]
+        x1, c1 = _joint_fit(params, f_id, sigma, x0, lt, ln)
+        if c1 < chi2_min:
+            best, chi2_min = x1, c1
+            prof = _profiles(params, f_id, sigma, best, lt, ln, n_profile)
+    chi2_min = min([chi2_min] + [float(p[1].min()) for p in prof.values()])
     thr = chi2.ppf(confidence, 1)
 
-    profiles = {}
-    lo_hi = {}
-    flags = {}
+    profiles, lo_hi, flags, notes = {}, {}, {}, {}
     for name, rng, idx, other_rng in (("k_n", ln, 1, lt), ("k_t", lt, 0, ln)):
         def profile(x, name=name, other_rng=other_rng, idx=idx):
             return _fit_one(params, f_id, sigma, name, x, best[1 - idx], other_rng)[1]
 
-        grid = np.unique(np.concatenate([np.linspace(rng[0], rng[1], n_profile), [best[idx]]]))
-        prof = np.array([profile(x) for x in grid])
-        # the profile's minimum can undercut the joint fit where the joint fit stopped early
-        chi2_min = min(chi2_min, float(prof.min()))
-        profiles[name] = (10.0**grid, prof)
-        i_min = int(np.argmin(prof))
-        edges = []
-        for direction in (-1, +1):
-            j = i_min
-            while 0 <= j + direction < len(grid) and prof[j + direction] - chi2_min <= thr:
-                j += direction
-            if not 0 <= j + direction < len(grid):
-                edges.append(None)  # the interval reaches the search bound
-                continue
-            a, b = sorted((grid[j], grid[j + direction]))
-            edges.append(brentq(lambda x: profile(x) - chi2_min - thr, a, b, xtol=1e-6))
-        flags[name] = (edges[0] is not None, edges[1] is not None)
-        lo_hi[name] = (10.0 ** (edges[0] if edges[0] is not None else rng[0]),
-                       10.0 ** edges[1] if edges[1] is not None else np.inf)
+        grid, chi2_p, _ = prof[name]
+        profiles[name] = (10.0**grid, chi2_p)
+        i_min = int(np.argmin(chi2_p))
+        (lo, why_lo), (hi, why_hi) = (interval_edge(profile, grid, chi2_p, i_min, d, chi2_min, thr) for d in (-1, +1))
+        flags[name] = (lo is not None, hi is not None)
+        notes[name] = tuple(w for w in (f"lower: {why_lo}" if lo is None else "",
+                                        f"upper: {why_hi}" if hi is None else "") if w)
+        lo_hi[name] = (10.0 ** (lo if lo is not None else rng[0]), 10.0 ** hi if hi is not None else np.inf)
     f_best = params(10.0 ** best[0], 10.0 ** best[1])
     return StiffnessFit(
         k_t=float(10.0 ** best[0]), k_n=float(10.0 ** best[1]),
         k_t_interval=lo_hi["k_t"], k_n_interval=lo_hi["k_n"],
         k_t_bounded=all(flags["k_t"]), k_n_bounded_above=flags["k_n"][1], k_n_bounded_below=flags["k_n"][0],
-        model_frequencies_hz=f_best, chi2_min=chi2_min, confidence=confidence, profiles=profiles,
+        model_frequencies_hz=f_best, chi2_min=chi2_min, confidence=confidence, profiles=profiles, notes=notes,
     )
