@@ -4,4 +4,63 @@ micro-vibro-impacting joint (Pourahmadian, Ahmadian & Jalali, J. Sound Vib. 2012
 The package holds the physics and numerics; it knows nothing of Snakemake.
 """
 
+import hashlib
+import os
+import re
+import sys
+import tempfile
+from pathlib import Path
+
 __version__ = "0.1.0"
+
+
+def _code_digest() -> str:
+    """The package's code digest, computed as ``contactid.io.package_digest`` computes it (that module
+    imports numpy and xarray; this one runs before numba is imported and takes milliseconds)."""
+    h = hashlib.sha256()
+    root = Path(__file__).resolve().parent
+    for path in sorted(root.rglob("*.py")):
+        h.update(str(path.relative_to(root)).encode())
+        h.update(path.read_bytes())
+    return h.hexdigest()[:16]
+
+
+def numba_cache_dir(current: str, digest: str) -> Path:
+    """Where numba caches the compiled kernels (they are ``@njit(cache=True)``) for code of this
+    ``digest``, given NUMBA_CACHE_DIR (``current``, empty if unset): a directory named by the digest,
+    so that a changed kernel, or a kernel whose callee in another module changed (numba's own check
+    reads only the kernel's file), is compiled afresh and never served stale.
+
+    A directory already named by this digest (the Snakefile sets ``.snakemake/numba-cache/<digest>``)
+    is kept; one named by another digest (the code changed since it was set) is swapped for this
+    digest's; any other gets ``/<digest>`` appended; unset, it is
+    ``$XDG_CACHE_HOME/contactid/numba-cache/<digest>`` (~/.cache by default)."""
+    if current:
+        path = Path(current)
+        if path.name == digest:
+            return path
+        base = path.parent if re.fullmatch(r"[0-9a-f]{16}", path.name) else path
+    else:
+        base = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "contactid" / "numba-cache"
+    return base / digest
+
+
+def _use_numba_cache_keyed_by_code() -> str:
+    """Set NUMBA_CACHE_DIR to ``numba_cache_dir`` (before any kernel module imports numba); one that
+    cannot be made is replaced by one under the temporary directory, since numba would otherwise fall
+    back to __pycache__ beside the sources, where callees go stale. Returns the directory."""
+    current = os.environ.get("NUMBA_CACHE_DIR", "")
+    target = numba_cache_dir(current, _code_digest())
+    if str(target) == current:
+        return current
+    try:
+        target.mkdir(parents=True, exist_ok=True)
+    except OSError:
+        target = Path(tempfile.gettempdir()) / f"contactid-numba-cache-{getattr(os, 'getuid', lambda: 0)()}" / target.name
+    os.environ["NUMBA_CACHE_DIR"] = str(target)
+    if "numba" in sys.modules:  # numba read its settings when it was imported: read them again
+        sys.modules["numba"].core.config.reload_config()
+    return str(target)
+
+
+NUMBA_CACHE_DIR = _use_numba_cache_keyed_by_code()

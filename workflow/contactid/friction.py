@@ -19,7 +19,7 @@ import numpy as np
 from numba import njit, prange
 
 
-@njit
+@njit(cache=True)
 def valanis_slope(S, xi, direction, normal_force, e_f, k_c, e_t, kappa, mu):
     """dS/dxi (N/m) of Eq. 21 at friction force S (N), displacement xi (m), motion
     direction +-1 and total normal force N (N)."""
@@ -30,7 +30,7 @@ def valanis_slope(S, xi, direction, normal_force, e_f, k_c, e_t, kappa, mu):
     return e0 * (1.0 + d) / (1.0 + kappa * d)
 
 
-@njit
+@njit(cache=True)
 def _clamp_to_slip_limit(S, xi, normal_force, e_f, k_c, e_t, kappa, mu):
     e0 = e_f * (1.0 - np.exp(-k_c * normal_force / e_f))
     lim = mu * normal_force * (1.0 - kappa * e_t / e0)
@@ -38,7 +38,7 @@ def _clamp_to_slip_limit(S, xi, normal_force, e_f, k_c, e_t, kappa, mu):
     return min(max(S, base - lim), base + lim)
 
 
-@njit
+@njit(cache=True)
 def valanis_step(S, xi0, xi1, n0, n1, e_f, k_c, e_t, kappa, mu, n_min):
     """Friction force after xi moves from xi0 to xi1 while N moves from n0 to n1
     (Heun's method in xi; N linear over the step). Returns S (N)."""
@@ -126,13 +126,13 @@ def valanis_friction_force_reference(xi, normal_force, params, tol: float = 1e-7
     return out
 
 
-@njit
+@njit(cache=True)
 def _slope_pre(S, xi, direction, e0, ratio, e_t, kappa):
     d = ratio * direction * (e_t * xi - S)
     return e0 * (1.0 + d) / (1.0 + kappa * d)
 
 
-@njit(parallel=True)
+@njit(parallel=True, cache=True)
 def _population_kernel(xi, n, p, tol, max_periods, n_min, out, periods_used):
     """valanis_step per sample with the normal-force terms (e_0, lambda/e_0 and the slip
     limit) precomputed per sample for each set: the same arithmetic, one exp per sample."""

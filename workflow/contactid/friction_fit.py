@@ -10,6 +10,7 @@ import logging
 import random
 from dataclasses import dataclass, field
 
+import numba
 import numpy as np
 from scipy.optimize import least_squares
 from scipy.stats import chi2 as chi2_dist
@@ -103,7 +104,7 @@ class _Problem:
         return np.sqrt(np.mean(self.residuals(params) ** 2, axis=1))
 
 
-def _ga(problem: _Problem, settings: FitSettings, seed: int):
+def _ga(problem: _Problem, settings: FitSettings, seed: int, label: str = "friction fit"):
     from deap import base, creator, tools
 
     if not hasattr(creator, "ValanisFitness"):
@@ -130,6 +131,9 @@ def _ga(problem: _Problem, settings: FitSettings, seed: int):
         hof = tools.HallOfFame(1)
         hof.update(pop)
         logbook = []
+        every = max(1, settings.generations // 8)  # about eight progress lines per run
+        log.info("%s: GA, %d individuals, %d generations, %d points per period; best misfit at start %.4g",
+                 label, settings.population, settings.generations, problem.S.size, hof[0].fitness.values[0])
         for gen in range(settings.generations):
             offspring = [creator.ValanisIndividual(list(ind)) for ind in tb.select(pop, len(pop))]
             for a, b in zip(offspring[::2], offspring[1::2]):
@@ -150,6 +154,9 @@ def _ga(problem: _Problem, settings: FitSettings, seed: int):
             hof.update(pop)
             vals = np.array([ind.fitness.values[0] for ind in pop])
             logbook.append((gen, float(vals.min()), float(vals.mean())))
+            if (gen + 1) % every == 0 or gen + 1 == settings.generations:
+                log.info("%s: GA generation %d/%d: best misfit %.4g, mean %.4g", label, gen + 1,
+                         settings.generations, vals.min(), vals.mean())
         return np.array(hof[0]), logbook
     finally:
         random.setstate(state)
@@ -167,16 +174,38 @@ def _polish(problem: _Problem, u0, fixed: dict | None = None):
             u[i] = v
         return u
 
-    r = least_squares(lambda x: problem.residuals(problem.physical(full(x)))[0], np.clip(u0[free], 0, 1),
-                      bounds=(0.0, 1.0), x_scale=0.05, xtol=1e-10, ftol=1e-12, diff_step=1e-4)
+    last = {}
+
+    def fun(x):
+        last["x"], last["r"] = x.copy(), problem.residuals(problem.physical(full(x)))[0]
+        return last["r"]
+
+    def jac(x):
+        # forward differences of step 1e-4 (backward at the upper bound), every perturbed set in one call of
+        # the law's kernel, which evaluates parameter sets in parallel
+        r0 = last["r"] if "x" in last and np.array_equal(last["x"], x) else fun(x)
+        h = np.where(x + 1e-4 <= 1.0, 1e-4, -1e-4)
+        X = x + np.diag(h)
+        R = problem.residuals(problem.physical(np.array([full(row) for row in X])))
+        return ((R - r0) / h[:, None]).T
+
+    threads = numba.get_num_threads()
+    numba.set_num_threads(1)  # a handful of sets per call: parallel threads cost more than they give
+    try:
+        r = least_squares(fun, np.clip(u0[free], 0, 1), jac=jac, bounds=(0.0, 1.0), x_scale=0.05, xtol=1e-10,
+                          ftol=1e-12)
+    finally:
+        numba.set_num_threads(threads)
     return full(r.x), float(np.sum(r.fun**2)), r
 
 
 def fit_friction_law(coef_xi, coef_n, coef_s, f0: float, preload: float, settings: FitSettings, seed: int,
-                     n_harmonics_data: int | None = None, intervals: bool = True) -> FitResult:
+                     n_harmonics_data: int | None = None, intervals: bool = True,
+                     label: str = "friction fit") -> FitResult:
     """GA + polish on the calibration case's xi, N (total = preload + dynamic) and S harmonics,
     with the grid refined until the parameters move by less than ``refine_tolerance``; then the
-    profile-likelihood intervals (skipped with ``intervals`` False: NaN intervals)."""
+    profile-likelihood intervals (skipped with ``intervals`` False: NaN intervals). ``label`` starts
+    the progress lines it logs."""
     K = np.atleast_2d(coef_s).shape[1] if n_harmonics_data is None else n_harmonics_data
     m = settings.grid_points
     history = []
@@ -189,11 +218,13 @@ def fit_friction_law(coef_xi, coef_n, coef_s, f0: float, preload: float, setting
         s = periodic_grid(coef_s, f0, m)[0]
         problem = _Problem(xi, n, s, settings.bounds)
         if u_best is None:
-            u_ga, logbook = _ga(problem, settings, seed)
+            u_ga, logbook = _ga(problem, settings, seed, label)
             u_best = u_ga
         u_best, ssr, res = _polish(problem, u_best)
         p = problem.physical(u_best)[0]
         history.append((m, *p, float(np.sqrt(ssr / m))))
+        log.info("%s: polished on %d points: misfit %.4g, %s", label, m, np.sqrt(ssr / m),
+                 ", ".join(f"{name} = {v:.4g}" for name, v in zip(PARAMETER_NAMES, p)))
         if prev is not None and np.max(np.abs(p / np.where(prev == 0, 1, prev) - 1)[[0, 1, 3, 4]]) < settings.refine_tolerance:
             break
         if 2 * m > settings.max_grid_points:
@@ -223,6 +254,9 @@ def fit_friction_law(coef_xi, coef_n, coef_s, f0: float, preload: float, setting
         profiles.setdefault(PARAMETER_NAMES[i], []).append((float(problem.physical(u)[0][i]), s_j))
         return u, s_j
 
+    if want_intervals:
+        log.info("%s: profile-likelihood intervals of the 5 parameters (%.0f %% confidence)", label,
+                 100 * settings.confidence)
     for i in range(5 if want_intervals else 0):
         for side, direction in ((0, -1.0), (1, +1.0)):
             edge = 0.0 if direction < 0 else 1.0
@@ -255,6 +289,9 @@ def fit_friction_law(coef_xi, coef_n, coef_s, f0: float, preload: float, setting
             unit = u_best.copy()
             unit[i] = crossing
             intervals[i, side] = problem.physical(unit)[0][i]
+        log.info("%s: %s in [%.4g, %.4g]%s", label, PARAMETER_NAMES[i], intervals[i, 0], intervals[i, 1],
+                 "" if bounded[i].all() else " (" + " and ".join(
+                     f"not bounded {end} by the data" for end, b in zip(("below", "above"), bounded[i]) if not b) + ")")
     profiles = {k: np.array(sorted(v)) for k, v in profiles.items()}
     # correlation from the Jacobian at the optimum (unit-cube coordinates), for sensitive parameters
     J = res.jac
@@ -290,11 +327,11 @@ def friction_fit_dataset(forces, preload: float, settings: FitSettings, seed: in
     fs = 1.0 / float(forces["time"].values[1] - forces["time"].values[0])
     f0 = float(forces.attrs["excitation_frequency_hz"])
 
-    def run(S, xi, N):
+    def run(S, xi, N, label):
         c = [fourier_series(x, fs, f0, n_harmonics)[0] for x in (xi, N, S)]
-        return fit_friction_law(*c, f0, preload, settings, seed, n_harmonics)
+        return fit_friction_law(*c, f0, preload, settings, seed, n_harmonics, label=label)
 
-    res = run(forces["S"].values, forces["xi"].values, forces["N_dyn"].values)
+    res = run(forces["S"].values, forces["xi"].values, forces["N_dyn"].values, "friction fit")
     data = {
         "parameter_value": ("parameter", res.params, {"units": "mixed (N/m, 1/m, N/m, 1, 1)", "long_name": "fitted e_f, k_c, e_t, kappa, mu"}),
         "interval_low": ("parameter", res.intervals[:, 0], {"units": "mixed", "long_name": "profile-likelihood interval, lower end"}),
@@ -320,7 +357,8 @@ def friction_fit_dataset(forces, preload: float, settings: FitSettings, seed: in
             if np.min(n_paper) <= 0:  # not a separation the working method sees: the paper's N is wrong
                 raise ValueError(f"the normal force reaches {np.min(n_paper):.3g} N <= 0 N, where the working "
                                  "method's contact stays closed: the paper's N is not a physical normal force")
-            rp = run(paper_forces["S_paper"].values, paper_forces["xi_paper"].values, paper_forces["N_dyn_paper"].values)
+            rp = run(paper_forces["S_paper"].values, paper_forces["xi_paper"].values, paper_forces["N_dyn_paper"].values,
+                     "friction fit (paper's chain)")
             data["paper_parameter_value"] = ("parameter", rp.params, {"units": "mixed", "long_name": "fitted to the paper's chain's forces"})
             data["paper_interval_low"] = ("parameter", rp.intervals[:, 0], {"units": "mixed", "long_name": "paper's chain: interval, lower end"})
             data["paper_interval_high"] = ("parameter", rp.intervals[:, 1], {"units": "mixed", "long_name": "paper's chain: interval, upper end"})

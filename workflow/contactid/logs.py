@@ -1,18 +1,71 @@
-"""Logging set-up for rule scripts: everything to the rule's log file."""
+"""Logging set-up for rule scripts: everything to the rule's log file, and the package's progress
+(INFO and above) to stderr as well, which Snakemake shows on the console."""
 
 from __future__ import annotations
 
 import logging
 import sys
+from collections.abc import Mapping
+from pathlib import Path
+
+import numpy as np
+
+
+def fmt(value, digits: int = 4) -> str:
+    """A value for a log line, written for people: numbers to ``digits`` significant digits, arrays
+    and lists as comma-separated numbers, mappings as ``key = value`` pairs (no numpy reprs)."""
+    if isinstance(value, (str, bytes, np.str_)):
+        return str(value)
+    if isinstance(value, (bool, np.bool_)):
+        return str(bool(value))
+    if isinstance(value, (int, np.integer)):
+        return str(int(value))
+    if isinstance(value, (float, np.floating)):
+        return f"{float(value):.{digits}g}"
+    if isinstance(value, Mapping):
+        return ", ".join(f"{fmt(k)} = " + (f"({fmt(v, digits)})" if isinstance(v, Mapping) else fmt(v, digits))
+                         for k, v in value.items())
+    if isinstance(value, (list, tuple, np.ndarray)):
+        return "[" + ", ".join(fmt(v, digits) for v in np.asarray(value, dtype=object).ravel()) + "]"
+    return str(value)
+
+
+class _ConsoleFormatter(logging.Formatter):
+    """``HH:MM:SS job: message``, with the level named from WARNING up; no traceback (the file has
+    it, and Python prints the uncaught one on stderr itself)."""
+
+    def __init__(self, label: str):
+        super().__init__("%(asctime)s %(message)s", datefmt="%H:%M:%S")
+        self.label = label
+
+    def format(self, record: logging.LogRecord) -> str:
+        record = logging.makeLogRecord({**record.__dict__, "exc_info": None, "exc_text": None, "stack_info": None})
+        level = f"{record.levelname}: " if record.levelno >= logging.WARNING else ""
+        record.msg, record.args = f"{self.label}: {level}{record.getMessage()}", None
+        return super().format(record)
+
+
+class _ProgressFilter(logging.Filter):
+    """The package's and the scripts' records (logger ``contactid...``), and warnings from anywhere."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return record.name.split(".")[0] == "contactid" or record.levelno >= logging.WARNING
 
 
 def setup_logging(path: str | None) -> logging.Logger:
-    """Send the package's and the script's log records to ``path`` (or stderr); an uncaught error is
-    logged there as well before it ends the script."""
+    """Send the package's and the script's log records to ``path`` (or stderr alone), and the
+    package's INFO records and every warning to stderr with a short format (``HH:MM:SS <log file's
+    name>: message``); an uncaught error is logged there as well before it ends the script."""
     handler = logging.FileHandler(path, mode="w") if path else logging.StreamHandler(sys.stderr)
     handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
     root = logging.getLogger()
     root.handlers[:] = [handler]
+    if path:
+        console = logging.StreamHandler(sys.stderr)
+        console.setLevel(logging.INFO)
+        console.addFilter(_ProgressFilter())
+        console.setFormatter(_ConsoleFormatter(Path(path).stem))
+        root.handlers.append(console)
     root.setLevel(logging.INFO)
     logging.captureWarnings(True)
     log = logging.getLogger("contactid")
@@ -27,7 +80,8 @@ def setup_logging(path: str | None) -> logging.Logger:
             log.error("%s", value)
         else:
             log.error("%s: %s", kind.__name__, value, exc_info=(kind, value, tb))
-        handler.flush()
+        for h in root.handlers:
+            h.flush()
         previous(kind, value, tb)
 
     sys.excepthook = log_then_raise

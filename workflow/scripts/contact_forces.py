@@ -1,7 +1,7 @@
 """Rule contact_forces: the working method and the paper's chain side by side, scored against truth."""
 
 from contactid.io import load_dataset, provenance, read_raw, write_dataset
-from contactid.logs import setup_logging
+from contactid.logs import fmt, setup_logging
 from contactid.nonlinear_chain import contact_forces_dataset
 
 log = setup_logging(snakemake.log[0])
@@ -18,4 +18,4 @@ if not ds.attrs["eta_observable"]:
 ds.attrs.update(provenance("contact_forces", {"structure": snakemake.params.structure, "nonlinear": nl},
                            {k: v for k, v in inp.items()}))
 write_dataset(ds, snakemake.output.forces)
-log.info("%s", {k: v for k, v in ds.attrs.items() if "nrmse" in k})
+log.info("NRMSE %s", fmt({k.removesuffix("_nrmse"): v for k, v in ds.attrs.items() if "nrmse" in k}))

@@ -7,7 +7,7 @@ import json
 
 from contactid.io import provenance, read_raw, write_dataset
 from contactid.linear_chain import check_sensor_layout, frf_dataset
-from contactid.logs import setup_logging
+from contactid.logs import fmt, setup_logging
 from contactid.raw_checks import check_settings, validate_coherence, validate_random_test
 
 log = setup_logging(snakemake.log[0])
@@ -29,4 +29,4 @@ write_dataset(ds, snakemake.output.frf)
 for w in warnings:
     log.warning("%s: %s", path, w)
 log.info("FRF with %d averages; share of lines with coherence >= %g: %s", ds.attrs["n_averages"],
-         checks["min_coherence"], shares)
+         checks["min_coherence"], fmt(shares, 3))

@@ -2,7 +2,7 @@
 
 from contactid.friction_fit import friction_fit_dataset, settings_from_config
 from contactid.io import load_dataset, provenance, write_dataset
-from contactid.logs import setup_logging
+from contactid.logs import fmt, setup_logging
 
 log = setup_logging(snakemake.log[0])
 p = snakemake.params
@@ -12,5 +12,5 @@ ds = friction_fit_dataset(forces, float(p.preload), settings_from_config(p.frict
 ds.attrs.update(provenance("friction_fit", {"friction": p.friction, "seed": p.seed, "preload": p.preload,
                                             "n_harmonics": p.n_harmonics}, {"forces": snakemake.input.forces}))
 write_dataset(ds, snakemake.output.fit)
-log.info("fitted %s, e0(N0) = %.5g N/m", dict(zip(ds["parameter"].values, ds["parameter_value"].values)),
-         ds.attrs["e0_at_preload_n_per_m"])
+log.info("fitted %s; e0(N0) = %.4g N/m, misfit %.4g", fmt(dict(zip(ds["parameter"].values, ds["parameter_value"].values))),
+         ds.attrs["e0_at_preload_n_per_m"], ds.attrs["misfit_nrmse"])

@@ -2,7 +2,7 @@
 
 from contactid.io import load_dataset, provenance, write_dataset
 from contactid.linear_chain import linear_modes_dataset
-from contactid.logs import setup_logging
+from contactid.logs import fmt, setup_logging
 
 log = setup_logging(snakemake.log[0])
 p = snakemake.params
@@ -11,4 +11,4 @@ ds = linear_modes_dataset(load_dataset(snakemake.input.stiction), p.structure, i
 ds.attrs.update(provenance("linear_modes", {"structure": p.structure, "linear_modes": p.linear_modes,
                                             "k_n_prior": p.k_n_prior}, {"stiction": snakemake.input.stiction}))
 write_dataset(ds, snakemake.output.modes)
-log.info("linear modes at %s Hz (k_n: %s)", ds["natural_frequency"].values, ds.attrs["k_n_choice"])
+log.info("linear modes at %s Hz (k_n: %s)", fmt(ds["natural_frequency"].values, 5), ds.attrs["k_n_choice"])

@@ -2,7 +2,7 @@
 
 from contactid.io import load_dataset, provenance, write_dataset
 from contactid.linear_chain import modal_dataset
-from contactid.logs import setup_logging
+from contactid.logs import fmt, setup_logging
 
 log = setup_logging(snakemake.log[0])
 m = snakemake.params.modal
@@ -10,4 +10,4 @@ ds = modal_dataset(load_dataset(snakemake.input.frf), int(m.get("n_modes", 3)), 
                    int(m.get("order", 16)))
 ds.attrs.update(provenance("modal", m, {"frf": snakemake.input.frf}))
 write_dataset(ds, snakemake.output.modal)
-log.info("natural frequencies %s Hz", ds["natural_frequency"].values)
+log.info("natural frequencies %s Hz", fmt(ds["natural_frequency"].values, 5))

@@ -15,7 +15,7 @@ raw.attrs.update(provenance("rig_dual_sine", cfg))
 truth.attrs.update(provenance("rig_dual_sine", cfg))
 write_dataset(truth, snakemake.output.truth)
 write_dataset(raw, snakemake.output.raw)
-log.info("%s: F1 = %.4g N, F3 = %.4g N, A1 = %.5g, A2 = %.5g m/s^2 (targets %.5g, %.5g), energy residual %s",
+log.info("%s: F1 = %.4g N, F3 = %.4g N, A1 = %.5g, A2 = %.5g m/s^2 (targets %.5g, %.5g), energy residual %.3g",
          case, truth.attrs["F1_n"], truth.attrs["F3_n"], truth.attrs["A1_m_per_s2"], truth.attrs["A2_m_per_s2"],
          truth.attrs["target_A1_m_per_s2"], truth.attrs["target_A2_m_per_s2"],
-         truth.attrs.get("energy_energy_residual"))
+         truth.attrs.get("energy_energy_residual", float("nan")))

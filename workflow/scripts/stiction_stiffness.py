@@ -2,7 +2,7 @@
 
 from contactid.io import load_dataset, provenance, write_dataset
 from contactid.linear_chain import stiction_dataset
-from contactid.logs import setup_logging
+from contactid.logs import fmt, setup_logging
 
 log = setup_logging(snakemake.log[0])
 p = snakemake.params
@@ -10,5 +10,5 @@ ds = stiction_dataset(load_dataset(snakemake.input.modal), p.structure, p.sticti
 ds.attrs.update(provenance("stiction_stiffness", {"structure": p.structure, "stiction": p.stiction},
                            {"modal": snakemake.input.modal}))
 write_dataset(ds, snakemake.output.stiction)
-log.info("k_t = %.4g N/m %s, k_n = %.4g N/m %s", float(ds["k_t"]), ds["k_t_interval"].values,
-         float(ds["k_n"]), ds["k_n_interval"].values)
+log.info("k_t = %.4g N/m, interval %s; k_n = %.4g N/m, interval %s", float(ds["k_t"]), fmt(ds["k_t_interval"].values),
+         float(ds["k_n"]), fmt(ds["k_n_interval"].values))

@@ -22,4 +22,4 @@ if "fit" in inp.keys():
     summary.update(friction_summary(load_dataset(inp.fit), validations))
 with open(snakemake.output.summary, "w") as fh:
     json.dump(summary, fh, indent=2, sort_keys=True, default=lambda o: o.item() if hasattr(o, "item") else str(o))
-log.info("%s", summary)
+log.info("summary of %s written to %s", ", ".join(summary), snakemake.output.summary)

@@ -2,7 +2,7 @@
 
 from contactid.friction_fit import validation_dataset
 from contactid.io import load_dataset, provenance, write_dataset
-from contactid.logs import setup_logging
+from contactid.logs import fmt, setup_logging
 
 log = setup_logging(snakemake.log[0])
 inp = snakemake.input
@@ -11,4 +11,4 @@ ds = validation_dataset(load_dataset(inp.forces), load_dataset(inp.fit), float(s
                         int(snakemake.params.n_harmonics), truth)
 ds.attrs.update(provenance("validate", {"preload": snakemake.params.preload}, {k: v for k, v in inp.items()}))
 write_dataset(ds, snakemake.output.validation)
-log.info("validation NRMSE: %s", {k: v for k, v in ds.attrs.items() if k.startswith("nrmse")})
+log.info("validation NRMSE %s", fmt({k.removeprefix("nrmse_"): v for k, v in ds.attrs.items() if k.startswith("nrmse")}))

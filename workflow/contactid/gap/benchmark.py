@@ -9,6 +9,7 @@ lacks that effect (the verdict must be "none", the localisation must point at th
 
 from __future__ import annotations
 
+import logging
 import time
 from typing import Mapping
 
@@ -16,6 +17,8 @@ import numpy as np
 
 from ..random_streams import generator
 from ..rig.effects import EFFECTS
+
+log = logging.getLogger(__name__)
 
 # magnitudes the benchmark draws from (rig units, see rig.effects): large enough to matter,
 # within the range where the rig's response stays periodic
@@ -82,8 +85,12 @@ def run_item(spec: Mapping, cfg: Mapping) -> dict:
     effects = {spec["effect"]: spec["magnitude"]} if spec["effect"] else {}
     cases = sorted(cfg["load_cases"], key=lambda c: int(c[2:]))
     cal = cfg.get("nonlinear", {}).get("calibration_case", "lc1")
+    hidden = f"{spec['effect']} at {spec['magnitude']:.4g}" if spec["effect"] else "no effect"
+    log.info("benchmark item (%s, seed %d): %s; making the rig records of %s", spec["kind"], int(spec["seed"]),
+             hidden, ", ".join(["random_test", *cases]))
     recs, converged = rig_records(cfg, effects, int(spec["seed"]), cases)
     t_rig = time.perf_counter() - t0
+    log.info("rig records made in %.1f s; identifying the model", t_rig)
     model, modes, modal, frf = identify(cfg, recs["random_test"], recs[cal])
     K = int(cfg.get("nonlinear", {}).get("n_harmonics", 25))
     fit_settings = settings_from_config(cfg.get("friction", {}))
@@ -94,10 +101,15 @@ def run_item(spec: Mapping, cfg: Mapping) -> dict:
         gap_cfg["candidates"] = list(spec["library"])
     settings = GapSettings.from_config(gap_cfg, int(cfg["seed"]), K)
     t1 = time.perf_counter()
+    log.info("model identified in %.1f s; diagnosing%s", t_id,
+             "" if spec.get("library") is None else f" with a library that lacks {spec['effect']}")
     diag = diagnose(model, records, cal, settings, fit_settings, linear_stage(model, frf, modal))
     t_diag = time.perf_counter() - t1
     by = {r["effect"]: r for r in diag.ranking}
     true = spec["effect"]
+    expected = "none" if spec["kind"] == "leave_out" else (true or "none")
+    log.info("benchmark item (%s): %s -> verdict %s (expected %s: %s), %.1f s in all", spec["kind"], hidden,
+             diag.verdict, expected, "right" if diag.verdict == expected else "wrong", time.perf_counter() - t0)
     return {**dict(spec), "verdict": diag.verdict, "reason": diag.reason, "correct": (diag.verdict == (true or "none"))
             if spec["kind"] != "leave_out" else diag.verdict == "none",
             "heldout_gap_before": diag.where["heldout_gap_before"],

@@ -105,9 +105,17 @@ def dual_sine_test(structure_cfg: Mapping, rig_cfg: Mapping, case_cfg: Mapping, 
     target = (scale * float(case_cfg["A1_m_per_s2"]), scale * float(case_cfg["A2_m_per_s2"]))
     sim = build_simulator(structure_cfg, rig_cfg, s)
     w = 2 * np.pi * s["excitation_frequency_hz"]
+    log.info("%s: response control to A1 = %.4g, A3 = %.4g m/s^2 at %.4g Hz (%d modes, %d steps per sample)", case,
+             target[0], target[1], s["excitation_frequency_hz"], sim.red.omega.size, sim.oversampling)
     ctl = control_response(sim, target[0], target[1], w, tol=float(s["control_tolerance"]))
     if not ctl.converged:
-        log.warning("%s: response control did not converge: %s", case, ctl.history[-1])
+        F1, F3, A1, A3, steady = ctl.history[-1]
+        log.warning("%s: response control did not converge in %d iterations: F1 = %.4g N, F3 = %.4g N give "
+                    "A1 = %.4g, A3 = %.4g m/s^2 (targets %.4g, %.4g)%s", case, len(ctl.history), F1, F3, A1, A3,
+                    target[0], target[1], "" if steady else ", not steady")
+    else:
+        log.info("%s: response control converged in %d iterations; recording %d samples", case, len(ctl.history),
+                 int(s["record_samples"]))
     q = sim.oversampling
     n_rec = int(s["record_samples"]) * q
     margin = 64 * q * 8

@@ -116,7 +116,7 @@ def iwan_slip_weights(n: int, spread: float = 0.8) -> np.ndarray:
     return w / w.sum()
 
 
-@njit
+@njit(cache=True)
 def _contact_state(z, v, xi_v, eta_v, G):
     n = z.size
     xi_lin = 0.0
@@ -133,7 +133,7 @@ def _contact_state(z, v, xi_v, eta_v, G):
     return xi_lin, xi_lin - short, dxi_dq, eta, deta, dxi
 
 
-@njit
+@njit(cache=True)
 def _normal_force(eta, deta, n0, delta0, p, hc, unilateral):
     """N = N0 ((delta0 - eta)/delta0)^p (1 - hc deta/dt), zero once the contact opens; a
     bilateral law (``unilateral`` False, p = 1) is the linear spring of Eq. 13 and may pull."""
@@ -146,7 +146,7 @@ def _normal_force(eta, deta, n0, delta0, p, hc, unilateral):
     return n if n > 0.0 else 0.0
 
 
-@njit
+@njit(cache=True)
 def _excitation(f_sin, f_cos, w, t):
     """f(t) = sum_h f_sin[h-1] sin(h w t) + f_cos[h-1] cos(h w t) (N)."""
     f = 0.0
@@ -158,7 +158,7 @@ def _excitation(f_sin, f_cos, w, t):
     return f
 
 
-@njit
+@njit(cache=True)
 def _iwan_force(xi, x_sl, weights, e0_total, mu_n):
     """Maxwell-slip sliders: stiffness e0 w_i, limit mu N w_i; x_sl (slider anchors) updated in place."""
     total = 0.0
@@ -176,7 +176,7 @@ def _iwan_force(xi, x_sl, weights, e0_total, mu_n):
     return total
 
 
-@njit
+@njit(cache=True)
 def integrate(z, v, state, t0, n_steps, dt, omega, zeta, xi_v, eta_v, G, bF, k_t, k_n,
               f_sin, f_cos, w, fr, n0, delta0, p, hc, unilateral, visc, iw_share, iw_w, x_sl, drift_rate, drift_t0,
               store_from, out_a, out_z, out_v, out_s, out_n, out_xi, out_eta, out_f, out_dxi, out_deta):
@@ -410,6 +410,9 @@ def control_response(sim: DualSineSimulator, target_a1: float, target_a3: float,
     """Tune F1, F3 until the driving-point acceleration harmonics at w and 3w
     equal the targets within ``tol`` (relative): Broyden's method on
     (F1, F3) -> (|A1|, |A3|), started from the stuck linear system's FRF."""
+    import logging
+
+    progress = logging.getLogger(__name__)
     h1, h3 = abs(sim.linear_frf(w)), abs(sim.linear_frf(3 * w))
     target = np.array([target_a1, target_a3])
     F = target / np.array([h1, h3])
@@ -423,6 +426,9 @@ def control_response(sim: DualSineSimulator, target_a1: float, target_a3: float,
         A = np.abs(c)
         history.append((float(F[0]), float(F[1]), float(A[0]), float(A[1]), bool(ok)))
         r = A - target
+        progress.info("response control %d: F1 = %.4g N, F3 = %.4g N -> A1 = %.4g (target %.4g), A3 = %.4g "
+                      "(target %.4g) m/s^2%s", it + 1, F[0], F[1], A[0], target[0], A[1], target[1],
+                      "" if ok else ", not yet steady")
         if ok and np.max(np.abs(r) / target) < tol:
             return ControlResult(float(F[0]), float(F[1]), float(A[0]), float(A[1]), True, history, log)
         if prev is not None:
