@@ -21,6 +21,7 @@ paper prints N = k_n eta; the sign follows from the virtual work (A4).
 from __future__ import annotations
 
 import math
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -236,8 +237,24 @@ def fix_signs(vectors: np.ndarray) -> np.ndarray:
     return vectors * np.sign(vectors[idx, np.arange(vectors.shape[1])])
 
 
+_MODES: dict = {}
+
+
 def all_modes(model: FEModel) -> Modes:
-    """All undamped modes, sorted by frequency, mass-normalised."""
+    """All undamped modes, sorted by frequency, mass-normalised (computed once per model object:
+    the identification and the gap diagnosis ask for the same model's modes many times)."""
+    key = id(model)
+    hit = _MODES.get(key)
+    if hit is not None and hit[0]() is model:
+        return hit[1]
+    modes = _all_modes(model)
+    if len(_MODES) > 64:
+        _MODES.clear()
+    _MODES[key] = (weakref.ref(model), modes)
+    return modes
+
+
+def _all_modes(model: FEModel) -> Modes:
     lam, vec = scipy.linalg.eigh(model.stiffness, model.mass)
     lam = np.clip(lam, 0.0, None)
     vec = fix_signs(vec)

@@ -217,24 +217,19 @@ def inverse_harmonics(model: FEModel, zeta: np.ndarray, F_coef: np.ndarray, A_co
     M = 8 * K  # one-period grid for the nonlinear term
     t_grid = np.arange(M) / (M * f0)
     geo_coef = np.zeros((n_dof, K), dtype=complex)  # harmonics of G q S (generalized force)
-    receptance = [1.0 / (wn**2 - ((k + 1) * w0) ** 2 + 2j * zeta * wn * (k + 1) * w0) for k in range(K)]
+    W = np.arange(1, K + 1) * w0
+    g = 1.0 / (wn[:, None] ** 2 - W[None, :] ** 2 + 2j * zeta[:, None] * wn[:, None] * W[None, :])  # (modes, K)
+    # the unknown inputs' transfer to the sensors per harmonic, (K, j, 2), and its pseudo-inverse
+    Amat = np.stack([-(sens @ (g * b_xi[:, None])), sens @ (g * b_eta[:, None])], axis=-1).transpose(1, 0, 2)
+    Apinv = np.linalg.pinv(Amat)  # (K, 2, j): the least-squares solution of each harmonic's 2 unknowns
+    disp = A_coef / (-(W**2))  # sensor displacements (j, K)
     for it in range(max(1, n_iterations)):
-        q_coef = np.zeros((n_dof, K), dtype=complex)
-        r_coef = np.zeros((2, K), dtype=complex)
-        residual = np.zeros(K)
-        for k in range(K):
-            W = (k + 1) * w0
-            g = receptance[k]
-            known = g * (b_f * F_coef[k] + phi.T @ geo_coef[:, k])
-            H_xi = -(sens @ (g * b_xi))
-            H_eta = sens @ (g * b_eta)
-            disp = A_coef[:, k] / (-(W**2))  # sensor displacements
-            rhs = disp - sens @ known
-            Amat = np.column_stack([H_xi, H_eta])
-            sol, *_ = np.linalg.lstsq(Amat, rhs, rcond=None)
-            r_coef[:, k] = sol
-            q_coef[:, k] = phi @ (known + g * (-b_xi * sol[0] + b_eta * sol[1]))
-            residual[k] = np.linalg.norm(Amat @ sol - rhs) / max(np.linalg.norm(disp), 1e-300)
+        known = g * (b_f[:, None] * F_coef[None, :K] + phi.T @ geo_coef)  # modal (modes, K)
+        rhs = disp - sens @ known
+        r_coef = np.einsum("kuj,jk->uk", Apinv, rhs)  # (2, K)
+        q_coef = phi @ (known + g * (-b_xi[:, None] * r_coef[0] + b_eta[:, None] * r_coef[1]))
+        misfit = np.einsum("kju,uk->jk", Amat, r_coef) - rhs
+        residual = np.linalg.norm(misfit, axis=0) / np.maximum(np.linalg.norm(disp, axis=0), 1e-300)
         if n_iterations <= 1:
             break
         qg = synthesize(q_coef, f0, t_grid, 0)

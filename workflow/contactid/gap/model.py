@@ -12,6 +12,7 @@ library (``candidates``) maps an effect's few parameters onto these fields.
 
 from __future__ import annotations
 
+import contextvars
 import dataclasses
 from dataclasses import dataclass, field
 from functools import lru_cache
@@ -189,18 +190,104 @@ def _delay(coef: np.ndarray, delays, w: float) -> np.ndarray:
     return coef * np.exp(-1j * np.outer(np.asarray(delays, dtype=float), h * w))
 
 
+STEADY_STATE = contextvars.ContextVar("steady_state", default="harmonic_balance")
+
+
 def simulate(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, record_periods: int = 16,
-             force_harmonics: int = 5, tol: float = 2e-5, grid: int = 256) -> SimResult:
+             force_harmonics: int = 5, tol: float = 2e-5, grid: int = 256, start: "SimResult | None" = None,
+             method: str | None = None, hb_harmonics: int | None = None) -> SimResult:
     """Steady-state response of the (augmented) identified model to the record's measured force
-    (its first ``force_harmonics`` harmonics), in the record's harmonics. With a preload drift the
-    whole record's length is simulated, as measured."""
+    (its first ``force_harmonics`` harmonics), in the record's harmonics.
+
+    ``method`` "harmonic_balance" (the default, or what ``STEADY_STATE`` holds) solves the periodic
+    steady state directly (``rig.harmonic_balance`` with ``hb_harmonics`` harmonics, all the record's
+    by default; warm-started from ``start``, a neighbouring simulation of the same record); where it
+    does not converge (a response that does not settle), and for an Iwan element, the time integrator
+    takes over.
+    "time_marching" integrates until the harmonics settle (the reference). With a preload drift the
+    whole record's length is integrated in time, as measured, from the periodic state at the
+    record's start. Harmonics above ``hb_harmonics`` are zero in the result."""
+    method = method or STEADY_STATE.get()
+    if method not in ("harmonic_balance", "time_marching"):
+        raise ValueError(f"simulate: method {method!r}; give 'harmonic_balance' or 'time_marching'")
     sim = simulator(model, aug, rec.fs, rec.f0)
     w = 2 * np.pi * rec.f0
     H = rec.acceleration.shape[1]
     coef = rec.force[:force_harmonics].copy()
+    n_per = int(round(2 * np.pi / w / sim.dt))
+    if method == "harmonic_balance" and not aug.iwan_share:  # (the Iwan element's tangent is not linearised yet)
+        periodic = _periodic_state(sim, coef, w, min(H, hb_harmonics or H), n_per, start)
+        if periodic is not None and not aug.preload_drift:
+            return _periodic_result(periodic, sim, model, aug, rec, grid)
+        if periodic is not None:  # drift: start the record from the periodic state
+            _load_state(sim, periodic)
+            return _marched_result(sim, model, aug, rec, coef, w, H, n_per, record_periods, True, grid)
     sim.start_from_linear(coef, None, w)
     _, _, settled = sim.settle(coef, None, w, tol=tol, max_chunks=30)
-    n_per = int(round(2 * np.pi / w / sim.dt))
+    return _marched_result(sim, model, aug, rec, coef, w, H, n_per, record_periods, settled, grid)
+
+
+def _periodic_state(sim: DualSineSimulator, coef, w, H, n_per, start):
+    """The periodic steady state by harmonic balance (the reduced model as the integrator has it,
+    on the integrator's own points per period), or None where Newton does not converge."""
+    from ..rig.harmonic_balance import HarmonicBalance
+
+    contact = dataclasses.replace(sim.contact, preload_drift=0.0)
+    hb = HarmonicBalance(sim.red, contact, sim.zeta, w, H, n_per)
+    Z0 = start.extra.get("Z") if start is not None else None
+    if Z0 is not None and Z0.shape[0] != sim.red.omega.size:
+        Z0 = None
+    sol = hb.solve(coef, Z0)
+    return sol if sol.converged else None
+
+
+def _load_state(sim: DualSineSimulator, periodic) -> None:
+    """Put the integrator in the periodic state at t = 0 (coordinates, velocities, friction state)."""
+    g = periodic.grid
+    sim.reset()
+    sim.z[:] = g["z"][0]
+    sim.v[:] = g["v"][0]
+    sim.state[:] = (g["S_valanis"][0], g["xi"][0], g["N"][0])
+    sim.x_sl[:] = periodic.iwan_anchors
+
+
+def _contact_harmonics(sig: dict, t_first: float, w: float, n_per: int, H: int) -> tuple[dict, dict]:
+    keys = ("S", "N", "xi", "eta", "xi_dot", "eta_dot")
+    x = np.array([sig[k] for k in keys])
+    C = periodic_harmonics(x, t_first, w, n_per, H)
+    return {k: C[i] for i, k in enumerate(keys)}, {k: float(np.mean(x[i])) for i, k in enumerate(keys)}
+
+
+def _period_grid(contact: dict, means: dict, f0: float, H: int, grid: int) -> dict:
+    """One period on a uniform grid (Fourier synthesis of the harmonics + mean)."""
+    tg = np.arange(grid) / (grid * f0)
+    E = np.exp(1j * np.outer(np.arange(1, H + 1) * 2 * np.pi * f0, tg))
+    grids = {k: means[k] + np.imag(c @ E) for k, c in contact.items()}
+    grids["t"] = tg
+    return grids
+
+
+def _periodic_result(periodic, sim, model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics,
+                     grid: int) -> SimResult:
+    w = periodic.w
+    H = rec.acceleration.shape[1]
+    g = periodic.grid
+    n_per = g["t"].size
+    acc = np.zeros((periodic.A.shape[0], H + 1), dtype=complex)
+    acc[:, :periodic.A.shape[1]] = periodic.A[:, :H + 1]
+    A = _delay(sim.red.sensors @ acc[:, 1:], aug.delays, w)
+    sig = {"S": g["S"], "N": g["N"], "xi": g["xi"], "eta": g["eta"], "xi_dot": g["dxi"], "eta_dot": g["deta"]}
+    contact, means = _contact_harmonics(sig, 0.0, w, n_per, H)
+    dt = 2 * np.pi / w / n_per
+    e_t = float(np.sum(g["S"] * g["dxi"]) * dt)
+    e_n = float(-np.sum((g["N"] - model.preload) * g["deta"]) * dt)
+    return SimResult(A, contact, _period_grid(contact, means, rec.f0, H, grid), {"tangential_j": e_t, "normal_j": e_n},
+                     True, None, None, {"means": means, "Z": periodic.Z, "method": "harmonic_balance",
+                                        "iterations": periodic.iterations})
+
+
+def _marched_result(sim, model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, coef, w, H, n_per,
+                    record_periods, settled, grid) -> SimResult:
     first = last = None
     if not settled and not aug.preload_drift:
         # the motion does not settle (impacts): average over as many periods as the record holds, as the
@@ -220,18 +307,11 @@ def simulate(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, re
         first = _delay(periodic_harmonics(acc[:, :third], t1, w, n_per, H), aug.delays, w)
         last = _delay(periodic_harmonics(acc[:, -third:], out["t"][n_rec - third], w, n_per, H), aug.delays, w)
     A = _delay(periodic_harmonics(acc, t1, w, n_per, H), aug.delays, w)
-    keys = (("S", "S"), ("N", "N"), ("xi", "xi"), ("eta", "eta"), ("dxi", "xi_dot"), ("deta", "eta_dot"))
-    sig = np.array([out[k] for k, _ in keys])
-    C = periodic_harmonics(sig, t1, w, n_per, H)
-    contact = {name: C[i] for i, (_, name) in enumerate(keys)}
-    means = {name: float(np.mean(sig[i])) for i, (_, name) in enumerate(keys)}
-    # one period on a uniform grid (Fourier synthesis of the harmonics + mean)
-    tg = np.arange(grid) / (grid * rec.f0)
-    E = np.exp(1j * np.outer(np.arange(1, H + 1) * w, tg))
-    grids = {k: means[k] + np.imag(c @ E) for k, c in contact.items()}
-    grids["t"] = tg
+    sig = {"S": out["S"], "N": out["N"], "xi": out["xi"], "eta": out["eta"], "xi_dot": out["dxi"],
+           "eta_dot": out["deta"]}
+    contact, means = _contact_harmonics(sig, t1, w, n_per, H)
     cyc = slice(n_rec - n_per, n_rec)  # the last period for the cycle energies
     e_t = float(np.sum(out["S"][cyc] * out["dxi"][cyc]) * sim.dt)
     e_n = float(-np.sum((out["N"][cyc] - model.preload) * out["deta"][cyc]) * sim.dt)
-    return SimResult(A, contact, grids, {"tangential_j": e_t, "normal_j": e_n}, bool(settled), first, last,
-                     {"means": means})
+    return SimResult(A, contact, _period_grid(contact, means, rec.f0, H, grid), {"tangential_j": e_t, "normal_j": e_n},
+                     bool(settled), first, last, {"means": means, "method": "time_marching"})

@@ -10,6 +10,8 @@ cases are then predicted with theta and the refitted friction law, never fitted.
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import logging
 from dataclasses import dataclass
 
@@ -71,14 +73,55 @@ def deskewed(rec: RecordHarmonics, delays) -> np.ndarray:
     return rec.acceleration * np.exp(1j * np.outer(np.asarray(delays, float), 2 * np.pi * rec.f0 * h))
 
 
+class _Memo:
+    """A small memo of pure results keyed by value, plus objects (records, forces) that the key names by
+    identity: the entry keeps them alive, so an id is never reused while its entry exists."""
+
+    def __init__(self, size: int = 64):
+        self.size, self.store = size, {}
+
+    enabled = contextvars.ContextVar("memo", default=True)
+
+    def get(self, key, compute):
+        if not self.enabled.get():
+            return compute()[0]
+        hit = self.store.get(key)
+        if hit is None:
+            if len(self.store) >= self.size:
+                self.store.pop(next(iter(self.store)))
+            hit = self.store[key] = compute()
+        return hit[0]
+
+
+_FORCES = _Memo()
+_FRICTION = _Memo()
+
+
+@contextlib.contextmanager
+def memoised(enabled: bool = True):
+    """Within the block, the inverse identification and the friction refit are memoised (the default)
+    or computed anew at every call (the plain baseline the benchmark measures against)."""
+    token = _Memo.enabled.set(bool(enabled))
+    try:
+        yield
+    finally:
+        _Memo.enabled.reset(token)
+
+
 def identified_forces(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics) -> InverseHarmonics:
-    """Contact forces of a record by inverse identification with the augmented model."""
-    fe = fe_model(model, aug)
-    zeta = augmented_zeta(fe, model.damping, aug.extra_damping)
-    return inverse_harmonics(fe, zeta, rec.force, deskewed(rec, aug.delays), rec.f0)
+    """Contact forces of a record by inverse identification with the augmented model (memoised: the
+    candidates that leave the structure, its damping and the channels as they are reuse it)."""
+    key = (model.structure_with(aug), model.damping, aug.extra_damping, tuple(aug.delays), id(rec))
+
+    def compute():
+        fe = fe_model(model, aug)
+        zeta = augmented_zeta(fe, model.damping, aug.extra_damping)
+        return inverse_harmonics(fe, zeta, rec.force, deskewed(rec, aug.delays), rec.f0), rec
+
+    return _FORCES.get(key, compute)
 
 
-@njit
+@njit(cache=True)
 def _iwan_periodic(xi, N, e_f, k_c, mu, weights, periods):
     n = weights.size
     x_sl = np.zeros(n)
@@ -142,13 +185,20 @@ def contact_grids(forces: InverseHarmonics, f0: float, preload: float, m: int) -
 def refit_friction(model: IdentifiedModel, aug: Augmentation, forces: InverseHarmonics, f0: float,
                    bounds, grid: int = 512) -> tuple[np.ndarray, float]:
     """The friction law (with the augmentation's terms) polished from the chain's fit to the
-    identified forces; returns (e_f, k_c, e_t, kappa, mu) and the NRMSE of S."""
-    # a drifting preload: the record's harmonics see the mean preload over the record
-    g = contact_grids(forces, f0, model.preload * (1.0 + 0.5 * aug.preload_drift), grid)
-    prob = _AugmentedProblem(g["xi"], g["xi_dot"], g["N"], g["S"], bounds, aug)
-    u0 = np.clip(prob.unit(np.asarray(model.friction))[0], 1e-6, 1 - 1e-6)
-    u, ssr, _ = _polish(prob, u0)
-    return prob.physical(u)[0], float(np.sqrt(ssr / grid))
+    identified forces; returns (e_f, k_c, e_t, kappa, mu) and the NRMSE of S (memoised: a candidate
+    that changes neither the forces nor the law gets the same polish)."""
+    law = (aug.iwan_share, aug.viscous, aug.preload_drift)
+    key = (model.friction, model.preload, law, id(forces), f0, tuple(map(tuple, np.atleast_2d(bounds))), grid)
+
+    def compute():
+        # a drifting preload: the record's harmonics see the mean preload over the record
+        g = contact_grids(forces, f0, model.preload * (1.0 + 0.5 * aug.preload_drift), grid)
+        prob = _AugmentedProblem(g["xi"], g["xi_dot"], g["N"], g["S"], bounds, aug)
+        u0 = np.clip(prob.unit(np.asarray(model.friction))[0], 1e-6, 1 - 1e-6)
+        u, ssr, _ = _polish(prob, u0)
+        return (prob.physical(u)[0], float(np.sqrt(ssr / grid))), forces
+
+    return _FRICTION.get(key, compute)
 
 
 # ------------------------------------------------------------------------------------------
@@ -171,23 +221,27 @@ class Calibration:
 
 
 def evaluate(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, bounds, n_harmonics: int,
-             refit: bool = True):
-    """Redo the chain with ``aug`` on one record: (gap, model with refitted friction, simulation, misfit)."""
+             refit: bool = True, start: SimResult | None = None):
+    """Redo the chain with ``aug`` on one record: (gap, model with refitted friction, simulation, misfit).
+    ``start``: a neighbouring simulation of the record to warm-start the steady state from."""
     misfit = float("nan")
     if refit:
         forces = identified_forces(model, aug, rec)
         fr, misfit = refit_friction(model, aug, forces, rec.f0, bounds)
         model = model.with_friction(fr)
-    sim = simulate(model, aug, rec)
+    sim = simulate(model, aug, rec, start=start, hb_harmonics=2 * n_harmonics)
     return gap_value(gap_residual(sim, rec, n_harmonics)), model, sim, misfit
 
 
 def calibrate(model: IdentifiedModel, cand: Candidate, rec: RecordHarmonics, settings: FitSettings,
-              n_harmonics: int, max_evaluations: int = 12) -> Calibration:
-    """theta of ``cand`` minimising the calibration case's gap (friction law refitted at each theta)."""
+              n_harmonics: int, max_evaluations: int = 12, start: SimResult | None = None) -> Calibration:
+    """theta of ``cand`` minimising the calibration case's gap (friction law refitted at each theta);
+    each simulation starts from the previous one's steady state (``start``: the model's own)."""
     bounds = settings.bounds
     n_eval = 0
     cache = {}
+
+    last = {"sim": start}
 
     def run(theta):
         nonlocal n_eval
@@ -196,7 +250,8 @@ def calibrate(model: IdentifiedModel, cand: Candidate, rec: RecordHarmonics, set
             n_eval += 1
             aug = cand.augmentation(np.atleast_1d(theta))
             try:
-                out = evaluate(model, aug, rec, bounds, n_harmonics)
+                out = evaluate(model, aug, rec, bounds, n_harmonics, start=last["sim"])
+                last["sim"] = out[2]  # the next theta is a neighbour: start from here
                 if not np.isfinite(out[0]):
                     raise FloatingPointError("the simulation diverged")
                 cache[key] = (*out, aug)

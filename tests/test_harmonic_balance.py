@@ -1,0 +1,86 @@
+"""Harmonic balance (rig.harmonic_balance, used by the gap diagnosis) against the time integrator it
+replaces: the periodic steady states agree on every load level and model effect."""
+
+import numpy as np
+import pytest
+
+from contactid.gap.model import Augmentation, IdentifiedModel, simulate
+from contactid.gap.records import RecordHarmonics
+from contactid.parameters import structure_from_config
+from contactid.rig.harmonic_balance import HarmonicBalance
+
+F0, FS = 54.375, 5120.0
+# the measured force harmonics of the default rig's load cases 1 and 3 (N; phase of the fundamental zero)
+FORCES = {"lc1": [6.8038, 0.0, 1.3454], "lc3": [10.5432, 0.0, 1.7364]}
+EFFECTS = {
+    "none": Augmentation(),
+    "normal_contact_damping": Augmentation(hunt_crossley=300.0),
+    "viscous_friction": Augmentation(viscous=300.0),
+    "multi_asperity_friction": Augmentation(iwan_share=0.7),
+    "contact_separation": Augmentation(unilateral_exponent=1.5),
+    "structural_damping": Augmentation(extra_damping=0.005),
+    "transducer_mass_error": Augmentation(mass_error=-0.3),
+    "channel_time_skew": Augmentation(delays=(2e-5, -1e-5, 0.0)),
+    "preload_drift": Augmentation(preload_drift=0.1),
+}
+
+
+@pytest.fixture(scope="module")
+def model(default_config):
+    # the default rig's identified model (linear chain and friction fit on the default data)
+    params = structure_from_config(default_config["structure"], 1.4308e7, 2.37e7)
+    return IdentifiedModel(params, (0.005, 0.005, 0.005), (3.857e7, 2.547e5, 1.0e4, 0.284, 0.397),
+                           float(default_config["structure"]["preload_n"]), frequencies=(54.75, 165.4, 333.8))
+
+
+def record(case: str) -> RecordHarmonics:
+    """A record that holds only what the simulation reads: the force harmonics (and no acceleration)."""
+    force = np.zeros(25, dtype=complex)
+    force[:3] = FORCES[case]
+    zeros = np.zeros((3, 25), dtype=complex)
+    return RecordHarmonics(case, F0, FS, 174, force, zeros, force[None], zeros[None], zeros, zeros,
+                           ("a1", "a2", "a3"), np.array([0.55, 0.3, 0.05]))
+
+
+@pytest.mark.parametrize("effect", list(EFFECTS))
+@pytest.mark.parametrize("case", ["lc1", "lc3"])
+def test_harmonics_agree_with_the_time_integrator(model, effect, case):
+    """Every compared harmonic (1..9) of every sensor within 0.1 % of that sensor's response amplitude."""
+    aug, rec = EFFECTS[effect], record(case)
+    reference = simulate(model, aug, rec, method="time_marching")
+    periodic = simulate(model, aug, rec, method="harmonic_balance", hb_harmonics=18)
+    marched = aug.preload_drift or aug.iwan_share  # a drifting record is marched from the periodic state
+    assert periodic.extra["method"] == ("time_marching" if marched else "harmonic_balance")
+    A, A_ref = periodic.acceleration[:, :9], reference.acceleration[:, :9]
+    amplitude = np.linalg.norm(A_ref, axis=1, keepdims=True)
+    assert np.max(np.abs(A - A_ref) / amplitude) < 1e-3
+    if aug.preload_drift:  # the record's change from its first to its last third, as the diagnosis compares it
+        change, change_ref = (periodic.last - periodic.first)[:, :9], (reference.last - reference.first)[:, :9]
+        assert np.max(np.abs(change - change_ref) / amplitude) < 1e-3
+    else:  # energy balance: the energy dissipated by friction per cycle agrees too
+        assert periodic.energy["tangential_j"] == pytest.approx(reference.energy["tangential_j"], rel=2e-3)
+
+
+def test_warm_start_from_a_neighbour_converges_in_fewer_steps(model):
+    rec = record("lc1")
+    cold = simulate(model, Augmentation(hunt_crossley=200.0), rec)
+    warm = simulate(model, Augmentation(hunt_crossley=220.0), rec, start=cold)
+    fresh = simulate(model, Augmentation(hunt_crossley=220.0), rec)
+    assert warm.extra["iterations"] < fresh.extra["iterations"]
+    assert np.allclose(warm.acceleration, fresh.acceleration, rtol=0, atol=1e-6 * np.abs(fresh.acceleration).max())
+
+
+def test_guards_name_what_cannot_be_solved(model):
+    import dataclasses
+
+    from contactid.gap.model import simulator
+
+    sim = simulator(model, Augmentation(), FS, F0)
+    n_per = int(round(1 / (F0 * sim.dt)))
+    w = 2 * np.pi * F0
+    with pytest.raises(ValueError, match="drifting preload"):
+        HarmonicBalance(sim.red, dataclasses.replace(sim.contact, preload_drift=0.1), sim.zeta, w, 9, n_per)
+    with pytest.raises(ValueError, match="cannot resolve"):
+        HarmonicBalance(sim.red, sim.contact, sim.zeta, w, 9, 20)
+    with pytest.raises(ValueError, match="method"):
+        simulate(model, Augmentation(), record("lc1"), method="shooting")

@@ -1,0 +1,367 @@
+"""Periodic steady state of the reduced rig model by harmonic balance (HB) with alternating
+frequency/time (AFT) evaluation of the contact laws, as NLvib and tmdsimpy compute it.
+
+The equations are the time integrator's (``rig.nonlinear``), in mass-normalised coordinates z:
+
+    z'' + C z' + Omega^2 z = b f(t) + g(z, z'),
+    g = -(dxi/dz) S + eta_v (N - N0) + k_t xi_v xi_lin + k_n eta_v eta
+
+with xi = xi_v.z - z^T G z / 2 (Eq. 9 with the beam shortening), eta = eta_v.z (Eq. 8), S the
+modified Valanis law (Eqs. 21-22; plus the Iwan share and the viscous term of an augmented
+model) and N the normal law of ``ContactParameters``. The response is z = z_0 + sum_h
+Im(Z_h e^{i h w t}), h = 1..H. Each residual evaluation synthesises z and z' on M points of one
+period, runs the contact laws along that periodic path (the hysteretic friction state is
+stepped around the loop, with the same step function as the integrator, until it repeats) and
+projects g back onto the harmonics. Newton's method solves the residual with a Jacobian from the
+laws' tangents along the path (the friction law's slope, the normal law's stiffness and
+damping, the shortening's axial-force term); the tangent Jacobian is exact where the contact
+sticks and close elsewhere, so Newton converges in a few steps from the linear solution or
+from a neighbouring solution (``start``).
+
+The time integrator stays the reference: ``tests/test_harmonic_balance.py`` checks that the
+harmonics agree within 0.1 % on every load case and model effect.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg
+from numba import njit
+
+from ..friction import valanis_step
+from .nonlinear import ContactParameters, ReducedModel, _iwan_force, _normal_force
+
+
+@dataclass
+class PeriodicResponse:
+    """A periodic steady state: Z (n_r, H + 1) complex harmonics of z (column 0 the mean, real) and A
+    those of the acceleration (as the integrator computes it); w (rad/s); the period's grid signals (M points from t = 0): z, v, a (M, n_r), f, S, N, xi,
+    eta, dxi, deta (M,), the friction law's own state S_valanis (M,) and the Iwan anchors at t = 0;
+    whether Newton converged, its iterations and the final relative residual."""
+
+    Z: np.ndarray
+    A: np.ndarray
+    w: float
+    grid: dict
+    converged: bool
+    iterations: int
+    residual: float
+    iwan_anchors: np.ndarray
+
+
+@njit(cache=True)
+def _periodic_friction(xi, N_from, N, fr, n_min, iw_share, iw_w, k_iwan_out, tol, max_periods, S_out, S_val_out,
+                       x_sl):
+    """Friction along a periodic path on the integrator's steps: step i moves xi[i-1] -> xi[i] while N
+    moves N_from[i] -> N[i] (the integrator's pair: the last step's final normal force and this step's
+    explicit estimate). The Valanis state is stepped with the integrator's ``valanis_step`` around the
+    loop until it repeats (change below tol x max|S|), the Iwan share's sliders likewise; S_val_out the
+    Valanis state, S_out (1 - s) S_val + s S_iwan (zero where N <= 0, the contact open); k_iwan_out the
+    Iwan element's tangent stiffness."""
+    e_f, k_c, e_t, kappa, mu = fr[0], fr[1], fr[2], fr[3], fr[4]
+    m = xi.size
+    S = 0.0
+    for period in range(max_periods):
+        change = 0.0
+        peak = 0.0
+        for i in range(m):
+            j = i - 1 if i > 0 else m - 1
+            S = valanis_step(S, xi[j], xi[i], N_from[i], N[i], e_f, k_c, e_t, kappa, mu, n_min)
+            s_iw = 0.0
+            if iw_share > 0.0:
+                if N[i] > 0.0:
+                    e0 = e_f * (1.0 - np.exp(-k_c * N[i] / e_f))
+                    s_iw = _iwan_force(xi[i], x_sl, iw_w, e0, mu * N[i])
+                else:
+                    for k in range(x_sl.size):
+                        x_sl[k] = xi[i]
+            tot = (1.0 - iw_share) * S + iw_share * s_iw if N[i] > 0.0 else 0.0
+            d = abs(tot - S_out[i])
+            if d > change:
+                change = d
+            if abs(tot) > peak:
+                peak = abs(tot)
+            S_out[i] = tot
+            S_val_out[i] = S
+        if period > 0 and change <= tol * max(peak, 1e-300):
+            break
+    for i in range(m):  # the Iwan element's tangent: e_0 times the share of its sliders that stick (secant)
+        j = i - 1 if i > 0 else m - 1
+        k_iw = 0.0
+        if iw_share > 0.0 and N[i] > n_min:
+            e0 = e_f * (1.0 - np.exp(-k_c * N[i] / e_f))
+            k_iw = e0
+            dx = xi[i] - xi[j]
+            if abs(dx) > 1e-15:
+                sec = (S_out[i] - S_out[j] - (1.0 - iw_share) * (S_val_out[i] - S_val_out[j])) / (iw_share * dx)
+                k_iw = min(max(sec, 0.0), e0)
+        k_iwan_out[i] = k_iw
+
+
+@njit(cache=True)
+def _friction_tangents(xi, N_from, N, S_val, fr, n_min, coef):
+    """Partial derivatives of the integrator's friction step along the converged periodic path:
+    S_i = step(S_{i-1}, xi_{i-1}, xi_i, N_from_i, N_i); coef[i] = d S_i / d(S_{i-1}, xi_{i-1}, xi_i,
+    N_from_i, N_i) by central differences (the step's clamps included)."""
+    e_f, k_c, e_t, kappa, mu = fr[0], fr[1], fr[2], fr[3], fr[4]
+    m = xi.size
+    for i in range(m):
+        j = i - 1 if i > 0 else m - 1
+        x = (S_val[j], xi[j], xi[i], N_from[i], N[i])
+        scale = (max(abs(S_val[j]), 1e-3), max(abs(xi[j]), abs(xi[i]), 1e-12), max(abs(xi[j]), abs(xi[i]), 1e-12),
+                 max(abs(N_from[i]), 1.0), max(abs(N[i]), 1.0))
+        for k in range(5):
+            h = 1e-7 * scale[k]
+            xp = [x[0], x[1], x[2], x[3], x[4]]
+            xm = [x[0], x[1], x[2], x[3], x[4]]
+            xp[k] += h
+            xm[k] -= h
+            fp = valanis_step(xp[0], xp[1], xp[2], xp[3], xp[4], e_f, k_c, e_t, kappa, mu, n_min)
+            fm = valanis_step(xm[0], xm[1], xm[2], xm[3], xm[4], e_f, k_c, e_t, kappa, mu, n_min)
+            coef[i, k] = (fp - fm) / (2.0 * h)
+
+
+@njit(cache=True)
+def _propagate(coef, dxi, dN_from, dN, out):
+    """Periodic solution dS (M, n_cols) of the linearised step recurrence
+    dS_i = a_i dS_{i-1} + b_i dxi_{i-1} + c_i dxi_i + d_i dN_from_i + e_i dN_i for every column."""
+    m, n_cols = dxi.shape
+    prod = 1.0
+    for i in range(m):
+        prod *= coef[i, 0]
+    closure = 1.0 / (1.0 - prod) if abs(1.0 - prod) > 1e-9 else 0.0
+    for c in range(n_cols):
+        s = 0.0  # one pass from zero gives the response r; the periodic start is r_end / (1 - prod a)
+        for i in range(m):
+            j = i - 1 if i > 0 else m - 1
+            s = coef[i, 0] * s + coef[i, 1] * dxi[j, c] + coef[i, 2] * dxi[i, c] + coef[i, 3] * dN_from[i, c] \
+                + coef[i, 4] * dN[i, c]
+        s0 = s * closure
+        s = s0
+        for i in range(m):
+            j = i - 1 if i > 0 else m - 1
+            s = coef[i, 0] * s + coef[i, 1] * dxi[j, c] + coef[i, 2] * dxi[i, c] + coef[i, 3] * dN_from[i, c] \
+                + coef[i, 4] * dN[i, c]
+            out[i, c] = s
+
+
+@njit(cache=True)
+def _normal_path(eta, deta, n0, delta0, p, hc, unilateral, N, dN_deta, dN_ddeta):
+    """Normal force and its tangents along the path (the integrator's ``_normal_force``)."""
+    for i in range(eta.size):
+        N[i] = _normal_force(eta[i], deta[i], n0, delta0, p, hc, unilateral)
+        if unilateral and (eta[i] >= delta0 or N[i] <= 0.0):
+            dN_deta[i] = 0.0
+            dN_ddeta[i] = 0.0
+            continue
+        nel = n0 * ((delta0 - eta[i]) / delta0) ** p if unilateral else n0 * (delta0 - eta[i]) / delta0
+        dnel = -p * nel / (delta0 - eta[i]) if unilateral else -n0 / delta0
+        dN_deta[i] = dnel * (1.0 - hc * deta[i])
+        dN_ddeta[i] = -hc * nel
+
+
+class HarmonicBalance:
+    """HB of one reduced model with its contact laws at one excitation frequency, on the time
+    integrator's own steps.
+
+    red, contact, zeta as for ``DualSineSimulator``; w (rad/s); H harmonics; M steps per period
+    (the integrator's dt = 2 pi / (w M)). The equations are the integrator's discrete ones: velocity
+    Verlet is the central difference a_n = (z_{n+1} - 2 z_n + z_{n-1}) / dt^2 with the velocity
+    v_n = (z_{n+1} - z_{n-1}) / (2 dt) in the damping and the normal contact's dashpot, the half-step
+    velocity (z_n - z_{n-1}) / dt in the explicit normal-force estimate and the viscous friction, and
+    the friction law stepped once per step. On the harmonics these differences are exact operators
+    (4 sin^2(h w dt / 2) / dt^2 in place of (h w)^2, sin(h w dt) / dt in place of h w), so the
+    solution is the integrator's periodic orbit up to the harmonics above H, and it shares the
+    integrator's (and the rig's) discretisation instead of differing from it by it."""
+
+    def __init__(self, red: ReducedModel, contact: ContactParameters, zeta: np.ndarray, w: float, H: int, M: int):
+        if contact.preload_drift:
+            raise ValueError("harmonic balance: a drifting preload is not periodic; use the time integrator")
+        if M < 4 * H:
+            raise ValueError(f"harmonic balance: M = {M} points cannot resolve H = {H} harmonics (M >= 4 H)")
+        self.red, self.contact, self.w, self.H, self.M = red, contact, float(w), int(H), int(M)
+        self.zeta = np.asarray(zeta, dtype=float)
+        self.fr = np.asarray(contact.friction, dtype=float)
+        self.iw_w = np.asarray(contact.iwan_weights, dtype=float)
+        n = red.omega.size
+        dt = 2 * np.pi / (w * M)
+        self.dt = dt
+        h = np.arange(1, H + 1)
+        ph = np.outer(np.arange(M) * dt * w, h)
+        # real basis: z_j(t_k) = E[k] u_j with u_j = [mean, Re Z_1..H, Im Z_1..H]
+        self.E = np.hstack([np.ones((M, 1)), np.sin(ph), np.cos(ph)])
+        self.Ec = (np.roll(self.E, -1, axis=0) - np.roll(self.E, 1, axis=0)) / (2 * dt)  # v_n
+        self.Eb = (self.E - np.roll(self.E, 1, axis=0)) / dt  # v_{n-1/2}
+        self.Q = self.E.T * np.concatenate([[1.0 / M], np.full(2 * H, 2.0 / M)])[:, None]
+        # linear operator per mode (block of 2H + 1): Omega^2 - D2_h on Re/Im, c D1_h across
+        self.D2 = (2.0 * np.sin(0.5 * h * w * dt) / dt) ** 2
+        D1 = np.sin(h * w * dt) / dt
+        k2 = red.omega**2
+        c = 2.0 * self.zeta * red.omega
+        self.L = np.zeros((n, 2 * H + 1, 2 * H + 1))
+        self.L[:, 0, 0] = k2
+        idx = np.arange(1, H + 1)
+        self.L[:, idx, idx] = k2[:, None] - self.D2[None, :]
+        self.L[:, idx + H, idx + H] = k2[:, None] - self.D2[None, :]
+        self.L[:, idx, idx + H] = -c[:, None] * D1[None, :]
+        self.L[:, idx + H, idx] = c[:, None] * D1[None, :]
+        self.n = n
+
+    # -- conversions ---------------------------------------------------------------------------
+    def to_real(self, Z: np.ndarray) -> np.ndarray:
+        """(n, H + 1) complex -> (n, 2H + 1) real."""
+        return np.hstack([Z[:, :1].real, Z[:, 1:].real, Z[:, 1:].imag])
+
+    def to_complex(self, U: np.ndarray) -> np.ndarray:
+        H = self.H
+        return np.hstack([U[:, :1] + 0j, U[:, 1:H + 1] + 1j * U[:, H + 1:]])
+
+    def force_vector(self, force_coef: np.ndarray) -> np.ndarray:
+        """b f(t) in the real basis: (n, 2H + 1) from the force harmonics f = sum Im(F_h e^{ihwt})."""
+        F = np.zeros(self.H + 1, dtype=complex)
+        k = min(len(force_coef), self.H)
+        F[1:k + 1] = force_coef[:k]
+        Fr = np.concatenate([[0.0], F[1:].real, F[1:].imag])
+        return np.outer(self.red.force, Fr)
+
+    def linear_start(self, force_coef: np.ndarray) -> np.ndarray:
+        """The stuck linear system's response (real basis)."""
+        rhs = self.force_vector(force_coef)
+        return np.array([np.linalg.solve(self.L[j], rhs[j]) for j in range(self.n)])
+
+    # -- AFT -----------------------------------------------------------------------------------
+    def _normal(self, eta, deta):
+        c = self.contact
+        N, dN, dNd = np.empty(self.M), np.empty(self.M), np.empty(self.M)
+        _normal_path(eta, deta, c.preload, c.static_approach, c.exponent, c.hunt_crossley, bool(c.unilateral),
+                     N, dN, dNd)
+        return N, dN, dNd
+
+    def path(self, U: np.ndarray) -> dict:
+        """The contact laws along the periodic path of U (real basis, (n, 2H + 1)) on the steps."""
+        r, c = self.red, self.contact
+        z = self.E @ U.T  # (M, n)
+        v = self.Ec @ U.T
+        vh = self.Eb @ U.T
+        xi_lin = z @ r.xi
+        Gz = z @ r.shortening
+        xi = xi_lin - 0.5 * np.einsum("ti,ti->t", z, Gz)
+        dxi_dq = r.xi[None, :] - Gz
+        dxi = np.einsum("ti,ti->t", dxi_dq, vh)
+        eta = z @ r.eta
+        # the normal force acting (full-step velocity in the dashpot), and the explicit estimate the
+        # friction step and the contact test use (half-step velocity)
+        N, dN, dNd = self._normal(eta, v @ r.eta)
+        N_est, dNe, dNed = self._normal(eta, vh @ r.eta)
+        M = self.M
+        S, S_val, k_iw = np.zeros(M), np.empty(M), np.empty(M)
+        x_sl = np.zeros(self.iw_w.size)
+        _periodic_friction(xi, np.roll(N, 1), N_est, self.fr, c.n_min, c.iwan_share, self.iw_w, k_iw, 1e-12, 400,
+                           S, S_val, x_sl)
+        contact = N_est > 0.0
+        if c.viscous:
+            S = S + c.viscous * np.where(contact, dxi, 0.0)
+        g = (-dxi_dq * S[:, None] + np.outer(N - c.preload, r.eta) + r.k_t * np.outer(xi_lin, r.xi)
+             + r.k_n * np.outer(eta, r.eta))
+        return {"z": z, "v": v, "xi": xi, "xi_lin": xi_lin, "dxi": dxi, "eta": eta, "deta": v @ r.eta, "N": N,
+                "dN_deta": dN, "dN_ddeta": dNd, "N_est": N_est, "dNe_deta": dNe, "dNe_ddeta": dNed, "S": S,
+                "S_valanis": S_val, "k_iwan": k_iw, "g": g, "contact": contact, "iwan_anchors": x_sl}
+
+    def residual(self, U: np.ndarray, Fb: np.ndarray, p: dict | None = None) -> tuple[np.ndarray, dict]:
+        p = self.path(U) if p is None else p
+        R = np.einsum("jab,jb->ja", self.L, U) - Fb - (self.Q @ p["g"]).T
+        return R, p
+
+    def jacobian(self, p: dict) -> np.ndarray:
+        """Jacobian dR/dU ((n (2H + 1))^2, mode-major ordering): the friction law's linearised step
+        recurrence around the periodic path (its memory and its dependence on N exact), the normal law's
+        tangents, the shortening's axial-force term; the shortening's share of the friction direction
+        (dxi/dz = xi_v - G z) is left out, which costs Newton a step or two, not its convergence."""
+        r, c = self.red, self.contact
+        Q, E = self.Q, self.E
+
+        def P(weight, basis=E):
+            return Q @ (weight[:, None] * basis)
+
+        M = self.M
+        coef = np.empty((M, 5))
+        N_from = np.roll(p["N"], 1)
+        _friction_tangents(p["xi"], N_from, p["N_est"], p["S_valanis"], self.fr, c.n_min, coef)
+        nb = E.shape[1]
+        dN_full = p["dN_deta"][:, None] * E + p["dN_ddeta"][:, None] * self.Ec
+        dN_est = p["dNe_deta"][:, None] * E + p["dNe_ddeta"][:, None] * self.Eb
+        zero = np.zeros((M, nb))
+        dS = np.empty((M, 2 * nb))
+        _propagate(coef, np.hstack([E, zero]), np.hstack([zero, np.roll(dN_full, 1, axis=0)]),
+                   np.hstack([zero, dN_est]), dS)
+        share = (1.0 - c.iwan_share) * p["contact"][:, None]
+        if c.iwan_share:  # the Iwan element's tangent (e_0 times its sticking sliders' share) on top
+            dS[:, :nb] = share * dS[:, :nb] + c.iwan_share * p["k_iwan"][:, None] * E
+            dS[:, nb:] = share * dS[:, nb:]
+        else:
+            dS *= share
+        P_xi, P_N = Q @ dS[:, :nb], Q @ dS[:, nb:]
+        xx = np.outer(r.xi, r.xi)
+        ee = np.outer(r.eta, r.eta)
+        Jnl = np.kron(xx, r.k_t * np.eye(nb) - P_xi) - np.kron(np.outer(r.xi, r.eta), P_N)
+        Jnl += np.kron(ee, P(p["dN_deta"] + r.k_n) + P(p["dN_ddeta"], self.Ec))
+        Jnl += np.kron(r.shortening, P(p["S"]))
+        if c.viscous:
+            Jnl -= np.kron(xx, P(c.viscous * p["contact"].astype(float), self.Eb))
+        return scipy.linalg.block_diag(*self.L) - Jnl
+
+    # -- Newton --------------------------------------------------------------------------------
+    def solve(self, force_coef: np.ndarray, start: np.ndarray | None = None, tol: float = 1e-8,
+              max_iter: int = 40) -> PeriodicResponse:
+        """Newton iteration from ``start`` (Z, (n, H' + 1) complex, any H') or the linear solution.
+        Converged when the residual is below ``tol`` of the force's norm (both in the real basis)."""
+        Fb = self.force_vector(force_coef)
+        scale = max(np.linalg.norm(Fb), 1e-300)
+        if start is None:
+            U = self.linear_start(force_coef)
+        else:
+            Z0 = np.zeros((self.n, self.H + 1), dtype=complex)
+            k = min(start.shape[1], self.H + 1)
+            Z0[:, :k] = start[:, :k]
+            U = self.to_real(Z0)
+        R, p = self.residual(U, Fb)
+        err = np.linalg.norm(R) / scale
+        converged = err < tol
+        it = 0
+        lu, fresh = None, False
+        while not converged and it < max_iter:
+            it += 1
+            if lu is None:
+                lu, fresh = scipy.linalg.lu_factor(self.jacobian(p), check_finite=False), True
+            step = scipy.linalg.lu_solve(lu, -R.ravel(), check_finite=False).reshape(U.shape)
+            lam, better = 1.0, False
+            for _ in range(8):  # backtracking on the residual norm
+                U_try = U + lam * step
+                R_try, p_try = self.residual(U_try, Fb)
+                err_try = np.linalg.norm(R_try) / scale
+                if np.isfinite(err_try) and err_try < err:
+                    better = True
+                    break
+                lam *= 0.5
+            if not better:
+                if fresh:
+                    break  # even the current tangent gives no descent: stop (not converged)
+                lu = None  # a stale Jacobian: refresh it and try again
+                continue
+            # keep the factorised Jacobian only while it still cuts the residual tenfold (chord steps)
+            if lam < 1.0 or err_try > 0.1 * err:
+                lu = None
+            fresh = False
+            U, R, p, err = U_try, R_try, p_try, err_try
+            converged = err < tol
+        return self._response(U, p, converged, it, err)
+
+    def _response(self, U, p, converged, it, err) -> PeriodicResponse:
+        Z = self.to_complex(U)
+        A = -np.concatenate([[0.0], self.D2]) * Z  # the integrator's acceleration: the second difference
+        grid = {k: p[k] for k in ("z", "v", "xi", "eta", "dxi", "deta", "N", "S", "S_valanis")}
+        grid["a"] = self.E @ self.to_real(A).T
+        grid["t"] = np.arange(self.M) * self.dt
+        return PeriodicResponse(Z, A, self.w, grid, bool(converged), int(it), float(err), p["iwan_anchors"])
