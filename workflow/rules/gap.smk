@@ -22,7 +22,9 @@ rule gap_diagnosis:
         n_harmonics=config.get("nonlinear", {}).get("n_harmonics", 25),
         calibration_case=calibration_case(),
         cases=load_cases(),
-    threads: 2
+    # one thread: Snakemake sets the job's BLAS threads to this, and the diagnosis's many small solves run
+    # several times slower with two BLAS threads than with one (measured 49 s against 11 s)
+    threads: 1
     resources:
         runtime=20,
         mem_mb=2000,

@@ -202,8 +202,7 @@ def simulate(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, re
     ``method`` "harmonic_balance" (the default, or what ``STEADY_STATE`` holds) solves the periodic
     steady state directly (``rig.harmonic_balance`` with ``hb_harmonics`` harmonics, all the record's
     by default; warm-started from ``start``, a neighbouring simulation of the same record); where it
-    does not converge (a response that does not settle), and for an Iwan element, the time integrator
-    takes over.
+    does not converge (a response that does not settle) the time integrator takes over.
     "time_marching" integrates until the harmonics settle (the reference). With a preload drift the
     whole record's length is integrated in time, as measured, from the periodic state at the
     record's start. Harmonics above ``hb_harmonics`` are zero in the result."""
@@ -215,7 +214,7 @@ def simulate(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, re
     H = rec.acceleration.shape[1]
     coef = rec.force[:force_harmonics].copy()
     n_per = int(round(2 * np.pi / w / sim.dt))
-    if method == "harmonic_balance" and not aug.iwan_share:  # (the Iwan element's tangent is not linearised yet)
+    if method == "harmonic_balance":
         periodic = _periodic_state(sim, coef, w, min(H, hb_harmonics or H), n_per, start)
         if periodic is not None and not aug.preload_drift:
             return _periodic_result(periodic, sim, model, aug, rec, grid)

@@ -31,7 +31,7 @@ import scipy.linalg
 from numba import njit
 
 from ..friction import valanis_step
-from .nonlinear import ContactParameters, ReducedModel, _iwan_force, _normal_force
+from .nonlinear import ContactParameters, ReducedModel, _normal_force
 
 
 @dataclass
@@ -52,16 +52,18 @@ class PeriodicResponse:
 
 
 @njit(cache=True)
-def _periodic_friction(xi, N_from, N, fr, n_min, iw_share, iw_w, k_iwan_out, tol, max_periods, S_out, S_val_out,
-                       x_sl):
+def _periodic_friction(xi, N_from, N, fr, n_min, iw_share, iw_w, tol, max_periods, S_out, S_val_out, iw_x, iw_flag):
     """Friction along a periodic path on the integrator's steps: step i moves xi[i-1] -> xi[i] while N
     moves N_from[i] -> N[i] (the integrator's pair: the last step's final normal force and this step's
     explicit estimate). The Valanis state is stepped with the integrator's ``valanis_step`` around the
-    loop until it repeats (change below tol x max|S|), the Iwan share's sliders likewise; S_val_out the
-    Valanis state, S_out (1 - s) S_val + s S_iwan (zero where N <= 0, the contact open); k_iwan_out the
-    Iwan element's tangent stiffness."""
+    loop until it repeats (change below tol x max|S|), the Iwan share's sliders as the integrator's
+    ``_iwan_force`` steps them; S_val_out the Valanis state, S_out (1 - s) S_val + s S_iwan (zero where
+    N <= 0, the contact open); iw_x (M, sliders) the anchors after each step and iw_flag how each slider
+    moved (0 stuck, +1 / -1 slipping, 2 reset by an open contact)."""
     e_f, k_c, e_t, kappa, mu = fr[0], fr[1], fr[2], fr[3], fr[4]
     m = xi.size
+    n_sl = iw_w.size
+    x_sl = np.zeros(n_sl)
     S = 0.0
     for period in range(max_periods):
         change = 0.0
@@ -73,10 +75,26 @@ def _periodic_friction(xi, N_from, N, fr, n_min, iw_share, iw_w, k_iwan_out, tol
             if iw_share > 0.0:
                 if N[i] > 0.0:
                     e0 = e_f * (1.0 - np.exp(-k_c * N[i] / e_f))
-                    s_iw = _iwan_force(xi[i], x_sl, iw_w, e0, mu * N[i])
+                    k = e0 / n_sl
+                    for q in range(n_sl):  # the integrator's _iwan_force, slider by slider
+                        lim = mu * N[i] * iw_w[q]
+                        f = k * (xi[i] - x_sl[q])
+                        iw_flag[i, q] = 0
+                        if f > lim:
+                            x_sl[q] = xi[i] - lim / k
+                            f = lim
+                            iw_flag[i, q] = 1
+                        elif f < -lim:
+                            x_sl[q] = xi[i] + lim / k
+                            f = -lim
+                            iw_flag[i, q] = -1
+                        s_iw += f
+                        iw_x[i, q] = x_sl[q]
                 else:
-                    for k in range(x_sl.size):
-                        x_sl[k] = xi[i]
+                    for q in range(n_sl):
+                        x_sl[q] = xi[i]
+                        iw_x[i, q] = xi[i]
+                        iw_flag[i, q] = 2
             tot = (1.0 - iw_share) * S + iw_share * s_iw if N[i] > 0.0 else 0.0
             d = abs(tot - S_out[i])
             if d > change:
@@ -87,17 +105,39 @@ def _periodic_friction(xi, N_from, N, fr, n_min, iw_share, iw_w, k_iwan_out, tol
             S_val_out[i] = S
         if period > 0 and change <= tol * max(peak, 1e-300):
             break
-    for i in range(m):  # the Iwan element's tangent: e_0 times the share of its sliders that stick (secant)
-        j = i - 1 if i > 0 else m - 1
-        k_iw = 0.0
-        if iw_share > 0.0 and N[i] > n_min:
-            e0 = e_f * (1.0 - np.exp(-k_c * N[i] / e_f))
-            k_iw = e0
-            dx = xi[i] - xi[j]
-            if abs(dx) > 1e-15:
-                sec = (S_out[i] - S_out[j] - (1.0 - iw_share) * (S_val_out[i] - S_val_out[j])) / (iw_share * dx)
-                k_iw = min(max(sec, 0.0), e0)
-        k_iwan_out[i] = k_iw
+
+
+@njit(cache=True)
+def _iwan_propagate(xi, N, iw_x, iw_flag, iw_w, e_f, k_c, mu, dxi, dN, out):
+    """Periodic linearisation of the Iwan element along the path (see ``_periodic_friction``): for every
+    column, the change of its force dS (M, n_cols) from changes of xi and of N (the sliders' stiffness
+    e_0(N) / n and limits mu N w_q), with each slider's memory of its anchor (kept while it sticks,
+    reset where it slips or the contact opens)."""
+    m, n_cols = dxi.shape
+    n_sl = iw_w.size
+    for c in range(n_cols):
+        for i in range(m):
+            out[i, c] = 0.0
+        for q in range(n_sl):
+            dx = 0.0  # the anchor's change; one pass sets it wherever the slider slips, the second records
+            for sweep in range(2):
+                for i in range(m):
+                    flag = iw_flag[i, q]
+                    if flag == 2:
+                        dx = dxi[i, c]
+                        continue
+                    e0 = e_f * (1.0 - np.exp(-k_c * N[i] / e_f))
+                    k = e0 / n_sl
+                    dk = k_c * np.exp(-k_c * N[i] / e_f) * dN[i, c] / n_sl
+                    lim = mu * N[i] * iw_w[q]
+                    dlim = mu * iw_w[q] * dN[i, c]
+                    if flag == 0:
+                        df = dk * (xi[i] - iw_x[i, q]) + k * (dxi[i, c] - dx)
+                    else:
+                        df = flag * dlim
+                        dx = dxi[i, c] - flag * (dlim * k - lim * dk) / (k * k)
+                    if sweep == 1:
+                        out[i, c] += df
 
 
 @njit(cache=True)
@@ -175,6 +215,8 @@ class HarmonicBalance:
     (4 sin^2(h w dt / 2) / dt^2 in place of (h w)^2, sin(h w dt) / dt in place of h w), so the
     solution is the integrator's periodic orbit up to the harmonics above H, and it shares the
     integrator's (and the rig's) discretisation instead of differing from it by it."""
+
+    _last_lu: dict = {}
 
     def __init__(self, red: ReducedModel, contact: ContactParameters, zeta: np.ndarray, w: float, H: int, M: int):
         if contact.preload_drift:
@@ -256,10 +298,10 @@ class HarmonicBalance:
         N, dN, dNd = self._normal(eta, v @ r.eta)
         N_est, dNe, dNed = self._normal(eta, vh @ r.eta)
         M = self.M
-        S, S_val, k_iw = np.zeros(M), np.empty(M), np.empty(M)
-        x_sl = np.zeros(self.iw_w.size)
-        _periodic_friction(xi, np.roll(N, 1), N_est, self.fr, c.n_min, c.iwan_share, self.iw_w, k_iw, 1e-12, 400,
-                           S, S_val, x_sl)
+        S, S_val = np.zeros(M), np.empty(M)
+        iw_x, iw_flag = np.zeros((M, self.iw_w.size)), np.zeros((M, self.iw_w.size), dtype=np.int8)
+        _periodic_friction(xi, np.roll(N, 1), N_est, self.fr, c.n_min, c.iwan_share, self.iw_w, 1e-12, 400,
+                           S, S_val, iw_x, iw_flag)
         contact = N_est > 0.0
         if c.viscous:
             S = S + c.viscous * np.where(contact, dxi, 0.0)
@@ -267,7 +309,8 @@ class HarmonicBalance:
              + r.k_n * np.outer(eta, r.eta))
         return {"z": z, "v": v, "xi": xi, "xi_lin": xi_lin, "dxi": dxi, "eta": eta, "deta": v @ r.eta, "N": N,
                 "dN_deta": dN, "dN_ddeta": dNd, "N_est": N_est, "dNe_deta": dNe, "dNe_ddeta": dNed, "S": S,
-                "S_valanis": S_val, "k_iwan": k_iw, "g": g, "contact": contact, "iwan_anchors": x_sl}
+                "S_valanis": S_val, "iwan_x": iw_x, "iwan_flag": iw_flag, "g": g, "contact": contact,
+                "iwan_anchors": iw_x[0].copy()}
 
     def residual(self, U: np.ndarray, Fb: np.ndarray, p: dict | None = None) -> tuple[np.ndarray, dict]:
         p = self.path(U) if p is None else p
@@ -296,12 +339,12 @@ class HarmonicBalance:
         dS = np.empty((M, 2 * nb))
         _propagate(coef, np.hstack([E, zero]), np.hstack([zero, np.roll(dN_full, 1, axis=0)]),
                    np.hstack([zero, dN_est]), dS)
-        share = (1.0 - c.iwan_share) * p["contact"][:, None]
-        if c.iwan_share:  # the Iwan element's tangent (e_0 times its sticking sliders' share) on top
-            dS[:, :nb] = share * dS[:, :nb] + c.iwan_share * p["k_iwan"][:, None] * E
-            dS[:, nb:] = share * dS[:, nb:]
-        else:
-            dS *= share
+        dS *= (1.0 - c.iwan_share) * p["contact"][:, None]
+        if c.iwan_share:  # the Iwan element's share, linearised with its sliders' memory
+            dS_iw = np.empty_like(dS)
+            _iwan_propagate(p["xi"], p["N_est"], p["iwan_x"], p["iwan_flag"], self.iw_w, self.fr[0], self.fr[1],
+                            self.fr[4], np.hstack([E, zero]), np.hstack([zero, dN_est]), dS_iw)
+            dS += c.iwan_share * dS_iw
         P_xi, P_N = Q @ dS[:, :nb], Q @ dS[:, nb:]
         xx = np.outer(r.xi, r.xi)
         ee = np.outer(r.eta, r.eta)
@@ -330,11 +373,14 @@ class HarmonicBalance:
         err = np.linalg.norm(R) / scale
         converged = err < tol
         it = 0
-        lu, fresh = None, False
+        # start from the last factorised Jacobian of this size (a neighbouring solve's): a chord that is
+        # refreshed as soon as it stops cutting the residual tenfold
+        lu, fresh = HarmonicBalance._last_lu.get((self.n, self.H, self.M)), False
         while not converged and it < max_iter:
             it += 1
             if lu is None:
                 lu, fresh = scipy.linalg.lu_factor(self.jacobian(p), check_finite=False), True
+                HarmonicBalance._last_lu = {(self.n, self.H, self.M): lu}
             step = scipy.linalg.lu_solve(lu, -R.ravel(), check_finite=False).reshape(U.shape)
             lam, better = 1.0, False
             for _ in range(8):  # backtracking on the residual norm
