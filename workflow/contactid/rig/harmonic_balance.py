@@ -374,7 +374,7 @@ class HarmonicBalance:
         converged = err < tol
         it = 0
         # start from the last factorised Jacobian of this size (a neighbouring solve's): a chord that is
-        # refreshed as soon as it stops cutting the residual tenfold
+        # refreshed as soon as it stops cutting the residual threefold
         lu, fresh = HarmonicBalance._last_lu.get((self.n, self.H, self.M)), False
         while not converged and it < max_iter:
             it += 1
@@ -396,8 +396,8 @@ class HarmonicBalance:
                     break  # even the current tangent gives no descent: stop (not converged)
                 lu = None  # a stale Jacobian: refresh it and try again
                 continue
-            # keep the factorised Jacobian only while it still cuts the residual tenfold (chord steps)
-            if lam < 1.0 or err_try > 0.1 * err:
+            # keep the factorised Jacobian while it still cuts the residual threefold (chord steps)
+            if lam < 1.0 or err_try > 0.3 * err:
                 lu = None
             fresh = False
             U, R, p, err = U_try, R_try, p_try, err_try
