@@ -195,7 +195,7 @@ def refit_friction(model: IdentifiedModel, aug: Augmentation, forces: InverseHar
         g = contact_grids(forces, f0, model.preload * (1.0 + 0.5 * aug.preload_drift), grid)
         prob = _AugmentedProblem(g["xi"], g["xi_dot"], g["N"], g["S"], bounds, aug)
         u0 = np.clip(prob.unit(np.asarray(model.friction))[0], 1e-6, 1 - 1e-6)
-        u, ssr, _ = _polish(prob, u0, tol=1e-7)  # parameters to 1e-7 of their ranges: far below what the gap sees
+        u, ssr, _ = _polish(prob, u0)
         return (prob.physical(u)[0], float(np.sqrt(ssr / grid))), forces
 
     return _FRICTION.get(key, compute)
