@@ -14,9 +14,10 @@ from pathlib import Path
 __version__ = "0.1.0"
 
 
-def _code_digest() -> str:
-    """The package's code digest, computed as ``contactid.io.package_digest`` computes it (that module
-    imports numpy and xarray; this one runs before numba is imported and takes milliseconds)."""
+def code_digest() -> str:
+    """sha256 over the package's Python sources (names and bytes), 16 hex digits: names numba's cache
+    here and is every rule's parameter (``contactid.io.package_digest``); it runs before numba is
+    imported and takes milliseconds."""
     h = hashlib.sha256()
     root = Path(__file__).resolve().parent
     for path in sorted(root.rglob("*.py")):
@@ -50,7 +51,7 @@ def _use_numba_cache_keyed_by_code() -> str:
     cannot be made is replaced by one under the temporary directory, since numba would otherwise fall
     back to __pycache__ beside the sources, where callees go stale. Returns the directory."""
     current = os.environ.get("NUMBA_CACHE_DIR", "")
-    target = numba_cache_dir(current, _code_digest())
+    target = numba_cache_dir(current, code_digest())
     if str(target) == current:
         return current
     try:

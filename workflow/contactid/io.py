@@ -46,13 +46,10 @@ def config_digest(subset) -> str:
 
 def package_digest() -> str:
     """sha256 over the package's Python sources (names and bytes): a rule parameter, so that
-    Snakemake reruns what a changed contactid computed."""
-    h = hashlib.sha256()
-    root = Path(__file__).resolve().parent
-    for path in sorted(root.rglob("*.py")):
-        h.update(str(path.relative_to(root)).encode())
-        h.update(path.read_bytes())
-    return h.hexdigest()[:16]
+    Snakemake reruns what a changed contactid computed (the same digest names numba's cache)."""
+    from . import code_digest
+
+    return code_digest()
 
 
 def git_revision() -> str:
