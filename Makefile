@@ -1,13 +1,14 @@
 # contactid: the two commands of the README, and the environment they share.
 #   make reproduce  - set up, then run the whole workflow
-#   make test       - set up, then run the test suite
+#   make test       - set up, then run the test suite (unit and workflow integration tests)
+#   make test-fast  - set up, then run the unit tests alone (not the workflow nor the slow in-process ones)
 #   make env        - create .venv/ with the pinned packages (and TeX Live via apt where missing)
 
 VENV := .venv
 PY := $(VENV)/bin/python
 CORES ?= 2
 
-.PHONY: env reproduce test slurm-test clean-results tex
+.PHONY: env reproduce test test-fast slurm-test clean-results tex
 
 env: $(VENV)/.installed tex
 
@@ -31,6 +32,9 @@ reproduce: env
 
 test: env
 	$(PY) -m pytest -q
+
+test-fast: env
+	$(PY) -m pytest -q -m "not workflow and not slow"
 
 # optional (not in CI by default): the noise-study sweep through a local single-node SLURM against -c2 here
 slurm-test: env

@@ -1,14 +1,125 @@
+import os
 import sys
 from pathlib import Path
 
-import pytest
-import yaml
+# one BLAS thread per process: the tests' matrices are small, and on a shared 2-core machine OpenBLAS's threads
+# oversubscribe the cores (the stiction fit's eigen-solves ran 7x slower); Snakemake runs started by the tests
+# inherit it, as two jobs run side by side on --cores 2. A value set by the caller wins.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import pytest  # noqa: E402
+import yaml  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "workflow"))
+sys.path.insert(0, str(ROOT / "tests"))
+
+import workflow_projects as wp  # noqa: E402
+
+# The workflow runs the integration tests read, each in a project of its own (tests/workflow_projects.py):
+# name -> (prepare, the run it follows, nice). They start in the background as soon as pytest knows which
+# selected tests need them, so that they run while other tests do: the small run first (it compiles numba's
+# kernels once), then the others with its compiled kernels; the acceptance run (the longest) at normal
+# priority, the short ones below it. Read only: a test that changes a project works on a copy.
+SHARED_RUNS = {
+    "small_run": (wp.prepare_small_run, None, 0),
+    "default_run": (wp.prepare_default_run, "small_run", 0),
+    "measured_run": (lambda d: wp.prepare_measured_run(d, _runs["small_run"].proj), "small_run", 5),
+    "noisy_run": (wp.prepare_noisy_run, "small_run", 5),
+    "same_seed_run": (wp.prepare_same_seed_run, "small_run", 5),
+    "other_seed_run": (wp.prepare_other_seed_run, "small_run", 5),
+    "rig_run": (wp.prepare_rig_run, "small_run", 5),
+    "noise_sweep_run": (wp.prepare_noise_sweep_run, "small_run", 5),
+}
+_runs: dict = {}
+
+
+def _shared_run(config, name: str) -> wp.BackgroundRun:
+    if name not in _runs:
+        prepare, after, nice = SHARED_RUNS[name]
+        _runs[name] = wp.BackgroundRun(config._tmp_path_factory.mktemp(name), prepare, _runs.get(after), nice)
+        if name == "small_run":  # projects made after it has finished get its compiled kernels
+            wp.KERNEL_DONOR = _runs[name]
+    return _runs[name]
+
+
+def pytest_collection_finish(session):
+    """Start the runs the selected tests need (in SHARED_RUNS' order: each after the one it follows)."""
+    if session.config.option.collectonly:
+        return
+    needed = {f for item in session.items for f in getattr(item, "fixturenames", ()) if f in SHARED_RUNS}
+    for name in SHARED_RUNS:
+        if name in needed:
+            _shared_run(session.config, name)
+
+
+def pytest_sessionfinish(session):
+    for run in _runs.values():
+        run.stop()
+
+
+def _wait(config, name: str) -> Path:
+    return _shared_run(config, name).wait()
 
 
 @pytest.fixture(scope="session")
 def default_config():
     with open(ROOT / "config" / "config.yaml") as fh:
         return yaml.safe_load(fh)
+
+
+@pytest.fixture(scope="session")
+def small_config():
+    with open(ROOT / ".test" / "config_small.yaml") as fh:
+        return yaml.safe_load(fh)
+
+
+@pytest.fixture(scope="session")
+def default_run(pytestconfig):
+    """The acceptance run: the whole workflow on config/config.yaml."""
+    return _wait(pytestconfig, "default_run")
+
+
+@pytest.fixture(scope="session")
+def small_run(pytestconfig):
+    """The workflow on the small integration config .test/config_small.yaml, up to every case's contact forces,
+    the friction fit and the gap diagnosis (workflow_projects.SMALL_RUN_TARGETS)."""
+    return _wait(pytestconfig, "small_run")
+
+
+@pytest.fixture(scope="session")
+def measured_run(pytestconfig, small_run):
+    """Every record a measured file (UFF58, TDMS, CSV, netCDF): the gap target and the contact forces
+    (workflow_projects.prepare_measured_run). Returns (project, snakemake's output)."""
+    proj = _wait(pytestconfig, "measured_run")
+    return proj, _runs["measured_run"].output()
+
+
+@pytest.fixture(scope="session")
+def noisy_run(pytestconfig):
+    """lc1's contact forces on the small config with ten times its sensor noise."""
+    return _wait(pytestconfig, "noisy_run")
+
+
+@pytest.fixture(scope="session")
+def same_seed_run(pytestconfig):
+    """The random test's chain and lc1's record on the small config (the small run's seed)."""
+    return _wait(pytestconfig, "same_seed_run")
+
+
+@pytest.fixture(scope="session")
+def other_seed_run(pytestconfig):
+    """The same with seed 1234."""
+    return _wait(pytestconfig, "other_seed_run")
+
+
+@pytest.fixture(scope="session")
+def rig_run(pytestconfig):
+    """`snakemake rig` on the small config with load cases lc1 and lc3."""
+    return _wait(pytestconfig, "rig_run")
+
+
+@pytest.fixture(scope="session")
+def noise_sweep_run(pytestconfig):
+    """`snakemake noise_study` on the small config: two noise levels, one record length, one seed."""
+    return _wait(pytestconfig, "noise_sweep_run")

@@ -70,6 +70,7 @@ def synthetic():
     return coefficients(xi), coefficients(n - 70.0), coefficients(S)
 
 
+@pytest.mark.slow  # three GA fits of the default size
 def test_fit_recovers_known_parameters_reproducibly(synthetic):
     settings = FitSettings()
     a = fit_friction_law(*synthetic, F0, 70.0, settings, seed=5, n_harmonics_data=25)

@@ -70,9 +70,11 @@ CASES = ["lc1", "lc2", "lc3"]
 
 
 @pytest.fixture(scope="module")
-def hc_data(default_config):
-    """Rig records with Hunt-Crossley normal damping (alpha = 400 s/m), identified by the chain."""
-    cfg = copy.deepcopy(default_config)
+def hc_data(small_config):
+    """Rig records with Hunt-Crossley normal damping (alpha = 400 s/m), identified by the chain; on the small
+    config (.test/config_small.yaml: a 51.2 s random test, 8192-sample dual-sine records, a small GA), whose
+    identified model leaves the effect-free held-out gap as small as the default config's (0.27 %, 0.26 %)."""
+    cfg = copy.deepcopy(small_config)
     recs, _ = rig_records(cfg, {"normal_contact_damping": 400.0}, 3, CASES)
     model, modes, modal, frf = identify(cfg, recs["random_test"], recs["lc1"])
     records = {c: record_harmonics(recs[c], c, 25) for c in CASES}
@@ -85,6 +87,7 @@ def _diagnose(data, candidates, **gap):
     return diagnose(model, records, "lc1", settings, settings_from_config(cfg["friction"]), linear)
 
 
+@pytest.mark.slow
 def test_diagnosis_names_the_hidden_effect_and_the_gap_shrinks(hc_data):
     d = _diagnose(hc_data, ["normal_contact_damping", "viscous_friction"])
     assert d.verdict == "normal_contact_damping", d.reason
@@ -95,13 +98,15 @@ def test_diagnosis_names_the_hidden_effect_and_the_gap_shrinks(hc_data):
     assert d.where["direction"] == "normal"
 
 
+@pytest.mark.slow
 def test_a_candidate_removing_less_than_min_reduction_is_not_named(hc_data):
-    # the right effect removes ~96 % of this gap; asking for more than it removes leaves the verdict open
+    # the right effect removes ~94 % of this gap; asking for more than it removes leaves the verdict open
     d = _diagnose(hc_data, ["normal_contact_damping"], min_reduction=0.99)
     assert d.ranking[0]["effect"] == "normal_contact_damping" and 0.5 < d.ranking[0]["reduction"] < 0.99
     assert d.verdict == "none" and "no candidate shrinks the held-out gap by 99%" in d.reason
 
 
+@pytest.mark.slow
 def test_effect_missing_from_library_gives_none_and_points_at_the_normal_direction(hc_data):
     d = _diagnose(hc_data, ["viscous_friction"])
     assert d.verdict == "none", d.reason

@@ -74,6 +74,7 @@ def test_low_level_agrees_with_linear_frf(default_config):
     assert df["difference_pct"].abs().max() < 0.5
 
 
+@pytest.mark.slow  # every rig effect simulated (tens of seconds)
 def test_effects_off_are_bit_identical_and_on_change_the_response(default_config, lc1):
     c = default_config
     rc = copy.deepcopy(c["rig"])

@@ -1,6 +1,6 @@
 """The workflow survives interruption: a run killed in the rig or in the friction fit resumes with
-``snakemake --rerun-incomplete`` to results bit-identical to an uninterrupted run made at the same
-time in another directory; outputs are written whole or not at all."""
+``snakemake --rerun-incomplete`` to results bit-identical to an uninterrupted run in another directory
+(the shared run on the small config); outputs are written whole or not at all."""
 
 import os
 import signal
@@ -14,7 +14,7 @@ import pytest
 import xarray as xr
 
 from contactid.io import write_dataset
-from test_workflow import make_project
+from workflow_projects import copy_project
 
 TARGET = "results/friction/friction_fit.nc"
 
@@ -66,11 +66,13 @@ def _datasets(proj: Path) -> dict:
 
 
 @pytest.mark.workflow
-def test_killed_runs_resume_to_bit_identical_results(tmp_path):
-    (tmp_path / "reference").mkdir()
-    (tmp_path / "interrupted").mkdir()
-    ref, run = make_project(tmp_path / "reference"), make_project(tmp_path / "interrupted")
-    reference = _start(ref, TARGET)  # uninterrupted, at the same time in another directory
+def test_killed_runs_resume_to_bit_identical_results(small_run, tmp_path):
+    # a copy of the shared small run without the rig's lc1 record and what the fit makes of it: the run makes
+    # them again (the rig, the lc1 chain, the friction fit); the rest of the workflow stays as the copy has it
+    run = copy_project(small_run, tmp_path / "run")
+    for rel in ("data/raw/lc1.nc", "data/truth/lc1.nc", TARGET, *[f"results/lc1/{f}.nc" for f in (
+            "raw_check", "generalized_coordinates", "nonlinear_modes", "reduced_model", "contact_forces")]):
+        (run / rel).unlink()
     # 1. SIGKILL in the middle of the rig (no chance to clean up: the lock and the incomplete marker stay)
     first = _start(run, TARGET)
     _interrupt_during(first, run, "rig_dual_sine", signal.SIGKILL)
@@ -81,13 +83,14 @@ def test_killed_runs_resume_to_bit_identical_results(tmp_path):
     second = _start(run, "--rerun-incomplete", TARGET)
     out = _interrupt_during(second, run, "friction_fit", signal.SIGINT)
     assert not (run / TARGET).exists(), out[-3000:]  # the interrupted job left no output
-    # 3. resume to the end
+    # 3. resume to the end: then nothing is left to do
     _finish(_start(run, "--rerun-incomplete", TARGET))
-    _finish(reference)
-    a, b = _datasets(ref), _datasets(run)
-    assert set(a) == set(b) and TARGET in a
-    for name in a:
-        x, y = xr.load_dataset(a[name], engine="netcdf4"), xr.load_dataset(b[name], engine="netcdf4")
+    assert "Nothing to be done" in _finish(_start(run, "-n", TARGET))
+    # the uninterrupted reference: the shared small run, the same config in another directory
+    ref, got = _datasets(small_run), _datasets(run)
+    assert set(got) == set(ref) and TARGET in got
+    for name in got:
+        x, y = xr.load_dataset(ref[name], engine="netcdf4"), xr.load_dataset(got[name], engine="netcdf4")
         assert x.attrs["content_sha256"] == y.attrs["content_sha256"], name
         for v in x.data_vars:
             np.testing.assert_array_equal(x[v].values, y[v].values, err_msg=f"{name}:{v}")

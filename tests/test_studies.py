@@ -8,7 +8,7 @@ import xarray as xr
 import yaml
 
 from contactid.studies import e0_at, noise_study_table
-from test_workflow import make_project, snakemake
+from workflow_projects import make_project, snakemake
 
 
 def test_parameter_table_is_the_full_product_and_refuses_empty_or_bad_axes():
@@ -28,11 +28,10 @@ def test_e0_is_eq22_and_tends_to_k_c_n_at_low_load():
 
 
 @pytest.mark.workflow
-def test_sweep_runs_one_job_per_point_and_errors_grow_with_noise(tmp_path):
-    proj = make_project(tmp_path, {"noise_study": {"noise_fractions": [0.001, 0.05], "record_samples": [8192],
-                                                   "seeds": [1], "in_report": False}})
-    res = snakemake(proj, "noise_study")
-    assert res.returncode == 0, res.stderr[-3000:]
+def test_sweep_runs_one_job_per_point_and_errors_grow_with_noise(noise_sweep_run):
+    # `snakemake noise_study` on the small config with two noise levels, one record length and one seed
+    # (workflow_projects.prepare_noise_sweep_run; the points' random test is the small config's 51.2 s record)
+    proj = noise_sweep_run
     points = sorted((proj / "results/studies/noise").glob("*.json"))
     assert [p.name for p in points] == ["noise_fraction~0.001_record_samples~8192_seed~1.json",
                                         "noise_fraction~0.05_record_samples~8192_seed~1.json"]

@@ -27,6 +27,9 @@ from .model import NONE, IdentifiedModel, fe_model
 from .records import RecordHarmonics
 from .refit import (baseline, calibrate, contact_grids, evaluate, gap_residual, gap_value,
                     identified_forces, law_friction_force)
+from .verdict import DRIFT_FACTOR, NORMAL_LIMIT, OPEN_LIMIT, RESIDUAL_FACTOR  # noqa: F401 (thresholds of the place)
+from .verdict import open_fraction, place as _place_of
+from .verdict import verdict as _verdict
 
 log = logging.getLogger(__name__)
 
@@ -148,7 +151,7 @@ def localise(model: IdentifiedModel, records: dict, sims: dict, n_harmonics: int
         N_law = A_el @ np.linalg.lstsq(A_el, N_id, rcond=None)[0]
         s_res.append(_rel(S_law, g["S"]))
         n_res.append(_rel(N_law, N_id))
-        open_frac.append(float(np.mean(g["N"] <= OPEN_LIMIT * model.preload)))
+        open_frac.append(open_fraction(g["N"], model.preload))
         # energy per cycle (J): identified from the record vs the simulation
         T = 1.0 / rec.f0
         et_id = float(np.mean(g["S"] * g["xi_dot"]) * T)
@@ -234,34 +237,12 @@ def identification_noise(model: IdentifiedModel, rec: RecordHarmonics) -> float:
     return float(np.std(r) / np.sqrt(len(r)))
 
 
-# thresholds of the place (measured on rig data with each effect; see README): the records drift when
-# their trend exceeds DRIFT_FACTOR standard errors; the structure and sensor model disagrees with the
-# records when the inverse identification's sensor misfit exceeds RESIDUAL_FACTOR standard errors; the
-# normal contact is not elastic when the best elastic normal law leaves more than NORMAL_LIMIT of N
-DRIFT_FACTOR = 8.0
-RESIDUAL_FACTOR = 20.0
-NORMAL_LIMIT = 0.25
-OPEN_LIMIT = 0.02  # the contact is taken as open where the identified N is below this fraction of N0
+# the place's thresholds (DRIFT_FACTOR, RESIDUAL_FACTOR, NORMAL_LIMIT, OPEN_LIMIT) and its logic live in
+# verdict.py (pure functions, unit-tested in tests/test_verdict.py); they stay importable from here
 
-
-def _place(summary, stage, id_res, scatter, records, H) -> tuple[str, str]:
-    drift = np.array([v["z"] for v in summary["drift"].values()])
-    if np.median(drift) > DRIFT_FACTOR:
-        change = np.median([v["change"] for v in summary["drift"].values()])
-        return "non_stationary", (f"the records' harmonics drift by {change:.2g} over a record "
-                                  f"({np.median(drift):.0f} standard errors)")
-    if np.median(id_res / scatter) > RESIDUAL_FACTOR:
-        return "structure_or_measurement", (f"the linear structure and sensor model cannot fit the records at w "
-                                            f"and 3w (sensor misfit {np.median(id_res):.2g}, "
-                                            f"{np.median(id_res / scatter):.0f} x the scatter)")
-    if stage["open_fraction"] > 0:
-        return "normal_contact", (f"the identified normal force falls to zero over {stage['open_fraction']:.0%} of the "
-                                  "cycle in the hardest load case: the contact opens")
-    if stage["contact_force_N"] > NORMAL_LIMIT:
-        return "normal_contact", (f"no elastic normal law fits the identified N(eta): {stage['contact_force_N']:.0%} "
-                                  "of N is left (dissipation or opening in the normal direction)")
-    return "tangential_contact", (f"structure, sensors and normal contact are consistent with the records; the "
-                                  f"friction law leaves {stage['contact_force_S']:.1%} of S")
+def _place(summary, stage, id_res, scatter, records=None, H=None) -> tuple[str, str]:
+    """The localisation's place and reason (``verdict.place`` on the summary's drift)."""
+    return _place_of(summary["drift"], stage, id_res, scatter)
 
 
 def linear_stage(model: IdentifiedModel, frf: xr.Dataset, modal: xr.Dataset) -> dict:
@@ -368,16 +349,17 @@ def diagnose(model: IdentifiedModel, records: Mapping[str, RecordHarmonics], cal
     results = {}
     for name in names:
         cand = LIBRARY[name]
-        cal = calibrate(model, cand, records[calibration_case], fit_settings, H, settings.max_evaluations)
+        cal = calibrate(model, cand, records[calibration_case], fit_settings, H, settings.max_evaluations,
+                        start=base_sims[calibration_case])
         sims = {calibration_case: None}
         res = {}
         for c in score_cases:
-            _, _, sim, _ = evaluate(cal.model, cal.augmentation, records[c], None, H, refit=False)
+            _, _, sim, _ = evaluate(cal.model, cal.augmentation, records[c], None, H, refit=False, start=base_sims[c])
             sims[c] = sim
             res[c] = gap_residual(sim, records[c], H)
         results[name] = (cal, sims, res)
-        log.info("candidate %s: theta %s, calibration gap %.4g, held-out %s", name, cal.theta, cal.gap,
-                 {c: round(gap_value(r), 5) for c, r in res.items()})
+        log.info("candidate %s: theta [%s], calibration gap %.4g, held-out gap %s", name, ", ".join(f"{t:.4g}" for t in np.ravel(cal.theta)),
+                 cal.gap, ", ".join(f"{c} {gap_value(r):.4g}" for c, r in res.items()))
     # bootstrap over record blocks: the sims are fixed, the records resampled
     rng = generator(settings.seed, "gap/bootstrap")
     boot = {c: _bootstrap_records(records[c], rng, settings.n_bootstrap, H) for c in score_cases}
@@ -427,34 +409,10 @@ def diagnose(model: IdentifiedModel, records: Mapping[str, RecordHarmonics], cal
                      "heldout_gap_after_by_case": {c: gap_value(r) for c, r in res.items()},
                      "identification_residual_after": res_after, "identification_noise": noise, "acts_on": acts_on, "consistent": bool(consistent),
                      "evaluations": cal.evaluations})
-    rows.sort(key=lambda r: r["score"])
+    # by score; scores equal to 3 decimals are a tie (the same model solved from other starts): library order
+    rows.sort(key=lambda r: round(r["score"], 3) if np.isfinite(r["score"]) else np.inf)
     scatter = float(np.std(before_b))
-    verdict, reason = "none", ""
-    eligible = [r for r in rows if r["consistent"]]
-    if rows and not eligible:
-        reason = (f"the gap lies in {where['place']} and no candidate of the library acts there and explains it "
-                  f"(best by score: {rows[0]['effect']}, acting on {rows[0]['acts_on']}, {rows[0]['reduction']:.1%})")
-    elif rows:
-        best = eligible[0]
-        second = next((r for r in rows if r is not best), None)
-        if before < settings.min_gap:
-            reason = (f"the held-out gap {before:.3g} is below gap.min_gap = {settings.min_gap:g}: the identified model "
-                      f"reproduces the records as well as the chain's own identification allows (best candidate "
-                      f"{best['effect']}: {best['reduction']:.1%})")
-        elif before < settings.noise_factor * scatter:
-            reason = f"the held-out gap {before:.3g} is within {settings.noise_factor} x the records' scatter {scatter:.2g}"
-        elif best["reduction"] < settings.min_reduction or best["reduction_interval"][0] <= 0:
-            reason = (f"no candidate shrinks the held-out gap by {settings.min_reduction:.0%} (best: {best['effect']}, "
-                      f"{best['reduction']:.1%})")
-        elif second is not None and second["heldout_gap_after"] < settings.separation * best["heldout_gap_after"]:
-            reason = (f"{best['effect']} and {second['effect']} explain the gap about equally (held-out gaps "
-                      f"{best['heldout_gap_after']:.3g}, {second['heldout_gap_after']:.3g}; separation {settings.separation})")
-        else:
-            verdict = best["effect"]
-            p_better = float(np.mean(boots[best["effect"]] < boots[second["effect"]])) if second else 1.0
-            reason = (f"{best['effect']} shrinks the held-out gap from {before:.3g} to {best['heldout_gap_after']:.3g} "
-                      f"({best['reduction']:.1%}); runner-up {second['effect'] if second else '-'} "
-                      f"{second['heldout_gap_after'] if second else float('nan'):.3g}; bootstrap P(better) {p_better:.2f}")
+    verdict, reason = _verdict(rows, before, scatter, where["place"], settings, boots)
     shrink = {}
     for label, r in zip(("winner", "runner_up"), rows[:2]):
         shrink[label] = {"effect": r["effect"],

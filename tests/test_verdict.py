@@ -1,0 +1,188 @@
+"""The gap diagnosis's decisions without the rig: every branch of the verdict and every threshold of the
+place, on hand-made numbers (milliseconds). tests/test_gap.py and tests/test_workflow.py check the same
+decisions on rig data."""
+
+import numpy as np
+import pytest
+
+from contactid.gap import verdict as V
+from contactid.gap.verdict import place, verdict
+
+SETTINGS = {"min_gap": 0.006, "noise_factor": 3.0, "min_reduction": 0.5, "separation": 1.5}  # the config's defaults
+PLACE = "tangential_contact"
+
+
+def row(effect, after, before=0.02, consistent=True, acts_on=PLACE, low=None):
+    """A ranked candidate as diagnose() builds it: held-out gap ``after`` against ``before``."""
+    red = 1 - after / before
+    return {"effect": effect, "acts_on": acts_on, "consistent": consistent, "heldout_gap_after": after,
+            "reduction": red, "reduction_interval": [red - 0.05 if low is None else low, red + 0.05]}
+
+
+# ----------------------------------------------------------------------------------------------
+# verdict
+# ----------------------------------------------------------------------------------------------
+
+def test_no_candidates_give_none_without_reason():
+    assert verdict([], 0.05, 1e-4, PLACE, SETTINGS) == ("none", "")
+
+
+def test_clean_winner_is_named_with_its_bootstrap_p_better():
+    rows = [row("viscous_friction", 0.002), row("structural_damping", 0.012)]
+    boots = {"viscous_friction": np.array([1.0, 2.0, 3.0, 4.0]), "structural_damping": np.array([2.0, 3.0, 4.0, 1.0])}
+    name, reason = verdict(rows, 0.02, 1e-4, PLACE, SETTINGS, boots)
+    assert name == "viscous_friction"
+    assert reason == ("viscous_friction shrinks the held-out gap from 0.02 to 0.002 (90.0%); runner-up "
+                      "structural_damping 0.012; bootstrap P(better) 0.75")
+
+
+def test_a_sole_candidate_wins_without_runner_up():
+    name, reason = verdict([row("viscous_friction", 0.002)], 0.02, 1e-4, PLACE, SETTINGS)
+    assert name == "viscous_friction"
+    assert "runner-up - nan" in reason and "P(better) 1.00" in reason
+
+
+def test_gap_below_min_gap_gives_none():
+    rows = [row("viscous_friction", 0.0005, before=0.0059)]
+    name, reason = verdict(rows, 0.0059, 1e-5, PLACE, SETTINGS)
+    assert name == "none"
+    assert reason.startswith("the held-out gap 0.0059 is below gap.min_gap = 0.006")
+    # at the threshold itself the gap counts (strict inequality): the clean winner is named
+    assert verdict([row("viscous_friction", 0.0005, before=0.006)], 0.006, 1e-5, PLACE, SETTINGS)[0] == "viscous_friction"
+
+
+def test_gap_within_the_records_scatter_gives_none():
+    rows = [row("viscous_friction", 0.002)]
+    name, reason = verdict(rows, 0.02, 0.007, PLACE, SETTINGS)  # 0.02 < 3 x 0.007
+    assert name == "none" and reason == "the held-out gap 0.02 is within 3.0 x the records' scatter 0.007"
+    assert verdict(rows, 0.02, 0.0066, PLACE, SETTINGS)[0] == "viscous_friction"  # 0.02 > 3 x 0.0066
+
+
+def test_reduction_below_min_reduction_gives_none():
+    rows = [row("viscous_friction", 0.0102), row("structural_damping", 0.019)]  # 49 % removed
+    name, reason = verdict(rows, 0.02, 1e-4, PLACE, SETTINGS)
+    assert name == "none" and reason == "no candidate shrinks the held-out gap by 50% (best: viscous_friction, 49.0%)"
+    rows = [row("viscous_friction", 0.010), row("structural_damping", 0.019)]  # exactly 50 %: enough
+    assert verdict(rows, 0.02, 1e-4, PLACE, SETTINGS)[0] == "viscous_friction"
+    assert verdict(rows, 0.02, 1e-4, PLACE, {**SETTINGS, "min_reduction": 0.6})[0] == "none"
+
+
+def test_bootstrap_lower_bound_at_or_below_zero_gives_none():
+    for low in (0.0, -0.2):
+        rows = [row("viscous_friction", 0.002, low=low), row("structural_damping", 0.019)]
+        name, reason = verdict(rows, 0.02, 1e-4, PLACE, SETTINGS)
+        assert name == "none" and reason.startswith("no candidate shrinks the held-out gap by 50%"), low
+    rows = [row("viscous_friction", 0.002, low=1e-3), row("structural_damping", 0.019)]
+    assert verdict(rows, 0.02, 1e-4, PLACE, SETTINGS)[0] == "viscous_friction"
+
+
+def test_runner_up_too_close_gives_none():
+    rows = [row("viscous_friction", 0.004), row("normal_contact_damping", 0.0059)]  # 0.0059 < 1.5 x 0.004
+    name, reason = verdict(rows, 0.02, 1e-4, PLACE, SETTINGS)
+    assert name == "none"
+    assert reason == ("viscous_friction and normal_contact_damping explain the gap about equally (held-out gaps "
+                      "0.004, 0.0059; separation 1.5)")
+    rows = [row("viscous_friction", 0.004), row("normal_contact_damping", 0.006)]  # exactly 1.5 x: separated
+    assert verdict(rows, 0.02, 1e-4, PLACE, SETTINGS)[0] == "viscous_friction"
+
+
+def test_no_candidate_acting_where_the_gap_lies_gives_none():
+    rows = [row("normal_contact_damping", 0.001, consistent=False, acts_on="normal_contact"),
+            row("contact_separation", 0.003, consistent=False, acts_on="normal_contact")]
+    name, reason = verdict(rows, 0.02, 1e-4, PLACE, SETTINGS)
+    assert name == "none"
+    assert reason == ("the gap lies in tangential_contact and no candidate of the library acts there and explains it "
+                      "(best by score: normal_contact_damping, acting on normal_contact, 95.0%)")
+    # this reason comes first, whatever the size of the gap
+    assert verdict(rows, 0.001, 1e-4, PLACE, SETTINGS)[1].startswith("the gap lies in tangential_contact")
+
+
+def test_the_winner_is_the_best_consistent_candidate_and_the_runner_up_any_other():
+    inconsistent = row("normal_contact_damping", 0.001, consistent=False, acts_on="normal_contact")
+    # the best-scored candidate acts elsewhere: the best consistent one is judged, against the best other one
+    rows = [inconsistent, row("viscous_friction", 0.002)]
+    name, reason = verdict(rows, 0.02, 1e-4, PLACE, SETTINGS)
+    assert name == "none" and reason.startswith("viscous_friction and normal_contact_damping explain the gap about equally")
+    rows = [row("viscous_friction", 0.002), {**inconsistent, "heldout_gap_after": 0.004}]
+    assert verdict(rows, 0.02, 1e-4, PLACE, SETTINGS)[0] == "viscous_friction"
+
+
+def test_verdict_reads_gap_settings_like_a_mapping():
+    from contactid.gap.diagnosis import GapSettings
+
+    rows = [row("viscous_friction", 0.004), row("normal_contact_damping", 0.0059)]
+    assert verdict(rows, 0.02, 1e-4, PLACE, GapSettings()) == verdict(rows, 0.02, 1e-4, PLACE, SETTINGS)
+    assert verdict(rows, 0.02, 1e-4, PLACE, GapSettings(separation=1.2))[0] == "viscous_friction"
+
+
+# ----------------------------------------------------------------------------------------------
+# place
+# ----------------------------------------------------------------------------------------------
+
+def quiet_stage(**kw):
+    return {"open_fraction": 0.0, "contact_force_N": 0.05, "contact_force_S": 0.012, **kw}
+
+
+def drift(*z, change=0.01):
+    return {f"lc{i + 1}": {"change": change, "z": v} for i, v in enumerate(z)}
+
+
+ID_RES, SCATTER = [0.002, 0.002, 0.002], [0.001, 0.001, 0.001]  # misfit 2 standard errors: consistent
+
+
+def test_consistent_records_put_the_gap_in_the_tangential_contact():
+    name, reason = place(drift(1.0, 1.2, 0.8), quiet_stage(), ID_RES, SCATTER)
+    assert name == "tangential_contact" and "the friction law leaves 1.2% of S" in reason
+
+
+def test_drift_beyond_drift_factor_is_non_stationary():
+    assert V.DRIFT_FACTOR == 8.0
+    name, reason = place(drift(1.0, 9.0, 12.0, change=0.05), quiet_stage(), ID_RES, SCATTER)  # median 9 > 8
+    assert name == "non_stationary" and reason == "the records' harmonics drift by 0.05 over a record (9 standard errors)"
+    assert place(drift(1.0, 8.0, 12.0), quiet_stage(), ID_RES, SCATTER)[0] == "tangential_contact"  # median 8: not > 8
+
+
+def test_sensor_misfit_beyond_residual_factor_is_structure_or_measurement():
+    assert V.RESIDUAL_FACTOR == 20.0
+    name, reason = place(drift(1, 1, 1), quiet_stage(), [0.021, 0.03, 0.001], SCATTER)  # median ratio 21
+    assert name == "structure_or_measurement" and "(sensor misfit 0.021, 21 x the scatter)" in reason
+    assert place(drift(1, 1, 1), quiet_stage(), [0.02, 0.03, 0.001], SCATTER)[0] == "tangential_contact"  # 20: not > 20
+
+
+def test_an_opening_contact_is_normal_contact():
+    name, reason = place(drift(1, 1, 1), quiet_stage(open_fraction=0.05), ID_RES, SCATTER)
+    assert name == "normal_contact" and "falls to zero over 5% of the cycle" in reason
+
+
+def test_normal_force_left_beyond_normal_limit_is_normal_contact():
+    assert V.NORMAL_LIMIT == 0.25
+    name, reason = place(drift(1, 1, 1), quiet_stage(contact_force_N=0.3), ID_RES, SCATTER)
+    assert name == "normal_contact" and "no elastic normal law fits the identified N(eta): 30% of N is left" in reason
+    assert place(drift(1, 1, 1), quiet_stage(contact_force_N=0.25), ID_RES, SCATTER)[0] == "tangential_contact"
+
+
+def test_open_limit_is_the_share_of_the_preload_below_which_the_contact_is_open():
+    assert V.OPEN_LIMIT == 0.02
+    N0 = 70.0
+    n = N0 * (1 + np.cos(np.linspace(0, 2 * np.pi, 100, endpoint=False)))  # dips to 0 at mid-cycle
+    assert V.open_fraction(n, N0) == pytest.approx(np.mean(n <= 1.4))
+    assert V.open_fraction(n, N0) > 0
+    assert V.open_fraction(np.maximum(n, 0.021 * N0), N0) == 0.0  # 2.1 % of N0 at least: closed
+    assert V.open_fraction(np.maximum(n, 0.02 * N0), N0) > 0  # at 2 % of N0: open
+
+
+def test_the_checks_come_in_order_drift_structure_opening_normal():
+    loud = quiet_stage(open_fraction=0.1, contact_force_N=0.5)
+    bad_res = [0.1, 0.1, 0.1]
+    assert place(drift(20, 20, 20), loud, bad_res, SCATTER)[0] == "non_stationary"
+    assert place(drift(1, 1, 1), loud, bad_res, SCATTER)[0] == "structure_or_measurement"
+    assert place(drift(1, 1, 1), loud, ID_RES, SCATTER)[1].startswith("the identified normal force falls to zero")
+
+
+def test_diagnosis_keeps_its_place_function_and_thresholds():
+    from contactid.gap import diagnosis
+
+    summary = {"drift": drift(1.0, 9.0, 12.0)}
+    assert diagnosis._place(summary, quiet_stage(), np.array(ID_RES), np.array(SCATTER), None, 9)[0] == "non_stationary"
+    assert (diagnosis.DRIFT_FACTOR, diagnosis.RESIDUAL_FACTOR, diagnosis.NORMAL_LIMIT, diagnosis.OPEN_LIMIT) == \
+        (V.DRIFT_FACTOR, V.RESIDUAL_FACTOR, V.NORMAL_LIMIT, V.OPEN_LIMIT)

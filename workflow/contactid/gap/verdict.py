@@ -1,0 +1,110 @@
+"""The decisions of the gap diagnosis as pure functions of plain numbers, testable without the rig:
+where the gap lies (``place``) and which candidate, if any, explains it (``verdict``).
+
+``diagnosis.localise`` and ``diagnosis.diagnose`` compute the numbers (stage gaps, drift, sensor
+misfits, ranked candidates with their held-out gaps and bootstrap intervals) and call these.
+"""
+
+from __future__ import annotations
+
+from typing import Mapping, Sequence
+
+import numpy as np
+
+# thresholds of the place (measured on rig data with each effect; see README): the records drift when
+# their trend exceeds DRIFT_FACTOR standard errors; the structure and sensor model disagrees with the
+# records when the inverse identification's sensor misfit exceeds RESIDUAL_FACTOR standard errors; the
+# normal contact is not elastic when the best elastic normal law leaves more than NORMAL_LIMIT of N
+DRIFT_FACTOR = 8.0
+RESIDUAL_FACTOR = 20.0
+NORMAL_LIMIT = 0.25
+OPEN_LIMIT = 0.02  # the contact is taken as open where the identified N is below this fraction of N0
+
+
+def open_fraction(normal_force, preload: float) -> float:
+    """Share of the cycle's samples where the contact is open: N at or below OPEN_LIMIT x the preload N0."""
+    return float(np.mean(np.asarray(normal_force) <= OPEN_LIMIT * preload))
+
+
+def place(drift: Mapping[str, Mapping], stage: Mapping[str, float], id_res, scatter) -> tuple[str, str]:
+    """Where the gap lies, with the reason: (place, reason).
+
+    drift: per load case {"change": relative change over the record, "z": its size in standard errors};
+    stage: at least "open_fraction", "contact_force_N" and "contact_force_S" (relative gaps);
+    id_res, scatter: per load case, the inverse identification's sensor misfit and its standard error.
+    The first that holds of: the records drift (median z > DRIFT_FACTOR) -> "non_stationary"; the
+    structure and sensor model misfits the records (median id_res / scatter > RESIDUAL_FACTOR) ->
+    "structure_or_measurement"; the contact opens, or no elastic normal law fits (contact_force_N >
+    NORMAL_LIMIT) -> "normal_contact"; otherwise "tangential_contact"."""
+    id_res, scatter = np.asarray(id_res, float), np.asarray(scatter, float)
+    z = np.array([v["z"] for v in drift.values()])
+    if np.median(z) > DRIFT_FACTOR:
+        change = np.median([v["change"] for v in drift.values()])
+        return "non_stationary", (f"the records' harmonics drift by {change:.2g} over a record "
+                                  f"({np.median(z):.0f} standard errors)")
+    if np.median(id_res / scatter) > RESIDUAL_FACTOR:
+        return "structure_or_measurement", (f"the linear structure and sensor model cannot fit the records at w "
+                                            f"and 3w (sensor misfit {np.median(id_res):.2g}, "
+                                            f"{np.median(id_res / scatter):.0f} x the scatter)")
+    if stage["open_fraction"] > 0:
+        return "normal_contact", (f"the identified normal force falls to zero over {stage['open_fraction']:.0%} of the "
+                                  "cycle in the hardest load case: the contact opens")
+    if stage["contact_force_N"] > NORMAL_LIMIT:
+        return "normal_contact", (f"no elastic normal law fits the identified N(eta): {stage['contact_force_N']:.0%} "
+                                  "of N is left (dissipation or opening in the normal direction)")
+    return "tangential_contact", (f"structure, sensors and normal contact are consistent with the records; the "
+                                  f"friction law leaves {stage['contact_force_S']:.1%} of S")
+
+
+def _setting(settings, name: str) -> float:
+    return float(settings[name] if isinstance(settings, Mapping) else getattr(settings, name))
+
+
+def verdict(rows: Sequence[Mapping], before: float, scatter: float, place: str, settings,
+            boots: Mapping[str, np.ndarray] | None = None) -> tuple[str, str]:
+    """The verdict of the diagnosis and its reason: (effect name or "none", reason).
+
+    rows: the candidates, best score first, each with "effect", "acts_on", "consistent" (acts where
+    the gap lies), "reduction" (1 - held-out gap after / before), "reduction_interval" (bootstrap 95 %)
+    and "heldout_gap_after"; before: the held-out gap before; scatter: the bootstrap standard deviation
+    of the gap before (the records' scatter); place: the localisation's place; settings: a GapSettings
+    or a mapping with min_gap, noise_factor, min_reduction and separation; boots: the bootstrap
+    held-out gaps after, per effect (for the winner's P(better) than the runner-up; nan without).
+
+    The best consistent candidate is named only when the gap before is at least min_gap and
+    noise_factor x scatter, it shrinks the gap by min_reduction with the bootstrap's lower bound
+    above zero, and the runner-up's held-out gap is at least separation x the winner's."""
+    min_gap, noise_factor = _setting(settings, "min_gap"), _setting(settings, "noise_factor")
+    min_reduction, separation = _setting(settings, "min_reduction"), _setting(settings, "separation")
+    verdict, reason = "none", ""
+    eligible = [r for r in rows if r["consistent"]]
+    if rows and not eligible:
+        reason = (f"the gap lies in {place} and no candidate of the library acts there and explains it "
+                  f"(best by score: {rows[0]['effect']}, acting on {rows[0]['acts_on']}, {rows[0]['reduction']:.1%})")
+    elif rows:
+        best = eligible[0]
+        second = next((r for r in rows if r is not best), None)
+        if before < min_gap:
+            reason = (f"the held-out gap {before:.3g} is below gap.min_gap = {min_gap:g}: the identified model "
+                      f"reproduces the records as well as the chain's own identification allows (best candidate "
+                      f"{best['effect']}: {best['reduction']:.1%})")
+        elif before < noise_factor * scatter:
+            reason = f"the held-out gap {before:.3g} is within {noise_factor} x the records' scatter {scatter:.2g}"
+        elif best["reduction"] < min_reduction or best["reduction_interval"][0] <= 0:
+            reason = (f"no candidate shrinks the held-out gap by {min_reduction:.0%} (best: {best['effect']}, "
+                      f"{best['reduction']:.1%})")
+        elif second is not None and second["heldout_gap_after"] < separation * best["heldout_gap_after"]:
+            reason = (f"{best['effect']} and {second['effect']} explain the gap about equally (held-out gaps "
+                      f"{best['heldout_gap_after']:.3g}, {second['heldout_gap_after']:.3g}; separation {separation})")
+        else:
+            verdict = best["effect"]
+            if second is None:
+                p_better = 1.0
+            elif boots is None:
+                p_better = float("nan")
+            else:
+                p_better = float(np.mean(np.asarray(boots[best["effect"]]) < np.asarray(boots[second["effect"]])))
+            reason = (f"{best['effect']} shrinks the held-out gap from {before:.3g} to {best['heldout_gap_after']:.3g} "
+                      f"({best['reduction']:.1%}); runner-up {second['effect'] if second else '-'} "
+                      f"{second['heldout_gap_after'] if second else float('nan'):.3g}; bootstrap P(better) {p_better:.2f}")
+    return verdict, reason
