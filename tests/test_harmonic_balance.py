@@ -50,7 +50,8 @@ def test_harmonics_agree_with_the_time_integrator(model, effect, case):
     aug, rec = EFFECTS[effect], record(case)
     reference = simulate(model, aug, rec, method="time_marching")
     periodic = simulate(model, aug, rec, method="harmonic_balance", hb_harmonics=18, polish=False)
-    assert periodic.extra["method"] == "harmonic_balance"
+    # an opening contact starts from the linear state (its orbit need not be unique)
+    assert periodic.extra["method"] == ("time_marching" if aug.unilateral_exponent else "harmonic_balance")
     A, A_ref = periodic.acceleration[:, :9], reference.acceleration[:, :9]
     amplitude = np.linalg.norm(A_ref, axis=1, keepdims=True)
     # an Iwan element's periodic state is not unique: a slider that slipped in the integrator's start-up
