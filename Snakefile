@@ -20,20 +20,16 @@ configfile: "config/config.yaml"
 validate(config, "workflow/schemas/config.schema.yaml")
 
 
-# numba's compiled kernels are cached per code digest, in .snakemake/numba-cache/<digest> (importing
-# contactid appends its digest to this directory; set before the import, so none is made elsewhere)
-NUMBA_CACHE_BASE = os.path.abspath(os.path.join(".snakemake", "numba-cache"))
-os.environ["NUMBA_CACHE_DIR"] = NUMBA_CACHE_BASE
-
+from contactid import use_numba_cache_under
 from contactid.io import package_digest
 
 # every rule takes the package's code digest as a parameter: a changed contactid reruns what it computed
 CODE_DIGEST = package_digest()
 
-# the jobs inherit this (a SLURM job parses this file again in the same working directory): a new
-# process loads the kernels instead of compiling them, and changed code never meets a kernel
-# compiled from the old (a job whose package digest differs uses its own digest's directory)
-os.environ["NUMBA_CACHE_DIR"] = os.path.join(NUMBA_CACHE_BASE, CODE_DIGEST)
+# numba's compiled kernels are cached per code digest in .snakemake/numba-cache/<digest>; the jobs inherit
+# the directory (a SLURM job parses this file again in the same working directory): a new process loads the
+# kernels instead of compiling them, and changed code never meets a kernel compiled from the old
+use_numba_cache_under(os.path.join(".snakemake", "numba-cache"))
 
 
 include: "workflow/rules/common.smk"

@@ -65,3 +65,12 @@ def _use_numba_cache_keyed_by_code() -> str:
 
 
 NUMBA_CACHE_DIR = _use_numba_cache_keyed_by_code()
+
+
+def use_numba_cache_under(base) -> str:
+    """Cache the kernels under ``base``/<code digest> from now on (the Snakefile points it at
+    .snakemake/numba-cache; the jobs inherit the variable). Returns the directory."""
+    global NUMBA_CACHE_DIR
+    os.environ["NUMBA_CACHE_DIR"] = str(Path(base).resolve() / code_digest())
+    NUMBA_CACHE_DIR = _use_numba_cache_keyed_by_code()
+    return NUMBA_CACHE_DIR
