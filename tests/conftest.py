@@ -19,17 +19,17 @@ import workflow_projects as wp  # noqa: E402
 # The workflow runs the integration tests read, each in a project of its own (tests/workflow_projects.py):
 # name -> (prepare, the run it follows, nice). They start in the background as soon as pytest knows which
 # selected tests need them, so that they run while other tests do: the small run first (it compiles numba's
-# kernels once), then the others with its compiled kernels; the acceptance run (the longest) at normal
-# priority, the short ones below it. Read only: a test that changes a project works on a copy.
+# kernels once), then the others with its compiled kernels; the acceptance run (the longest chain) at normal
+# priority, the short ones at nice 10. Read only: a test that changes a project works on a copy.
 SHARED_RUNS = {
     "small_run": (wp.prepare_small_run, None, 0),
     "default_run": (wp.prepare_default_run, "small_run", 0),
-    "measured_run": (lambda d: wp.prepare_measured_run(d, _runs["small_run"].proj), "small_run", 5),
-    "noisy_run": (wp.prepare_noisy_run, "small_run", 5),
-    "same_seed_run": (wp.prepare_same_seed_run, "small_run", 5),
-    "other_seed_run": (wp.prepare_other_seed_run, "small_run", 5),
-    "rig_run": (wp.prepare_rig_run, "small_run", 5),
-    "noise_sweep_run": (wp.prepare_noise_sweep_run, "small_run", 5),
+    "measured_run": (lambda d: wp.prepare_measured_run(d, _runs["small_run"].proj), "small_run", 10),
+    "noisy_run": (wp.prepare_noisy_run, "small_run", 10),
+    "same_seed_run": (wp.prepare_same_seed_run, "small_run", 10),
+    "other_seed_run": (wp.prepare_other_seed_run, "small_run", 10),
+    "rig_run": (wp.prepare_rig_run, "small_run", 10),
+    "noise_sweep_run": (wp.prepare_noise_sweep_run, "small_run", 10),
 }
 _runs: dict = {}
 

@@ -157,7 +157,9 @@ class BackgroundRun:
     """A project and ``snakemake --cores 2 [targets]`` in it, in the background: ``prepare(directory)`` makes the
     project in an empty directory and returns (project, targets). Both happen now, or, given ``after`` (another
     BackgroundRun), once that one has ended (the project then gets its compiled kernels if it succeeded), in a
-    thread. ``nice`` lowers the run's CPU priority (a run the tests need later yields to those needed sooner).
+    thread. ``nice`` lowers the run's CPU priority (a run the tests need later yields to those needed sooner);
+    the run stays in pytest's session (a process group of its own), where the kernel's autogroup scheduling
+    lets nice values count (a new session would get an equal share of the CPU whatever its nice value).
     ``wait()`` returns the project once the run has finished, and fails the calling test with the end of the
     run's output if the project could not be made or the run failed."""
 
@@ -196,7 +198,7 @@ class BackgroundRun:
                 with open(self.log, "w") as out:
                     self.proc = subprocess.Popen([sys.executable, "-m", "snakemake", "--cores", "2", *self.targets],
                                                  cwd=self.proj, env=snakemake_env(self.proj), stdout=out,
-                                                 stderr=subprocess.STDOUT, start_new_session=True,
+                                                 stderr=subprocess.STDOUT, process_group=0,
                                                  preexec_fn=(lambda: os.nice(nice)) if nice else None)
         except BaseException as exc:  # reported by wait(), in the test that needs the run
             self._error = exc
