@@ -201,7 +201,8 @@ def simulate(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, re
 
     ``method`` "harmonic_balance" (the default, or what ``STEADY_STATE`` holds) solves the periodic
     steady state directly (``rig.harmonic_balance`` on the integrator's own discrete equations with
-    ``hb_harmonics`` harmonics, all the record's by default; warm-started from ``start``, a
+    ``hb_harmonics`` harmonics (all the record's by default, at most a quarter of the steps per period);
+    warm-started from ``start``, a
     neighbouring simulation of the same record). That state is within about 1e-3 of the integrator's
     own periodic orbit (the harmonics it leaves out); with ``polish`` the integrator then runs from
     it until its harmonics settle by the reference's own test (8-period chunks changing by less than
@@ -226,7 +227,7 @@ def simulate(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, re
     # model starts from the linear state, as the reference does (measured: the blind benchmark's
     # contact-separation items fell from 3/6 to 2/6 with the harmonic-balance start)
     if method == "harmonic_balance" and not aug.unilateral_exponent:
-        periodic = _periodic_state(sim, coef, w, min(H, hb_harmonics or H), n_per, start)
+        periodic = _periodic_state(sim, coef, w, min(n_per // 4, hb_harmonics or H), n_per, start)
         if periodic is not None and not polish and not aug.preload_drift:
             return _periodic_result(periodic, sim, model, aug, rec, grid)
     if periodic is not None:

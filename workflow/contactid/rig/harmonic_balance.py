@@ -115,27 +115,31 @@ def _iwan_propagate(xi, N, iw_x, iw_flag, iw_w, e_f, k_c, mu, dxi, dN, out):
     reset where it slips or the contact opens)."""
     m, n_cols = dxi.shape
     n_sl = iw_w.size
-    for c in range(n_cols):
-        for i in range(m):
+    for i in range(m):
+        for c in range(n_cols):
             out[i, c] = 0.0
-        for q in range(n_sl):
-            dx = 0.0  # the anchor's change; one pass sets it wherever the slider slips, the second records
-            for sweep in range(2):
-                for i in range(m):
-                    flag = iw_flag[i, q]
-                    if flag == 2:
-                        dx = dxi[i, c]
-                        continue
-                    e0 = e_f * (1.0 - np.exp(-k_c * N[i] / e_f))
-                    k = e0 / n_sl
-                    dk = k_c * np.exp(-k_c * N[i] / e_f) * dN[i, c] / n_sl
-                    lim = mu * N[i] * iw_w[q]
-                    dlim = mu * iw_w[q] * dN[i, c]
+    dx = np.zeros(n_cols)  # the anchor's change per column
+    for q in range(n_sl):
+        for c in range(n_cols):
+            dx[c] = 0.0
+        for sweep in range(2):  # one pass sets the anchor's change wherever the slider slips, the second records
+            for i in range(m):
+                flag = iw_flag[i, q]
+                if flag == 2:
+                    for c in range(n_cols):
+                        dx[c] = dxi[i, c]
+                    continue
+                ex = np.exp(-k_c * N[i] / e_f)
+                k = e_f * (1.0 - ex) / n_sl
+                lim = mu * N[i] * iw_w[q]
+                for c in range(n_cols):
+                    dk = k_c * ex * dN[i, c] / n_sl
                     if flag == 0:
-                        df = dk * (xi[i] - iw_x[i, q]) + k * (dxi[i, c] - dx)
+                        df = dk * (xi[i] - iw_x[i, q]) + k * (dxi[i, c] - dx[c])
                     else:
+                        dlim = mu * iw_w[q] * dN[i, c]
                         df = flag * dlim
-                        dx = dxi[i, c] - flag * (dlim * k - lim * dk) / (k * k)
+                        dx[c] = dxi[i, c] - flag * (dlim * k - lim * dk) / (k * k)
                     if sweep == 1:
                         out[i, c] += df
 
@@ -172,19 +176,18 @@ def _propagate(coef, dxi, dN_from, dN, out):
     for i in range(m):
         prod *= coef[i, 0]
     closure = 1.0 / (1.0 - prod) if abs(1.0 - prod) > 1e-9 else 0.0
-    for c in range(n_cols):
-        s = 0.0  # one pass from zero gives the response r; the periodic start is r_end / (1 - prod a)
+    s = np.zeros(n_cols)  # one pass from zero gives the response r; the periodic start is r_end / (1 - prod a)
+    for sweep in range(2):
+        if sweep == 1:
+            for c in range(n_cols):
+                s[c] *= closure
         for i in range(m):
             j = i - 1 if i > 0 else m - 1
-            s = coef[i, 0] * s + coef[i, 1] * dxi[j, c] + coef[i, 2] * dxi[i, c] + coef[i, 3] * dN_from[i, c] \
-                + coef[i, 4] * dN[i, c]
-        s0 = s * closure
-        s = s0
-        for i in range(m):
-            j = i - 1 if i > 0 else m - 1
-            s = coef[i, 0] * s + coef[i, 1] * dxi[j, c] + coef[i, 2] * dxi[i, c] + coef[i, 3] * dN_from[i, c] \
-                + coef[i, 4] * dN[i, c]
-            out[i, c] = s
+            a, b, cc, d, e = coef[i, 0], coef[i, 1], coef[i, 2], coef[i, 3], coef[i, 4]
+            for c in range(n_cols):
+                s[c] = a * s[c] + b * dxi[j, c] + cc * dxi[i, c] + d * dN_from[i, c] + e * dN[i, c]
+                if sweep == 1:
+                    out[i, c] = s[c]
 
 
 @njit(cache=True)
@@ -250,8 +253,44 @@ class HarmonicBalance:
         self.L[:, idx, idx + H] = -c[:, None] * D1[None, :]
         self.L[:, idx + H, idx] = c[:, None] * D1[None, :]
         self.n = n
+        # the Jacobian is blockdiag(L) - W B W^T with W = [xi (x) I, eta (x) I]: the contact acts through two
+        # mode-space directions only (see ``factor``), so Newton solves a (2 (2H + 1))^2 system, not (n (2H + 1))^2
+        # L's inverse per mode, in the same 2 x 2-per-harmonic structure: (mean, a_h, b_h) with
+        # inv [[a, -b], [b, a]] = [[a, b], [-b, a]] / (a^2 + b^2)
+        a, b = k2[:, None] - self.D2[None, :], c[:, None] * D1[None, :]
+        den = a * a + b * b
+        self.Linv = (1.0 / k2, a / den, b / den)
+        xi, eta = red.xi, red.eta
+        self.C = {key: tuple(np.tensordot(wt, part, axes=(0, 0)) for part in self.Linv)
+                  for key, wt in (("11", xi * xi), ("12", xi * eta), ("22", eta * eta))}
 
     # -- conversions ---------------------------------------------------------------------------
+    def _block_apply(self, blk: tuple, X: np.ndarray) -> np.ndarray:
+        """A 2 x 2-per-harmonic operator (mean, a_h, b_h) on X (2H + 1, ...) or, with per-mode
+        coefficients (n, ...), on X (n, 2H + 1)."""
+        H = self.H
+        c0, ca, cb = blk
+        if np.ndim(c0) == 1:  # per mode, X (n, 2H + 1)
+            re, im = X[:, 1:H + 1], X[:, H + 1:]
+            return np.hstack([c0[:, None] * X[:, :1], ca * re + cb * im, ca * im - cb * re])
+        re, im = X[1:H + 1], X[H + 1:]
+        ca, cb = ca.reshape((-1,) + (1,) * (X.ndim - 1)), cb.reshape((-1,) + (1,) * (X.ndim - 1))
+        return np.concatenate([c0 * X[:1], ca * re + cb * im, ca * im - cb * re])
+
+    def project(self, X: np.ndarray) -> np.ndarray:
+        """Q @ X by FFT: the mean, sine and cosine coefficients (2H + 1, ...) of the columns of X (M, ...)."""
+        F = np.fft.rfft(X, axis=0)
+        H, M = self.H, self.M
+        return np.concatenate([F[:1].real / M, F[1:H + 1].imag * (-2.0 / M), F[1:H + 1].real * (2.0 / M)])
+
+    def synthesise(self, U: np.ndarray) -> np.ndarray:
+        """E @ U.T by inverse FFT: the signals (M, n) of the real-basis harmonics U (n, 2H + 1)."""
+        H, M = self.H, self.M
+        F = np.zeros((M // 2 + 1, U.shape[0]), dtype=complex)
+        F[0] = U[:, 0] * M
+        F[1:H + 1] = (0.5 * M) * (U[:, H + 1:] - 1j * U[:, 1:H + 1]).T
+        return np.fft.irfft(F, n=M, axis=0)
+
     def to_real(self, Z: np.ndarray) -> np.ndarray:
         """(n, H + 1) complex -> (n, 2H + 1) real."""
         return np.hstack([Z[:, :1].real, Z[:, 1:].real, Z[:, 1:].imag])
@@ -284,9 +323,9 @@ class HarmonicBalance:
     def path(self, U: np.ndarray) -> dict:
         """The contact laws along the periodic path of U (real basis, (n, 2H + 1)) on the steps."""
         r, c = self.red, self.contact
-        z = self.E @ U.T  # (M, n)
-        v = self.Ec @ U.T
-        vh = self.Eb @ U.T
+        z = self.synthesise(U)  # (M, n); the velocities are the integrator's differences (Ec, Eb)
+        v = (np.roll(z, -1, axis=0) - np.roll(z, 1, axis=0)) / (2.0 * self.dt)
+        vh = (z - np.roll(z, 1, axis=0)) / self.dt
         xi_lin = z @ r.xi
         Gz = z @ r.shortening
         xi = xi_lin - 0.5 * np.einsum("ti,ti->t", z, Gz)
@@ -314,11 +353,12 @@ class HarmonicBalance:
 
     def residual(self, U: np.ndarray, Fb: np.ndarray, p: dict | None = None) -> tuple[np.ndarray, dict]:
         p = self.path(U) if p is None else p
-        R = np.einsum("jab,jb->ja", self.L, U) - Fb - (self.Q @ p["g"]).T
+        R = np.einsum("jab,jb->ja", self.L, U) - Fb - self.project(p["g"]).T
         return R, p
 
     def jacobian(self, p: dict) -> np.ndarray:
-        """Jacobian dR/dU ((n (2H + 1))^2, mode-major ordering): the friction law's linearised step
+        """The dense Jacobian dR/dU ((n (2H + 1))^2, mode-major ordering), the check of ``factor`` (Newton
+        uses that): the friction law's linearised step
         recurrence around the periodic path (its memory and its dependence on N exact), the normal law's
         tangents, the shortening's axial-force term; the shortening's share of the friction direction
         (dxi/dz = xi_v - G z) is left out, which costs Newton a step or two, not its convergence."""
@@ -355,6 +395,62 @@ class HarmonicBalance:
             Jnl -= np.kron(xx, P(c.viscous * p["contact"].astype(float), self.Eb))
         return scipy.linalg.block_diag(*self.L) - Jnl
 
+    def contact_blocks(self, p: dict) -> np.ndarray:
+        """B ((2 (2H + 1))^2) of the Jacobian's contact part W B W^T, W = [xi (x) I, eta (x) I]: the friction
+        law's linearised step recurrence around the path (its memory and its dependence on N exact, the
+        Iwan sliders' with their anchors' memory), the normal law's tangents, the viscous term. Left out:
+        the beam shortening's share (dxi/dz = xi_v - G z and the axial-force term G S), second order in z,
+        which costs Newton a step, not its convergence."""
+        c = self.contact
+        E = self.E
+        M = self.M
+        nb = E.shape[1]
+        coef = np.empty((M, 5))
+        _friction_tangents(p["xi"], np.roll(p["N"], 1), p["N_est"], p["S_valanis"], self.fr, c.n_min, coef)
+        dN_full = p["dN_deta"][:, None] * E + p["dN_ddeta"][:, None] * self.Ec
+        dN_est = p["dNe_deta"][:, None] * E + p["dNe_ddeta"][:, None] * self.Eb
+        zero = np.zeros((M, nb))
+        dS = np.empty((M, 2 * nb))
+        _propagate(coef, np.hstack([E, zero]), np.hstack([zero, np.roll(dN_full, 1, axis=0)]),
+                   np.hstack([zero, dN_est]), dS)
+        dS *= (1.0 - c.iwan_share) * p["contact"][:, None]
+        if c.iwan_share:
+            dS_iw = np.empty_like(dS)
+            _iwan_propagate(p["xi"], p["N_est"], p["iwan_x"], p["iwan_flag"], self.iw_w, self.fr[0], self.fr[1],
+                            self.fr[4], np.hstack([E, zero]), np.hstack([zero, dN_est]), dS_iw)
+            dS += c.iwan_share * dS_iw
+        if c.viscous:
+            dS[:, :nb] += c.viscous * p["contact"][:, None] * self.Eb
+        P = self.project(dS)
+        B = np.zeros((2 * nb, 2 * nb))
+        B[:nb, :nb] = self.red.k_t * np.eye(nb) - P[:, :nb]
+        B[:nb, nb:] = -P[:, nb:]
+        B[nb:, nb:] = self.project((p["dN_deta"] + self.red.k_n)[:, None] * E + p["dN_ddeta"][:, None] * self.Ec)
+        return B
+
+    def factor(self, p: dict) -> tuple:
+        """The Newton matrix along path ``p``, factorised by the Woodbury identity: J = D - W B W^T with
+        D = blockdiag(L) (the linear modes, fixed) and the contact's B; J^-1 r = D^-1 (r + W B y) where
+        (I - C B) y = W^T D^-1 r and C = W^T D^-1 W. One (2 (2H + 1))^2 LU per Jacobian."""
+        B = self.contact_blocks(p)
+        nb = B.shape[0] // 2
+        C, ap = self.C, self._block_apply
+        CB = np.vstack([ap(C["11"], B[:nb]) + ap(C["12"], B[nb:]), ap(C["12"], B[:nb]) + ap(C["22"], B[nb:])])
+        lu = scipy.linalg.lu_factor(np.eye(2 * nb) - CB, check_finite=False)
+        return (self, B, lu)
+
+    @staticmethod
+    def apply_inverse(f: tuple, R: np.ndarray) -> np.ndarray:
+        """J^-1 R for a factor ``f`` of ``factor`` (R (n, 2H + 1), mode-major); the factor may be a
+        neighbouring model's (a chord step), it carries its own linear part."""
+        hb, B, lu = f
+        xi, eta = hb.red.xi, hb.red.eta
+        DR = hb._block_apply(hb.Linv, R)
+        s = np.concatenate([xi @ DR, eta @ DR])
+        By = B @ scipy.linalg.lu_solve(lu, s, check_finite=False)
+        nb = R.shape[1]
+        return hb._block_apply(hb.Linv, R + np.outer(xi, By[:nb]) + np.outer(eta, By[nb:]))
+
     # -- Newton --------------------------------------------------------------------------------
     def solve(self, force_coef: np.ndarray, start: np.ndarray | None = None, tol: float = 1e-8,
               max_iter: int = 40) -> PeriodicResponse:
@@ -379,9 +475,9 @@ class HarmonicBalance:
         while not converged and it < max_iter:
             it += 1
             if lu is None:
-                lu, fresh = scipy.linalg.lu_factor(self.jacobian(p), check_finite=False), True
+                lu, fresh = self.factor(p), True
                 HarmonicBalance._last_lu = {(self.n, self.H, self.M): lu}
-            step = scipy.linalg.lu_solve(lu, -R.ravel(), check_finite=False).reshape(U.shape)
+            step = self.apply_inverse(lu, -R)
             lam, better = 1.0, False
             for _ in range(8):  # backtracking on the residual norm
                 U_try = U + lam * step
