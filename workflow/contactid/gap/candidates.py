@@ -23,12 +23,15 @@ from .model import Augmentation
 
 @dataclass(frozen=True)
 class Parameter:
-    """One parameter of a candidate: name, unit, search range [low, high]."""
+    """One parameter of a candidate: name, unit, search range [low, high], and where a search over
+    several parameters starts (``start``; the middle of the range by default), for example the value
+    that leaves the identified model as it is."""
 
     name: str
     unit: str
     low: float
     high: float
+    start: float | None = None
 
 
 @dataclass(frozen=True)
@@ -91,7 +94,9 @@ register(Candidate("channel_time_skew", "each accelerometer channel late on the 
                    acts_on="structure_or_measurement"))
 register(Candidate("contact_separation", "unilateral hardening normal contact N0 ((delta0 - eta)/delta0)^p that opens "
                    "(instead of Eq. 13's linear spring), delta0 = p N0 / (c k_n)",
-                   (Parameter("exponent", "1", 1.0, 3.0), Parameter("stiffness_factor", "1", 0.3, 3.0)),
+                   (Parameter("exponent", "1", 1.0, 3.0),
+                    # c = 1 keeps the identified k_n as the law's tangent stiffness at the preload
+                    Parameter("stiffness_factor", "1", 0.3, 3.0, start=1.0)),
                    lambda th: Augmentation(unilateral_exponent=float(th[0]), normal_stiffness_factor=float(th[1])),
                    acts_on="normal_contact"))
 register(Candidate("preload_drift", "static normal preload drifting linearly over each record",
