@@ -8,7 +8,8 @@ REFERENCE, every steady state by time marching until the harmonics settle; extra
 model and records. Both must give the same verdict and ranking order; the held-out gaps are
 printed side by side (harmonic balance solves the integrator's discrete equations; what differs is
 the harmonics it leaves out, about 1e-4 of the response). Also printed: the new package forced
-to time marching without memoisation (what harmonic balance and the memos alone buy).
+to time marching without memoisation (what harmonic balance and the memos alone buy), and the new
+package with its candidates in two worker processes (as the gap_diagnosis rule runs them).
 
 Data sets: the default workflow's records (effect-free), and three rig data sets with one effect
 each (generated, identified and cached under benchmarks/cache/ on the first run, about a minute
@@ -87,7 +88,7 @@ def effect_data(cfg, effect, magnitude):
     return {"linear_modes": modes, "modal": modal, "frf": frf, "friction_fit": fit}, {c: recs[c] for c in cases}
 
 
-def run(pkg, method, memo, ds, raw, cfg, warm_up=False):
+def run(pkg, method, memo, ds, raw, cfg, warm_up=False, workers=1):
     """One diagnosis with package ``pkg`` (contactid or contactid_ref) on the datasets and raw records."""
     gm = importlib.import_module(f"{pkg}.gap.model")
     gd = importlib.import_module(f"{pkg}.gap.diagnosis")
@@ -103,7 +104,8 @@ def run(pkg, method, memo, ds, raw, cfg, warm_up=False):
     try:
         with memoised(memo if pkg == "contactid" else True):
             t0 = time.perf_counter()
-            d = gd.diagnose(model, records, cfg["nonlinear"]["calibration_case"], settings, fit_settings, lin)
+            kw = {"workers": workers} if workers > 1 else {}
+            d = gd.diagnose(model, records, cfg["nonlinear"]["calibration_case"], settings, fit_settings, lin, **kw)
             return d, time.perf_counter() - t0
     finally:
         if token is not None:
@@ -116,6 +118,7 @@ def compare(label, ds, raw, cfg) -> dict:
     new, t_new = run("contactid", "harmonic_balance", True, ds, raw, cfg)
     old, t_old = run("contactid_ref", None, None, ds, raw, cfg)
     _, t_plain = run("contactid", "time_marching", False, ds, raw, cfg)
+    two, t_two = run("contactid", "harmonic_balance", True, ds, raw, cfg, workers=2)
     order_old = [r["effect"] for r in old.ranking]
     order_new = [r["effect"] for r in new.ranking]
     before = (old.where["heldout_gap_before"], new.where["heldout_gap_before"])
@@ -123,14 +126,17 @@ def compare(label, ds, raw, cfg) -> dict:
     diffs = [abs(r["heldout_gap_after"] - after[r["effect"]]) for r in new.ranking]
     rel = [abs(r["heldout_gap_after"] / after[r["effect"]] - 1) for r in new.ranking]
     row = {"data": label, "seconds_reference": t_old, "seconds_harmonic_balance": t_new,
-           "seconds_time_marching_unmemoised": t_plain, "ratio": t_old / t_new, "verdict": [old.verdict, new.verdict],
+           "seconds_time_marching_unmemoised": t_plain, "seconds_two_workers": t_two,
+           "same_with_two_workers": [r["effect"] for r in two.ranking] == [r["effect"] for r in new.ranking],
+           "ratio": t_old / t_new, "verdict": [old.verdict, new.verdict],
            "same_verdict": old.verdict == new.verdict, "same_ranking": order_old == order_new,
            "ranking": [order_old, order_new], "heldout_gap_before": list(before),
            "heldout_gap_after": [[after[e] for e in order_old], [r["heldout_gap_after"] for r in new.ranking]],
            "max_abs_gap_difference": max([abs(before[1] - before[0]), *diffs]),
            "max_rel_gap_difference": max([abs(before[1] / before[0] - 1), *rel])}
     print(f"{label}: before harmonic balance ({REFERENCE}) {t_old:.1f} s, now {t_new:.1f} s (x{row['ratio']:.1f}; now "
-          f"forced to time marching without memos {t_plain:.1f} s); verdict {old.verdict} / {new.verdict}; ranking "
+          f"forced to time marching without memos {t_plain:.1f} s; with two worker processes {t_two:.1f} s, "
+          f"{'same' if row['same_with_two_workers'] else 'OTHER'} ranking); verdict {old.verdict} / {new.verdict}; ranking "
           f"{'same' if row['same_ranking'] else 'DIFFERENT'}; held-out gap before {before[0]:.4%} / {before[1]:.4%}; "
           f"largest held-out gap difference {row['max_abs_gap_difference']:.2e} (absolute), "
           f"{row['max_rel_gap_difference']:.1%} (relative)", flush=True)
@@ -140,6 +146,9 @@ def compare(label, ds, raw, cfg) -> dict:
 
 
 def main():
+    from contactid.gap.diagnosis import _pool
+
+    _pool(2)  # forked now, before numba's parallel threads start in this process (the runs with two workers)
     cfg = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
     reference_package()
     only = sys.argv[sys.argv.index("--only") + 1] if "--only" in sys.argv else None

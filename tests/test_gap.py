@@ -81,15 +81,48 @@ def hc_data(small_config):
     return cfg, model, records, linear_stage(model, frf, modal)
 
 
-def _diagnose(data, candidates, **gap):
+def _diagnose(data, candidates, workers=1, **gap):
     cfg, model, records, linear = data
     settings = GapSettings.from_config({**cfg["gap"], "candidates": candidates, "n_bootstrap": 50, **gap}, 1, 25)
-    return diagnose(model, records, "lc1", settings, settings_from_config(cfg["friction"]), linear)
+    return diagnose(model, records, "lc1", settings, settings_from_config(cfg["friction"]), linear, workers=workers)
+
+
+TWO = ["normal_contact_damping", "viscous_friction"]
+
+
+@pytest.fixture(scope="module")
+def hc_diagnosis(hc_data):
+    return _diagnose(hc_data, TWO)
+
+
+def _diagnose_in_two_processes(data):
+    """In a fresh process (numba's parallel threads not started: forking is safe), with two workers."""
+    from contactid.gap.diagnosis import fork_safe
+
+    assert fork_safe()
+    return _diagnose(data, TWO, workers=2)
 
 
 @pytest.mark.slow
-def test_diagnosis_names_the_hidden_effect_and_the_gap_shrinks(hc_data):
-    d = _diagnose(hc_data, ["normal_contact_damping", "viscous_friction"])
+def test_candidates_in_two_processes_equal_the_serial_ones(hc_data, hc_diagnosis):
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    from contactid.gap.diagnosis import fork_safe
+
+    assert not fork_safe()  # this process ran the friction fit's parallel kernel: a fork here could hang
+    with ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("spawn")) as ex:  # its workers may fork
+        parallel = ex.submit(_diagnose_in_two_processes, hc_data).result()
+    assert parallel.verdict == hc_diagnosis.verdict
+    assert [r["effect"] for r in parallel.ranking] == [r["effect"] for r in hc_diagnosis.ranking]
+    for a, b in zip(parallel.ranking, hc_diagnosis.ranking):
+        assert a["heldout_gap_after"] == pytest.approx(b["heldout_gap_after"], rel=1e-4)
+        assert a["calibration_gap"] == pytest.approx(b["calibration_gap"], rel=1e-4)
+
+
+@pytest.mark.slow
+def test_diagnosis_names_the_hidden_effect_and_the_gap_shrinks(hc_diagnosis):
+    d = hc_diagnosis
     assert d.verdict == "normal_contact_damping", d.reason
     best = d.ranking[0]
     assert best["reduction"] > 0.5

@@ -8,6 +8,11 @@ from contactid.rig.structure import random_test_rig_config
 
 check_config(config)
 
+# The chain from the random test to the gap diagnosis is the workflow's critical path: its jobs go first
+# whenever a core is free, and the dual-sine rigs, figures and tables fill the other core around them (before,
+# the scheduler ran two dual-sine rigs first and the FRF waited 13 s for a core).
+CRITICAL_PATH = 10
+
 
 def _is_measured(block):
     return (block or {}).get("source", "rig") == "measured"

@@ -2,6 +2,7 @@
 
 
 rule friction_fit:
+    priority: CRITICAL_PATH
     input:
         forces=lambda wc: f"results/{calibration_case()}/contact_forces.nc",
     output:

@@ -8,6 +8,7 @@ rule gap:
 
 
 rule gap_diagnosis:
+    priority: CRITICAL_PATH
     input:
         unpack(gap_inputs),
     output:
@@ -22,9 +23,9 @@ rule gap_diagnosis:
         n_harmonics=config.get("nonlinear", {}).get("n_harmonics", 25),
         calibration_case=calibration_case(),
         cases=load_cases(),
-    # one thread: Snakemake sets the job's BLAS threads to this, and the diagnosis's many small solves run
-    # several times slower with two BLAS threads than with one (measured 49 s against 11 s)
-    threads: 1
+    # the candidates run in this many processes (forked; each with one BLAS thread: the script sets that, as
+    # the many small solves run several times slower with two BLAS threads than with one, 49 s against 11 s)
+    threads: 2
     resources:
         runtime=20,
         mem_mb=2000,

@@ -2,6 +2,7 @@
 
 
 rule frf:
+    priority: CRITICAL_PATH
     input:
         raw=random_test_raw(),
     output:
@@ -24,6 +25,7 @@ rule frf:
 
 
 rule modal:
+    priority: CRITICAL_PATH
     input:
         frf="results/linear/frf.nc",
     output:
@@ -42,6 +44,7 @@ rule modal:
 
 
 rule stiction_stiffness:
+    priority: CRITICAL_PATH
     input:
         modal="results/linear/modal.nc",
     output:
@@ -61,6 +64,7 @@ rule stiction_stiffness:
 
 
 rule linear_modes:
+    priority: CRITICAL_PATH
     input:
         stiction="results/linear/stiction.nc",
     output:

@@ -1,6 +1,7 @@
 # The dual-sine records of the load cases (Sections 3-5): checks, and later the nonlinear chain.
 
 rule raw_check:
+    priority: CRITICAL_PATH
     input:
         raw=lambda wc: raw_record(wc.case),
     output:
@@ -19,6 +20,7 @@ rule raw_check:
 
 
 rule generalized_coordinates:
+    priority: CRITICAL_PATH
     input:
         raw=lambda wc: raw_record(wc.case),
         check="results/{case}/raw_check.nc",
@@ -37,6 +39,7 @@ rule generalized_coordinates:
 
 
 rule nonlinear_modes:
+    priority: CRITICAL_PATH
     input:
         raw=lambda wc: raw_record(wc.case),
         gc="results/{case}/generalized_coordinates.nc",
@@ -56,6 +59,7 @@ rule nonlinear_modes:
 
 
 rule reduced_model:
+    priority: CRITICAL_PATH
     input:
         raw=lambda wc: raw_record(wc.case),
         nnm="results/{case}/nonlinear_modes.nc",
@@ -75,6 +79,7 @@ rule reduced_model:
 
 
 rule contact_forces:
+    priority: CRITICAL_PATH
     input:
         unpack(contact_forces_inputs),
     output:

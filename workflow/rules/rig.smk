@@ -7,6 +7,7 @@ rule rig:
 
 
 rule rig_random_test:
+    priority: CRITICAL_PATH
     output:
         raw="data/raw/random_test.nc",
         truth="data/truth/random_test.nc",

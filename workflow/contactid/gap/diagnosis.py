@@ -327,10 +327,78 @@ def _bootstrap_records(rec: RecordHarmonics, rng, n: int, H: int) -> np.ndarray:
     return rec.block_acceleration[idx][:, :, :, :H].mean(axis=1)
 
 
+def _candidate(name: str, model: IdentifiedModel, records: Mapping[str, RecordHarmonics], calibration_case: str,
+               score_cases: list, base_sims: dict, fit_settings: FitSettings, H: int, max_evaluations: int):
+    """One candidate: calibrated on the calibration case, predicted on the scored cases (each simulation
+    warm-started from the baseline's). Returns (calibration, sims, residuals) by case."""
+    cal = calibrate(model, LIBRARY[name], records[calibration_case], fit_settings, H, max_evaluations,
+                    start=base_sims[calibration_case])
+    sims = {calibration_case: None}
+    res = {}
+    for c in score_cases:
+        _, _, sim, _ = evaluate(cal.model, cal.augmentation, records[c], None, H, refit=False, start=base_sims[c])
+        sims[c] = sim
+        res[c] = gap_residual(sim, records[c], H)
+    log.info("candidate %s: theta [%s], calibration gap %.4g, held-out gap %s", name,
+             ", ".join(f"{t:.4g}" for t in np.ravel(cal.theta)), cal.gap,
+             ", ".join(f"{c} {gap_value(r):.4g}" for c, r in res.items()))
+    return cal, sims, res
+
+
+def _candidate_task(task):
+    name, common = task
+    return _candidate(name, **common)
+
+
+def fork_safe() -> bool:
+    """Whether worker processes may be forked here: not after numba's parallel threads have started
+    (its default threading layer, workqueue, is not fork-safe; TBB is)."""
+    import numba
+    from numba.np.ufunc import parallel as _parallel
+
+    return not getattr(_parallel, "_is_initialized", True) or numba.threading_layer() == "tbb"
+
+
+_POOLS: dict = {}  # workers -> a pool forked while that was safe, kept for the process's later diagnoses
+
+
+def _pool(workers: int):
+    """A pool of ``workers`` forked processes: made while forking is safe (``fork_safe``) and then reused, or
+    None if it cannot be made safely."""
+    if workers not in _POOLS:
+        if not fork_safe():
+            return None
+        import atexit
+        import multiprocessing
+
+        pool = multiprocessing.get_context("fork").Pool(workers)
+        atexit.register(pool.terminate)
+        _POOLS[workers] = pool
+    return _POOLS[workers]
+
+
+def _candidates(names, workers: int, **common):
+    """Start the candidates (see ``_candidate``) and return a function that gives {name: (calibration, sims,
+    residuals)} in library order. With ``workers`` > 1 they run at once in forked worker processes while this
+    process goes on (the results equal the serial ones to the steady-state solver's tolerance); serially, when
+    the function is called. A pool can only be forked before numba's parallel threads start in this process (in
+    a rule script: before the localisation runs the friction kernel); later calls reuse it."""
+    workers = max(1, min(int(workers), len(names)))
+    pool = _pool(workers) if workers > 1 else None
+    if workers > 1 and pool is None:
+        log.info("gap candidates: numba's parallel threads already run in this process; one process instead of %d",
+                 workers)
+    if pool is None:
+        return lambda: {name: _candidate(name, **common) for name in names}
+    pending = pool.map_async(_candidate_task, [(name, common) for name in names], chunksize=1)
+    return lambda: dict(zip(names, pending.get()))
+
+
 def diagnose(model: IdentifiedModel, records: Mapping[str, RecordHarmonics], calibration_case: str,
-             settings: GapSettings, fit_settings: FitSettings, linear: dict | None = None) -> Diagnosis:
+             settings: GapSettings, fit_settings: FitSettings, linear: dict | None = None,
+             workers: int = 1) -> Diagnosis:
     """Run the whole diagnosis on the load cases' records (``calibration_case`` for the refits,
-    the others held out)."""
+    the others held out); the candidates in ``workers`` processes (see ``_candidates``)."""
     H = settings.n_harmonics
     if calibration_case not in records:
         raise ValueError(f"gap: the calibration case {calibration_case!r} is not among the load cases {list(records)}")
@@ -343,23 +411,14 @@ def diagnose(model: IdentifiedModel, records: Mapping[str, RecordHarmonics], cal
         g, sim = baseline(model, records[c], H)
         base_sims[c] = sim
         base_res[c] = gap_residual(sim, records[c], H)
+    # candidates: calibrate, predict the held-out cases (forked before the localisation runs numba's
+    # parallel friction kernel in this process)
+    names = list(settings.candidates or tuple(LIBRARY))
+    candidate_results = _candidates(names, workers, model=model, records=records, calibration_case=calibration_case,
+                                    score_cases=score_cases, base_sims=base_sims, fit_settings=fit_settings, H=H,
+                                    max_evaluations=settings.max_evaluations)
     where, arrays = localise(model, dict(records), base_sims, H, linear)
-    # candidates: calibrate, predict the held-out cases
-    names = settings.candidates or tuple(LIBRARY)
-    results = {}
-    for name in names:
-        cand = LIBRARY[name]
-        cal = calibrate(model, cand, records[calibration_case], fit_settings, H, settings.max_evaluations,
-                        start=base_sims[calibration_case])
-        sims = {calibration_case: None}
-        res = {}
-        for c in score_cases:
-            _, _, sim, _ = evaluate(cal.model, cal.augmentation, records[c], None, H, refit=False, start=base_sims[c])
-            sims[c] = sim
-            res[c] = gap_residual(sim, records[c], H)
-        results[name] = (cal, sims, res)
-        log.info("candidate %s: theta [%s], calibration gap %.4g, held-out gap %s", name, ", ".join(f"{t:.4g}" for t in np.ravel(cal.theta)),
-                 cal.gap, ", ".join(f"{c} {gap_value(r):.4g}" for c, r in res.items()))
+    results = candidate_results()
     # bootstrap over record blocks: the sims are fixed, the records resampled
     rng = generator(settings.seed, "gap/bootstrap")
     boot = {c: _bootstrap_records(records[c], rng, settings.n_bootstrap, H) for c in score_cases}
