@@ -8,9 +8,10 @@ from contactid.rig.structure import random_test_rig_config
 
 check_config(config)
 
-# The chain from the random test to the gap diagnosis is the workflow's critical path: its jobs go first
-# whenever a core is free, and the dual-sine rigs, figures and tables fill the other core around them (before,
-# the scheduler ran two dual-sine rigs first and the FRF waited 13 s for a core).
+# The chain from the raw records to the gap diagnosis is the workflow's critical path: its jobs go first
+# whenever a core is free (the linear chain, which everything waits for, before the dual-sine rigs), and the
+# figures and tables fill the cores around them. Before, the scheduler ran two dual-sine rigs first and the FRF
+# waited 13 s for a core; with the linear chain alone first, the last rig ran after the diagnosis.
 CRITICAL_PATH = 10
 
 

@@ -2,7 +2,7 @@
 
 
 rule frf:
-    priority: CRITICAL_PATH
+    priority: CRITICAL_PATH + 2
     input:
         raw=random_test_raw(),
     output:
@@ -25,7 +25,7 @@ rule frf:
 
 
 rule modal:
-    priority: CRITICAL_PATH
+    priority: CRITICAL_PATH + 2
     input:
         frf="results/linear/frf.nc",
     output:
@@ -44,7 +44,7 @@ rule modal:
 
 
 rule stiction_stiffness:
-    priority: CRITICAL_PATH
+    priority: CRITICAL_PATH + 2
     input:
         modal="results/linear/modal.nc",
     output:
@@ -64,7 +64,7 @@ rule stiction_stiffness:
 
 
 rule linear_modes:
-    priority: CRITICAL_PATH
+    priority: CRITICAL_PATH + 2
     input:
         stiction="results/linear/stiction.nc",
     output:

@@ -7,7 +7,7 @@ rule rig:
 
 
 rule rig_random_test:
-    priority: CRITICAL_PATH
+    priority: CRITICAL_PATH + 2
     output:
         raw="data/raw/random_test.nc",
         truth="data/truth/random_test.nc",
@@ -28,6 +28,7 @@ rule rig_random_test:
 
 
 rule rig_dual_sine:
+    priority: CRITICAL_PATH
     output:
         raw="data/raw/{case}.nc",
         truth="data/truth/{case}.nc",
