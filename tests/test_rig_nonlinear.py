@@ -74,8 +74,8 @@ def test_low_level_agrees_with_linear_frf(default_config):
     assert df["difference_pct"].abs().max() < 0.5
 
 
-@pytest.mark.slow  # every rig effect simulated (tens of seconds)
-def test_effects_off_are_bit_identical_and_on_change_the_response(default_config, lc1):
+@pytest.mark.slow  # every rig effect simulated (on the small config's shorter records)
+def test_effects_off_are_bit_identical_and_on_change_the_response(default_config, small_config, lc1):
     c = default_config
     rc = copy.deepcopy(c["rig"])
     rc["effects"] = {name: 0.0 for name in EFFECTS}
@@ -84,7 +84,8 @@ def test_effects_off_are_bit_identical_and_on_change_the_response(default_config
     raw0, _ = lc1
     assert np.array_equal(raw_off["acceleration"].values, raw0["acceleration"].values)
     assert np.array_equal(raw_off["force"].values, raw0["force"].values)
-    df = effect_study(c["structure"], c["rig"], c["load_cases"]["lc1"], FS).set_index("effect")
+    s = small_config
+    df = effect_study(s["structure"], s["rig"], s["load_cases"]["lc1"], FS).set_index("effect")
     assert set(df.index) == set(EFFECTS)
     changed = df[["F1_change_pct", "F3_change_pct", "drive_acceleration_nrmse_pct"]].abs().max(axis=1)
     assert (changed > 0.5).all(), changed
