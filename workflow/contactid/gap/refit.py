@@ -275,15 +275,14 @@ def calibrate(model: IdentifiedModel, cand: Candidate, rec: RecordHarmonics, set
         if run(np.zeros(j))[0] <= run(theta)[0]:
             theta = np.zeros(j)
     elif len(cand.parameters) == 1:
-        # a scan of the range (its sixths), then the bounded search between the best point's neighbours: a
-        # search over the whole range from its middle can settle in a side basin (the blind benchmark's
+        # a scan of the range (its quarter points), then the bounded search between the best point's neighbours:
+        # a search over the whole range from its middle can settle in a side basin (the blind benchmark's
         # transducer-mass items: theta 0.35 instead of 0.22, a held-out gap four times larger)
         p = cand.parameters[0]
-        grid = p.low + (p.high - p.low) * np.arange(7) / 6
-        best = min(range(1, 6), key=lambda i: run(np.array([grid[i]]))[0])
+        grid = p.low + (p.high - p.low) * np.arange(5) / 4
+        best = min(range(1, 4), key=lambda i: run(np.array([grid[i]]))[0])
         res = minimize_scalar(lambda x: run(np.array([x]))[0], bounds=(grid[best - 1], grid[best + 1]),
-                              method="bounded", options={"xatol": 1e-3 * (p.high - p.low),
-                                                         "maxiter": max(4, max_evaluations - 5)})
+                              method="bounded", options={"xatol": 1e-3 * (p.high - p.low), "maxiter": max_evaluations})
         theta = np.array([res.x]) if run(np.array([res.x]))[0] <= run(np.array([grid[best]]))[0] \
             else np.array([grid[best]])
         # the bounded search never tries the ends: compare with "off" (the low end or zero)
