@@ -23,10 +23,14 @@ rule gap_diagnosis:
         n_harmonics=config.get("nonlinear", {}).get("n_harmonics", 25),
         calibration_case=calibration_case(),
         cases=load_cases(),
-    # the candidates run in this many processes (forked; each with one BLAS thread: the script sets that, as
-    # the many small solves run several times slower with two BLAS threads than with one, 49 s against 11 s)
-    threads: 2
+    # one thread for the scheduler, so that the job starts as soon as the fit is done (a two-thread job waits
+    # until both cores are free, and the figures and tables kept one busy: 24 s lost), and one BLAS thread (Snakemake
+    # sets them to the threads; the many small solves ran 49 s with two against 11 s with one); its candidates
+    # run in `workers` forked processes beside the jobs that finish the figures (a resource, not a parameter:
+    # the results do not depend on it, and a changed --cores must not rerun the job)
+    threads: 1
     resources:
+        workers=min(2, workflow.cores),
         runtime=20,
         mem_mb=2000,
     conda:

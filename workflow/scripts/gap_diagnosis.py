@@ -1,24 +1,15 @@
 """Rule gap_diagnosis: the identified model against every load case's raw record (issue 7)."""
 
-import os
-import sys
+import time
 
-# the rule's threads are processes (the candidates run in parallel); Snakemake sets the BLAS threads to the
-# rule's threads, and the many small solves run several times slower with two BLAS threads than with one
-if "numpy" not in sys.modules:
-    for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
-        os.environ[var] = "1"
-
-import time  # noqa: E402
-
-from contactid.friction_fit import settings_from_config  # noqa: E402
-from contactid.gap.candidates import load_plugins  # noqa: E402
-from contactid.gap.diagnosis import GapSettings, diagnose, linear_stage  # noqa: E402
-from contactid.gap.model import identified_model  # noqa: E402
-from contactid.gap.output import diagnosis_json, gap_dataset  # noqa: E402
-from contactid.gap.records import record_harmonics  # noqa: E402
-from contactid.io import load_dataset, provenance, read_raw, write_dataset, write_text  # noqa: E402
-from contactid.logs import setup_logging  # noqa: E402
+from contactid.friction_fit import settings_from_config
+from contactid.gap.candidates import load_plugins
+from contactid.gap.diagnosis import GapSettings, diagnose, linear_stage
+from contactid.gap.model import identified_model
+from contactid.gap.output import diagnosis_json, gap_dataset
+from contactid.gap.records import record_harmonics
+from contactid.io import load_dataset, provenance, read_raw, write_dataset, write_text
+from contactid.logs import setup_logging
 
 log = setup_logging(snakemake.log[0])
 p = snakemake.params
@@ -31,7 +22,7 @@ model = identified_model(p.structure, load_dataset(inp.modes), load_dataset(inp.
 records = {c: record_harmonics(read_raw(path, dual_sine=True), c, K) for c, path in zip(p.cases, inp.raw)}
 linear = linear_stage(model, load_dataset(inp.frf), load_dataset(inp.modal))
 diag = diagnose(model, records, p.calibration_case, settings, settings_from_config(p.friction), linear,
-                workers=snakemake.threads)
+                workers=int(snakemake.resources.workers))
 seconds = time.perf_counter() - t0
 prov = provenance("gap_diagnosis", {"gap": p.gap, "structure": p.structure, "friction": p.friction, "seed": p.seed},
                   {"modes": inp.modes, "modal": inp.modal, "frf": inp.frf, "fit": inp.fit,
