@@ -119,7 +119,7 @@ def test_newton_matrix_by_woodbury_is_the_dense_jacobian(model):
                          n_per)
     sol = hb.solve(np.array(FORCES["lc3"], dtype=complex))
     p = hb.path(hb.to_real(sol.Z))
-    J = hb.jacobian(p) + np.kron(sim.red.shortening, hb.Q @ (p["S"][:, None] * hb.E))
+    J = hb.jacobian(p) + np.kron(sim.red.shortening, hb.project(p["S"][:, None] * hb.E))
     x = np.random.default_rng(1).normal(size=(hb.n, 2 * hb.H + 1))
     back = hb.apply_inverse(hb.factor(p), (J @ x.ravel()).reshape(x.shape))
     assert np.max(np.abs(back - x)) < 1e-9 * np.max(np.abs(x))

@@ -239,7 +239,6 @@ class HarmonicBalance:
         self.E = np.hstack([np.ones((M, 1)), np.sin(ph), np.cos(ph)])
         self.Ec = (np.roll(self.E, -1, axis=0) - np.roll(self.E, 1, axis=0)) / (2 * dt)  # v_n
         self.Eb = (self.E - np.roll(self.E, 1, axis=0)) / dt  # v_{n-1/2}
-        self.Q = self.E.T * np.concatenate([[1.0 / M], np.full(2 * H, 2.0 / M)])[:, None]
         # linear operator per mode (block of 2H + 1): Omega^2 - D2_h on Re/Im, c D1_h across
         self.D2 = (2.0 * np.sin(0.5 * h * w * dt) / dt) ** 2
         D1 = np.sin(h * w * dt) / dt
@@ -278,7 +277,8 @@ class HarmonicBalance:
         return np.concatenate([c0 * X[:1], ca * re + cb * im, ca * im - cb * re])
 
     def project(self, X: np.ndarray) -> np.ndarray:
-        """Q @ X by FFT: the mean, sine and cosine coefficients (2H + 1, ...) of the columns of X (M, ...)."""
+        """The mean, sine and cosine coefficients (2H + 1, ...) of the columns of X (M, ...), by FFT: the
+        projection onto E's basis, E.T @ X scaled by 1 / M (mean) and 2 / M (harmonics)."""
         F = np.fft.rfft(X, axis=0)
         H, M = self.H, self.M
         return np.concatenate([F[:1].real / M, F[1:H + 1].imag * (-2.0 / M), F[1:H + 1].real * (2.0 / M)])
@@ -357,42 +357,16 @@ class HarmonicBalance:
         return R, p
 
     def jacobian(self, p: dict) -> np.ndarray:
-        """The dense Jacobian dR/dU ((n (2H + 1))^2, mode-major ordering), the check of ``factor`` (Newton
-        uses that): the friction law's linearised step
-        recurrence around the periodic path (its memory and its dependence on N exact), the normal law's
-        tangents, the shortening's axial-force term; the shortening's share of the friction direction
-        (dxi/dz = xi_v - G z) is left out, which costs Newton a step or two, not its convergence."""
-        r, c = self.red, self.contact
-        Q, E = self.Q, self.E
-
-        def P(weight, basis=E):
-            return Q @ (weight[:, None] * basis)
-
-        M = self.M
-        coef = np.empty((M, 5))
-        N_from = np.roll(p["N"], 1)
-        _friction_tangents(p["xi"], N_from, p["N_est"], p["S_valanis"], self.fr, c.n_min, coef)
-        nb = E.shape[1]
-        dN_full = p["dN_deta"][:, None] * E + p["dN_ddeta"][:, None] * self.Ec
-        dN_est = p["dNe_deta"][:, None] * E + p["dNe_ddeta"][:, None] * self.Eb
-        zero = np.zeros((M, nb))
-        dS = np.empty((M, 2 * nb))
-        _propagate(coef, np.hstack([E, zero]), np.hstack([zero, np.roll(dN_full, 1, axis=0)]),
-                   np.hstack([zero, dN_est]), dS)
-        dS *= (1.0 - c.iwan_share) * p["contact"][:, None]
-        if c.iwan_share:  # the Iwan element's share, linearised with its sliders' memory
-            dS_iw = np.empty_like(dS)
-            _iwan_propagate(p["xi"], p["N_est"], p["iwan_x"], p["iwan_flag"], self.iw_w, self.fr[0], self.fr[1],
-                            self.fr[4], np.hstack([E, zero]), np.hstack([zero, dN_est]), dS_iw)
-            dS += c.iwan_share * dS_iw
-        P_xi, P_N = Q @ dS[:, :nb], Q @ dS[:, nb:]
-        xx = np.outer(r.xi, r.xi)
-        ee = np.outer(r.eta, r.eta)
-        Jnl = np.kron(xx, r.k_t * np.eye(nb) - P_xi) - np.kron(np.outer(r.xi, r.eta), P_N)
-        Jnl += np.kron(ee, P(p["dN_deta"] + r.k_n) + P(p["dN_ddeta"], self.Ec))
-        Jnl += np.kron(r.shortening, P(p["S"]))
-        if c.viscous:
-            Jnl -= np.kron(xx, P(c.viscous * p["contact"].astype(float), self.Eb))
+        """The dense Jacobian dR/dU ((n (2H + 1))^2, mode-major ordering) that ``factor`` inverts (Newton uses
+        that): blockdiag(L) - W B W^T with ``contact_blocks``' B, assembled term by term, and the beam
+        shortening's axial-force term (G S) that the factor leaves out; the shortening's share of the friction
+        direction (dxi/dz = xi_v - G z) is left out of both."""
+        r = self.red
+        B = self.contact_blocks(p)
+        nb = B.shape[0] // 2
+        Jnl = (np.kron(np.outer(r.xi, r.xi), B[:nb, :nb]) + np.kron(np.outer(r.xi, r.eta), B[:nb, nb:])
+               + np.kron(np.outer(r.eta, r.eta), B[nb:, nb:]))
+        Jnl += np.kron(r.shortening, self.project(p["S"][:, None] * self.E))
         return scipy.linalg.block_diag(*self.L) - Jnl
 
     def contact_blocks(self, p: dict) -> np.ndarray:
@@ -411,13 +385,13 @@ class HarmonicBalance:
         dN_est = p["dNe_deta"][:, None] * E + p["dNe_ddeta"][:, None] * self.Eb
         zero = np.zeros((M, nb))
         dS = np.empty((M, 2 * nb))
-        _propagate(coef, np.hstack([E, zero]), np.hstack([zero, np.roll(dN_full, 1, axis=0)]),
-                   np.hstack([zero, dN_est]), dS)
+        dxi_cols, dN_est_cols = np.hstack([E, zero]), np.hstack([zero, dN_est])  # columns: U's xi part, then its N part
+        _propagate(coef, dxi_cols, np.hstack([zero, np.roll(dN_full, 1, axis=0)]), dN_est_cols, dS)
         dS *= (1.0 - c.iwan_share) * p["contact"][:, None]
-        if c.iwan_share:
+        if c.iwan_share:  # the Iwan element's share, linearised with its sliders' memory
             dS_iw = np.empty_like(dS)
             _iwan_propagate(p["xi"], p["N_est"], p["iwan_x"], p["iwan_flag"], self.iw_w, self.fr[0], self.fr[1],
-                            self.fr[4], np.hstack([E, zero]), np.hstack([zero, dN_est]), dS_iw)
+                            self.fr[4], dxi_cols, dN_est_cols, dS_iw)
             dS += c.iwan_share * dS_iw
         if c.viscous:
             dS[:, :nb] += c.viscous * p["contact"][:, None] * self.Eb
