@@ -84,7 +84,8 @@ def effect_data(cfg, effect, magnitude):
             recs[n].to_netcdf(folder / f"{n}.nc", engine="netcdf4")
     recs = {n: load_dataset(folder / f"{n}.nc") for n in names}
     model, modes, modal, frf = identify(cfg, recs["random_test"], recs[cfg["nonlinear"]["calibration_case"]])
-    fit = xr.Dataset({"parameter_value": ("parameter", np.asarray(model.friction))})
+    fit = xr.Dataset({"parameter_value": ("parameter", np.asarray(model.friction))},
+                     attrs={"regularization": model.regularization})
     return {"linear_modes": modes, "modal": modal, "frf": frf, "friction_fit": fit}, {c: recs[c] for c in cases}
 
 

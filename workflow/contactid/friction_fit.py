@@ -16,7 +16,7 @@ from scipy.optimize import least_squares
 from scipy.stats import chi2 as chi2_dist
 
 from .contact_laws import stiction_shear_stiffness
-from .friction import PARAMETER_NAMES, valanis_friction_force
+from .friction import PARAMETER_NAMES, REGULARIZATIONS, valanis_friction_force
 from .random_streams import generator
 
 log = logging.getLogger(__name__)
@@ -30,7 +30,8 @@ class FitSettings:
     GA population, generations, crossover and mutation probabilities; the first grid size and
     the largest; the relative parameter change that stops the refinement; the confidence level;
     the relative rms accuracy assumed for the identified S (a floor on the misfit scale of the
-    profile likelihood, since the identification's own error is not noise)."""
+    profile likelihood, since the identification's own error is not noise); how Eq. 21 is read
+    (``regularization``: ``none`` as printed, or ``slip_limit``; see ``contactid.friction``)."""
 
     bounds: tuple = ((1e6, 1e9), (1e4, 1e7), (0.0, 1e6), (0.0, 0.95), (0.05, 1.5))
     population: int = 64
@@ -42,6 +43,7 @@ class FitSettings:
     refine_tolerance: float = 1e-3
     confidence: float = 0.95
     misfit_floor: float = 0.01
+    regularization: str = "none"
 
 
 @dataclass
@@ -73,10 +75,11 @@ N_OPEN = 1.0e-3  # N: where the identified normal force is lower, the contact is
 
 
 class _Problem:
-    def __init__(self, xi, normal_force, S, bounds):
+    def __init__(self, xi, normal_force, S, bounds, regularization="none"):
         # where the identified N falls to zero the contact opens and carries no friction: the law is
         # evaluated there with a vanishing normal force (the kernel refuses N <= 0)
         self.xi, self.N = xi, np.maximum(normal_force, N_OPEN)
+        self.regularization = regularization
         self.S = S - S.mean()
         self.scale = np.sqrt(np.mean(self.S**2))
         self.lo = np.array([np.log10(b[0]) if lg else b[0] for b, lg in zip(bounds, LOG_SCALED)])
@@ -95,7 +98,7 @@ class _Problem:
         return (v - self.lo) / (self.hi - self.lo)
 
     def residuals(self, params):
-        S = valanis_friction_force(self.xi, self.N, params)
+        S = valanis_friction_force(self.xi, self.N, params, regularization=self.regularization)
         S = S - S.mean(axis=1, keepdims=True)
         return (S - self.S) / self.scale
 
@@ -216,7 +219,7 @@ def fit_friction_law(coef_xi, coef_n, coef_s, f0: float, preload: float, setting
         xi = periodic_grid(coef_xi, f0, m)[0]
         n = preload + periodic_grid(coef_n, f0, m)[0]
         s = periodic_grid(coef_s, f0, m)[0]
-        problem = _Problem(xi, n, s, settings.bounds)
+        problem = _Problem(xi, n, s, settings.bounds, settings.regularization)
         if u_best is None:
             u_ga, logbook = _ga(problem, settings, seed, label)
             u_best = u_ga
@@ -348,6 +351,7 @@ def friction_fit_dataset(forces, preload: float, settings: FitSettings, seed: in
              "e0_interval_high": res.e0_interval[1], "misfit_nrmse": res.misfit, "grid_points": res.grid_points,
              "preload_n": preload, "excitation_frequency_hz": f0, "n_harmonics": n_harmonics, "seed": seed,
              "population": settings.population, "generations": settings.generations,
+             "regularization": settings.regularization,
              "warnings": "; ".join(res.warnings) or "none"}
     n_total = preload + forces["N_dyn"].values
     attrs["open_fraction"] = float(np.mean(n_total <= N_OPEN))  # share of the record with the contact open
@@ -387,9 +391,13 @@ def validation_dataset(forces, fit, preload: float, n_harmonics: int, truth=None
     N = preload + periodic_grid(c["N_dyn"], f0, m)[0]
     S_id = periodic_grid(c["S"], f0, m)[0]
     xi_dot = periodic_grid(c["xi_dot"], f0, m)[0]
-    S_pred = valanis_friction_force(xi, N, fit["parameter_value"].values[None, :])[0]
-    S_pred = S_pred - S_pred.mean()
-    attrs = {"nrmse_vs_identified": nrmse(S_pred, S_id), "excitation_frequency_hz": f0}
+    reading = fit.attrs["regularization"]
+    S_pred = valanis_friction_force(xi, N, fit["parameter_value"].values[None, :], regularization=reading)[0]
+    other = next(r for r in REGULARIZATIONS if r != reading)
+    S_other = valanis_friction_force(xi, N, fit["parameter_value"].values[None, :], regularization=other)[0]
+    S_pred, S_other = S_pred - S_pred.mean(), S_other - S_other.mean()
+    attrs = {"nrmse_vs_identified": nrmse(S_pred, S_id), "excitation_frequency_hz": f0, "regularization": reading,
+             "other_regularization": other, "nrmse_other_regularization": nrmse(S_other, S_pred)}
     data = {
         "xi": ("phase", xi, {"units": "m", "long_name": "identified xi over one period"}),
         "xi_dot": ("phase", xi_dot, {"units": "m/s", "long_name": "identified d xi/dt over one period"}),
@@ -421,4 +429,5 @@ def settings_from_config(cfg) -> FitSettings:
                        grid_points=int(cfg.get("grid_points", d.grid_points)),
                        max_grid_points=int(cfg.get("max_grid_points", d.max_grid_points)),
                        confidence=float(cfg.get("confidence", d.confidence)),
-                       misfit_floor=float(cfg.get("misfit_floor", d.misfit_floor)))
+                       misfit_floor=float(cfg.get("misfit_floor", d.misfit_floor)),
+                       regularization=str(cfg.get("regularization", d.regularization)))

@@ -279,7 +279,11 @@ def friction_summary(fit: xr.Dataset, validations: Mapping[str, xr.Dataset]) -> 
     out = {"friction": {**p, "e0_at_preload": fit.attrs["e0_at_preload_n_per_m"],
                         "intervals": {**intervals, "e0_at_preload": [fit.attrs["e0_interval_low"], fit.attrs["e0_interval_high"]]},
                         "only_bounded": bounded_only, "misfit_nrmse": fit.attrs["misfit_nrmse"],
-                        "correlation_e_f_k_c": float(fit["correlation"].values[0, 1])},
+                        "correlation_e_f_k_c": float(fit["correlation"].values[0, 1]),
+                        "regularization": fit.attrs["regularization"],
+                        # S of the fitted parameters read the other way (slip_limit vs as printed), NRMSE per case
+                        "S_change_other_regularization": {c: v.attrs["nrmse_other_regularization"]
+                                                          for c, v in validations.items()}},
            "validation_nrmse": {c: v.attrs["nrmse_vs_identified"] for c, v in validations.items()}}
     if any("nrmse_vs_truth" in v.attrs for v in validations.values()):
         out["validation_nrmse_vs_truth"] = {c: v.attrs["nrmse_vs_truth"] for c, v in validations.items()

@@ -142,7 +142,8 @@ def localise(model: IdentifiedModel, records: dict, sims: dict, n_harmonics: int
         id_res.append(float(np.sqrt(np.mean(forces.residual[[0, 2]] ** 2))))
         scatter.append(identification_noise(model, rec))
         g = contact_grids(forces, rec.f0, model.preload, 256)
-        S_law = law_friction_force(g["xi"], g["xi_dot"], g["N"], np.asarray(model.friction), NONE)[0]
+        S_law = law_friction_force(g["xi"], g["xi_dot"], g["N"], np.asarray(model.friction), NONE,
+                                   model.regularization)[0]
         S_law -= S_law.mean()
         N_id = g["N"] - model.preload
         # the best elastic normal law at the identified motion (stiffness + hardening): what it leaves

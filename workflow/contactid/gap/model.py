@@ -65,7 +65,8 @@ NONE = Augmentation()
 class IdentifiedModel:
     """The chain's identified model: structure (with identified k_t, k_n), damping ratios of the
     identified structural modes (by order), friction parameters (e_f, k_c, e_t, kappa, mu), preload
-    N0 (N), the number of stuck modes kept and the integration oversampling."""
+    N0 (N), the number of stuck modes kept and the integration oversampling; the reading of Eq. 21
+    the friction law was fitted with (``regularization``, from friction_fit.nc)."""
 
     structure: StructureParameters
     damping: tuple
@@ -74,6 +75,7 @@ class IdentifiedModel:
     n_modes: int = 8
     oversampling: int = 8
     frequencies: tuple = ()
+    regularization: str = "none"
 
     def structure_with(self, aug: Augmentation) -> StructureParameters:
         """The structure with the augmentation's changes; changed masses re-fit k_t and k_n to the identified
@@ -99,7 +101,8 @@ def identified_model(structure_cfg: Mapping, linear_modes: xr.Dataset, modal: xr
     return IdentifiedModel(params, tuple(float(z) for z in modal["damping_ratio"].values),
                            tuple(float(x) for x in friction_fit["parameter_value"].values),
                            float(structure_cfg["preload_n"]), int(n_modes), int(oversampling),
-                           tuple(float(f) for f in modal["natural_frequency"].values))
+                           tuple(float(f) for f in modal["natural_frequency"].values),
+                           str(friction_fit.attrs["regularization"]))
 
 
 @lru_cache(maxsize=64)
@@ -144,7 +147,8 @@ def simulator(model: IdentifiedModel, aug: Augmentation, fs: float, f0: float | 
     contact = ContactParameters(friction=tuple(model.friction), preload=model.preload,
                                 static_approach=p * model.preload / k_n, exponent=p,
                                 hunt_crossley=aug.hunt_crossley, viscous=aug.viscous, iwan_share=aug.iwan_share,
-                                preload_drift=aug.preload_drift, unilateral=aug.unilateral_exponent >= 1.0)
+                                preload_drift=aug.preload_drift, unilateral=aug.unilateral_exponent >= 1.0,
+                                regularization=model.regularization)
     q = max(int(model.oversampling), int(np.ceil(red.omega.max() / (1.6 * fs))))
     dt = 1.0 / (q * fs)
     if f0:

@@ -38,7 +38,8 @@ def identify(cfg: Mapping, raw_random: xr.Dataset, raw_calibration: xr.Dataset, 
     modes, modal, frf = linear_chain(cfg, raw_random, return_frf=True)
     K = int(cfg.get("nonlinear", {}).get("n_harmonics", 25))
     settings = settings_from_config(cfg.get("friction", {}))
-    unfitted = xr.Dataset({"parameter_value": ("parameter", np.ones(5))})
+    unfitted = xr.Dataset({"parameter_value": ("parameter", np.ones(5))},
+                          attrs={"regularization": settings.regularization})
     model = identified_model(cfg["structure"], modes, modal, unfitted, n_modes=n_modes)
     rec = record_harmonics(raw_calibration, "calibration", K)
     forces = identified_forces(model, NONE, rec)

@@ -150,11 +150,12 @@ def _iwan_periodic(xi, N, e_f, k_c, mu, weights, periods):
     return out
 
 
-def law_friction_force(xi, xi_dot, N, params, aug: Augmentation) -> np.ndarray:
+def law_friction_force(xi, xi_dot, N, params, aug: Augmentation, regularization: str) -> np.ndarray:
     """S (N) of the (augmented) friction law over one period: (1 - s) Valanis + s Iwan + sigma_2 dxi/dt
-    (params: e_f, k_c, e_t, kappa, mu; N total, clipped at 1 mN where the contact would open)."""
+    (params: e_f, k_c, e_t, kappa, mu; N total, clipped at 1 mN where the contact would open; regularization:
+    the reading of Eq. 21, see ``contactid.friction``)."""
     Nc = np.maximum(N, 1e-3)
-    S = valanis_friction_force(xi, Nc, np.atleast_2d(params))
+    S = valanis_friction_force(xi, Nc, np.atleast_2d(params), regularization=regularization)
     if aug.iwan_share:
         p = np.atleast_2d(params)
         iw = np.array([_iwan_periodic(xi, N, q[0], q[1], q[4], iwan_slip_weights(16), 3) for q in p])
@@ -165,12 +166,12 @@ def law_friction_force(xi, xi_dot, N, params, aug: Augmentation) -> np.ndarray:
 
 
 class _AugmentedProblem(_Problem):
-    def __init__(self, xi, xi_dot, N, S, bounds, aug):
-        super().__init__(xi, N, S, bounds)
+    def __init__(self, xi, xi_dot, N, S, bounds, aug, regularization):
+        super().__init__(xi, N, S, bounds, regularization)
         self.xi_dot, self.aug = xi_dot, aug
 
     def residuals(self, params):
-        S = law_friction_force(self.xi, self.xi_dot, self.N, params, self.aug)
+        S = law_friction_force(self.xi, self.xi_dot, self.N, params, self.aug, self.regularization)
         S = S - S.mean(axis=1, keepdims=True)
         return (S - self.S) / self.scale
 
@@ -188,12 +189,13 @@ def refit_friction(model: IdentifiedModel, aug: Augmentation, forces: InverseHar
     identified forces; returns (e_f, k_c, e_t, kappa, mu) and the NRMSE of S (memoised: a candidate
     that changes neither the forces nor the law gets the same polish)."""
     law = (aug.iwan_share, aug.viscous, aug.preload_drift)
-    key = (model.friction, model.preload, law, id(forces), f0, tuple(map(tuple, np.atleast_2d(bounds))), grid)
+    key = (model.friction, model.preload, model.regularization, law, id(forces), f0,
+           tuple(map(tuple, np.atleast_2d(bounds))), grid)
 
     def compute():
         # a drifting preload: the record's harmonics see the mean preload over the record
         g = contact_grids(forces, f0, model.preload * (1.0 + 0.5 * aug.preload_drift), grid)
-        prob = _AugmentedProblem(g["xi"], g["xi_dot"], g["N"], g["S"], bounds, aug)
+        prob = _AugmentedProblem(g["xi"], g["xi_dot"], g["N"], g["S"], bounds, aug, model.regularization)
         u0 = np.clip(prob.unit(np.asarray(model.friction))[0], 1e-6, 1 - 1e-6)
         u, ssr, _ = _polish(prob, u0)
         return (prob.physical(u)[0], float(np.sqrt(ssr / grid))), forces

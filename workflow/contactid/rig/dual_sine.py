@@ -54,6 +54,7 @@ def contact_parameters(structure_cfg: Mapping, rig_cfg: Mapping) -> ContactParam
         friction=(fr.e_f, fr.k_c, fr.e_t, fr.kappa, fr.mu), preload=n0, static_approach=law.static_approach,
         exponent=law.exponent, hunt_crossley=eff["normal_contact_damping"], viscous=eff["viscous_friction"],
         iwan_share=eff["multi_asperity_friction"], preload_drift=eff["preload_drift"],
+        regularization=str(truth["friction"].get("regularization", "none")),
     )
 
 

@@ -31,7 +31,7 @@ import scipy.linalg
 from numba import njit
 
 from ..friction import valanis_step
-from .nonlinear import ContactParameters, ReducedModel, _normal_force
+from .nonlinear import ContactParameters, ReducedModel, _normal_force, friction_record
 
 
 @dataclass
@@ -60,7 +60,7 @@ def _periodic_friction(xi, N_from, N, fr, n_min, iw_share, iw_w, tol, max_period
     ``_iwan_force`` steps them; S_val_out the Valanis state, S_out (1 - s) S_val + s S_iwan (zero where
     N <= 0, the contact open); iw_x (M, sliders) the anchors after each step and iw_flag how each slider
     moved (0 stuck, +1 / -1 slipping, 2 reset by an open contact)."""
-    e_f, k_c, e_t, kappa, mu = fr[0], fr[1], fr[2], fr[3], fr[4]
+    e_f, k_c, e_t, kappa, mu, slip_limit = fr[0], fr[1], fr[2], fr[3], fr[4], fr[5] > 0.5
     m = xi.size
     n_sl = iw_w.size
     x_sl = np.zeros(n_sl)
@@ -70,7 +70,7 @@ def _periodic_friction(xi, N_from, N, fr, n_min, iw_share, iw_w, tol, max_period
         peak = 0.0
         for i in range(m):
             j = i - 1 if i > 0 else m - 1
-            S = valanis_step(S, xi[j], xi[i], N_from[i], N[i], e_f, k_c, e_t, kappa, mu, n_min)
+            S = valanis_step(S, xi[j], xi[i], N_from[i], N[i], e_f, k_c, e_t, kappa, mu, n_min, slip_limit)
             s_iw = 0.0
             if iw_share > 0.0:
                 if N[i] > 0.0:
@@ -149,7 +149,7 @@ def _friction_tangents(xi, N_from, N, S_val, fr, n_min, coef):
     """Partial derivatives of the integrator's friction step along the converged periodic path:
     S_i = step(S_{i-1}, xi_{i-1}, xi_i, N_from_i, N_i); coef[i] = d S_i / d(S_{i-1}, xi_{i-1}, xi_i,
     N_from_i, N_i) by central differences (the step's clamps included)."""
-    e_f, k_c, e_t, kappa, mu = fr[0], fr[1], fr[2], fr[3], fr[4]
+    e_f, k_c, e_t, kappa, mu, slip_limit = fr[0], fr[1], fr[2], fr[3], fr[4], fr[5] > 0.5
     m = xi.size
     for i in range(m):
         j = i - 1 if i > 0 else m - 1
@@ -162,8 +162,8 @@ def _friction_tangents(xi, N_from, N, S_val, fr, n_min, coef):
             xm = [x[0], x[1], x[2], x[3], x[4]]
             xp[k] += h
             xm[k] -= h
-            fp = valanis_step(xp[0], xp[1], xp[2], xp[3], xp[4], e_f, k_c, e_t, kappa, mu, n_min)
-            fm = valanis_step(xm[0], xm[1], xm[2], xm[3], xm[4], e_f, k_c, e_t, kappa, mu, n_min)
+            fp = valanis_step(xp[0], xp[1], xp[2], xp[3], xp[4], e_f, k_c, e_t, kappa, mu, n_min, slip_limit)
+            fm = valanis_step(xm[0], xm[1], xm[2], xm[3], xm[4], e_f, k_c, e_t, kappa, mu, n_min, slip_limit)
             coef[i, k] = (fp - fm) / (2.0 * h)
 
 
@@ -228,7 +228,7 @@ class HarmonicBalance:
             raise ValueError(f"harmonic balance: M = {M} points cannot resolve H = {H} harmonics (M >= 4 H)")
         self.red, self.contact, self.w, self.H, self.M = red, contact, float(w), int(H), int(M)
         self.zeta = np.asarray(zeta, dtype=float)
-        self.fr = np.asarray(contact.friction, dtype=float)
+        self.fr = friction_record(contact)
         self.iw_w = np.asarray(contact.iwan_weights, dtype=float)
         n = red.omega.size
         dt = 2 * np.pi / (w * M)

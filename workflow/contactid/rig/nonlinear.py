@@ -31,7 +31,7 @@ import scipy.signal
 from numba import njit
 
 from ..beam_model import FEModel, all_modes, fix_signs, shortening_matrix
-from ..friction import valanis_step
+from ..friction import slip_limit_flag, valanis_step
 from ..signals import harmonic_amplitudes
 
 
@@ -89,7 +89,8 @@ def reduced_model(model: FEModel, n_modes: int, static_correction: bool = True) 
 class ContactParameters:
     """Contact laws of the rig (SI units).
 
-    friction: (e_f, k_c, e_t, kappa, mu) of Eqs. 21-22; preload N0 (N);
+    friction: (e_f, k_c, e_t, kappa, mu) of Eqs. 21-22; regularization: how the law is read
+    (``none``: as printed, ``slip_limit``; see ``contactid.friction``); preload N0 (N);
     static_approach delta0 (m) and exponent p of the normal law; hunt_crossley
     alpha (s/m); viscous sigma_2 (N s/m); iwan_share (0..1) and the Iwan
     sliders' slip-limit weights (sum 1); preload_drift (relative, over the record).
@@ -106,6 +107,13 @@ class ContactParameters:
     preload_drift: float = 0.0
     n_min: float = 1e-6
     unilateral: bool = True
+    regularization: str = "none"
+
+
+def friction_record(contact: ContactParameters) -> np.ndarray:
+    """The kernels' friction record: (e_f, k_c, e_t, kappa, mu, slip_limit) with slip_limit 1.0 for the
+    ``slip_limit`` reading of Eq. 21 and 0.0 for the law as printed."""
+    return np.array([*(float(x) for x in contact.friction), float(slip_limit_flag(contact.regularization))])
 
 
 def iwan_slip_weights(n: int, spread: float = 0.8) -> np.ndarray:
@@ -187,7 +195,7 @@ def integrate(z, v, state, t0, n_steps, dt, omega, zeta, xi_v, eta_v, G, bF, k_t
     contact forces and motions, velocities and the force are written to the out arrays
     (row = step - store_from). Returns the time reached.
     """
-    e_f, k_c, e_t, kappa, mu = fr[0], fr[1], fr[2], fr[3], fr[4]
+    e_f, k_c, e_t, kappa, mu, slip_limit = fr[0], fr[1], fr[2], fr[3], fr[4], fr[5] > 0.5
     n = z.size
     c = 2.0 * zeta * omega
     om2 = omega * omega
@@ -218,7 +226,7 @@ def integrate(z, v, state, t0, n_steps, dt, omega, zeta, xi_v, eta_v, G, bF, k_t
         N_old = N
         xi_lin, xi, dxi_dq, eta, deta, dxi = _contact_state(z, v, xi_v, eta_v, G)
         N = _normal_force(eta, deta, n0, delta0, p, hc, unilateral)  # explicit estimate for the friction law
-        S_val = valanis_step(S_val, xi_old, xi, N_old, N, e_f, k_c, e_t, kappa, mu, 1e-6)
+        S_val = valanis_step(S_val, xi_old, xi, N_old, N, e_f, k_c, e_t, kappa, mu, 1e-6, slip_limit)
         if N > 0.0:
             e0 = e_f * (1.0 - np.exp(-k_c * N / e_f))
             s_iw = _iwan_force(xi, x_sl, iw_w, e0, mu * N) if iw_share > 0.0 else 0.0
@@ -306,7 +314,7 @@ class DualSineSimulator:
         self.contact = contact
         self.zeta = np.asarray(zeta, dtype=float)
         self.dt = float(dt)
-        self.fr = np.asarray(contact.friction, dtype=float)
+        self.fr = friction_record(contact)
         self.iw_w = np.asarray(contact.iwan_weights, dtype=float)
         self.reset()
 
