@@ -13,6 +13,44 @@ class ConfigError(ValueError):
     """An inconsistent configuration."""
 
 
+def _true_structure_errors(structure: Mapping, changes: Mapping, path: str = "rig.true_structure") -> list:
+    """rig.true_structure may hold any subset of the ``structure`` keys, each of the same kind (a number, a
+    list of as many numbers, or a block); anything else is named with its fix."""
+    errors = []
+    for key, value in changes.items():
+        where = f"{path}.{key}"
+        if key not in structure:
+            errors.append(f"{where} is not a key of structure (one of: {', '.join(sorted(structure))}); "
+                          "rig.true_structure takes any subset of the structure keys")
+            continue
+        nominal = structure[key]
+        if isinstance(nominal, Mapping):
+            if not isinstance(value, Mapping):
+                errors.append(f"{where} must be a block like structure.{key} (keys {', '.join(sorted(nominal))})")
+            else:
+                errors += _true_structure_errors(nominal, value, where)
+        elif isinstance(nominal, list):
+            if not isinstance(value, list) or len(value) != len(nominal):
+                errors.append(f"{where} must be a list of {len(nominal)} entries like structure.{key}")
+            elif key == "names" and value != nominal:
+                errors.append(f"{where}: the rig's sensors are the configured ones; change positions or masses instead")
+        elif value is None:
+            if key != "clamp_rotational_stiffness_nm_per_rad":
+                errors.append(f"{where} is null; give a number like structure.{key}")
+        elif isinstance(value, bool) or not isinstance(value, (int, float)):
+            hint = ""
+            if isinstance(value, str):
+                try:
+                    float(value)
+                    hint = " (YAML reads 2e11 as text: write 2.0e+11)"
+                except ValueError:
+                    pass
+            errors.append(f"{where} = {value!r} must be a number like structure.{key}{hint}")
+        elif not value > 0 and key != "gravity_m_per_s2":
+            errors.append(f"{where} = {value!r} must be positive")
+    return errors
+
+
 def check_config(cfg: Mapping, source: str = "config/config.yaml") -> None:
     """Raise :class:`ConfigError` on cross-field inconsistencies of ``cfg``."""
     errors = []
@@ -82,6 +120,7 @@ def check_config(cfg: Mapping, source: str = "config/config.yaml") -> None:
                 errors.append(str(exc))
         elif block.get("format", "netcdf") != "netcdf" and block.get("source", "rig") != "measured":
             errors.append(f"{where}.format = {block['format']!r} applies to measured files only; set source: measured")
+    errors += _true_structure_errors(st, (cfg.get("rig") or {}).get("true_structure") or {})
     try:
         from .rig.effects import effect_magnitudes
 

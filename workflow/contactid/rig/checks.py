@@ -11,6 +11,7 @@ import pandas as pd
 
 from ..beam_model import assemble, all_modes
 from ..signals import harmonic_amplitudes
+from .damping import rig_damping_ratios
 from .dual_sine import build_simulator, dual_sine_settings, dual_sine_test
 from .effects import EFFECTS
 from .nonlinear import control_response
@@ -54,7 +55,7 @@ def low_level_frf_check(structure_cfg: Mapping, rig_cfg: Mapping, sampling_rate_
     ctl = control_response(sim, case["A1_m_per_s2"], case["A2_m_per_s2"], w)
     model = assemble(rig_structure(structure_cfg, rig_cfg))
     modes = all_modes(model)
-    zeta = float(rig_cfg.get("modal_damping_ratio", 0.005))
+    zeta = rig_damping_ratios(rig_cfg, modes.frequencies_hz)
     wn = 2 * np.pi * modes.frequencies_hz
     b = modes.shapes.T @ model.force_vector
     rows = []

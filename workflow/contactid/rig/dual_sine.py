@@ -18,11 +18,12 @@ from ..beam_model import assemble
 from ..contact_laws import NormalLaw, ValanisParameters
 from ..io import raw_dataset
 from ..random_streams import generator
+from .damping import rig_damping_ratios
 from .effects import effect_magnitudes
 from .frontend import add_noise, anti_alias_decimate, delay_channels
 from ..signals import harmonic_amplitudes
 from .nonlinear import ContactParameters, DualSineSimulator, control_response, reduced_model
-from .structure import channel_delays, rig_structure
+from .structure import channel_delays, rig_structure, true_structure_config
 
 log = logging.getLogger(__name__)
 
@@ -47,7 +48,7 @@ def contact_parameters(structure_cfg: Mapping, rig_cfg: Mapping) -> ContactParam
     """The rig's true contact laws with the configured effects."""
     truth = rig_cfg["truth"]
     fr = ValanisParameters.from_config(truth["friction"])
-    n0 = float(structure_cfg["preload_n"])
+    n0 = float(true_structure_config(structure_cfg, rig_cfg)["preload_n"])
     law = NormalLaw(n0, float(truth["normal"]["stiffness_at_preload_n_per_m"]), float(truth["normal"]["exponent"]))
     eff = effect_magnitudes(rig_cfg.get("effects"))
     return ContactParameters(
@@ -55,6 +56,7 @@ def contact_parameters(structure_cfg: Mapping, rig_cfg: Mapping) -> ContactParam
         exponent=law.exponent, hunt_crossley=eff["normal_contact_damping"], viscous=eff["viscous_friction"],
         iwan_share=eff["multi_asperity_friction"], preload_drift=eff["preload_drift"],
         regularization=str(truth["friction"].get("regularization", "none")),
+        cubic=float(truth["normal"].get("cubic_n_per_m3", 0.0)),
     )
 
 
@@ -65,7 +67,7 @@ def build_simulator(structure_cfg: Mapping, rig_cfg: Mapping, settings: Mapping,
     model = assemble(params)
     red = reduced_model(model, int(n_modes or settings["n_modes"]))
     eff = effect_magnitudes(rig_cfg.get("effects"))
-    zeta = np.full(red.omega.size, float(rig_cfg.get("modal_damping_ratio", 0.005)))
+    zeta = rig_damping_ratios(rig_cfg, red.omega / (2 * np.pi))
     zeta[red.beam_mode] += eff["structural_damping"]
     q = int(oversampling or settings["oversampling"])
     # explicit central differences are stable for omega_max dt < 2: keep a margin (1.6) by oversampling more
@@ -149,7 +151,7 @@ def dual_sine_test(structure_cfg: Mapping, rig_cfg: Mapping, case_cfg: Mapping, 
     h_first = np.abs(harmonic_amplitudes(drive[:third], rec["t"][:third], w, (1, 3)))
     h_last = np.abs(harmonic_amplitudes(drive[-third:], rec["t"][-third:], w, (1, 3)))
 
-    raw = raw_dataset(time, force, acc, sensor_names, rig_structure(structure_cfg, rig_cfg).sensor_positions,
+    raw = raw_dataset(time, force, acc, sensor_names, tuple(structure_cfg["sensors"]["positions_m"]),
                       sampling_rate_hz, attrs={"test": "dual_sine", "excitation_frequency_hz": s["excitation_frequency_hz"]})
     sub = slice(0, n_rec, q)
     hist = np.array(ctl.history, dtype=float)
@@ -184,7 +186,8 @@ def dual_sine_test(structure_cfg: Mapping, rig_cfg: Mapping, case_cfg: Mapping, 
             "effects": str({k: v for k, v in eff.items() if v}),
             **{f"friction_{k}": v for k, v in zip(("e_f", "k_c", "e_t", "kappa", "mu"), sim.contact.friction)},
             "preload_n": sim.contact.preload, "normal_static_approach_m": sim.contact.static_approach,
-            "normal_exponent": sim.contact.exponent, "k_t": red.k_t, "k_n": red.k_n,
+            "normal_exponent": sim.contact.exponent, "normal_cubic_n_per_m3": sim.contact.cubic,
+            "friction_regularization": sim.contact.regularization, "k_t": red.k_t, "k_n": red.k_n,
             **{f"energy_{k}": v for k, v in energy.items()},
             **{f"setting_{k}": v for k, v in s.items()},
         },

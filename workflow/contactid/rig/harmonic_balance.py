@@ -191,16 +191,17 @@ def _propagate(coef, dxi, dN_from, dN, out):
 
 
 @njit(cache=True)
-def _normal_path(eta, deta, n0, delta0, p, hc, unilateral, N, dN_deta, dN_ddeta):
+def _normal_path(eta, deta, n0, delta0, p, cubic, hc, unilateral, N, dN_deta, dN_ddeta):
     """Normal force and its tangents along the path (the integrator's ``_normal_force``)."""
     for i in range(eta.size):
-        N[i] = _normal_force(eta[i], deta[i], n0, delta0, p, hc, unilateral)
+        N[i] = _normal_force(eta[i], deta[i], n0, delta0, p, hc, unilateral, cubic)
         if unilateral and (eta[i] >= delta0 or N[i] <= 0.0):
             dN_deta[i] = 0.0
             dN_ddeta[i] = 0.0
             continue
-        nel = n0 * ((delta0 - eta[i]) / delta0) ** p if unilateral else n0 * (delta0 - eta[i]) / delta0
-        dnel = -p * nel / (delta0 - eta[i]) if unilateral else -n0 / delta0
+        power = n0 * ((delta0 - eta[i]) / delta0) ** p if unilateral else n0 * (delta0 - eta[i]) / delta0
+        nel = power - cubic * eta[i] ** 3
+        dnel = (-p * power / (delta0 - eta[i]) if unilateral else -n0 / delta0) - 3.0 * cubic * eta[i] ** 2
         dN_deta[i] = dnel * (1.0 - hc * deta[i])
         dN_ddeta[i] = -hc * nel
 
@@ -316,7 +317,7 @@ class HarmonicBalance:
     def _normal(self, eta, deta):
         c = self.contact
         N, dN, dNd = np.empty(self.M), np.empty(self.M), np.empty(self.M)
-        _normal_path(eta, deta, c.preload, c.static_approach, c.exponent, c.hunt_crossley, bool(c.unilateral),
+        _normal_path(eta, deta, c.preload, c.static_approach, c.exponent, c.cubic, c.hunt_crossley, bool(c.unilateral),
                      N, dN, dNd)
         return N, dN, dNd
 

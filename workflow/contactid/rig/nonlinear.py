@@ -91,7 +91,7 @@ class ContactParameters:
 
     friction: (e_f, k_c, e_t, kappa, mu) of Eqs. 21-22; regularization: how the law is read
     (``none``: as printed, ``slip_limit``; see ``contactid.friction``); preload N0 (N);
-    static_approach delta0 (m) and exponent p of the normal law; hunt_crossley
+    static_approach delta0 (m), exponent p and cubic hardening k_3 (N/m^3) of the normal law; hunt_crossley
     alpha (s/m); viscous sigma_2 (N s/m); iwan_share (0..1) and the Iwan
     sliders' slip-limit weights (sum 1); preload_drift (relative, over the record).
     """
@@ -108,6 +108,7 @@ class ContactParameters:
     n_min: float = 1e-6
     unilateral: bool = True
     regularization: str = "none"
+    cubic: float = 0.0
 
 
 def friction_record(contact: ContactParameters) -> np.ndarray:
@@ -142,14 +143,17 @@ def _contact_state(z, v, xi_v, eta_v, G):
 
 
 @njit(cache=True)
-def _normal_force(eta, deta, n0, delta0, p, hc, unilateral):
-    """N = N0 ((delta0 - eta)/delta0)^p (1 - hc deta/dt), zero once the contact opens; a
-    bilateral law (``unilateral`` False, p = 1) is the linear spring of Eq. 13 and may pull."""
+def _normal_force(eta, deta, n0, delta0, p, hc, unilateral, cubic):
+    """N = [N0 ((delta0 - eta)/delta0)^p - k_3 eta^3] (1 - hc deta/dt) (N), zero once the contact opens; a
+    bilateral law (``unilateral`` False, p = 1) is the linear spring of Eq. 13 (plus the cubic) and may pull.
+    With p = 1 the elastic part is the polynomial hardening N0 - k_n eta - k_3 eta^3 (cubic = k_3, N/m^3)."""
     if not unilateral:
-        return n0 * (delta0 - eta) / delta0 * (1.0 - hc * deta)
+        return (n0 * (delta0 - eta) / delta0 - cubic * eta**3) * (1.0 - hc * deta)
     if eta >= delta0:
         return 0.0
-    nel = n0 * ((delta0 - eta) / delta0) ** p
+    nel = n0 * ((delta0 - eta) / delta0) ** p - cubic * eta**3
+    if nel <= 0.0:
+        return 0.0
     n = nel * (1.0 - hc * deta)
     return n if n > 0.0 else 0.0
 
@@ -186,7 +190,7 @@ def _iwan_force(xi, x_sl, weights, e0_total, mu_n):
 
 @njit(cache=True)
 def integrate(z, v, state, t0, n_steps, dt, omega, zeta, xi_v, eta_v, G, bF, k_t, k_n,
-              f_sin, f_cos, w, fr, n0, delta0, p, hc, unilateral, visc, iw_share, iw_w, x_sl, drift_rate, drift_t0,
+              f_sin, f_cos, w, fr, n0, delta0, p, cubic, hc, unilateral, visc, iw_share, iw_w, x_sl, drift_rate, drift_t0,
               store_from, out_a, out_z, out_v, out_s, out_n, out_xi, out_eta, out_f, out_dxi, out_deta):
     """Advance the reduced model ``n_steps`` steps of ``dt`` from time ``t0``.
 
@@ -201,7 +205,7 @@ def integrate(z, v, state, t0, n_steps, dt, omega, zeta, xi_v, eta_v, G, bF, k_t
     om2 = omega * omega
     S_val = state[0]
     xi_lin, xi, dxi_dq, eta, deta, dxi = _contact_state(z, v, xi_v, eta_v, G)
-    N = _normal_force(eta, deta, n0, delta0, p, hc, unilateral)
+    N = _normal_force(eta, deta, n0, delta0, p, hc, unilateral, cubic)
     P = n0
     a = np.empty(n)
     t = t0
@@ -225,7 +229,7 @@ def integrate(z, v, state, t0, n_steps, dt, omega, zeta, xi_v, eta_v, G, bF, k_t
         xi_old = xi
         N_old = N
         xi_lin, xi, dxi_dq, eta, deta, dxi = _contact_state(z, v, xi_v, eta_v, G)
-        N = _normal_force(eta, deta, n0, delta0, p, hc, unilateral)  # explicit estimate for the friction law
+        N = _normal_force(eta, deta, n0, delta0, p, hc, unilateral, cubic)  # explicit estimate for the friction law
         S_val = valanis_step(S_val, xi_old, xi, N_old, N, e_f, k_c, e_t, kappa, mu, 1e-6, slip_limit)
         if N > 0.0:
             e0 = e_f * (1.0 - np.exp(-k_c * N / e_f))
@@ -238,7 +242,7 @@ def integrate(z, v, state, t0, n_steps, dt, omega, zeta, xi_v, eta_v, G, bF, k_t
         P = n0 * (1.0 + drift_rate * (t - drift_t0)) if (drift_rate != 0.0 and t > drift_t0) else n0
         f = _excitation(f_sin, f_cos, w, t)
         # normal force: elastic part explicit, Hunt-Crossley damping implicit (it is stiff)
-        N_el = _normal_force(eta, 0.0, n0, delta0, p, 0.0, unilateral)
+        N_el = _normal_force(eta, 0.0, n0, delta0, p, 0.0, unilateral, cubic)
         c_n = hc * N_el
         uDu = 0.0
         uy = 0.0
@@ -366,7 +370,7 @@ class DualSineSimulator:
         self.t = integrate(self.z, self.v, self.state, self.t, n_steps, self.dt, r.omega, self.zeta, r.xi, r.eta,
                            r.shortening, r.force, r.k_t, r.k_n, np.ascontiguousarray(coef.real),
                            np.ascontiguousarray(coef.imag), w, self.fr, c.preload, c.static_approach,
-                           c.exponent, c.hunt_crossley, bool(c.unilateral), c.viscous, c.iwan_share, self.iw_w, self.x_sl,
+                           c.exponent, c.cubic, c.hunt_crossley, bool(c.unilateral), c.viscous, c.iwan_share, self.iw_w, self.x_sl,
                            self.drift_rate, self.drift_t0, n_steps if store_from is None else store_from, out_a, out_z, out_v,
                            out["S"], out["N"], out["xi"], out["eta"], out["f"], out["dxi"], out["deta"])
         first = 1 + (n_steps if store_from is None else store_from)

@@ -17,6 +17,7 @@ import scipy.signal
 
 from ..beam_model import FEModel, all_modes
 from ..random_streams import generator
+from .damping import damping_ratios
 from .frontend import add_noise, anti_alias_decimate, delay_channels
 
 
@@ -27,7 +28,8 @@ class RandomTestSettings:
     sampling_rate_hz: output sampling rate; duration_s: recorded length;
     band_hz: (low, high) band of the random force; force_rms_n: its rms (N);
     noise_fraction: sensor noise rms as a fraction of each channel's rms;
-    modal_damping_ratio: damping ratio of every mode; oversampling: internal
+    modal_damping_ratio: damping ratio (at damping_reference_hz, spread over the modes by damping_form,
+    see ``rig.damping``); oversampling: internal
     integration rate over output rate; settle_s: discarded start-up time;
     channel_delays_s: per-accelerometer sampling delay (effect channel_time_skew).
     """
@@ -41,6 +43,8 @@ class RandomTestSettings:
     oversampling: int = 4
     settle_s: float = 2.0
     channel_delays_s: tuple | None = None
+    damping_form: str = "modal"
+    damping_reference_hz: float = 54.4
 
 
 @dataclass(frozen=True)
@@ -52,9 +56,10 @@ class RandomTestRecord:
     acceleration: np.ndarray
 
 
-def modal_acceleration_filters(model: FEModel, damping_ratio: float, dt: float):
+def modal_acceleration_filters(model: FEModel, damping_ratio, dt: float):
     """Discrete (b, a) filters from the force at d_p to each modal acceleration
-    and the modal participation at each sensor, FOH-exact for every mode.
+    and the modal participation at each sensor, FOH-exact for every mode. damping_ratio: one value
+    for every mode, or a function of the modes' frequencies (Hz) giving each its ratio.
 
     Modes above the simulation's Nyquist frequency are left out: their
     acceleration response below the output band edge is below
@@ -65,10 +70,11 @@ def modal_acceleration_filters(model: FEModel, damping_ratio: float, dt: float):
     keep = modes.frequencies_hz < 0.5 / dt
     phi = modes.shapes[:, keep]
     wn = 2 * np.pi * modes.frequencies_hz[keep]
+    zetas = damping_ratio(wn / (2 * np.pi)) if callable(damping_ratio) else np.full(wn.size, float(damping_ratio))
     b_force = phi.T @ model.force_vector
     sens = model.sensor_vectors @ phi
     filters = []
-    for w, bf in zip(wn, b_force):
+    for w, bf, damping_ratio in zip(wn, b_force, zetas):
         # q'' + 2 zeta w q' + w^2 q = bf f;  a = q'' = -w^2 q - 2 zeta w q' + bf f
         A = np.array([[0.0, 1.0], [-(w**2), -2 * damping_ratio * w]])
         B = np.array([[0.0], [bf]])
@@ -96,7 +102,8 @@ def simulate_random_test(model: FEModel, settings: RandomTestSettings, seed: int
     f_sim = scipy.signal.sosfilt(sos, white)
     f_sim *= s.force_rms_n / np.std(f_sim[n_settle * q:])
 
-    filters, sens = modal_acceleration_filters(model, s.modal_damping_ratio, 1.0 / fs_sim)
+    filters, sens = modal_acceleration_filters(
+        model, lambda f: damping_ratios(f, s.modal_damping_ratio, s.damping_form, s.damping_reference_hz), 1.0 / fs_sim)
     acc_sim = np.zeros((sens.shape[0], n_sim))
     for (num, den), part in zip(filters, sens.T):
         qdd = scipy.signal.lfilter(num, den, f_sim)
@@ -127,6 +134,8 @@ def settings_from_config(random_test_cfg, rig_cfg, n_channels: int = 3) -> Rando
         modal_damping_ratio=float(rig_cfg.get("modal_damping_ratio", d.modal_damping_ratio)),
         oversampling=int(rig_cfg.get("oversampling", d.oversampling)),
         channel_delays_s=channel_delays(rig_cfg, n_channels),
+        damping_form=str((rig_cfg.get("true_damping") or {}).get("form", "modal")),
+        damping_reference_hz=float((rig_cfg.get("true_damping") or {}).get("reference_frequency_hz", 54.4)),
     )
 
 
@@ -149,13 +158,15 @@ def random_test_datasets(structure_cfg, rig_cfg, random_test_cfg, seed: int, n_t
     settings = settings_from_config(random_test_cfg, rig_cfg, len(params.sensor_positions))
     rec = simulate_random_test(model, settings, seed)
     names = structure_cfg["sensors"]["names"]
-    raw = raw_dataset(rec.time, rec.force, rec.acceleration, names, params.sensor_positions,
+    # the raw record names the sensors where the tester believes them (the nominal structure)
+    raw = raw_dataset(rec.time, rec.force, rec.acceleration, names, tuple(structure_cfg["sensors"]["positions_m"]),
                       settings.sampling_rate_hz, attrs={"test": "random"})
     modes = structural_modes(model, n_truth_modes)
     truth = xr.Dataset(
         {
             "natural_frequency": ("mode", modes.frequencies_hz, {"units": "Hz", "long_name": "true undamped natural frequency"}),
-            "damping_ratio": ("mode", np.full(n_truth_modes, settings.modal_damping_ratio),
+            "damping_ratio": ("mode", damping_ratios(modes.frequencies_hz, settings.modal_damping_ratio,
+                                                     settings.damping_form, settings.damping_reference_hz),
                               {"units": "1", "long_name": "true modal damping ratio"}),
             "mode_shape_at_sensor": (("sensor", "mode"), model.sensor_vectors @ modes.shapes,
                                      {"units": "kg^-1/2", "long_name": "mass-normalised mode shape at the sensors"}),

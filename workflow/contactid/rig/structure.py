@@ -1,8 +1,10 @@
-"""The rig's structure: the configured structure with the contact springs taken
-from the rig's true contact laws (their small-amplitude limits)."""
+"""The rig's structure: the configured structure, with ``rig.true_structure``'s changes where given
+(the rig's truth may differ from the structure the identification assumes), and the contact springs
+taken from the rig's true contact laws (their small-amplitude limits)."""
 
 from __future__ import annotations
 
+import copy
 from typing import Mapping
 
 from ..contact_laws import NormalLaw, ValanisParameters, stiction_shear_stiffness
@@ -10,11 +12,28 @@ from ..parameters import StructureParameters, structure_from_config
 from .effects import effect_magnitudes
 
 
+def deep_merge(base: Mapping, changes: Mapping) -> dict:
+    """A copy of ``base`` with ``changes`` applied key by key (nested mappings merged, the rest replaced)."""
+    out = copy.deepcopy(dict(base))
+    for key, value in (changes or {}).items():
+        if isinstance(value, Mapping) and isinstance(out.get(key), Mapping):
+            out[key] = deep_merge(out[key], value)
+        else:
+            out[key] = copy.deepcopy(value)
+    return out
+
+
+def true_structure_config(structure_cfg: Mapping, rig_cfg: Mapping) -> dict:
+    """The structure the rig simulates: ``structure`` with ``rig.true_structure`` merged in (any subset of
+    the ``structure`` keys). The identification keeps ``structure``; raw records name the nominal sensors."""
+    return deep_merge(structure_cfg, rig_cfg.get("true_structure") or {})
+
+
 def rig_contact_stiffness(structure_cfg: Mapping, rig_cfg: Mapping) -> tuple[float, float]:
-    """True (k_t, k_n) in N/m: e_0 of Eq. 22 at the preload, and the normal law's tangent."""
+    """True (k_t, k_n) in N/m: e_0 of Eq. 22 at the (true) preload, and the normal law's tangent."""
     truth = rig_cfg["truth"]
     fr = ValanisParameters.from_config(truth["friction"])
-    n0 = float(structure_cfg["preload_n"])
+    n0 = float(true_structure_config(structure_cfg, rig_cfg)["preload_n"])
     k_t = float(stiction_shear_stiffness(n0, fr.e_f, fr.k_c))
     k_n = NormalLaw(n0, float(truth["normal"]["stiffness_at_preload_n_per_m"]),
                     float(truth["normal"]["exponent"])).stiffness_at_preload
@@ -25,7 +44,8 @@ def rig_structure(structure_cfg: Mapping, rig_cfg: Mapping) -> StructureParamete
     """StructureParameters of the rig (finer mesh, true contact stiffnesses; the
     effect transducer_mass_error scales every transducer mass by 1 + m)."""
     k_t, k_n = rig_contact_stiffness(structure_cfg, rig_cfg)
-    p = structure_from_config(structure_cfg, k_t, k_n, n_elements=int(rig_cfg.get("fe_elements", 96)))
+    p = structure_from_config(true_structure_config(structure_cfg, rig_cfg), k_t, k_n,
+                              n_elements=int(rig_cfg.get("fe_elements", 96)))
     m = effect_magnitudes(rig_cfg.get("effects"))["transducer_mass_error"]
     if m:
         p = p.replace(sensor_masses=tuple((1 + m) * x for x in p.sensor_masses),

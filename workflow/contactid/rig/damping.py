@@ -1,0 +1,40 @@
+"""The rig's true damping: its form may differ from the identified model's modal damping.
+
+``rig.modal_damping_ratio`` is the damping ratio at ``rig.true_damping.reference_frequency_hz``;
+``rig.true_damping.form`` spreads it over the modes (and the reduced model's static contact shapes):
+
+- ``modal``: every mode the same ratio (the identified model's form);
+- ``stiffness_proportional``: C = beta K, zeta_i = zeta_ref f_i / f_ref (grows with frequency, so the
+  static contact shapes, high in frequency, are damped most);
+- ``mass_proportional``: C = alpha M, zeta_i = zeta_ref f_ref / f_i.
+"""
+
+from __future__ import annotations
+
+from typing import Mapping
+
+import numpy as np
+
+FORMS = ("modal", "stiffness_proportional", "mass_proportional")
+MAX_RATIO = 2.0  # ratios are capped (an overdamped static shape stays overdamped)
+
+
+def damping_ratios(frequencies_hz, ratio: float, form: str = "modal", reference_hz: float = 54.4) -> np.ndarray:
+    """Damping ratio (1) of each mode at undamped frequency f_i (Hz), for the damping form (see the module)."""
+    f = np.asarray(frequencies_hz, dtype=float)
+    if form == "modal":
+        z = np.full(f.shape, float(ratio))
+    elif form == "stiffness_proportional":
+        z = float(ratio) * f / float(reference_hz)
+    elif form == "mass_proportional":
+        z = float(ratio) * float(reference_hz) / np.maximum(f, 1e-9)
+    else:
+        raise ValueError(f"rig.true_damping.form = {form!r} is not one of {FORMS}")
+    return np.minimum(z, MAX_RATIO)
+
+
+def rig_damping_ratios(rig_cfg: Mapping, frequencies_hz) -> np.ndarray:
+    """The rig's damping ratio of each mode (rig.modal_damping_ratio spread by rig.true_damping)."""
+    td = rig_cfg.get("true_damping") or {}
+    return damping_ratios(frequencies_hz, float(rig_cfg.get("modal_damping_ratio", 0.005)), td.get("form", "modal"),
+                          float(td.get("reference_frequency_hz", 54.4)))
