@@ -165,3 +165,47 @@ def test_report_section_is_plain_latex_with_and_without_the_benchmark():
         assert "\\n" not in text.replace("\\newcommand", "")  # no literal backslash-n reaches LaTeX
         assert "30\\%" in text and "tangential\\_contact" in text
     assert "93.8" in gap_section(diag, bench) and "Not built" in gap_section(diag, None)
+
+
+def _synthetic_diagnosis(steps, verdict="none", after=None):
+    stage = {k: 0.01 for k in ("accelerations", "generalized_coordinates", "identification_residual", "contact_force_S",
+                               "contact_force_N", "energy_tangential", "frf_peak_amplitude")}
+    rows = [{"effect": "transducer_mass_error", "n_parameters": 1, "heldout_gap_before": 0.04, "heldout_gap_after": after,
+             "heldout_gap_after_interval": [after, after], "reduction": None if after is None else 1 - after / 0.04,
+             "score": None, "parameters": {"mass_error": -0.3}},
+            {"effect": "viscous_friction", "n_parameters": 1, "heldout_gap_before": 0.04, "heldout_gap_after": 0.03,
+             "heldout_gap_after_interval": [0.029, 0.031], "reduction": 0.25, "score": -3.0, "parameters": {"sigma_2": 0.0}}]
+    left = steps[-1]["heldout_gap_after"] if steps else 0.04
+    return {"calibration_case": "lc1", "verdict": verdict, "reason": "a reason with 50% and a_b", "ranking": rows,
+            "where": {"stage": stage, "heldout_gap_before": 0.04, "heldout_gap_before_interval": [0.039, 0.041],
+                      "record_scatter": 1e-4, "by_harmonic": {1: 0.01}, "worst_sensor": "a1", "worst_harmonic": 3,
+                      "even_share": 0.1, "worst_cycle_part": "slip", "place": "normal_contact", "place_reason": "N left"},
+            "explanation": steps,
+            "remaining_gap": {"heldout_gap": left, "share": left**2 / 0.04**2, "at_floor": left < 0.006, "floor": 0.006,
+                              "min_reduction": 0.5, "place": "structure_or_measurement", "place_reason": "sensor misfit"},
+            "shrink": {}}
+
+
+@pytest.mark.parametrize("steps, verdict, after", [
+    ([], "none", None),  # no verdict, a candidate whose prediction diverged (null in diagnosis.json)
+    ([{"effect": "transducer_mass_error", "parameters": {"mass_error": -0.3}, "heldout_gap_before": 0.04,
+       "heldout_gap_after": 0.01, "share": 0.9375},
+      {"effect": "normal_contact_damping", "parameters": {"alpha": 240.0}, "heldout_gap_before": 0.01,
+       "heldout_gap_after": 0.004, "share": 0.0525}], "transducer_mass_error", 0.01),
+])
+def test_every_figure_and_the_report_section_for_any_diagnosis(tmp_path, steps, verdict, after):
+    """No step fails after its result exists: a negative parameter, a null gap, no verdict, two steps."""
+    from contactid.gap import figures
+    from contactid.gap.report import gap_section
+
+    diag = _synthetic_diagnosis(steps, verdict, after)
+    for view in ("stages", "ranking", "shrink", "explanation"):
+        path = tmp_path / f"{view}.png"
+        getattr(figures, view)(diag, str(path))
+        assert path.stat().st_size > 1000
+    text = gap_section(diag, None)
+    assert "Step by step" in text and "gap_explanation.png" in text
+    if steps:
+        assert "normal\\_contact\\_damping" in text and "mass\\_error $= -0.300$" in text and "at the identification" in text
+    else:
+        assert "nothing is added" in text and "structure\\_or\\_measurement" in text

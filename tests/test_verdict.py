@@ -186,3 +186,71 @@ def test_diagnosis_keeps_its_place_function_and_thresholds():
     assert diagnosis._place(summary, quiet_stage(), np.array(ID_RES), np.array(SCATTER), None, 9)[0] == "non_stationary"
     assert (diagnosis.DRIFT_FACTOR, diagnosis.RESIDUAL_FACTOR, diagnosis.NORMAL_LIMIT, diagnosis.OPEN_LIMIT) == \
         (V.DRIFT_FACTOR, V.RESIDUAL_FACTOR, V.NORMAL_LIMIT, V.OPEN_LIMIT)
+
+
+# ----------------------------------------------------------------------------------------------
+# the additive explanation (diagnosis.explain) on hand-made candidate results
+# ----------------------------------------------------------------------------------------------
+
+class _Cal:
+    def __init__(self, name, theta):
+        self.candidate, self.theta = name, np.atleast_1d(theta)
+
+
+def _explain(first, passes, before=0.04, scatter=1e-4, settings=None):
+    """diagnosis.explain with results {name: gap}; passes: the results of each later pass, keyed by the
+    names tried (so that a test fails if the wrong candidates are tried on top)."""
+    from types import SimpleNamespace
+
+    from contactid.gap.diagnosis import explain
+
+    s = SimpleNamespace(**(settings or SETTINGS))
+    wrap = lambda res: {n: (_Cal(n, 0.1), {"gap": g}, None) for n, g in res.items()}  # noqa: E731
+    tried = []
+
+    def next_pass(remaining, cal):
+        tried.append((cal.candidate, tuple(remaining)))
+        return wrap(passes[len(tried) - 1])
+
+    steps, left, last = explain(wrap(first), list(first), before, scatter, s, lambda sims: sims["gap"], next_pass)
+    return steps, left, tried
+
+
+def test_explanation_adds_effects_until_none_shrinks_what_is_left():
+    first = {"viscous_friction": 0.02, "normal_contact_damping": 0.03, "structural_damping": 0.039}
+    # on top of viscous friction: normal damping halves what is left, structural damping does not
+    second = {"normal_contact_damping": 0.008, "structural_damping": 0.019}
+    third = {"structural_damping": 0.0075}
+    steps, left, tried = _explain(first, [second, third])
+    assert [s["effect"] for s in steps] == ["viscous_friction", "normal_contact_damping"]
+    assert tried == [("viscous_friction", ("normal_contact_damping", "structural_damping")),
+                     ("normal_contact_damping", ("structural_damping",))]
+    assert left == 0.008
+    assert [s["share"] for s in steps] == pytest.approx([(0.04**2 - 0.02**2) / 0.04**2,
+                                                         (0.02**2 - 0.008**2) / 0.04**2])
+    assert sum(s["share"] for s in steps) + V.gap_shares(0.04, [0.02, 0.008])[1] == pytest.approx(1.0)
+    assert steps[0]["heldout_gap_before"] == 0.04 and steps[1]["heldout_gap_before"] == 0.02
+
+
+def test_explanation_stops_at_the_floor_and_tries_nothing_more():
+    steps, left, tried = _explain({"viscous_friction": 0.005, "structural_damping": 0.03}, [])
+    assert [s["effect"] for s in steps] == ["viscous_friction"] and left == 0.005 and tried == []
+
+
+def test_explanation_is_empty_when_nothing_shrinks_the_gap_materially():
+    steps, left, tried = _explain({"viscous_friction": 0.025, "structural_damping": 0.03}, [])
+    assert steps == [] and left == 0.04 and tried == []
+    # a drop beyond min_reduction but within the records' scatter is not material either
+    steps, _, _ = _explain({"viscous_friction": 0.019}, [], scatter=0.01)
+    assert steps == []
+    # nor is anything when the gap before is already at the floor
+    steps, left, _ = _explain({"viscous_friction": 0.001}, [], before=0.005)
+    assert steps == [] and left == 0.005
+
+
+def test_material_and_floor_rules():
+    assert V.explains_materially(0.04, 0.02, 1e-4, SETTINGS)
+    assert not V.explains_materially(0.04, 0.0201, 1e-4, SETTINGS)
+    assert not V.explains_materially(0.04, 0.01, 0.01, SETTINGS)
+    assert not V.explains_materially(0.04, float("inf"), 1e-4, SETTINGS)
+    assert V.at_floor(0.0059, SETTINGS) and not V.at_floor(0.006, SETTINGS)

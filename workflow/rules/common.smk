@@ -169,7 +169,8 @@ def all_outputs():
 def gap_inputs(wildcards):
     """The diagnosis reads the raw records of every load case and the chain's identified model."""
     inputs = {"modes": "results/linear/linear_modes.nc", "modal": "results/linear/modal.nc",
-              "frf": "results/linear/frf.nc", "fit": "results/friction/friction_fit.nc"}
+              "frf": "results/linear/frf.nc", "fit": "results/friction/friction_fit.nc",
+              "updating": "results/gap/model_updating.json"}
     inputs["raw"] = [raw_record(c) for c in load_cases()]
     inputs["checks"] = [f"results/{c}/raw_check.nc" for c in load_cases()]  # a record that fails validation stops the gap
     return inputs
@@ -177,7 +178,7 @@ def gap_inputs(wildcards):
 
 def gap_outputs():
     return ["results/gap/diagnosis.json", "results/gap/gap.nc"] + [
-        f"results/gap/gap_{v}.png" for v in ("stages", "harmonics", "cycle", "force_state", "ranking", "shrink")]
+        f"results/gap/gap_{v}.png" for v in ("stages", "harmonics", "cycle", "force_state", "ranking", "shrink", "explanation")]
 
 
 def benchmark_base_config():

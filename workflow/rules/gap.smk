@@ -7,6 +7,27 @@ rule gap:
         gap_outputs(),
 
 
+rule model_updating:
+    input:
+        modal="results/linear/modal.nc",
+        modes="results/linear/linear_modes.nc",
+    output:
+        "results/gap/model_updating.json",
+    params:
+        code=CODE_DIGEST,
+        structure=config["structure"],
+        gap=config.get("gap", {}),
+        seed=config["seed"],
+        n_harmonics=config.get("nonlinear", {}).get("n_harmonics", 25),
+    threads: 1
+    conda:
+        "../envs/contactid.yaml"
+    log:
+        "logs/model_updating.log",
+    script:
+        "../scripts/model_updating.py"
+
+
 rule gap_diagnosis:
     priority: CRITICAL_PATH
     input:
@@ -54,6 +75,7 @@ rule gap_figures:
         force_state=report("results/gap/gap_force_state.png", caption="../report/gap.rst", category="Gap diagnosis"),
         ranking=report("results/gap/gap_ranking.png", caption="../report/gap.rst", category="Gap diagnosis"),
         shrink=report("results/gap/gap_shrink.png", caption="../report/gap.rst", category="Gap diagnosis"),
+        explanation=report("results/gap/gap_explanation.png", caption="../report/gap.rst", category="Gap diagnosis"),
     params:
         code=CODE_DIGEST,
     conda:

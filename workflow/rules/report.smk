@@ -37,7 +37,7 @@ rule report:
         noise_figure=["results/figures/noise_study.pdf"] if noise_study_in_report() else [],
         gap_figures=[
             f"results/gap/gap_{v}.png"
-            for v in ("stages", "harmonics", "cycle", "ranking", "shrink", "force_state")
+            for v in ("stages", "harmonics", "cycle", "ranking", "shrink", "force_state", "explanation")
         ],
         benchmark_figure=(
             ["results/gap_benchmark/confusion.png"]

@@ -1,15 +1,18 @@
 """Rule gap_diagnosis: the identified model against every load case's raw record (issue 7)."""
 
+import json
 import time
 
 from contactid.friction_fit import settings_from_config
 from contactid.gap.candidates import load_plugins
-from contactid.gap.diagnosis import GapSettings, diagnose, linear_stage
+from contactid.gap.diagnosis import GapSettings, diagnose, linear_stage, prepare_workers
 from contactid.gap.model import identified_model
+from contactid.gap.pipeline import updated_model
 from contactid.gap.output import diagnosis_json, gap_dataset
 from contactid.gap.records import record_harmonics
 from contactid.io import load_dataset, provenance, read_raw, write_dataset, write_text
 from contactid.logs import setup_logging
+from contactid.updating import UpdatingResult
 
 log = setup_logging(snakemake.log[0])
 p = snakemake.params
@@ -18,11 +21,20 @@ t0 = time.perf_counter()
 load_plugins(p.gap.get("plugins"))
 K = int(p.n_harmonics)
 settings = GapSettings.from_config(p.gap, int(p.seed), K)
-model = identified_model(p.structure, load_dataset(inp.modes), load_dataset(inp.modal), load_dataset(inp.fit))
+workers = int(snakemake.resources.workers)
+prepare_workers(workers)  # before the friction fit after updating starts numba's threads
+modal = load_dataset(inp.modal)
+chain_model = identified_model(p.structure, load_dataset(inp.modes), modal, load_dataset(inp.fit))
 records = {c: record_harmonics(read_raw(path, dual_sine=True), c, K) for c, path in zip(p.cases, inp.raw)}
-linear = linear_stage(model, load_dataset(inp.frf), load_dataset(inp.modal))
-diag = diagnose(model, records, p.calibration_case, settings, settings_from_config(p.friction), linear,
-                workers=int(snakemake.resources.workers))
+fit_settings = settings_from_config(p.friction)
+with open(inp.updating) as fh:
+    upd_summary = json.load(fh)
+upd = UpdatingResult.from_summary(upd_summary, chain_model.structure) if upd_summary["enabled"] else None
+model, updating = updated_model(chain_model, modal, records[p.calibration_case], fit_settings, settings, int(p.seed),
+                                upd) if upd is not None else (chain_model, None)
+linear = linear_stage(model, load_dataset(inp.frf), modal)
+diag = diagnose(model, records, p.calibration_case, settings, fit_settings, linear, workers=workers,
+                identified=chain_model, updating=updating)
 seconds = time.perf_counter() - t0
 prov = provenance("gap_diagnosis", {"gap": p.gap, "structure": p.structure, "friction": p.friction, "seed": p.seed},
                   {"modes": inp.modes, "modal": inp.modal, "frf": inp.frf, "fit": inp.fit,

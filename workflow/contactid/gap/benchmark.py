@@ -78,7 +78,7 @@ def run_item(spec: Mapping, cfg: Mapping) -> dict:
     """Generate the item's rig records, identify the model from them, diagnose; the result row."""
     from ..friction_fit import settings_from_config
     from .diagnosis import GapSettings, diagnose, linear_stage
-    from .pipeline import identify, rig_records
+    from .pipeline import identify, rig_records, updated_model
     from .records import record_harmonics
 
     t0 = time.perf_counter()
@@ -103,7 +103,10 @@ def run_item(spec: Mapping, cfg: Mapping) -> dict:
     t1 = time.perf_counter()
     log.info("model identified in %.1f s; diagnosing%s", t_id,
              "" if spec.get("library") is None else f" with a library that lacks {spec['effect']}")
-    diag = diagnose(model, records, cal, settings, fit_settings, linear_stage(model, frf, modal))
+    chain_model = model
+    model, updating = updated_model(chain_model, modal, records[cal], fit_settings, settings, int(cfg["seed"]))
+    diag = diagnose(model, records, cal, settings, fit_settings, linear_stage(model, frf, modal),
+                    identified=chain_model, updating=updating)
     t_diag = time.perf_counter() - t1
     by = {r["effect"]: r for r in diag.ranking}
     true = spec["effect"]

@@ -23,12 +23,12 @@ from ..identification import modal_damping_vector
 from ..friction_fit import FitSettings
 from ..random_streams import generator
 from .candidates import LIBRARY
-from .model import NONE, IdentifiedModel, fe_model
+from .model import NONE, Augmentation, IdentifiedModel, fe_model
 from .records import RecordHarmonics
 from .refit import (baseline, calibrate, contact_grids, evaluate, gap_residual, gap_value,
                     identified_forces, law_friction_force)
 from .verdict import DRIFT_FACTOR, NORMAL_LIMIT, OPEN_LIMIT, RESIDUAL_FACTOR  # noqa: F401 (thresholds of the place)
-from .verdict import open_fraction, place as _place_of
+from .verdict import at_floor, explains_materially, gap_shares, open_fraction, place as _place_of
 from .verdict import verdict as _verdict
 
 log = logging.getLogger(__name__)
@@ -42,7 +42,9 @@ class GapSettings:
     must shrink at least this much (relative) for a verdict; separation: the winner's held-out gap
     must be at least this factor below the runner-up's; noise_factor: the gap before must exceed this
     many bootstrap standard deviations of the records' scatter; n_bootstrap: resamples of the
-    record blocks; seed."""
+    record blocks; seed; model_updating: update the base structure from the random test before the candidates
+    (``contactid.updating``; updating_parameters the structural factors, residue_accuracy the residues' relative
+    standard error, frequency_floor the relative model-form uncertainty added to each frequency)."""
 
     n_harmonics: int = 9
     identification_harmonics: int = 25
@@ -54,6 +56,10 @@ class GapSettings:
     n_bootstrap: int = 200
     seed: int = 0
     max_evaluations: int = 10
+    model_updating: bool = True
+    updating_parameters: tuple = ("stiffness_scale", "mass_scale", "transducer_mass_scale", "tangential_lever_arm_scale")
+    residue_accuracy: float = 0.02
+    frequency_floor: float = 0.001
 
     @classmethod
     def from_config(cls, gap_cfg: Mapping | None, seed: int, n_harmonics_id: int) -> "GapSettings":
@@ -70,7 +76,8 @@ class GapSettings:
                 min_reduction=float(g.get("min_reduction", d.min_reduction)),
                 separation=float(g.get("separation", d.separation)), noise_factor=float(g.get("noise_factor", d.noise_factor)),
                 n_bootstrap=int(g.get("n_bootstrap", d.n_bootstrap)), seed=int(seed),
-                max_evaluations=int(g.get("max_evaluations", d.max_evaluations)))
+                max_evaluations=int(g.get("max_evaluations", d.max_evaluations)),
+                **_updating_settings(g.get("model_updating"), d))
         if not 0.0 < s.min_reduction < 1.0:
             raise ValueError(f"gap.min_reduction = {s.min_reduction}: give a fraction in (0, 1)")
         if s.separation < 1.0:
@@ -79,6 +86,22 @@ class GapSettings:
             raise ValueError(f"gap.n_harmonics = {s.n_harmonics}: give 3 .. nonlinear.n_harmonics "
                              f"({s.identification_harmonics})")
         return s
+
+
+def _updating_settings(block, d: "GapSettings") -> dict:
+    """GapSettings fields of the config block gap.model_updating (false = off; a block = on with its settings)."""
+    if block is False or block is None and not d.model_updating:
+        return {"model_updating": False}
+    b = {} if block in (None, True) else dict(block)
+    from ..updating import FACTORS
+
+    params = tuple(b.get("parameters", d.updating_parameters))
+    unknown = [x for x in params if x not in FACTORS]
+    if unknown:
+        raise ValueError(f"gap.model_updating.parameters: unknown {unknown}; choose from {', '.join(FACTORS)}")
+    return {"model_updating": bool(b.get("enabled", True)), "updating_parameters": params,
+            "residue_accuracy": float(b.get("residue_accuracy", d.residue_accuracy)),
+            "frequency_floor": float(b.get("frequency_floor", d.frequency_floor))}
 
 
 # ------------------------------------------------------------------------------------------
@@ -108,11 +131,13 @@ def cycle_parts(g: dict, k_t: float) -> dict:
     return {"stick": stick, "slip": slip, "velocity_reversal": reversal, "peak_compression": peak}
 
 
-def localise(model: IdentifiedModel, records: dict, sims: dict, n_harmonics: int, linear: dict | None = None) -> tuple[dict, dict]:
+def localise(model: IdentifiedModel, records: dict, sims: dict, n_harmonics: int, linear: dict | None = None,
+             aug: Augmentation = NONE) -> tuple[dict, dict]:
     """The gap by stage, sensor, harmonic, part of the cycle and load level (the identified model
-    as the chain left it). Returns (summary for diagnosis.json, arrays for gap.nc)."""
+    as the chain left it, or with the effects ``aug`` added). Returns (summary for diagnosis.json, arrays for
+    gap.nc)."""
     H = n_harmonics
-    fe = fe_model(model)
+    fe = fe_model(model, aug)
     cases = list(records)
     arrays = {}
     stage = {}
@@ -136,13 +161,13 @@ def localise(model: IdentifiedModel, records: dict, sims: dict, n_harmonics: int
     part_names = ("stick", "slip", "velocity_reversal", "peak_compression")
     for c in cases:
         rec = records[c]
-        forces = identified_forces(model, NONE, rec)
+        forces = identified_forces(model, aug, rec)
         # the sensors' misfit of the inverse identification at the driven harmonics (1 and 3): the
         # structure and sensor model's consistency with the records, whatever the contact does
         id_res.append(float(np.sqrt(np.mean(forces.residual[[0, 2]] ** 2))))
         scatter.append(identification_noise(model, rec))
         g = contact_grids(forces, rec.f0, model.preload, 256)
-        S_law = law_friction_force(g["xi"], g["xi_dot"], g["N"], np.asarray(model.friction), NONE,
+        S_law = law_friction_force(g["xi"], g["xi_dot"], g["N"], np.asarray(model.friction), aug,
                                    model.regularization)[0]
         S_law -= S_law.mean()
         N_id = g["N"] - model.preload
@@ -284,9 +309,12 @@ class Diagnosis:
     arrays: dict = field(default_factory=dict)
     sims: dict = field(default_factory=dict)
     shrink: dict = field(default_factory=dict)
+    explanation: list = field(default_factory=list)
+    remaining_gap: dict = field(default_factory=dict)
 
     def summary(self) -> dict:
         return {"verdict": self.verdict, "reason": self.reason, "ranking": self.ranking, "where": self.where,
+                "explanation": self.explanation, "remaining_gap": self.remaining_gap,
                 "shrink": self.shrink, "calibration_case": self.calibration_case, "heldout_cases": self.heldout_cases}
 
 
@@ -329,11 +357,13 @@ def _bootstrap_records(rec: RecordHarmonics, rng, n: int, H: int) -> np.ndarray:
 
 
 def _candidate(name: str, model: IdentifiedModel, records: Mapping[str, RecordHarmonics], calibration_case: str,
-               score_cases: list, base_sims: dict, fit_settings: FitSettings, H: int, max_evaluations: int):
-    """One candidate: calibrated on the calibration case, predicted on the scored cases (each simulation
-    warm-started from the baseline's). Returns (calibration, sims, residuals) by case."""
+               score_cases: list, base_sims: dict, fit_settings: FitSettings, H: int, max_evaluations: int,
+               base: Augmentation = NONE):
+    """One candidate (added to the effects ``base``): calibrated on the calibration case, predicted on the
+    scored cases (each simulation warm-started from the baseline's). Returns (calibration, sims, residuals)
+    by case."""
     cal = calibrate(model, LIBRARY[name], records[calibration_case], fit_settings, H, max_evaluations,
-                    start=base_sims[calibration_case])
+                    start=base_sims[calibration_case], base=base)
     sims = {calibration_case: None}
     res = {}
     for c in score_cases:
@@ -378,6 +408,12 @@ def _pool(workers: int):
     return _POOLS[workers]
 
 
+def prepare_workers(workers: int) -> bool:
+    """Fork the candidates' worker processes now, while forking is safe (before anything in this process runs
+    numba's parallel friction kernel, e.g. the friction fit after model updating); True if they exist."""
+    return workers > 1 and _pool(workers) is not None
+
+
 def _candidates(names, workers: int, **common):
     """Start the candidates (see ``_candidate``) and return a function that gives {name: (calibration, sims,
     residuals)} in library order. With ``workers`` > 1 they run at once in forked worker processes while this
@@ -395,11 +431,55 @@ def _candidates(names, workers: int, **common):
     return lambda: dict(zip(names, pending.get()))
 
 
+def _parameter_values(name: str, cal) -> dict:
+    """{parameter name: refitted value} of a calibrated candidate (per-channel ones numbered by channel)."""
+    cand = LIBRARY[name]
+    return {p.name if not cand.per_channel else f"{p.name}_{i}": float(v)
+            for i, (p, v) in enumerate(zip(cand.parameters * len(cal.theta), cal.theta))}
+
+
+def explain(first: dict, names: list, before: float, scatter: float, settings: GapSettings, heldout_gap,
+            next_pass) -> tuple[list, float, tuple | None]:
+    """The additive explanation of the held-out gap: add the candidate that leaves the smallest held-out gap
+    (its refit included), then try the remaining candidates on top of it (``next_pass(remaining, calibration)``
+    gives their results), and so on; stop when no candidate shrinks what is left materially
+    (``verdict.explains_materially``) or what is left is at the identification's floor (``verdict.at_floor``).
+
+    first: {name: (calibration, sims, residuals)} of the first pass; heldout_gap(sims) the held-out gap of a
+    model's simulations. Returns (steps [{effect, parameters, heldout_gap_before, heldout_gap_after, share}],
+    the gap left, (calibration, sims) of the last step or None). share: the part of the held-out gap's power
+    (its square) the step removes; the shares and the remaining share sum to 1."""
+    steps, gap, last, results, remaining = [], before, None, first, list(names)
+    while remaining and not at_floor(gap, settings):
+        gaps = {n: heldout_gap(results[n][1]) for n in remaining}
+        gaps = {n: g for n, g in gaps.items() if np.isfinite(g)}
+        if not gaps:
+            break
+        best = min(gaps, key=gaps.get)  # ties: library order
+        if not explains_materially(gap, gaps[best], scatter, settings):
+            break
+        cal, sims, _ = results[best]
+        steps.append({"effect": best, "parameters": _parameter_values(best, cal), "heldout_gap_before": gap,
+                      "heldout_gap_after": gaps[best]})
+        log.info("explanation step %d: %s leaves a held-out gap of %.4g (from %.4g)", len(steps), best,
+                 gaps[best], gap)
+        gap, last = gaps[best], (cal, sims)
+        remaining.remove(best)
+        if remaining and not at_floor(gap, settings):
+            results = next_pass(remaining, cal)
+    shares, _ = gap_shares(before, [s["heldout_gap_after"] for s in steps])
+    for s, share in zip(steps, shares):
+        s["share"] = share
+    return steps, gap, last
+
+
 def diagnose(model: IdentifiedModel, records: Mapping[str, RecordHarmonics], calibration_case: str,
              settings: GapSettings, fit_settings: FitSettings, linear: dict | None = None,
-             workers: int = 1) -> Diagnosis:
+             workers: int = 1, identified: IdentifiedModel | None = None, updating=None) -> Diagnosis:
     """Run the whole diagnosis on the load cases' records (``calibration_case`` for the refits,
-    the others held out); the candidates in ``workers`` processes (see ``_candidates``)."""
+    the others held out); the candidates in ``workers`` processes (see ``_candidates``). ``identified``: the
+    chain's own model when ``model`` is its update (``gap.pipeline.updated_model``; ``updating`` its
+    UpdatingResult): the explanation then starts with the update's step."""
     H = settings.n_harmonics
     if calibration_case not in records:
         raise ValueError(f"gap: the calibration case {calibration_case!r} is not among the load cases {list(records)}")
@@ -463,8 +543,7 @@ def diagnose(model: IdentifiedModel, records: Mapping[str, RecordHarmonics], cal
                      "reduction": 1 - after / before if np.isfinite(after) else -np.inf, "reduction_interval": [float(np.percentile(red_b, 2.5)),
                                                                             float(np.percentile(red_b, 97.5))],
                      "heldout_gap_after_interval": [float(np.percentile(after_b, 2.5)), float(np.percentile(after_b, 97.5))],
-                     "n_parameters": k, "parameters": {p.name if not LIBRARY[name].per_channel else f"{p.name}_{i}": float(v)
-                                                       for i, (p, v) in enumerate(zip(LIBRARY[name].parameters * len(cal.theta), cal.theta))},
+                     "n_parameters": k, "parameters": _parameter_values(name, cal),
                      "calibration_gap": cal.gap, "friction": [float(x) for x in cal.friction],
                      "heldout_gap_after_by_case": {c: gap_value(r) for c, r in res.items()},
                      "identification_residual_after": res_after, "identification_noise": noise, "acts_on": acts_on, "consistent": bool(consistent),
@@ -480,6 +559,43 @@ def diagnose(model: IdentifiedModel, records: Mapping[str, RecordHarmonics], cal
     where["heldout_gap_before"] = before
     where["heldout_gap_before_interval"] = [float(np.percentile(before_b, 2.5)), float(np.percentile(before_b, 97.5))]
     where["record_scatter"] = scatter
+
+    def next_pass(remaining, cal):
+        starts = {calibration_case: cal.simulation if cal.simulation is not None else base_sims[calibration_case],
+                  **{c: s for c, s in results[cal.candidate][1].items() if s is not None}}
+        return _candidates(remaining, workers, model=cal.model, records=records, calibration_case=calibration_case,
+                           score_cases=score_cases, base_sims=starts, fit_settings=fit_settings, H=H,
+                           max_evaluations=settings.max_evaluations, base=cal.augmentation)()
+
+    steps, left, last = explain(results, names, before, scatter, settings, heldout_gap, next_pass)
+    first_before = before
+    if updating is not None:
+        where["model_updating"] = updating.summary()
+        # the friction law the candidates start from (refitted with the updated structure when accepted)
+        e_f, k_c, e_t, kappa, mu = model.friction
+        where["model_updating"]["friction"] = {"e_f": e_f, "k_c": k_c, "e_t": e_t, "kappa": kappa, "mu": mu,
+                                               "e0_at_preload": e_f * (1 - np.exp(-k_c * model.preload / e_f))}
+    if identified is not None and updating is not None and updating.accepted:
+        id_sims = {c: baseline(identified, records[c], H)[1] for c in score_cases}
+        first_before = heldout_gap(id_sims)
+        where["heldout_gap_identified"] = first_before
+        steps.insert(0, {"effect": "model_updating", "parameters": {**updating.factors, "k_t": updating.k_t,
+                                                                    "k_n": updating.k_n},
+                         "heldout_gap_before": first_before, "heldout_gap_after": before})
+        log.info("explanation step 0: model updating takes the held-out gap from %.4g to %.4g", first_before, before)
+    shares, left_share = gap_shares(first_before, [s["heldout_gap_after"] for s in steps])
+    for s, share in zip(steps, shares):
+        s["share"] = share
+    remaining = {"heldout_gap": left, "share": left_share,
+                 "at_floor": at_floor(left, settings), "floor": settings.min_gap, "min_reduction": settings.min_reduction,
+                 "place": where["place"], "place_reason": where["place_reason"]}
+    if last is not None and not remaining["at_floor"]:  # where what is left lies, with the explanation's effects in
+        cal, sims = last
+        all_sims = {c: (cal.simulation if c == calibration_case else sims[c]) for c in cases}
+        if all(s is not None for s in all_sims.values()):
+            where_left, _ = localise(cal.model, dict(records), all_sims, H, linear, aug=cal.augmentation)
+            remaining["place"] = where_left["place"]
+            remaining["place_reason"] = where_left["place_reason"]
     diag = Diagnosis(verdict, reason, rows, where, calibration_case, held, arrays,
-                     {"base": base_sims, **{n: r[1] for n, r in results.items()}}, shrink)
+                     {"base": base_sims, **{n: r[1] for n, r in results.items()}}, shrink, steps, remaining)
     return diag

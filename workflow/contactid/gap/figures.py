@@ -12,6 +12,11 @@ import numpy as np  # noqa: E402
 import xarray as xr  # noqa: E402
 
 
+def _num(x) -> float:
+    """A diagnosis.json number as a float (null, written for a non-finite value, as NaN)."""
+    return float("nan") if x is None else float(x)
+
+
 def _save(fig, path):
     fig.tight_layout()
     fig.savefig(path, dpi=130)
@@ -87,16 +92,17 @@ def ranking(diag: dict, path: str):
     rows = diag["ranking"]
     fig, ax = plt.subplots(figsize=(7, 3.6))
     names = [r["effect"] for r in rows]
-    after = np.array([100 * r["heldout_gap_after"] for r in rows])
-    lo = np.array([100 * r["heldout_gap_after_interval"][0] for r in rows])
-    hi = np.array([100 * r["heldout_gap_after_interval"][1] for r in rows])
+    after = np.array([100 * _num(r["heldout_gap_after"]) for r in rows])
+    lo = np.array([100 * _num(r["heldout_gap_after_interval"][0]) for r in rows])
+    hi = np.array([100 * _num(r["heldout_gap_after_interval"][1]) for r in rows])
     y = np.arange(len(rows))
     ax.barh(y, after, xerr=[np.maximum(after - lo, 0), np.maximum(hi - after, 0)], color="tab:blue", label="with the effect")
     if rows:
         ax.axvline(100 * rows[0]["heldout_gap_before"], color="k", ls="--", label="identified model (before)")
     ax.set_yticks(y, names)
     ax.invert_yaxis()
-    ax.set_xlim(0, 1.15 * max(hi.max() if len(hi) else 1.0, 100 * rows[0]["heldout_gap_before"] if rows else 1.0))
+    finite = hi[np.isfinite(hi)]
+    ax.set_xlim(0, 1.15 * max(finite.max() if finite.size else 1.0, 100 * rows[0]["heldout_gap_before"] if rows else 1.0))
     ax.set_xlabel("held-out gap (%)")
     ax.set_title(f"Candidates ranked; verdict: {diag['verdict']}")
     ax.legend(fontsize=7)
@@ -138,6 +144,35 @@ def shrink(diag: dict, path: str):
     _save(fig, path)
 
 
+def explanation(diag: dict, path: str):
+    """The additive explanation as a waterfall: the identified model's held-out gap, what each added effect
+    removes (its share of the gap's power), what remains; the identification's floor (gap.min_gap) drawn."""
+    steps = diag.get("explanation") or []
+    left = diag.get("remaining_gap") or {}
+    before = diag["where"]["heldout_gap_before"]
+    fig, ax = plt.subplots(figsize=(6.5, 3.4))
+    labels, bottoms, heights, colors = ["identified model"], [0.0], [100 * before], ["0.5"]
+    for s in steps:
+        labels.append(f"+ {s['effect']}\n({100 * s['share']:.0f} % of the power)")
+        bottoms.append(100 * s["heldout_gap_after"])
+        heights.append(100 * (s["heldout_gap_before"] - s["heldout_gap_after"]))
+        colors.append("tab:green")
+    remaining = left.get("heldout_gap", before)
+    labels.append(f"remaining\n({left.get('place', diag['where'].get('place', '?'))})")
+    bottoms.append(0.0)
+    heights.append(100 * remaining)
+    colors.append("tab:red" if not left.get("at_floor") else "tab:blue")
+    x = np.arange(len(labels))
+    ax.bar(x, heights, bottom=bottoms, color=colors, width=0.6)
+    if left.get("floor") is not None:
+        ax.axhline(100 * left["floor"], color="k", ls=":", lw=1, label=f"floor gap.min_gap = {100 * left['floor']:.2g} %")
+        ax.legend(fontsize=8, loc="upper right")
+    ax.set_xticks(x, labels, fontsize=8)
+    ax.set_ylabel("held-out gap (%)")
+    ax.set_title("The held-out gap explained step by step" if steps else "No effect explains the held-out gap materially")
+    _save(fig, path)
+
+
 def all_figures(diagnosis_path: str, gap_path: str, out: dict):
     diag = json.load(open(diagnosis_path))
     ds = xr.open_dataset(gap_path, engine="netcdf4")
@@ -147,4 +182,5 @@ def all_figures(diagnosis_path: str, gap_path: str, out: dict):
     force_state(ds, out["force_state"])
     ranking(diag, out["ranking"])
     shrink(diag, out["shrink"])
+    explanation(diag, out["explanation"])
     ds.close()

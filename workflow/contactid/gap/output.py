@@ -18,6 +18,8 @@ def _clean(x):
         return [_clean(v) for v in x]
     if isinstance(x, (np.floating, float)):
         return None if not math.isfinite(float(x)) else float(x)
+    if isinstance(x, (np.bool_,)):
+        return bool(x)
     if isinstance(x, (np.integer,)):
         return int(x)
     return x

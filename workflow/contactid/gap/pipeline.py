@@ -67,3 +67,46 @@ def rig_records(cfg: Mapping, effects: Mapping, seed: int, cases, random_test: b
         converged[case] = int(truth.attrs["control_converged"])
         out[case] = raw
     return out, converged
+
+
+def structure_update(structure, modal: xr.Dataset, settings):
+    """The base structure (StructureParameters with the chain's k_t, k_n) updated from the random test's modal
+    fit (``contactid.updating``), or None when gap.model_updating is off."""
+    from ..stiction import frequency_sigma
+    from ..updating import update_structure
+
+    if not settings.model_updating:
+        return None
+    f = modal["natural_frequency"].values
+    sigma = frequency_sigma(f, modal["natural_frequency_std"].values, settings.frequency_floor)
+    return update_structure(structure, f, sigma, modal["residue_abs"].values, settings.residue_accuracy,
+                            settings.updating_parameters)
+
+
+def updated_model(model, modal: xr.Dataset, calibration, fit_settings, settings, seed: int, upd=None):
+    """The base model updated from the random test before the candidates (``structure_update``, or ``upd`` when
+    already computed), with the inverse identification and the friction fit redone on the calibration record
+    (``calibration``: its RecordHarmonics). Returns (model to diagnose, UpdatingResult or None when updating is
+    off); the model is the chain's own when the update is not accepted."""
+    import dataclasses
+    import logging
+
+    from .model import NONE
+
+    log = logging.getLogger(__name__)
+    if upd is None:
+        upd = structure_update(model.structure, modal, settings)
+    if upd is None:
+        return model, None
+    factors = ", ".join(f"{k} {v:.4g}" for k, v in upd.factors.items())
+    if not upd.accepted:
+        log.info("model updating: not accepted (chi2 %.3g -> %.3g for %d factors); the chain's structure is kept",
+                 upd.chi2_nominal, upd.chi2_updated, len(upd.factors))
+        return model, upd
+    log.info("model updating: accepted (chi2 %.3g -> %.3g): %s, k_t %.4g, k_n %.4g N/m; friction law refitted",
+             upd.chi2_nominal, upd.chi2_updated, factors, upd.k_t, upd.k_n)
+    m2 = dataclasses.replace(model, structure=upd.structure)
+    forces = identified_forces(m2, NONE, calibration)
+    fit = fit_friction_law(forces.xi, forces.N_dyn, forces.S, calibration.f0, m2.preload, fit_settings, int(seed),
+                           calibration.acceleration.shape[1], intervals=False, label="friction fit after updating")
+    return m2.with_friction(fit.params), upd

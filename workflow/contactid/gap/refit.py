@@ -220,6 +220,7 @@ class Calibration:
     augmentation: Augmentation
     evaluations: int
     friction_misfit: float
+    simulation: SimResult | None = None
 
 
 def evaluate(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, bounds, n_harmonics: int,
@@ -236,9 +237,11 @@ def evaluate(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, bo
 
 
 def calibrate(model: IdentifiedModel, cand: Candidate, rec: RecordHarmonics, settings: FitSettings,
-              n_harmonics: int, max_evaluations: int = 12, start: SimResult | None = None) -> Calibration:
+              n_harmonics: int, max_evaluations: int = 12, start: SimResult | None = None,
+              base: Augmentation = NONE) -> Calibration:
     """theta of ``cand`` minimising the calibration case's gap (friction law refitted at each theta);
-    each simulation starts from the previous one's steady state (``start``: the model's own)."""
+    each simulation starts from the previous one's steady state (``start``: the model's own). ``base``:
+    effects already added (the additive explanation's earlier steps); the candidate's are added to them."""
     bounds = settings.bounds
     n_eval = 0
     cache = {}
@@ -250,7 +253,7 @@ def calibrate(model: IdentifiedModel, cand: Candidate, rec: RecordHarmonics, set
         key = tuple(np.round(np.atleast_1d(theta), 12))
         if key not in cache:
             n_eval += 1
-            aug = cand.augmentation(np.atleast_1d(theta))
+            aug = base.merge(cand.augmentation(np.atleast_1d(theta)))
             try:
                 out = evaluate(model, aug, rec, bounds, n_harmonics, start=last["sim"])
                 last["sim"] = out[2]  # the next theta is a neighbour: start from here
@@ -313,7 +316,7 @@ def calibrate(model: IdentifiedModel, cand: Candidate, rec: RecordHarmonics, set
         theta = np.array([0.0 if p.low <= 0.0 <= p.high else p.low for p in cand.parameters]) \
             if not cand.per_channel else np.zeros_like(np.atleast_1d(theta))
         g, m2, sim, misfit, aug = run(theta)
-    return Calibration(cand.name, np.atleast_1d(theta), np.asarray(m2.friction), g, m2, aug, n_eval, misfit)
+    return Calibration(cand.name, np.atleast_1d(theta), np.asarray(m2.friction), g, m2, aug, n_eval, misfit, sim)
 
 
 def baseline(model: IdentifiedModel, rec: RecordHarmonics, n_harmonics: int) -> tuple[float, SimResult]:

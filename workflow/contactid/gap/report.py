@@ -8,8 +8,33 @@ import pandas as pd
 from ..latex import _fmt, plain_text as _t, tabular
 
 
+def _num(x) -> float:
+    """A diagnosis.json number (null where it was not finite) as a float."""
+    return float("nan") if x is None else float(x)
+
+
 def _pct(x) -> str:
     return "--" if x is None else f"${_fmt(100 * float(x), 3)}$\\,\\%"
+
+
+def explanation_text(diag: dict) -> str:
+    """The additive explanation in words (Fig. gap_explanation)."""
+    steps, left = diag.get("explanation") or [], diag.get("remaining_gap") or {}
+    if not steps:
+        text = (r"No candidate shrinks the held-out gap materially (by gap.min\_reduction $=" +
+                _fmt(left.get("min_reduction", float("nan")), 2) + r"$ of it, beyond the records' scatter), so "
+                r"nothing is added to the identified model. ")
+    else:
+        parts = [_t(s["effect"]) + r" (refitted: " + ", ".join(f"{_t(k)} $= {_fmt(v, 3)}$" for k, v in s["parameters"].items()) +
+                 r") takes the held-out gap from " + _pct(s["heldout_gap_before"]) + " to " + _pct(s["heldout_gap_after"]) +
+                 r" (" + _pct(s["share"]) + r" of its power)" for s in steps]
+        text = r"Added one after the other, each refitted on top of the ones before: " + "; then ".join(parts) + ". "
+    if left:
+        text += (r"What remains is " + _pct(left["heldout_gap"]) + r" (" + _pct(left["share"]) + r" of the power), " +
+                 (r"at the identification's own floor (gap.min\_gap " + _pct(left["floor"]) + ")"
+                  if left["at_floor"] else r"in \emph{" + _t(left["place"]) + r"} (" + _t(left["place_reason"]) + ")") +
+                 r"; Fig.~\ref{fig:gap_explanation}.")
+    return text
 
 
 def gap_section(diag: dict, bench: dict | None) -> str:
@@ -35,11 +60,13 @@ def gap_section(diag: dict, bench: dict | None) -> str:
         "",
         r"\paragraph{Which effect.} Verdict: \textbf{" + _t(diag["verdict"]) + r"} --- " + _t(diag["reason"]) + ".",
         "",
+        r"\paragraph{Step by step.} " + explanation_text(diag),
+        "",
     ]
-    rows = pd.DataFrame([{"effect": r["effect"], "k": r["n_parameters"], "before": 100 * r["heldout_gap_before"],
-                          "after": 100 * r["heldout_gap_after"], "low": 100 * r["heldout_gap_after_interval"][0],
-                          "high": 100 * r["heldout_gap_after_interval"][1], "reduction": 100 * r["reduction"],
-                          "score": r["score"]} for r in diag["ranking"]])
+    rows = pd.DataFrame([{"effect": r["effect"], "k": r["n_parameters"], "before": 100 * _num(r["heldout_gap_before"]),
+                          "after": 100 * _num(r["heldout_gap_after"]), "low": 100 * _num(r["heldout_gap_after_interval"][0]),
+                          "high": 100 * _num(r["heldout_gap_after_interval"][1]), "reduction": 100 * _num(r["reduction"]),
+                          "score": _num(r["score"])} for r in diag["ranking"]])
     out = "\n".join(lines) + "\n"
     if len(rows):
         out += tabular(rows, {"effect": "candidate", "k": "$k$", "before": "before (\\%)", "after": "after (\\%)",
@@ -56,6 +83,9 @@ def gap_section(diag: dict, bench: dict | None) -> str:
             "\\caption{The gap by stage, the candidates ranked, by harmonic and sensor, by part of the cycle and "
             "dissipation in each direction, the held-out gap before and after the two best candidates, and the residual "
             "force-state maps.}\\label{fig:gap}\\end{figure}\n")
+    out += ("\\begin{figure}[H]\\centering\\includegraphics[width=0.7\\textwidth]{gap_explanation.png}"
+            "\\caption{The held-out gap explained step by step: the identified model, what each added effect removes, "
+            "what remains (dotted: the identification's floor).}\\label{fig:gap_explanation}\\end{figure}\n")
     if bench is None:
         out += ("\n\\paragraph{Blind benchmark.} Not built with this report (\\texttt{gap\\_benchmark.in\\_report: "
                 "false}); run \\texttt{snakemake gap\\_benchmark}.\n")

@@ -108,3 +108,28 @@ def verdict(rows: Sequence[Mapping], before: float, scatter: float, place: str, 
                       f"({best['reduction']:.1%}); runner-up {second['effect'] if second else '-'} "
                       f"{second['heldout_gap_after'] if second else float('nan'):.3g}; bootstrap P(better) {p_better:.2f}")
     return verdict, reason
+
+
+def explains_materially(gap: float, after: float, scatter: float, settings) -> bool:
+    """Whether an added effect shrinks what is left of the held-out gap materially: by at least
+    min_reduction of it, and by more than noise_factor x the records' scatter (the additive explanation's
+    stopping rule; gap and after are the held-out gaps before and after the step)."""
+    if not (np.isfinite(gap) and np.isfinite(after)):
+        return False
+    drop = gap - after
+    return bool(drop >= _setting(settings, "min_reduction") * gap and drop > _setting(settings, "noise_factor") * scatter)
+
+
+def at_floor(gap: float, settings) -> bool:
+    """Whether a held-out gap is at the identification's own floor (below min_gap): nothing left to explain."""
+    return bool(gap < _setting(settings, "min_gap"))
+
+
+def gap_shares(before: float, steps_after: Sequence[float]) -> tuple[list, float]:
+    """Shares of the held-out gap's power (its square) removed by each step of the additive explanation, and the
+    share left: they sum to 1. before: the identified model's held-out gap; steps_after: the gap after each step."""
+    shares, prev = [], before
+    for after in steps_after:
+        shares.append(float((prev**2 - after**2) / before**2))
+        prev = after
+    return shares, float(prev**2 / before**2)

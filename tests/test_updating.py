@@ -1,0 +1,58 @@
+"""Model updating of the base structure from the random test's modal data (issue 15), on exact modal data of
+a known structure."""
+
+import numpy as np
+import pytest
+
+from contactid.gap.diagnosis import GapSettings
+from contactid.parameters import structure_from_config
+from contactid.updating import FACTORS, UpdatingResult, apply_factors, modal_predictions, update_structure
+
+
+@pytest.fixture(scope="module")
+def nominal(default_config):
+    return structure_from_config(default_config["structure"], 1.43e7, 2.37e7)
+
+
+def data_of(p, n=3):
+    f, R = modal_predictions(p, n)
+    return f, 0.002 * f, R  # frequencies with 0.2 % standard errors, exact residues
+
+
+@pytest.mark.slow  # two updates (about 5 s each)
+def test_masses_and_stiffness_off_are_found_and_the_lever_arm_is_stated_unbound(nominal):
+    truth = apply_factors(nominal, {"stiffness_scale": 1.03, "transducer_mass_scale": 1.4})
+    f, sd, R = data_of(truth)
+    upd = update_structure(nominal, f, sd, R, residue_accuracy=0.01)
+    assert upd.accepted and upd.chi2_updated < 0.05 * upd.chi2_nominal
+    assert upd.factors["transducer_mass_scale"] == pytest.approx(1.4, rel=0.05)
+    # E and the density trade off (the frequencies see E / rho): their ratio is what the data give
+    assert upd.factors["stiffness_scale"] / upd.factors["mass_scale"] == pytest.approx(1.03, rel=0.01)
+    assert upd.k_t == pytest.approx(1.43e7, rel=0.1)
+    ident = upd.identifiability
+    assert ident["transducer_mass_scale"]["bound_by_data"]
+    assert ident["tangential_lever_arm_scale"]["most_correlated_with"] == "k_t"
+    assert ident["k_t"]["correlation"] < -0.8
+    assert np.allclose(upd.model_frequencies_hz, f, rtol=2e-3)
+    # the summary rebuilds the same structure
+    again = UpdatingResult.from_summary(upd.summary(), nominal)
+    assert again.structure == upd.structure
+
+
+@pytest.mark.slow
+def test_data_of_the_nominal_structure_are_not_updated(nominal):
+    f, sd, R = data_of(nominal)
+    upd = update_structure(nominal, f * (1 + 1e-4), sd, R * (1 + 5e-3), residue_accuracy=0.02)
+    assert not upd.accepted
+    assert upd.structure == nominal.with_contact(upd.k_t, upd.k_n)
+    assert all(v == 1.0 for v in upd.factors.values())
+
+
+def test_updating_settings_and_their_errors():
+    s = GapSettings.from_config({"model_updating": {"parameters": ["transducer_mass_scale"], "residue_accuracy": 0.05}},
+                                1, 25)
+    assert s.model_updating and s.updating_parameters == ("transducer_mass_scale",) and s.residue_accuracy == 0.05
+    assert not GapSettings.from_config({"model_updating": {"enabled": False}}, 1, 25).model_updating
+    assert GapSettings.from_config({}, 1, 25).updating_parameters == tuple(FACTORS)
+    with pytest.raises(ValueError, match="gap.model_updating.parameters: unknown"):
+        GapSettings.from_config({"model_updating": {"parameters": ["youngs"]}}, 1, 25)

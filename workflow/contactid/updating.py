@@ -1,0 +1,201 @@
+"""Model updating of the base (linear) structure from the random test, before contact effects are tried.
+
+The identified model assumes the configured ``structure``; a real rig is a few per cent off everywhere.
+The random test's modal fit gives the natural frequencies f_i (with their standard errors) and the
+magnitudes of the accelerance residues |R_si| = |phi_i(x_s) phi_i(x_d)| / (2 omega_i) (mass-normalised
+shapes at the sensors and the drive point), which carry the mode shapes and the mass scaling, not the
+frequencies alone. Updating fits the stuck contact's k_t, k_n and scale factors of the structure to both,
+as a maximum a posteriori estimate: each structural factor x_j = ln(theta_j / theta_j,nominal) has a
+Gaussian prior N(0, s_j^2) (its plausible spread about the nominal value), so parameters the data do not
+bound stay at their nominal values instead of wandering along a valley.
+
+Identifiability is stated per parameter from the linearised posterior: the posterior standard deviation
+over the prior's (``posterior_over_prior``); a ratio below IDENTIFIED (0.5) means the data bound the
+parameter, otherwise it is set by its prior. The strongest posterior correlation names the parameter it
+trades off against (for example k_t against the tangential lever arm: the frequencies see about
+a^2 k_t k_b / (k_t + k_b)).
+
+The update is accepted only when it lowers the data misfit chi^2 by more than chi^2_k(0.99) for its k
+structural factors (a significant improvement); otherwise the nominal structure is kept.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+from scipy.optimize import least_squares
+from scipy.stats import chi2 as chi2_dist
+
+from .beam_model import assemble, structural_modes
+from .parameters import StructureParameters
+
+IDENTIFIED = 0.5  # posterior sd / prior sd below this: the data bound the parameter
+
+
+@dataclass(frozen=True)
+class StructuralFactor:
+    """A structural parameter of the updating: its name, what it scales, the prior's relative spread s
+    (of ln theta) and how it changes the structure."""
+
+    name: str
+    description: str
+    prior_sd: float
+    apply: Callable[[StructureParameters, float], StructureParameters]
+
+
+def _scale_masses(p: StructureParameters, m: float) -> StructureParameters:
+    return p.replace(sensor_masses=tuple(m * x for x in p.sensor_masses), force_transducer_mass=m * p.force_transducer_mass)
+
+
+def _clamp(p: StructureParameters, m: float) -> StructureParameters:
+    # m scales a clamp compliance of 1 / CLAMP_REFERENCE (N m/rad); m -> 0 is the rigid clamp
+    return p.replace(clamp_rotational_stiffness=CLAMP_REFERENCE / m)
+
+
+CLAMP_REFERENCE = 1.0e5  # N m/rad: a clamp about 700 x stiffer than the beam's EI / L
+
+FACTORS = {f.name: f for f in (
+    StructuralFactor("stiffness_scale", "Young's modulus E (the beam's bending and axial stiffness)", 0.05,
+                     lambda p, m: p.replace(youngs_modulus=m * p.youngs_modulus)),
+    StructuralFactor("mass_scale", "the beam's density", 0.03, lambda p, m: p.replace(density=m * p.density)),
+    StructuralFactor("transducer_mass_scale", "every transducer mass (accelerometers and force transducer)", 0.5,
+                     _scale_masses),
+    StructuralFactor("tangential_lever_arm_scale", "the tangential lever arm (height of the contact line)", 0.1,
+                     lambda p, m: p.replace(tangential_lever_arm=m * p.tangential_lever_arm)),
+)}
+DEFAULT_FACTORS = tuple(FACTORS)
+
+
+@dataclass
+class UpdatingResult:
+    """The update: the factors (name -> multiplier of the nominal value), k_t, k_n (N/m), the updated
+    structure, the data misfit chi^2 before (nominal structure, k_t and k_n refitted) and after, whether the
+    update is accepted, and per parameter its posterior sd over prior sd, whether the data bound it, and the
+    parameter it correlates with most (with the correlation)."""
+
+    factors: dict
+    k_t: float
+    k_n: float
+    structure: StructureParameters
+    chi2_nominal: float
+    chi2_updated: float
+    accepted: bool
+    identifiability: dict = field(default_factory=dict)
+    model_frequencies_hz: np.ndarray | None = None
+    n_data: int = 0
+
+    @classmethod
+    def from_summary(cls, summary: dict, params: StructureParameters) -> "UpdatingResult":
+        """The result written by ``summary`` (model_updating.json), with the structure rebuilt from ``params``
+        (the configured structure) by the same factors, k_t and k_n."""
+        p = apply_factors(params.with_contact(float(summary["k_t"]), float(summary["k_n"])), summary["factors"])
+        return cls(dict(summary["factors"]), float(summary["k_t"]), float(summary["k_n"]), p,
+                   float(summary["chi2_nominal"]), float(summary["chi2_updated"]), bool(summary["accepted"]),
+                   dict(summary["identifiability"]), None, int(summary["n_data"]))
+
+    def summary(self) -> dict:
+        return {"accepted": self.accepted, "factors": dict(self.factors), "k_t": self.k_t, "k_n": self.k_n,
+                "chi2_nominal": self.chi2_nominal, "chi2_updated": self.chi2_updated, "n_data": self.n_data,
+                "identifiability": self.identifiability}
+
+
+def apply_factors(params: StructureParameters, factors: dict) -> StructureParameters:
+    """The structure with each named factor (multiplier of its nominal value) applied."""
+    for name, value in factors.items():
+        params = FACTORS[name].apply(params, float(value))
+    return params
+
+
+def modal_predictions(params: StructureParameters, n_modes: int) -> tuple[np.ndarray, np.ndarray]:
+    """Natural frequencies (Hz) of the first ``n_modes`` structural modes and the residue magnitudes
+    |phi_i(x_s) phi_i(x_d)| / (2 omega_i) (sensor, mode) of the driving-point force's accelerance."""
+    model = assemble(params)
+    modes = structural_modes(model, n_modes)
+    phi_s = model.sensor_vectors @ modes.shapes
+    phi_d = model.force_vector @ modes.shapes
+    w = 2 * np.pi * modes.frequencies_hz
+    return modes.frequencies_hz, np.abs(phi_s * phi_d[None, :]) / (2 * w[None, :])
+
+
+def update_structure(params: StructureParameters, f_id_hz, f_sigma_hz, residues, residue_accuracy: float = 0.02,
+                     factors=DEFAULT_FACTORS, contact_prior_sd: float = 3.0, confidence: float = 0.99) -> UpdatingResult:
+    """Update the structure ``params`` (with its k_t, k_n as the start) to the random test's modal data.
+
+    f_id_hz, f_sigma_hz: (n,) identified natural frequencies and their standard errors (Hz); residues:
+    (n_sensors, n) |R_si| of the modal fit (or None: frequencies alone); residue_accuracy: relative standard
+    error of a residue; factors: names of FACTORS to update; contact_prior_sd: prior sd of ln k_t and
+    ln k_n (wide). See the module's docstring."""
+    f_id = np.asarray(f_id_hz, float)
+    f_sd = np.asarray(f_sigma_hz, float)
+    n = f_id.size
+    R_id = None if residues is None else np.asarray(residues, float)
+    names = [str(f) for f in factors]
+    for f in names:
+        if f not in FACTORS:
+            raise ValueError(f"gap.model_updating.parameters: unknown {f!r}; choose from {', '.join(FACTORS)}")
+    sd = np.array([contact_prior_sd, contact_prior_sd] + [FACTORS[f].prior_sd for f in names])
+    x_nom = np.array([np.log(params.k_t), np.log(params.k_n)] + [0.0] * len(names))
+
+    def structure(x):
+        return apply_factors(params.with_contact(float(np.exp(x[0])), float(np.exp(x[1]))),
+                             {f: float(np.exp(v)) for f, v in zip(names, x[2:])})
+
+    def data_residuals(x):
+        try:
+            f, R = modal_predictions(structure(x), n)
+        except ValueError:
+            return np.full(n + (0 if R_id is None else R_id.size), 1e3)
+        r = [(f - f_id) / f_sd]
+        if R_id is not None:
+            r.append(((R - R_id) / (residue_accuracy * R_id)).ravel())
+        return np.concatenate(r)
+
+    def residuals(x, free):
+        return np.concatenate([data_residuals(x), ((x - x_nom) / sd)[free]])
+
+    def fit(free):
+        def res(z):
+            x = x_nom.copy()
+            x[free] = z
+            return residuals(x, free)
+
+        sol = least_squares(res, x_nom[free], x_scale=sd[free] * 0.1, xtol=1e-10, ftol=1e-12, max_nfev=400)
+        x = x_nom.copy()
+        x[free] = sol.x
+        return x, sol
+
+    contact_only = np.array([True, True] + [False] * len(names))
+    x0, _ = fit(contact_only)  # the nominal structure with k_t, k_n refitted to the same data
+    chi2_nominal = float(np.sum(data_residuals(x0) ** 2))
+    free = np.ones(x_nom.size, bool)
+    x_nom_saved = x_nom.copy()
+    x_nom[:2] = x0[:2]  # start (not prior centre) of the contact parameters
+    x1, sol = fit(free)
+    x_nom = x_nom_saved
+    chi2_updated = float(np.sum(data_residuals(x1) ** 2))
+    accepted = bool(names) and bool(chi2_nominal - chi2_updated > chi2_dist.ppf(confidence, len(names)))
+    # linearised posterior: J of the residuals (data + prior) in x
+    J = sol.jac
+    try:
+        cov = np.linalg.inv(J.T @ J)
+    except np.linalg.LinAlgError:
+        cov = np.linalg.pinv(J.T @ J)
+    post_sd = np.sqrt(np.clip(np.diag(cov), 0, None))
+    corr = cov / np.outer(post_sd, post_sd)
+    labels = ["k_t", "k_n"] + names
+    ident = {}
+    for i, name in enumerate(labels):
+        others = [j for j in range(len(labels)) if j != i]
+        j = max(others, key=lambda j: abs(corr[i, j])) if others else None
+        ratio = float(post_sd[i] / sd[i])
+        ident[name] = {"posterior_sd": float(post_sd[i]), "prior_sd": float(sd[i]), "posterior_over_prior": ratio,
+                       "bound_by_data": bool(ratio < IDENTIFIED),
+                       "most_correlated_with": labels[j] if j is not None else None,
+                       "correlation": float(corr[i, j]) if j is not None else None}
+    x = x1 if accepted else x0
+    f_best, _ = modal_predictions(structure(x), n)
+    return UpdatingResult({f: float(np.exp(v)) for f, v in zip(names, x[2:])}, float(np.exp(x[0])),
+                          float(np.exp(x[1])), structure(x), chi2_nominal, chi2_updated, accepted, ident, f_best,
+                          int(n + (0 if R_id is None else R_id.size)))

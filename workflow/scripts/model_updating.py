@@ -1,0 +1,23 @@
+"""Rule model_updating: the base structure updated from the random test's modal fit (issue 15)."""
+
+import json
+
+from contactid.gap.diagnosis import GapSettings
+from contactid.gap.pipeline import structure_update
+from contactid.io import load_dataset, write_text
+from contactid.logs import setup_logging
+from contactid.parameters import structure_from_config
+
+log = setup_logging(snakemake.log[0])
+p = snakemake.params
+modes = load_dataset(snakemake.input.modes)
+settings = GapSettings.from_config(p.gap, int(p.seed), int(p.n_harmonics))
+structure = structure_from_config(p.structure, float(modes["k_t"]), float(modes["k_n"]))
+upd = structure_update(structure, load_dataset(snakemake.input.modal), settings)
+summary = {"enabled": upd is not None, **(upd.summary() if upd is not None else {})}
+write_text(snakemake.output[0], json.dumps(summary, indent=2, default=float))
+if upd is not None:
+    log.info("model updating %s: chi2 %.3g -> %.3g; %s; not bound by the data: %s",
+             "accepted" if upd.accepted else "not accepted", upd.chi2_nominal, upd.chi2_updated,
+             ", ".join(f"{k} {v:.4g}" for k, v in upd.factors.items()),
+             ", ".join(k for k, v in upd.identifiability.items() if not v["bound_by_data"]) or "none")
