@@ -160,7 +160,13 @@ def test_report_section_is_plain_latex_with_and_without_the_benchmark():
                       "place_reason": "the friction law leaves 1% of S"}}
     bench = {"n_blind": 48, "top1_accuracy": 0.9375, "false_alarms": 0, "n_effect_free": 2,
              "shrink_of_correct": {"min": 0.83, "median": 0.94}, "leave_out": {"n": 8, "verdict_none": 7, "place_right": 8},
-             "diagnosis_seconds": {"median": 53.0}, "per_effect_accuracy": {"viscous_friction": 1.0}}
+             "diagnosis_seconds": {"median": 53.0}, "per_effect_accuracy": {"viscous_friction": 1.0},
+             "compound": {"n": 40, "n_by_effect_count": {"0": 14, "1": 13, "2": 13},
+                          "perturbation_only_no_contact_effect": 0.9, "one_effect_named": 0.8,
+                          "one_effect_no_absent_contact_effect": 0.9, "two_effects_both_named": 0.5,
+                          "two_effects_one_named": 0.9, "remaining_gap_median": 0.005,
+                          "perturbation_only_median_abs_error": {"mu": 0.05, "kappa": 0.2, "e0": 0.1}}}
+    assert "Compound benchmark" in gap_section(diag, bench) and "14 with 0" in gap_section(diag, bench)
     for text in (gap_section(diag, None), gap_section(diag, bench)):
         assert "\\n" not in text.replace("\\newcommand", "")  # no literal backslash-n reaches LaTeX
         assert "30\\%" in text and "tangential\\_contact" in text

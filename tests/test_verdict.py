@@ -254,3 +254,43 @@ def test_material_and_floor_rules():
     assert not V.explains_materially(0.04, 0.01, 0.01, SETTINGS)
     assert not V.explains_materially(0.04, float("inf"), 1e-4, SETTINGS)
     assert V.at_floor(0.0059, SETTINGS) and not V.at_floor(0.006, SETTINGS)
+
+
+# ----------------------------------------------------------------------------------------------
+# the compound benchmark's items and scores (gap.benchmark), on hand-made rows
+# ----------------------------------------------------------------------------------------------
+
+def test_compound_items_are_seeded_and_balanced():
+    from contactid.gap.benchmark import COMPOUND_EFFECTS, RANGES, compound_items
+
+    items = compound_items(6, [1, 2], 7, RANGES)
+    assert len(items) == 12 and items == compound_items(6, [1, 2], 7, RANGES)
+    places = {e: p for p, es in COMPOUND_EFFECTS.items() for e in es}
+    for name, spec in items.items():
+        k = int(name.split("-")[1])
+        assert len(spec["effects"]) == k % 3
+        assert len({places[e] for e in spec["effects"]}) == len(spec["effects"])  # two effects act in two places
+        for e, m in spec["effects"].items():
+            assert RANGES[e][0] <= m <= RANGES[e][1]
+        p = spec["perturbation"]
+        assert abs(p["youngs_modulus"]) <= 0.03 and abs(p["transducer_masses"]) <= 0.4
+        assert abs(p["tangential_lever_arm"]) <= 0.08
+
+
+def test_compound_score_counts_named_effects_against_the_truth():
+    from contactid.gap.benchmark import compound_score
+
+    def row(effects, named, mu=0.01):
+        return {"effects": {e: 1.0 for e in effects}, "updating_accepted": True,
+                "explanation": [{"effect": "model_updating"}] + [{"effect": e} for e in named],
+                "remaining_gap": {"heldout_gap": 0.005}, "friction_errors": {"mu": mu, "kappa": 0.1, "e0": -0.02}}
+
+    rows = [row([], []), row([], ["viscous_friction"]), row([], ["contact_separation"]),  # model form: not a contact effect
+            row(["viscous_friction"], ["viscous_friction"]), row(["viscous_friction"], ["normal_contact_damping"]),
+            row(["viscous_friction", "structural_damping"], ["viscous_friction"])]
+    s = compound_score(rows)
+    assert s["perturbation_only_no_contact_effect"] == pytest.approx(2 / 3)
+    assert s["one_effect_named"] == 0.5 and s["one_effect_no_absent_contact_effect"] == 0.5
+    assert s["two_effects_both_named"] == 0.0 and s["two_effects_one_named"] == 1.0
+    assert s["per_effect"]["viscous_friction"] == {"recall": 2 / 3, "precision": 2 / 3, "true": 3, "named": 3}
+    assert s["perturbation_only_median_abs_error"]["mu"] == pytest.approx(0.01)

@@ -4,7 +4,9 @@ magnitude, diagnosed from their raw records alone, and scored.
 Items (config ``gap_benchmark``): for every effect, ``magnitudes`` random magnitudes in its
 benchmark range for every seed in ``seeds``; one effect-free data set per seed (false alarms);
 and, with ``leave_out``, for every effect one data set at mid-range diagnosed with a library that
-lacks that effect (the verdict must be "none", the localisation must point at the right place).
+lacks that effect (the verdict must be "none", the localisation must point at the right place);
+and ``compound`` items per seed: a rig whose structure, normal law and damping differ from the model's
+at random, with 0, 1 or 2 effects, diagnosed with model updating and scored on the additive explanation.
 """
 
 from __future__ import annotations
@@ -71,6 +73,7 @@ def benchmark_items(cfg: Mapping, seed: int) -> dict:
             lib = [x for x in EFFECTS if x != e]
             items[f"lo_{e}-0-s{seeds[0]}"] = {"effect": e, "magnitude": 0.5 * (lo + hi), "seed": seeds[0],
                                               "library": lib, "kind": "leave_out"}
+    items.update(compound_items(int(cfg.get("compound", 20)), seeds, seed, ranges))
     return items
 
 
@@ -83,9 +86,15 @@ def run_item(spec: Mapping, cfg: Mapping) -> dict:
 
     t0 = time.perf_counter()
     effects = {spec["effect"]: spec["magnitude"]} if spec["effect"] else {}
+    compound = spec["kind"] == "compound"
+    if compound:
+        cfg = compound_config(cfg, spec)
+        effects = dict(spec["effects"])
     cases = sorted(cfg["load_cases"], key=lambda c: int(c[2:]))
     cal = cfg.get("nonlinear", {}).get("calibration_case", "lc1")
     hidden = f"{spec['effect']} at {spec['magnitude']:.4g}" if spec["effect"] else "no effect"
+    if compound:
+        hidden = "perturbed rig with " + (", ".join(f"{e} at {m:.4g}" for e, m in effects.items()) or "no effect")
     log.info("benchmark item (%s, seed %d): %s; making the rig records of %s", spec["kind"], int(spec["seed"]),
              hidden, ", ".join(["random_test", *cases]))
     recs, converged = rig_records(cfg, effects, int(spec["seed"]), cases)
@@ -109,6 +118,21 @@ def run_item(spec: Mapping, cfg: Mapping) -> dict:
                     identified=chain_model, updating=updating)
     t_diag = time.perf_counter() - t1
     by = {r["effect"]: r for r in diag.ranking}
+    if compound:
+        named = [s["effect"] for s in diag.explanation if s["effect"] != "model_updating"]
+        preload = float(cfg["structure"]["preload_n"])
+        row = {**dict(spec), "verdict": diag.verdict, "reason": diag.reason, "explanation": diag.explanation,
+               "remaining_gap": diag.remaining_gap, "named": named, "correct": set(named) == set(effects),
+               "updating_accepted": bool(updating is not None and updating.accepted),
+               "heldout_gap_before": diag.where.get("heldout_gap_identified", diag.where["heldout_gap_before"]),
+               "friction_errors": friction_errors(model, cfg["rig"]["truth"]["friction"], preload),
+               "friction_errors_chain": friction_errors(chain_model, cfg["rig"]["truth"]["friction"], preload),
+               "where": diag.where, "control_converged": converged,
+               "seconds": {"rig": t_rig, "identification": t_id, "diagnosis": time.perf_counter() - t1}}
+        log.info("benchmark item (compound): %s -> explanation %s (remaining gap %.3g), mu error %.2g %%, %.1f s",
+                 hidden, ", ".join(["model_updating"] * row["updating_accepted"] + named) or "none",
+                 diag.remaining_gap["heldout_gap"], 100 * row["friction_errors"]["mu"], time.perf_counter() - t0)
+        return row
     true = spec["effect"]
     expected = "none" if spec["kind"] == "leave_out" else (true or "none")
     log.info("benchmark item (%s): %s -> verdict %s (expected %s: %s), %.1f s in all", spec["kind"], hidden,
@@ -126,6 +150,8 @@ def run_item(spec: Mapping, cfg: Mapping) -> dict:
 
 def score(rows: list) -> dict:
     """Top-1 accuracy, confusion matrix, false alarms, shrink and the leave-out results."""
+    comp = [r for r in rows if r["kind"] == "compound"]
+    rows = [r for r in rows if r["kind"] != "compound"]
     blind = [r for r in rows if r["kind"] == "blind"]
     free = [r for r in rows if r["kind"] == "effect_free"]
     lo = [r for r in rows if r["kind"] == "leave_out"]
@@ -155,6 +181,7 @@ def score(rows: list) -> dict:
                                 for e in labels if e != "none"},
         "diagnosis_seconds": {"median": float(np.median([r["seconds"]["diagnosis"] for r in rows])) if rows else None,
                               "max": float(np.max([r["seconds"]["diagnosis"] for r in rows])) if rows else None},
+        **({"compound": compound_score(comp)} if comp else {}),
     }
 
 
@@ -183,3 +210,112 @@ def confusion_figure(result: dict, path: str) -> None:
     fig.tight_layout()
     fig.savefig(path, dpi=130)
     plt.close(fig)
+
+
+# ------------------------------------------------------------------------------------------
+# compound items: a perturbed rig (its truth is not the model) with 0, 1 or 2 effects
+# ------------------------------------------------------------------------------------------
+
+# the effects a compound item may add (transducer masses are perturbed anyway; contact_separation is a load
+# factor that may keep a perturbed rig from settling), by the place they act
+COMPOUND_EFFECTS = {
+    "tangential_contact": ("viscous_friction", "multi_asperity_friction"),
+    "normal_contact": ("normal_contact_damping",),
+    "structure_or_measurement": ("structural_damping", "channel_time_skew"),
+    "non_stationary": ("preload_drift",),
+}
+# candidates that explain a contact effect (a perturbation-only set must name none of them); contact_separation
+# changes the normal law's shape, which the perturbation's hardening also does, so it counts as model form
+CONTACT_EFFECTS = ("normal_contact_damping", "viscous_friction", "multi_asperity_friction", "preload_drift")
+PERTURBATION = {"youngs_modulus": 0.03, "transducer_masses": 0.4, "tangential_lever_arm": 0.08}
+HARDENING_CUBIC = (2.0e19, 6.0e19)  # N/m^3 of the polynomial hardening N0 - k_n eta - k_3 eta^3
+DAMPING_FORMS = ("modal", "stiffness_proportional", "mass_proportional")
+
+
+def compound_items(n_per_seed: int, seeds, seed: int, ranges: Mapping) -> dict:
+    """{name: spec} of the compound items: item k of each seed perturbs the rig's structure at random (E
+    +-3 %, transducer masses +-40 %, lever arm +-8 %; polynomial hardening on or off; a damping form) and adds
+    k mod 3 effects (two in different places), each at a random magnitude in its benchmark range."""
+    items = {}
+    places = list(COMPOUND_EFFECTS)
+    for s in seeds:
+        for k in range(int(n_per_seed)):
+            rng = generator(seed, f"gap_benchmark/compound/{k}/{s}")
+            pert = {name: float(rng.uniform(-a, a)) for name, a in PERTURBATION.items()}
+            hardening = bool(rng.random() < 0.5)
+            cubic = float(rng.uniform(*HARDENING_CUBIC)) if hardening else 0.0
+            form = DAMPING_FORMS[int(rng.integers(len(DAMPING_FORMS)))]
+            n_eff = k % 3
+            chosen = rng.choice(len(places), size=n_eff, replace=False) if n_eff else []
+            effects = {}
+            for i in chosen:
+                options = COMPOUND_EFFECTS[places[int(i)]]
+                e = options[int(rng.integers(len(options)))]
+                lo, hi = ranges[e]
+                effects[e] = float(rng.uniform(lo, hi))
+            items[f"compound-{k}-s{s}"] = {"kind": "compound", "seed": int(s), "effect": None, "magnitude": 0.0,
+                                           "library": None, "effects": effects, "perturbation": pert,
+                                           "normal_cubic_n_per_m3": cubic, "damping_form": form}
+    return items
+
+
+def compound_config(cfg: Mapping, spec: Mapping) -> dict:
+    """The config of a compound item's rig: rig.true_structure, the normal law and the damping form perturbed
+    as ``spec`` says (the identification keeps ``structure``)."""
+    import copy
+
+    out = copy.deepcopy(dict(cfg))
+    st, p = out["structure"], spec["perturbation"]
+    rig = out["rig"]
+    rig["true_structure"] = {
+        "beam": {"youngs_modulus_pa": st["beam"]["youngs_modulus_pa"] * (1 + p["youngs_modulus"])},
+        "sensors": {"masses_kg": [m * (1 + p["transducer_masses"]) for m in st["sensors"]["masses_kg"]]},
+        "force_transducer_mass_kg": st["force_transducer_mass_kg"] * (1 + p["transducer_masses"]),
+        "contact_geometry": {"tangential_lever_arm_m": st["contact_geometry"]["tangential_lever_arm_m"]
+                             * (1 + p["tangential_lever_arm"])},
+    }
+    if spec["normal_cubic_n_per_m3"]:
+        rig["truth"]["normal"] = {**rig["truth"]["normal"], "exponent": 1.0,
+                                  "cubic_n_per_m3": float(spec["normal_cubic_n_per_m3"])}
+    rig["true_damping"] = {"form": spec["damping_form"], "reference_frequency_hz": 54.4}
+    return out
+
+
+def friction_errors(model, truth_friction: Mapping, preload: float) -> dict:
+    """Relative errors of the model's mu, kappa and e_0 at the preload against the rig's truth."""
+    e_f, k_c, _, kappa, mu = model.friction
+    t = truth_friction
+    e0 = e_f * (1 - np.exp(-k_c * preload / e_f))
+    e0_t = t["e_f_n_per_m"] * (1 - np.exp(-t["k_c_per_m"] * preload / t["e_f_n_per_m"]))
+    return {"mu": float(mu / t["mu"] - 1), "kappa": float(kappa / t["kappa"] - 1), "e0": float(e0 / e0_t - 1)}
+
+
+def compound_score(rows: list) -> dict:
+    """Scores of the compound items (see config/README.md, gap_benchmark.compound)."""
+    def named(r):
+        return {s["effect"] for s in r["explanation"] if s["effect"] != "model_updating"}
+
+    by_n = {n: [r for r in rows if len(r["effects"]) == n] for n in (0, 1, 2)}
+    share = lambda xs: float(np.mean(xs)) if xs else None  # noqa: E731
+    truth_effects = sorted({e for r in rows for e in r["effects"]} | {e for r in rows for e in named(r)})
+    per_effect = {}
+    for e in truth_effects:
+        tp = sum(e in r["effects"] and e in named(r) for r in rows)
+        fn = sum(e in r["effects"] and e not in named(r) for r in rows)
+        fp = sum(e not in r["effects"] and e in named(r) for r in rows)
+        per_effect[e] = {"recall": tp / (tp + fn) if tp + fn else None, "precision": tp / (tp + fp) if tp + fp else None,
+                         "true": tp + fn, "named": tp + fp}
+    errors = {k: [abs(r["friction_errors"][k]) for r in by_n[0]] for k in ("mu", "kappa", "e0")}
+    return {
+        "n": len(rows), "n_by_effect_count": {str(n): len(v) for n, v in by_n.items()},
+        "perturbation_only_no_contact_effect": share([not (named(r) & set(CONTACT_EFFECTS)) for r in by_n[0]]),
+        "one_effect_named": share([set(r["effects"]) <= named(r) for r in by_n[1]]),
+        "one_effect_no_absent_contact_effect": share([not ((named(r) - set(r["effects"])) & set(CONTACT_EFFECTS))
+                                                      for r in by_n[1]]),
+        "two_effects_both_named": share([set(r["effects"]) <= named(r) for r in by_n[2]]),
+        "two_effects_one_named": share([bool(set(r["effects"]) & named(r)) for r in by_n[2]]),
+        "per_effect": per_effect,
+        "remaining_gap_median": float(np.median([r["remaining_gap"]["heldout_gap"] for r in rows])) if rows else None,
+        "updating_accepted": share([bool(r["updating_accepted"]) for r in rows]),
+        "perturbation_only_median_abs_error": {k: float(np.median(v)) if v else None for k, v in errors.items()},
+    }
