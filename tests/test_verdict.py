@@ -294,3 +294,14 @@ def test_compound_score_counts_named_effects_against_the_truth():
     assert s["two_effects_both_named"] == 0.0 and s["two_effects_one_named"] == 1.0
     assert s["per_effect"]["viscous_friction"] == {"recall": 2 / 3, "precision": 2 / 3, "true": 3, "named": 3}
     assert s["perturbation_only_median_abs_error"]["mu"] == pytest.approx(0.01)
+
+
+def test_an_update_that_moves_only_the_transducer_masses_is_the_transducer_mass_error():
+    ident = {f: {"posterior_sd": 0.05} for f in ("stiffness_scale", "mass_scale", "transducer_mass_scale")}
+    assert V.updating_effect({"stiffness_scale": 1.01, "mass_scale": 0.99, "transducer_mass_scale": 1.3},
+                             ident) == "transducer_mass_error"
+    # two factors moved: no single library effect; nothing moved: none
+    assert V.updating_effect({"stiffness_scale": 1.2, "mass_scale": 1.0, "transducer_mass_scale": 1.3}, ident) is None
+    assert V.updating_effect({"stiffness_scale": 1.0, "mass_scale": 1.0, "transducer_mass_scale": 1.1}, ident) is None
+    # the stiffness alone moved: model form without an effect of its own
+    assert V.updating_effect({"stiffness_scale": 1.2, "mass_scale": 1.0, "transducer_mass_scale": 1.0}, ident) is None

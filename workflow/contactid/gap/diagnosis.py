@@ -28,7 +28,8 @@ from .records import RecordHarmonics
 from .refit import (baseline, calibrate, contact_grids, evaluate, gap_residual, gap_value,
                     identified_forces, law_friction_force)
 from .verdict import DRIFT_FACTOR, NORMAL_LIMIT, OPEN_LIMIT, RESIDUAL_FACTOR  # noqa: F401 (thresholds of the place)
-from .verdict import at_floor, explains_materially, gap_shares, open_fraction, place as _place_of
+from .verdict import UPDATING_Z
+from .verdict import at_floor, explains_materially, gap_shares, open_fraction, place as _place_of, updating_effect
 from .verdict import verdict as _verdict
 
 log = logging.getLogger(__name__)
@@ -586,6 +587,15 @@ def diagnose(model: IdentifiedModel, records: Mapping[str, RecordHarmonics], cal
     shares, left_share = gap_shares(first_before, [s["heldout_gap_after"] for s in steps])
     for s, share in zip(steps, shares):
         s["share"] = share
+    if steps and steps[0]["effect"] == "model_updating" and verdict == "none" and shares[0] == max(shares) \
+            and explains_materially(first_before, before, scatter, settings):
+        # the update explains most of the gap: if it amounts to one library effect, that is the verdict
+        effect = updating_effect(updating.factors, updating.identifiability)
+        if effect is not None:
+            verdict = effect
+            reason = (f"model updating ({', '.join(f'{k} {v:.3g}' for k, v in updating.factors.items())}) takes the "
+                      f"held-out gap from {first_before:.3g} to {before:.3g} ({shares[0]:.0%} of its power); only "
+                      f"the {effect.replace('_error', '')} factor moved beyond {UPDATING_Z:g} standard deviations")
     remaining = {"heldout_gap": left, "share": left_share,
                  "at_floor": at_floor(left, settings), "floor": settings.min_gap, "min_reduction": settings.min_reduction,
                  "place": where["place"], "place_reason": where["place_reason"]}

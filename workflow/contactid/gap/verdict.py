@@ -133,3 +133,16 @@ def gap_shares(before: float, steps_after: Sequence[float]) -> tuple[list, float
         shares.append(float((prev**2 - after**2) / before**2))
         prev = after
     return shares, float(prev**2 / before**2)
+
+
+# a structural factor of model updating that is one of the library's effects (the others have no effect of their own)
+UPDATING_EFFECTS = {"transducer_mass_scale": "transducer_mass_error"}
+UPDATING_Z = 3.0  # a factor moved when |ln factor| exceeds this many posterior standard deviations
+
+
+def updating_effect(factors: Mapping[str, float], identifiability: Mapping[str, Mapping]) -> str | None:
+    """The library effect an accepted model update amounts to: when exactly one structural factor moved
+    (|ln factor| > UPDATING_Z posterior sd) and it maps to an effect (UPDATING_EFFECTS), that effect; else None."""
+    moved = [f for f, v in factors.items()
+             if abs(np.log(v)) > UPDATING_Z * max(identifiability[f]["posterior_sd"], 1e-12)]
+    return UPDATING_EFFECTS.get(moved[0]) if len(moved) == 1 else None
