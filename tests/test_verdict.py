@@ -182,10 +182,22 @@ def test_the_checks_come_in_order_drift_structure_opening_normal():
 def test_diagnosis_keeps_its_place_function_and_thresholds():
     from contactid.gap import diagnosis
 
-    summary = {"drift": drift(1.0, 9.0, 12.0)}
-    assert diagnosis._place(summary, quiet_stage(), np.array(ID_RES), np.array(SCATTER), None, 9)[0] == "non_stationary"
     assert (diagnosis.DRIFT_FACTOR, diagnosis.RESIDUAL_FACTOR, diagnosis.NORMAL_LIMIT, diagnosis.OPEN_LIMIT) == \
         (V.DRIFT_FACTOR, V.RESIDUAL_FACTOR, V.NORMAL_LIMIT, V.OPEN_LIMIT)
+
+
+def test_an_unobservable_eta_leaves_the_contact_direction_open():
+    stage = {**quiet_stage(), "contact_force_N": 0.5}  # N-based: would be normal_contact
+    assert place(drift(0.0, 1.0, 1.0), stage, ID_RES, SCATTER)[0] == "normal_contact"
+    name, reason = place(drift(0.0, 1.0, 1.0), stage, ID_RES, SCATTER, eta_observable=False, eta_spread=0.35)
+    assert name == "contact" and "35%" in reason
+    # drift and the structure come first, whatever eta does; an opening contact needs N alone
+    assert place(drift(1.0, 9.0, 12.0), stage, ID_RES, SCATTER, eta_observable=False)[0] == "non_stationary"
+    opening = {**stage, "open_fraction": 0.1}
+    assert place(drift(0.0, 1.0, 1.0), opening, ID_RES, SCATTER, eta_observable=False)[0] == "normal_contact"
+    assert V.acts_where("normal_contact", "contact") and V.acts_where("tangential_contact", "contact")
+    assert not V.acts_where("structure_or_measurement", "contact") and V.acts_where("any", "contact")
+    assert V.acts_where("normal_contact", "normal_contact") and not V.acts_where("normal_contact", "tangential_contact")
 
 
 # ----------------------------------------------------------------------------------------------

@@ -85,6 +85,8 @@ class UpdatingResult:
     identifiability: dict = field(default_factory=dict)
     model_frequencies_hz: np.ndarray | None = None
     n_data: int = 0
+    covariance: list | None = None  # of (ln k_t, ln k_n, ln factors), linearised posterior
+    nominal: StructureParameters | None = None  # the structure the factors multiply
 
     @classmethod
     def from_summary(cls, summary: dict, params: StructureParameters) -> "UpdatingResult":
@@ -93,12 +95,31 @@ class UpdatingResult:
         p = apply_factors(params.with_contact(float(summary["k_t"]), float(summary["k_n"])), summary["factors"])
         return cls(dict(summary["factors"]), float(summary["k_t"]), float(summary["k_n"]), p,
                    float(summary["chi2_nominal"]), float(summary["chi2_updated"]), bool(summary["accepted"]),
-                   dict(summary["identifiability"]), None, int(summary["n_data"]))
+                   dict(summary["identifiability"]), None, int(summary["n_data"]), summary["covariance"], params)
+
+    def posterior_structures(self) -> list:
+        """The structures the random test allows: the update moved by +-1 standard deviation along each principal
+        axis of the linearised posterior of (ln k_t, ln k_n, ln factors), for observability tests (one parameter
+        at a time would leave the data's valley: E alone by its marginal sd moves the frequencies far more
+        than the data allow)."""
+        if self.covariance is None or self.nominal is None:
+            return []
+        cov = np.asarray(self.covariance, float)
+        lam, vec = np.linalg.eigh(cov)
+        x = np.log([self.k_t, self.k_n] + [self.factors[f] for f in self.factors])
+        names = list(self.factors)
+        out = []
+        for lam_i, v in zip(lam, vec.T):
+            for sign in (-1.0, 1.0):
+                y = x + sign * np.sqrt(max(lam_i, 0.0)) * v
+                out.append(apply_factors(self.nominal.with_contact(float(np.exp(y[0])), float(np.exp(y[1]))),
+                                         {f: float(np.exp(val)) for f, val in zip(names, y[2:])}))
+        return out
 
     def summary(self) -> dict:
         return {"accepted": self.accepted, "factors": dict(self.factors), "k_t": self.k_t, "k_n": self.k_n,
                 "chi2_nominal": self.chi2_nominal, "chi2_updated": self.chi2_updated, "n_data": self.n_data,
-                "identifiability": self.identifiability}
+                "identifiability": self.identifiability, "covariance": self.covariance}
 
 
 def apply_factors(params: StructureParameters, factors: dict) -> StructureParameters:
@@ -198,4 +219,4 @@ def update_structure(params: StructureParameters, f_id_hz, f_sigma_hz, residues,
     f_best, _ = modal_predictions(structure(x), n)
     return UpdatingResult({f: float(np.exp(v)) for f, v in zip(names, x[2:])}, float(np.exp(x[0])),
                           float(np.exp(x[1])), structure(x), chi2_nominal, chi2_updated, accepted, ident, f_best,
-                          int(n + (0 if R_id is None else R_id.size)))
+                          int(n + (0 if R_id is None else R_id.size)), cov.tolist(), params)

@@ -162,8 +162,10 @@ def score(rows: list) -> dict:
     correct = [r for r in blind if r["verdict"] == r["effect"]]
     shrink = [r["shrink_true"] for r in correct]
     place_ok = []
-    for r in lo:
-        place_ok.append(r["where"].get("place") == EXPECTED_PLACE[r["effect"]])
+    from .verdict import acts_where
+
+    for r in lo:  # "contact" (eta not observable) is right for a normal or tangential effect, if less specific
+        place_ok.append(acts_where(EXPECTED_PLACE[r["effect"]], r["where"].get("place")))
     return {
         "n_blind": len(blind), "top1_accuracy": len(correct) / max(len(blind), 1),
         "n_effect_free": len(free), "false_alarms": sum(r["verdict"] != "none" for r in free),

@@ -29,7 +29,8 @@ from .refit import (baseline, calibrate, contact_grids, evaluate, gap_residual, 
                     identified_forces, law_friction_force)
 from .verdict import DRIFT_FACTOR, NORMAL_LIMIT, OPEN_LIMIT, RESIDUAL_FACTOR  # noqa: F401 (thresholds of the place)
 from .verdict import UPDATING_Z
-from .verdict import at_floor, explains_materially, gap_shares, open_fraction, place as _place_of, updating_effect
+from .verdict import (acts_where, at_floor, explains_materially, gap_shares, open_fraction, place as _place_of,
+                      updating_effect)
 from .verdict import verdict as _verdict
 
 log = logging.getLogger(__name__)
@@ -43,7 +44,9 @@ class GapSettings:
     must shrink at least this much (relative) for a verdict; separation: the winner's held-out gap
     must be at least this factor below the runner-up's; noise_factor: the gap before must exceed this
     many bootstrap standard deviations of the records' scatter; n_bootstrap: resamples of the
-    record blocks; seed; model_updating: update the base structure from the random test before the candidates
+    record blocks; seed; eta_observability_limit: the normal motion eta counts as observable when it moves by at
+    most this (relative) over the structures the random test allows (``eta_model_spread``), else the place cannot be the normal
+    or the tangential contact alone; model_updating: update the base structure from the random test before the candidates
     (``contactid.updating``; updating_parameters the structural factors, residue_accuracy the residues' relative
     standard error, frequency_floor the relative model-form uncertainty added to each frequency)."""
 
@@ -58,6 +61,7 @@ class GapSettings:
     seed: int = 0
     max_evaluations: int = 10
     model_updating: bool = True
+    eta_observability_limit: float = 0.1
     updating_parameters: tuple = ("stiffness_scale", "mass_scale", "transducer_mass_scale", "tangential_lever_arm_scale")
     residue_accuracy: float = 0.02
     frequency_floor: float = 0.001
@@ -78,6 +82,7 @@ class GapSettings:
                 separation=float(g.get("separation", d.separation)), noise_factor=float(g.get("noise_factor", d.noise_factor)),
                 n_bootstrap=int(g.get("n_bootstrap", d.n_bootstrap)), seed=int(seed),
                 max_evaluations=int(g.get("max_evaluations", d.max_evaluations)),
+                eta_observability_limit=float(g.get("eta_observability_limit", d.eta_observability_limit)),
                 **_updating_settings(g.get("model_updating"), d))
         if not 0.0 < s.min_reduction < 1.0:
             raise ValueError(f"gap.min_reduction = {s.min_reduction}: give a fraction in (0, 1)")
@@ -133,7 +138,7 @@ def cycle_parts(g: dict, k_t: float) -> dict:
 
 
 def localise(model: IdentifiedModel, records: dict, sims: dict, n_harmonics: int, linear: dict | None = None,
-             aug: Augmentation = NONE) -> tuple[dict, dict]:
+             aug: Augmentation = NONE, eta_limit: float = 0.1, structures=()) -> tuple[dict, dict]:
     """The gap by stage, sensor, harmonic, part of the cycle and load level (the identified model
     as the chain left it, or with the effects ``aug`` added). Returns (summary for diagnosis.json, arrays for
     gap.nc)."""
@@ -236,8 +241,15 @@ def localise(model: IdentifiedModel, records: dict, sims: dict, n_harmonics: int
     }
     summary["identification_residual"] = {c: v for c, v in zip(cases, id_res)}
     summary["identification_noise"] = {c: v for c, v in zip(cases, scatter)}
-    summary["place"], summary["place_reason"] = _place(summary, stage, np.array(id_res), np.array(scatter),
-                                                       records, H)
+    spread = {c: eta_model_spread(model, aug, records[c], structures) for c in cases}
+    finite = [v for v in spread.values() if np.isfinite(v)]
+    worst = max(finite) if finite else float("nan")
+    summary["eta_observability"] = {"model_spread": spread, "limit": eta_limit,
+                                    "observable": bool(not finite or worst <= eta_limit)}
+    summary["place"], summary["place_reason"] = _place_of(summary["drift"], stage, np.array(id_res), np.array(scatter),
+                                                          summary["eta_observability"]["observable"], worst)
+    if not summary["eta_observability"]["observable"]:
+        summary["direction"] = "unresolved"  # the normal direction's numbers rest on an unobservable eta
     return summary, arrays
 
 
@@ -264,12 +276,26 @@ def identification_noise(model: IdentifiedModel, rec: RecordHarmonics) -> float:
     return float(np.std(r) / np.sqrt(len(r)))
 
 
+def eta_model_spread(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, structures) -> float:
+    """How far the identified normal motion eta moves over the structures the data allow: the largest relative
+    change (norm over the harmonics) of eta identified with each of ``structures`` (the model's structure moved
+    by one posterior standard deviation of each updated parameter, ``updating.posterior_structures``) against
+    eta with the model's own. The k_t, k_n intervals alone (the chain's test) miss the structure's own
+    uncertainty. NaN without structures."""
+    import dataclasses
+
+    if not structures:
+        return float("nan")
+    full = identified_forces(model, aug, rec).eta
+    out = 0.0
+    for p in structures:
+        other = identified_forces(dataclasses.replace(model, structure=p), aug, rec).eta
+        out = max(out, float(np.linalg.norm(other - full) / max(np.linalg.norm(full), 1e-300)))
+    return out
+
+
 # the place's thresholds (DRIFT_FACTOR, RESIDUAL_FACTOR, NORMAL_LIMIT, OPEN_LIMIT) and its logic live in
 # verdict.py (pure functions, unit-tested in tests/test_verdict.py); they stay importable from here
-
-def _place(summary, stage, id_res, scatter, records=None, H=None) -> tuple[str, str]:
-    """The localisation's place and reason (``verdict.place`` on the summary's drift)."""
-    return _place_of(summary["drift"], stage, id_res, scatter)
 
 
 def linear_stage(model: IdentifiedModel, frf: xr.Dataset, modal: xr.Dataset) -> dict:
@@ -499,7 +525,9 @@ def diagnose(model: IdentifiedModel, records: Mapping[str, RecordHarmonics], cal
     candidate_results = _candidates(names, workers, model=model, records=records, calibration_case=calibration_case,
                                     score_cases=score_cases, base_sims=base_sims, fit_settings=fit_settings, H=H,
                                     max_evaluations=settings.max_evaluations)
-    where, arrays = localise(model, dict(records), base_sims, H, linear)
+    structures = tuple(updating.posterior_structures()) if updating is not None else ()
+    where, arrays = localise(model, dict(records), base_sims, H, linear, eta_limit=settings.eta_observability_limit,
+                             structures=structures)
     results = candidate_results()
     # bootstrap over record blocks: the sims are fixed, the records resampled
     rng = generator(settings.seed, "gap/bootstrap")
@@ -537,7 +565,7 @@ def diagnose(model: IdentifiedModel, records: Mapping[str, RecordHarmonics], cal
         acts_on = LIBRARY[name].acts_on
         # a winner must act where the localisation puts the gap; the structure/sensor misfit left by the
         # candidate (res_after, against the noise level) is reported beside it
-        consistent = acts_on in ("any", where["place"])
+        consistent = acts_where(acts_on, where["place"])
         score = n_data * np.log(after**2 / before**2) + 2 * k if np.isfinite(after) else np.inf
         red_b = 1 - after_b / before_b
         rows.append({"effect": name, "heldout_gap_before": before, "heldout_gap_after": after, "score": float(score),
@@ -603,7 +631,8 @@ def diagnose(model: IdentifiedModel, records: Mapping[str, RecordHarmonics], cal
         cal, sims = last
         all_sims = {c: (cal.simulation if c == calibration_case else sims[c]) for c in cases}
         if all(s is not None for s in all_sims.values()):
-            where_left, _ = localise(cal.model, dict(records), all_sims, H, linear, aug=cal.augmentation)
+            where_left, _ = localise(cal.model, dict(records), all_sims, H, linear, aug=cal.augmentation,
+                                     eta_limit=settings.eta_observability_limit, structures=structures)
             remaining["place"] = where_left["place"]
             remaining["place_reason"] = where_left["place_reason"]
     diag = Diagnosis(verdict, reason, rows, where, calibration_case, held, arrays,

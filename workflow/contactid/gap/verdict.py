@@ -26,7 +26,14 @@ def open_fraction(normal_force, preload: float) -> float:
     return float(np.mean(np.asarray(normal_force) <= OPEN_LIMIT * preload))
 
 
-def place(drift: Mapping[str, Mapping], stage: Mapping[str, float], id_res, scatter) -> tuple[str, str]:
+def acts_where(acts_on: str, place: str) -> bool:
+    """Whether a candidate acting on ``acts_on`` acts where the gap lies: the same place, "any", or either
+    contact direction when the place is "contact" (the normal motion not observable)."""
+    return acts_on in ("any", place) or (place == "contact" and acts_on in ("normal_contact", "tangential_contact"))
+
+
+def place(drift: Mapping[str, Mapping], stage: Mapping[str, float], id_res, scatter,
+          eta_observable: bool = True, eta_spread: float = 0.0) -> tuple[str, str]:
     """Where the gap lies, with the reason: (place, reason).
 
     drift: per load case {"change": relative change over the record, "z": its size in standard errors};
@@ -34,7 +41,10 @@ def place(drift: Mapping[str, Mapping], stage: Mapping[str, float], id_res, scat
     id_res, scatter: per load case, the inverse identification's sensor misfit and its standard error.
     The first that holds of: the records drift (median z > DRIFT_FACTOR) -> "non_stationary"; the
     structure and sensor model misfits the records (median id_res / scatter > RESIDUAL_FACTOR) ->
-    "structure_or_measurement"; the contact opens, or no elastic normal law fits (contact_force_N >
+    "structure_or_measurement"; the contact opens (the identified N, observable, reaches zero) ->
+    "normal_contact"; the normal motion eta is not observable (``eta_observable`` False: the identified eta
+    moves by ``eta_spread`` over the structures the data allow), so the normal law cannot be tested and the
+    directions cannot be told apart -> "contact"; no elastic normal law fits N(eta) (contact_force_N >
     NORMAL_LIMIT) -> "normal_contact"; otherwise "tangential_contact"."""
     id_res, scatter = np.asarray(id_res, float), np.asarray(scatter, float)
     z = np.array([v["z"] for v in drift.values()])
@@ -49,6 +59,10 @@ def place(drift: Mapping[str, Mapping], stage: Mapping[str, float], id_res, scat
     if stage["open_fraction"] > 0:
         return "normal_contact", (f"the identified normal force falls to zero over {stage['open_fraction']:.0%} of the "
                                   "cycle in the hardest load case: the contact opens")
+    if not eta_observable:
+        return "contact", (f"the identified normal motion eta is not observable (it moves by {eta_spread:.0%} over "
+                           "the structures the random test allows), so no normal law can be tested against it and the "
+                           "normal and the tangential contact cannot be told apart")
     if stage["contact_force_N"] > NORMAL_LIMIT:
         return "normal_contact", (f"no elastic normal law fits the identified N(eta): {stage['contact_force_N']:.0%} "
                                   "of N is left (dissipation or opening in the normal direction)")
