@@ -15,8 +15,8 @@ parameter, otherwise it is set by its prior. The strongest posterior correlation
 trades off against (for example k_t against the tangential lever arm: the frequencies see about
 a^2 k_t k_b / (k_t + k_b)).
 
-The update is accepted only when it lowers the data misfit chi^2 by more than chi^2_k(0.99) for its k
-structural factors (a significant improvement); otherwise the nominal structure is kept.
+The update is accepted only when it lowers the data misfit chi^2 by more than chi^2_k(confidence) (0.95 by
+default) for its k structural factors (a significant improvement); otherwise the nominal structure is kept.
 """
 
 from __future__ import annotations
@@ -140,14 +140,15 @@ def modal_predictions(params: StructureParameters, n_modes: int) -> tuple[np.nda
     return modes.frequencies_hz, np.abs(phi_s * phi_d[None, :]) / (2 * w[None, :])
 
 
-def update_structure(params: StructureParameters, f_id_hz, f_sigma_hz, residues, residue_accuracy: float = 0.02,
-                     factors=DEFAULT_FACTORS, contact_prior_sd: float = 3.0, confidence: float = 0.99) -> UpdatingResult:
+def update_structure(params: StructureParameters, f_id_hz, f_sigma_hz, residues, residue_accuracy: float = 0.01,
+                     factors=DEFAULT_FACTORS, contact_prior_sd: float = 3.0, confidence: float = 0.95) -> UpdatingResult:
     """Update the structure ``params`` (with its k_t, k_n as the start) to the random test's modal data.
 
     f_id_hz, f_sigma_hz: (n,) identified natural frequencies and their standard errors (Hz); residues:
     (n_sensors, n) |R_si| of the modal fit (or None: frequencies alone); residue_accuracy: relative standard
     error of a residue; factors: names of FACTORS to update; contact_prior_sd: prior sd of ln k_t and
-    ln k_n (wide). See the module's docstring."""
+    ln k_n (wide); confidence: the update is accepted when chi^2 drops by more than chi^2_k(confidence). See the
+    module's docstring."""
     f_id = np.asarray(f_id_hz, float)
     f_sd = np.asarray(f_sigma_hz, float)
     n = f_id.size

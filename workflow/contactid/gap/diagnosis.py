@@ -48,7 +48,8 @@ class GapSettings:
     most this (relative) over the structures the random test allows (``eta_model_spread``), else the place cannot be the normal
     or the tangential contact alone; model_updating: update the base structure from the random test before the candidates
     (``contactid.updating``; updating_parameters the structural factors, residue_accuracy the residues' relative
-    standard error, frequency_floor the relative model-form uncertainty added to each frequency)."""
+    standard error, frequency_floor the relative model-form uncertainty added to each frequency,
+    updating_confidence the significance an update needs to be accepted)."""
 
     n_harmonics: int = 9
     identification_harmonics: int = 25
@@ -63,8 +64,9 @@ class GapSettings:
     model_updating: bool = True
     eta_observability_limit: float = 0.1
     updating_parameters: tuple = ("stiffness_scale", "mass_scale", "transducer_mass_scale", "tangential_lever_arm_scale")
-    residue_accuracy: float = 0.02
+    residue_accuracy: float = 0.01
     frequency_floor: float = 0.001
+    updating_confidence: float = 0.95
 
     @classmethod
     def from_config(cls, gap_cfg: Mapping | None, seed: int, n_harmonics_id: int) -> "GapSettings":
@@ -107,6 +109,7 @@ def _updating_settings(block, d: "GapSettings") -> dict:
         raise ValueError(f"gap.model_updating.parameters: unknown {unknown}; choose from {', '.join(FACTORS)}")
     return {"model_updating": bool(b.get("enabled", True)), "updating_parameters": params,
             "residue_accuracy": float(b.get("residue_accuracy", d.residue_accuracy)),
+            "updating_confidence": float(b.get("confidence", d.updating_confidence)),
             "frequency_floor": float(b.get("frequency_floor", d.frequency_floor))}
 
 
