@@ -99,6 +99,13 @@ def run_item(spec: Mapping, cfg: Mapping) -> dict:
              hidden, ", ".join(["random_test", *cases]))
     recs, converged = rig_records(cfg, effects, int(spec["seed"]), cases)
     t_rig = time.perf_counter() - t0
+    bad = [n for n, ds in recs.items() if not (np.isfinite(ds["acceleration"].values).all()
+                                               and np.isfinite(ds["force"].values).all())]
+    if bad:  # the rig could not simulate this data set: say so, score it apart
+        log.warning("benchmark item (%s): the rig's records of %s are not finite; not diagnosed", spec["kind"],
+                    ", ".join(bad))
+        return {**dict(spec), "failed": f"rig records not finite: {', '.join(bad)}", "verdict": None,
+                "correct": False, "control_converged": converged, "seconds": {"rig": t_rig}}
     log.info("rig records made in %.1f s; identifying the model", t_rig)
     model, modes, modal, frf = identify(cfg, recs["random_test"], recs[cal])
     K = int(cfg.get("nonlinear", {}).get("n_harmonics", 25))
@@ -150,6 +157,8 @@ def run_item(spec: Mapping, cfg: Mapping) -> dict:
 
 def score(rows: list) -> dict:
     """Top-1 accuracy, confusion matrix, false alarms, shrink and the leave-out results."""
+    failed = [r for r in rows if r.get("failed")]
+    rows = [r for r in rows if not r.get("failed")]
     comp = [r for r in rows if r["kind"] == "compound"]
     rows = [r for r in rows if r["kind"] != "compound"]
     blind = [r for r in rows if r["kind"] == "blind"]
@@ -184,6 +193,7 @@ def score(rows: list) -> dict:
         "diagnosis_seconds": {"median": float(np.median([r["seconds"]["diagnosis"] for r in rows])) if rows else None,
                               "max": float(np.max([r["seconds"]["diagnosis"] for r in rows])) if rows else None},
         **({"compound": compound_score(comp)} if comp else {}),
+        "failed": [{k: r.get(k) for k in ("kind", "effect", "effects", "seed", "failed")} for r in failed],
     }
 
 

@@ -380,6 +380,15 @@ class DualSineSimulator:
         out["v"] = out_v
         return out
 
+    def snapshot(self) -> tuple:
+        """The integrator's state (to return to with ``restore``)."""
+        return (self.z.copy(), self.v.copy(), self.state.copy(), self.x_sl.copy(), self.t, self.drift_rate, self.drift_t0)
+
+    def restore(self, snap: tuple) -> None:
+        z, v, state, x_sl, t, rate, t0 = snap
+        self.z[:], self.v[:], self.state[:], self.x_sl[:] = z, v, state, x_sl
+        self.t, self.drift_rate, self.drift_t0 = t, rate, t0
+
     def settle(self, F1, F3, w: float, chunk_periods: int = 8, tol: float = 1e-4,
                min_chunks: int = 3, max_chunks: int = 200) -> tuple[np.ndarray, SteadyStateLog, bool]:
         """Run chunks of ``chunk_periods`` periods until the driving-point harmonics
@@ -421,7 +430,9 @@ def control_response(sim: DualSineSimulator, target_a1: float, target_a3: float,
                      max_iter: int = 40) -> ControlResult:
     """Tune F1, F3 until the driving-point acceleration harmonics at w and 3w
     equal the targets within ``tol`` (relative): Broyden's method on
-    (F1, F3) -> (|A1|, |A3|), started from the stuck linear system's FRF."""
+    (F1, F3) -> (|A1|, |A3|), started from the stuck linear system's FRF. A trial force whose response is
+    not finite (violent impacts beyond what the explicit integrator resolves) is halved back towards the last
+    force that gave a finite response, from that force's state."""
     import logging
 
     progress = logging.getLogger(__name__)
@@ -433,10 +444,22 @@ def control_response(sim: DualSineSimulator, target_a1: float, target_a3: float,
     history = []
     prev = None
     log = None
+    good = None  # (F, simulator state) of the last finite response
     for it in range(max_iter):
         c, log, ok = sim.settle(F[0], F[1], w)
         A = np.abs(c)
         history.append((float(F[0]), float(F[1]), float(A[0]), float(A[1]), bool(ok)))
+        if not np.all(np.isfinite(A)) or not np.all(np.isfinite(sim.z)):
+            progress.info("response control %d: F1 = %.4g N, F3 = %.4g N -> the response is not finite; halving the "
+                          "step back", it + 1, F[0], F[1])
+            if good is None:
+                F = 0.5 * F
+                sim.start_from_linear(F[0], F[1], w)
+            else:
+                F = 0.5 * (F + good[0])
+                sim.restore(good[1])
+            continue
+        good = (F.copy(), sim.snapshot())
         r = A - target
         progress.info("response control %d: F1 = %.4g N, F3 = %.4g N -> A1 = %.4g (target %.4g), A3 = %.4g "
                       "(target %.4g) m/s^2%s", it + 1, F[0], F[1], A[0], target[0], A[1], target[1],
