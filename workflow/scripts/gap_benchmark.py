@@ -10,8 +10,12 @@ from contactid.logs import setup_logging
 log = setup_logging(snakemake.log[0])
 rows = [json.load(open(path)) for path in snakemake.input.rows]
 result = score(rows)
-result["items"] = [{k: r[k] for k in ("item", "effect", "magnitude", "seed", "kind", "verdict", "shrink_true",
-                                      "heldout_gap_before", "seconds")} for r in rows]
+# one line per item: the single-effect items' shrink, the compound items' effects and explanation, a failure's reason
+KEYS = {"blind": ("shrink_true",), "effect_free": ("shrink_true",), "leave_out": ("shrink_true",),
+        "compound": ("effects", "named", "updating_accepted", "friction_errors")}
+result["items"] = [{k: r[k] for k in ("item", "effect", "magnitude", "seed", "kind", "verdict", "seconds",
+                                      *(("failed",) if r.get("failed") else ("heldout_gap_before", *KEYS[r["kind"]])))}
+                   for r in rows]
 write_text(snakemake.output.summary, json.dumps(_clean(result), indent=2))
 labels = list(result["confusion"])
 cols = sorted({c for row in result["confusion"].values() for c in row}, key=lambda c: (c == "none", c))
