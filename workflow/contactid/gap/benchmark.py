@@ -295,10 +295,12 @@ def compound_config(cfg: Mapping, spec: Mapping) -> dict:
 
 def friction_errors(model, truth_friction: Mapping, preload: float) -> dict:
     """Relative errors of the model's mu, kappa and e_0 at the preload against the rig's truth."""
+    from ..contact_laws import stiction_shear_stiffness
+
     e_f, k_c, _, kappa, mu = model.friction
     t = truth_friction
-    e0 = e_f * (1 - np.exp(-k_c * preload / e_f))
-    e0_t = t["e_f_n_per_m"] * (1 - np.exp(-t["k_c_per_m"] * preload / t["e_f_n_per_m"]))
+    e0 = stiction_shear_stiffness(preload, e_f, k_c)
+    e0_t = stiction_shear_stiffness(preload, t["e_f_n_per_m"], t["k_c_per_m"])
     return {"mu": float(mu / t["mu"] - 1), "kappa": float(kappa / t["kappa"] - 1), "e0": float(e0 / e0_t - 1)}
 
 

@@ -19,6 +19,7 @@ import numpy as np
 import xarray as xr
 
 from ..beam_model import all_modes, structural_modes
+from ..contact_laws import stiction_shear_stiffness
 from ..identification import modal_damping_vector
 from ..friction_fit import FitSettings
 from ..random_streams import generator
@@ -97,12 +98,10 @@ class GapSettings:
 
 
 def _updating_settings(block, d: "GapSettings") -> dict:
-    """GapSettings fields of the config block gap.model_updating (false = off; a block = on with its settings)."""
-    if block is False or block is None and not d.model_updating:
-        return {"model_updating": False}
-    b = {} if block in (None, True) else dict(block)
+    """GapSettings fields of the config block gap.model_updating (absent: the defaults)."""
     from ..updating import FACTORS
 
+    b = dict(block or {})
     params = tuple(b.get("parameters", d.updating_parameters))
     unknown = [x for x in params if x not in FACTORS]
     if unknown:
@@ -606,7 +605,7 @@ def diagnose(model: IdentifiedModel, records: Mapping[str, RecordHarmonics], cal
         # the friction law the candidates start from (refitted with the updated structure when accepted)
         e_f, k_c, e_t, kappa, mu = model.friction
         where["model_updating"]["friction"] = {"e_f": e_f, "k_c": k_c, "e_t": e_t, "kappa": kappa, "mu": mu,
-                                               "e0_at_preload": e_f * (1 - np.exp(-k_c * model.preload / e_f))}
+                                               "e0_at_preload": float(stiction_shear_stiffness(model.preload, e_f, k_c))}
     if identified is not None and updating is not None and updating.accepted:
         id_sims = {c: baseline(identified, records[c], H)[1] for c in score_cases}
         first_before = heldout_gap(id_sims)

@@ -61,22 +61,26 @@ def contact_parameters(structure_cfg: Mapping, rig_cfg: Mapping) -> ContactParam
 
 
 def normal_tangent_ratio(contact: ContactParameters, k_n: float, load: float) -> float:
-    """The normal law's tangent stiffness where the compression reaches ``load`` x N0, over k_n (>= 1): the power
-    law's and the cubic hardening's, found by bisection on the compression."""
-    n0, d0, p, k3 = contact.preload, contact.static_approach, contact.exponent, contact.cubic
+    """The normal law's tangent stiffness where the compression reaches ``load`` x N0, over k_n (>= 1): the
+    integrator's law and the harmonic balance's tangent of it (``_normal_path``), at the compression found by
+    ``brentq``."""
+    from scipy.optimize import brentq
 
-    def force(c):  # compression c = -eta > 0
-        return n0 * ((d0 + c) / d0) ** p + k3 * c**3
+    from .harmonic_balance import _normal_path
 
-    lo, hi = 0.0, d0
-    while force(hi) < load * n0:
+    c = contact
+
+    def normal(eta):  # N (N) and dN/deta (N/m) of the elastic law
+        N, dN, dNd = np.empty(1), np.empty(1), np.empty(1)
+        _normal_path(np.array([eta]), np.zeros(1), c.preload, c.static_approach, c.exponent, c.cubic, 0.0, True,
+                     N, dN, dNd)
+        return N[0], dN[0]
+
+    hi = c.static_approach  # compression -eta; doubled until N passes load x N0
+    while normal(-hi)[0] < load * c.preload:
         hi *= 2.0
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if force(mid) < load * n0 else (lo, mid)
-    c = 0.5 * (lo + hi)
-    tangent = p * n0 / d0 * ((d0 + c) / d0) ** (p - 1) + 3 * k3 * c**2
-    return max(1.0, tangent / k_n)
+    eta = -brentq(lambda x: normal(-x)[0] - load * c.preload, 0.0, hi, xtol=1e-15)
+    return max(1.0, -normal(eta)[1] / k_n)
 
 
 def build_simulator(structure_cfg: Mapping, rig_cfg: Mapping, settings: Mapping, n_modes: int | None = None,
