@@ -165,8 +165,17 @@ def test_report_section_is_plain_latex_with_and_without_the_benchmark():
                           "perturbation_only_no_contact_effect": 0.9, "one_effect_named": 0.8,
                           "one_effect_no_absent_contact_effect": 0.9, "two_effects_both_named": 0.5,
                           "two_effects_one_named": 0.9, "remaining_gap_median": 0.005,
-                          "perturbation_only_median_abs_error": {"mu": 0.05, "kappa": 0.2, "e0": 0.1}}}
+                          "perturbation_only_median_abs_error": {"mu": 0.05, "kappa": 0.2, "e0": 0.1},
+                          "perturbation_only_interval_coverage": {"mu": 1.0, "kappa": 0.9286, "e0": 1.0},
+                          "perturbation_only_median_interval_halfwidth": {"mu": 0.16, "kappa": 0.6, "e0": 0.37}}}
     assert "Compound benchmark" in gap_section(diag, bench) and "14 with 0" in gap_section(diag, bench)
+    assert "$\\kappa$ $92.9$\\,\\%" in gap_section(diag, bench)  # interval coverage, three digits
+    par = {n: {"value": 0.4, "profile_interval": [0.39, 0.41], "sd_cases": 0.01, "sd_structure": 0.08,
+               "interval": [0.33, 0.48], "scale": "log"} for n in ("e_f", "k_c", "e_t", "kappa", "mu", "e0")}
+    intervals = {"model": "updated", "n_structures": 12, "parameters": {**par, "confidence": 0.95}}
+    text = gap_section(diag, None, intervals)
+    assert "model-form uncertainty" in text and "e\\_0 at N\\_0" in text and "$0.48" in text
+    assert "\\n" not in text.replace("\\newcommand", "")
     for text in (gap_section(diag, None), gap_section(diag, bench)):
         assert "\\n" not in text.replace("\\newcommand", "")  # no literal backslash-n reaches LaTeX
         assert "30\\%" in text and "tangential\\_contact" in text

@@ -56,3 +56,21 @@ def test_updating_settings_and_their_errors():
     assert GapSettings.from_config({}, 1, 25).updating_parameters == tuple(FACTORS)
     with pytest.raises(ValueError, match="gap.model_updating.parameters: unknown"):
         GapSettings.from_config({"model_updating": {"parameters": ["youngs"]}}, 1, 25)
+
+
+def test_prior_sd_setting_is_checked_and_named():
+    s = GapSettings.from_config({"model_updating": {"prior_sd": {"tangential_lever_arm_scale": 0.01}}}, 1, 25)
+    assert s.updating_prior_sd == (("tangential_lever_arm_scale", 0.01),)
+    with pytest.raises(ValueError, match="prior_sd: unknown factor 'lever'"):
+        GapSettings.from_config({"model_updating": {"prior_sd": {"lever": 0.01}}}, 1, 25)
+    with pytest.raises(ValueError, match=r"prior_sd.mass_scale = '3%'.*for example 0.02"):
+        GapSettings.from_config({"model_updating": {"prior_sd": {"mass_scale": "3%"}}}, 1, 25)
+
+
+@pytest.mark.slow  # one update (about 5 s)
+def test_a_measured_lever_arm_prior_sets_its_posterior(nominal):
+    f, sd, R = data_of(nominal)
+    upd = update_structure(nominal, f, sd, R, residue_accuracy=0.01, prior_sd={"tangential_lever_arm_scale": 0.01})
+    lever = upd.identifiability["tangential_lever_arm_scale"]
+    assert lever["prior_sd"] == 0.01 and lever["posterior_sd"] <= 0.01
+    assert upd.identifiability["stiffness_scale"]["prior_sd"] == FACTORS["stiffness_scale"].prior_sd

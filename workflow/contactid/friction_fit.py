@@ -204,11 +204,12 @@ def _polish(problem: _Problem, u0, fixed: dict | None = None):
 
 def fit_friction_law(coef_xi, coef_n, coef_s, f0: float, preload: float, settings: FitSettings, seed: int,
                      n_harmonics_data: int | None = None, intervals: bool = True,
-                     label: str = "friction fit") -> FitResult:
+                     label: str = "friction fit", start=None) -> FitResult:
     """GA + polish on the calibration case's xi, N (total = preload + dynamic) and S harmonics,
     with the grid refined until the parameters move by less than ``refine_tolerance``; then the
     profile-likelihood intervals (skipped with ``intervals`` False: NaN intervals). ``label`` starts
-    the progress lines it logs."""
+    the progress lines it logs. ``start`` (the 5 parameters) skips the GA: the polish starts there (a refit of
+    a known optimum on other forces, for example the model-form spread of ``contactid.gap.uncertainty``)."""
     K = np.atleast_2d(coef_s).shape[1] if n_harmonics_data is None else n_harmonics_data
     m = settings.grid_points
     history = []
@@ -220,7 +221,9 @@ def fit_friction_law(coef_xi, coef_n, coef_s, f0: float, preload: float, setting
         n = preload + periodic_grid(coef_n, f0, m)[0]
         s = periodic_grid(coef_s, f0, m)[0]
         problem = _Problem(xi, n, s, settings.bounds, settings.regularization)
-        if u_best is None:
+        if u_best is None and start is not None:
+            u_best = np.clip(problem.unit(np.asarray(start, float))[0], 0.0, 1.0)
+        elif u_best is None:
             u_ga, logbook = _ga(problem, settings, seed, label)
             u_best = u_ga
         u_best, ssr, res = _polish(problem, u_best)

@@ -291,6 +291,15 @@ def friction_summary(fit: xr.Dataset, validations: Mapping[str, xr.Dataset]) -> 
     return out
 
 
+def model_form_summary(intervals: Mapping) -> dict:
+    """`friction.model_form_intervals` of summary.json from friction_intervals.json: the model the intervals are
+    for (``chain`` or ``updated``), the confidence and per parameter its value and interval with the model-form
+    term (``e0`` is e_0 at the preload)."""
+    par = intervals["parameters"]
+    return {"model": intervals["model"], "confidence": par["confidence"],
+            **{n: {"value": v["value"], "interval": v["interval"]} for n, v in par.items() if n != "confidence"}}
+
+
 def plot_friction_figures(fit: xr.Dataset, validations: Mapping[str, xr.Dataset], truth_friction: Mapping | None,
                           paths: Mapping[str, str]) -> None:
     """Fig. 7 (e_0 vs N), Fig. 8 (S vs xi), Fig. 9 (S vs xi'), and the GA convergence."""

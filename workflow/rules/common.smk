@@ -138,6 +138,7 @@ def summary_inputs(wildcards):
         inputs[f"validation_{c}"] = f"results/{c}/validation.nc"
     if load_cases():
         inputs["fit"] = "results/friction/friction_fit.nc"
+        inputs["friction_intervals"] = "results/gap/friction_intervals.json"
     for c, path in truth_records().items():
         inputs[f"truth_{c}"] = path
     return inputs
@@ -177,7 +178,7 @@ def gap_inputs(wildcards):
 
 
 def gap_outputs():
-    return ["results/gap/diagnosis.json", "results/gap/gap.nc"] + [
+    return ["results/gap/diagnosis.json", "results/gap/gap.nc", "results/gap/friction_intervals.json"] + [
         f"results/gap/gap_{v}.png" for v in ("stages", "harmonics", "cycle", "force_state", "ranking", "shrink", "explanation")]
 
 
@@ -195,7 +196,7 @@ def benchmark_items():
 
 def gap_report_inputs(wildcards):
     """The report's gap section: the diagnosis, and the blind benchmark when gap_benchmark.in_report."""
-    inputs = {"diagnosis": "results/gap/diagnosis.json"}
+    inputs = {"diagnosis": "results/gap/diagnosis.json", "intervals": "results/gap/friction_intervals.json"}
     if gap_benchmark_in_report():
         inputs["benchmark"] = "results/gap_benchmark/benchmark.json"
     return inputs

@@ -28,6 +28,31 @@ rule model_updating:
         "../scripts/model_updating.py"
 
 
+rule friction_intervals:
+    """The friction law's 95 % intervals with a model-form term: the spread of refits over the other load cases and
+    over the structures the random test allows (results/gap/friction_intervals.json)."""
+    input:
+        unpack(gap_inputs),
+    output:
+        "results/gap/friction_intervals.json",
+    params:
+        code=CODE_DIGEST,
+        structure=config["structure"],
+        gap=config.get("gap", {}),
+        friction=config.get("friction", {}),
+        seed=config["seed"],
+        n_harmonics=config.get("nonlinear", {}).get("n_harmonics", 25),
+        calibration_case=calibration_case(),
+        cases=load_cases(),
+    threads: 1
+    conda:
+        "../envs/contactid.yaml"
+    log:
+        "logs/friction_intervals.log",
+    script:
+        "../scripts/friction_intervals.py"
+
+
 rule gap_diagnosis:
     priority: CRITICAL_PATH
     input:

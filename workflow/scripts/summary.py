@@ -4,7 +4,8 @@ import json
 
 from contactid.io import load_dataset
 from contactid.logs import setup_logging
-from contactid.reporting import contact_force_summary, friction_summary, linear_summary, load_case_summary
+from contactid.reporting import (contact_force_summary, friction_summary, linear_summary, load_case_summary,
+                                 model_form_summary)
 
 log = setup_logging(snakemake.log[0])
 inp = snakemake.input
@@ -20,6 +21,9 @@ summary.update(contact_force_summary(forces, nnms))
 if "fit" in inp.keys():
     validations = {k[len("validation_"):]: load_dataset(v) for k, v in inp.items() if k.startswith("validation_")}
     summary.update(friction_summary(load_dataset(inp.fit), validations))
+if "friction_intervals" in inp.keys():
+    with open(inp.friction_intervals) as fh:
+        summary["friction"]["model_form_intervals"] = model_form_summary(json.load(fh))
 with open(snakemake.output.summary, "w") as fh:
     json.dump(summary, fh, indent=2, sort_keys=True, default=lambda o: o.item() if hasattr(o, "item") else str(o))
 log.info("summary of %s written to %s", ", ".join(summary), snakemake.output.summary)

@@ -126,16 +126,26 @@ def run_item(spec: Mapping, cfg: Mapping) -> dict:
     t_diag = time.perf_counter() - t1
     by = {r["effect"]: r for r in diag.ranking}
     if compound:
+        from .uncertainty import friction_uncertainty
+
         named = [s["effect"] for s in diag.explanation if s["effect"] != "model_updating"]
         preload = float(cfg["structure"]["preload_n"])
+        t_unc = time.perf_counter()
+        unc = friction_uncertainty(model, records, cal, fit_settings, int(cfg["seed"]),
+                                   updating.posterior_structures() if updating is not None else ())
+        t_unc = time.perf_counter() - t_unc
         row = {**dict(spec), "verdict": diag.verdict, "reason": diag.reason, "explanation": diag.explanation,
                "remaining_gap": diag.remaining_gap, "named": named, "correct": set(named) == set(effects),
                "updating_accepted": bool(updating is not None and updating.accepted),
                "heldout_gap_before": diag.where.get("heldout_gap_identified", diag.where["heldout_gap_before"]),
                "friction_errors": friction_errors(model, cfg["rig"]["truth"]["friction"], preload),
                "friction_errors_chain": friction_errors(chain_model, cfg["rig"]["truth"]["friction"], preload),
+               "friction_intervals": {n: unc.summary()[n]["interval"] for n in ("mu", "kappa", "e0")},
+               "friction_covered": unc.covers(friction_truth(cfg["rig"]["truth"]["friction"], preload)),
+               "friction_interval_halfwidth": unc.relative_halfwidth(("mu", "kappa", "e0")),
                "where": diag.where, "control_converged": converged,
-               "seconds": {"rig": t_rig, "identification": t_id, "diagnosis": time.perf_counter() - t1}}
+               "seconds": {"rig": t_rig, "identification": t_id, "diagnosis": time.perf_counter() - t1 - t_unc,
+                           "intervals": t_unc}}
         log.info("benchmark item (compound): %s -> explanation %s (remaining gap %.3g), mu error %.2g %%, %.1f s",
                  hidden, ", ".join(["model_updating"] * row["updating_accepted"] + named) or "none",
                  diag.remaining_gap["heldout_gap"], 100 * row["friction_errors"]["mu"], time.perf_counter() - t0)
@@ -293,6 +303,15 @@ def compound_config(cfg: Mapping, spec: Mapping) -> dict:
     return out
 
 
+def friction_truth(truth_friction: Mapping, preload: float) -> dict:
+    """The rig's true mu, kappa and e_0 at the preload (N/m, Eq. 22)."""
+    from ..contact_laws import stiction_shear_stiffness
+
+    t = truth_friction
+    return {"mu": float(t["mu"]), "kappa": float(t["kappa"]),
+            "e0": float(stiction_shear_stiffness(preload, t["e_f_n_per_m"], t["k_c_per_m"]))}
+
+
 def friction_errors(model, truth_friction: Mapping, preload: float) -> dict:
     """Relative errors of the model's mu, kappa and e_0 at the preload against the rig's truth."""
     from ..contact_laws import stiction_shear_stiffness
@@ -320,6 +339,10 @@ def compound_score(rows: list) -> dict:
         per_effect[e] = {"recall": tp / (tp + fn) if tp + fn else None, "precision": tp / (tp + fp) if tp + fp else None,
                          "true": tp + fn, "named": tp + fp}
     errors = {k: [abs(r["friction_errors"][k]) for r in by_n[0]] for k in ("mu", "kappa", "e0")}
+    covered = {k: [bool(r["friction_covered"][k]) for r in by_n[0] if k in (r.get("friction_covered") or {})]
+               for k in ("mu", "kappa", "e0")}
+    width = {k: [r["friction_interval_halfwidth"][k] for r in by_n[0] if r.get("friction_interval_halfwidth")]
+             for k in ("mu", "kappa", "e0")}
     return {
         "n": len(rows), "n_by_effect_count": {str(n): len(v) for n, v in by_n.items()},
         "perturbation_only_no_contact_effect": share([not (named(r) & set(CONTACT_EFFECTS)) for r in by_n[0]]),
@@ -332,4 +355,6 @@ def compound_score(rows: list) -> dict:
         "remaining_gap_median": float(np.median([r["remaining_gap"]["heldout_gap"] for r in rows])) if rows else None,
         "updating_accepted": share([bool(r["updating_accepted"]) for r in rows]),
         "perturbation_only_median_abs_error": {k: float(np.median(v)) if v else None for k, v in errors.items()},
+        "perturbation_only_interval_coverage": {k: share(v) for k, v in covered.items()},
+        "perturbation_only_median_interval_halfwidth": {k: float(np.median(v)) if v else None for k, v in width.items()},
     }

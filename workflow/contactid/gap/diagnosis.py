@@ -68,6 +68,7 @@ class GapSettings:
     residue_accuracy: float = 0.01
     frequency_floor: float = 0.001
     updating_confidence: float = 0.95
+    updating_prior_sd: tuple = ()  # ((factor, sd of its ln), ...) replacing contactid.updating.FACTORS' priors
 
     @classmethod
     def from_config(cls, gap_cfg: Mapping | None, seed: int, n_harmonics_id: int) -> "GapSettings":
@@ -109,7 +110,21 @@ def _updating_settings(block, d: "GapSettings") -> dict:
     return {"model_updating": bool(b.get("enabled", True)), "updating_parameters": params,
             "residue_accuracy": float(b.get("residue_accuracy", d.residue_accuracy)),
             "updating_confidence": float(b.get("confidence", d.updating_confidence)),
-            "frequency_floor": float(b.get("frequency_floor", d.frequency_floor))}
+            "frequency_floor": float(b.get("frequency_floor", d.frequency_floor)),
+            "updating_prior_sd": _prior_sd(b.get("prior_sd"), FACTORS)}
+
+
+def _prior_sd(block, factors) -> tuple:
+    """((factor, prior sd of its ln), ...) of gap.model_updating.prior_sd, checked."""
+    out = []
+    for name, v in dict(block or {}).items():
+        if name not in factors:
+            raise ValueError(f"gap.model_updating.prior_sd: unknown factor {name!r}; choose from {', '.join(factors)}")
+        if not isinstance(v, (int, float)) or isinstance(v, bool) or not 0.0 < float(v) <= 2.0:
+            raise ValueError(f"gap.model_updating.prior_sd.{name} = {v!r}: give the relative spread of the factor "
+                             f"(sd of its ln) as a number in (0, 2], for example 0.02 for a value known to 2 %")
+        out.append((str(name), float(v)))
+    return tuple(sorted(out))
 
 
 # ------------------------------------------------------------------------------------------

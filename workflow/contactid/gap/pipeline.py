@@ -80,7 +80,8 @@ def structure_update(structure, modal: xr.Dataset, settings):
     f = modal["natural_frequency"].values
     sigma = frequency_sigma(f, modal["natural_frequency_std"].values, settings.frequency_floor)
     return update_structure(structure, f, sigma, modal["residue_abs"].values, settings.residue_accuracy,
-                            settings.updating_parameters, confidence=settings.updating_confidence)
+                            settings.updating_parameters, confidence=settings.updating_confidence,
+                            prior_sd=dict(settings.updating_prior_sd))
 
 
 def updated_model(model, modal: xr.Dataset, calibration, fit_settings, settings, seed: int, upd=None):

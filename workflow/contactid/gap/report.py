@@ -8,6 +8,19 @@ import pandas as pd
 from ..latex import _fmt, plain_text as _t, tabular
 
 
+def _coverage_text(c: dict) -> str:
+    """The compound benchmark's interval coverage (intervals with the model-form term), when scored."""
+    cov, hw = c.get("perturbation_only_interval_coverage"), c.get("perturbation_only_median_interval_halfwidth")
+    if not cov or any(v is None for v in cov.values()):
+        return ""
+    return (r" The 95\,\% intervals with the model-form term (spread over load cases and over the structures "
+            r"the random test allows) held the truth in: " +
+            ", ".join(f"{sym} {_pct(cov[k])}" for k, sym in (("mu", r"$\mu$"), ("kappa", r"$\kappa$"), ("e0", "$e_0$"))) +
+            r" of these sets, with median half-widths " +
+            ", ".join(sym + r" $\pm$\," + _pct(hw[k]) for k, sym in (("mu", r"$\mu$"), ("kappa", r"$\kappa$"), ("e0", "$e_0$")))
+            + ".")
+
+
 def _num(x) -> float:
     """A diagnosis.json number (null where it was not finite) as a float."""
     return float("nan") if x is None else float(x)
@@ -37,7 +50,30 @@ def explanation_text(diag: dict) -> str:
     return text
 
 
-def gap_section(diag: dict, bench: dict | None) -> str:
+def intervals_text(intervals: dict | None) -> str:
+    """The friction law's intervals with the model-form term (friction_intervals.json) as a paragraph and table."""
+    if not intervals:
+        return ""
+    par = intervals["parameters"]
+    names = {"e_f": "e_f (N/m)", "k_c": "k_c (1/m)", "e_t": "e_t (N/m)", "kappa": "kappa", "mu": "mu",
+             "e0": "e_0 at N_0 (N/m)"}
+    rows = pd.DataFrame([{"p": names[n], "value": v["value"], "plo": v["profile_interval"][0],
+                          "phi": v["profile_interval"][1], "sdc": v["sd_cases"], "sds": v["sd_structure"],
+                          "lo": v["interval"][0], "hi": v["interval"][1]} for n, v in par.items() if n in names])
+    text = (r"\paragraph{Friction law with model-form uncertainty.} The profile-likelihood intervals hold if the model "
+            r"is right. The law of the " + _t(intervals["model"]) + r" model was refitted on each other load case and "
+            r"on the calibration forces identified with each of the " + str(intervals["n_structures"]) + r" structures "
+            r"the random test allows ($\pm$1 posterior standard deviation along each principal axis of the model "
+            r"updating); their spreads (sd, on a log scale for the positive parameters) widen the intervals. The "
+            r"tangential lever arm, which the linear data do not bound, sets most of the structural term of $\mu$ and "
+            r"$e_0$: the data bind $\mu a$ and $e_0 a^2$.")
+    return text + "\n" + tabular(rows, {"p": "parameter", "value": "value", "plo": "profile low", "phi": "profile high",
+                                          "sdc": "sd cases", "sds": "sd structure", "lo": "low", "hi": "high"},
+                                   "Friction law: profile-likelihood interval and the 95\\,\\% interval with the "
+                                   "model-form term (spreads over load cases and structures).", "tab:intervals")
+
+
+def gap_section(diag: dict, bench: dict | None, intervals: dict | None = None) -> str:
     w = diag["where"]
     st = w["stage"]
     lines = [
@@ -86,6 +122,7 @@ def gap_section(diag: dict, bench: dict | None) -> str:
     out += ("\\begin{figure}[H]\\centering\\includegraphics[width=0.7\\textwidth]{gap_explanation.png}"
             "\\caption{The held-out gap explained step by step: the identified model, what each added effect removes, "
             "what remains (dotted: the identification's floor).}\\label{fig:gap_explanation}\\end{figure}\n")
+    out += intervals_text(intervals)
     if bench is None:
         out += ("\n\\paragraph{Blind benchmark.} Not built with this report (\\texttt{gap\\_benchmark.in\\_report: "
                 "false}); run \\texttt{snakemake gap\\_benchmark}.\n")
@@ -113,7 +150,7 @@ def gap_section(diag: dict, bench: dict | None) -> str:
                 _pct(c["two_effects_one_named"]) + r". Median remaining held-out gap " + _pct(c["remaining_gap_median"]) +
                 r". Perturbation only, after updating, median errors: $\mu$ " + _pct(err["mu"]) + r", $\kappa$ " +
                 _pct(err["kappa"]) + r", $e_0$ " + _pct(err["e0"]) + r" (the tangential lever arm, which linear data do not "
-                r"bound, scales the identified $S$ and so $\mu$).") + "\n"
+                r"bound, scales the identified $S$ and so $\mu$)." + _coverage_text(c)) + "\n"
     acc = pd.DataFrame([{"effect": e, "accuracy": 100 * a} for e, a in bench["per_effect_accuracy"].items()])
     out += tabular(acc, {"effect": "effect", "accuracy": "top-1 (\\%)"}, "Blind benchmark: accuracy per effect.",
                    "tab:bench")

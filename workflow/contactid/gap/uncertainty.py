@@ -1,0 +1,153 @@
+"""Friction-law intervals with a model-form term (issue 15, item 6).
+
+The profile-likelihood intervals of the friction fit (``contactid.friction_fit``) state what the calibration
+record's scatter allows *if the model is right*. Off the model (a structure a few per cent off, another damping
+form, another normal law) they are overconfident: the fitted parameters move more than they say. Two spreads
+measure how far they move with what the data cannot tell apart:
+
+- **load cases**: the law refitted (polished from the calibration optimum) on the contact forces of each
+  other load case. A right model gives the same parameters at every amplitude; a wrong one drifts with it.
+  sd_cases = rms over the other cases of the change from the calibration fit.
+- **structure**: the law refitted on the calibration forces identified with each structure the random test
+  allows (``UpdatingResult.posterior_structures``: +-1 posterior sd along each principal axis). The
+  tangential lever arm a is the main term: the linear data bind a^2 k_t, not a; the contact forces scale
+  as S ~ 1/a and xi ~ a, so the data bind mu a and e_0 a^2, and mu is known no better than a is.
+  sd_structure = sqrt(sum over axes of ((p_plus - p_minus) / 2)^2).
+
+The interval with model form widens the profile interval by z sd on each side, sd = sqrt(sd_cases^2 +
+sd_structure^2), z the normal quantile of the confidence; on a log scale for the positive parameters
+(e_f, k_c, mu, e_0), linear for e_t and kappa, and clipped to the search bounds.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+from dataclasses import dataclass
+from typing import Mapping
+
+import numpy as np
+from scipy.stats import norm
+
+from ..contact_laws import stiction_shear_stiffness
+from ..friction import PARAMETER_NAMES
+from ..friction_fit import FitSettings, fit_friction_law
+from .model import NONE, IdentifiedModel
+from .records import RecordHarmonics
+from .refit import identified_forces
+
+log = logging.getLogger(__name__)
+
+NAMES = (*PARAMETER_NAMES, "e0")  # the five law parameters and e_0 at the preload (Eq. 22)
+LOG_SCALE = np.array([True, True, False, False, True, True])  # e_f, k_c, mu, e_0 spread on a log scale
+
+
+@dataclass
+class FrictionUncertainty:
+    """Per parameter (``NAMES``): the value, the profile-likelihood interval (6, 2), the model-form standard
+    deviations from the load cases and from the structure (on the parameter's scale: ln for LOG_SCALE, else
+    linear), the interval with model form (6, 2), and the refits behind them ({case: (6,)}, [(6,), ...])."""
+
+    value: np.ndarray
+    profile: np.ndarray
+    sd_cases: np.ndarray
+    sd_structure: np.ndarray
+    interval: np.ndarray
+    confidence: float
+    case_fits: dict
+    structure_fits: list
+
+    def covers(self, truth: Mapping) -> dict:
+        """{name: whether the interval with model form holds the true value} for the names in ``truth``."""
+        out = {}
+        for i, n in enumerate(NAMES):
+            if n in truth and truth[n] is not None:
+                out[n] = bool(self.interval[i, 0] <= float(truth[n]) <= self.interval[i, 1])
+        return out
+
+    def relative_halfwidth(self, names=NAMES) -> dict:
+        """{name: half the interval with model form over the value} (a relative +- of the interval)."""
+        out = {}
+        for n in names:
+            i = NAMES.index(n)
+            out[n] = float((self.interval[i, 1] - self.interval[i, 0]) / 2.0 / max(abs(self.value[i]), 1e-300))
+        return out
+
+    def summary(self) -> dict:
+        """JSON-ready {name: {value, profile_interval, sd_cases, sd_structure, interval, scale}}."""
+        return {n: {"value": float(self.value[i]), "profile_interval": [float(v) for v in self.profile[i]],
+                    "sd_cases": float(self.sd_cases[i]), "sd_structure": float(self.sd_structure[i]),
+                    "interval": [float(v) for v in self.interval[i]],
+                    "scale": "log" if LOG_SCALE[i] else "linear"}
+                for i, n in enumerate(NAMES)} | {"confidence": self.confidence}
+
+
+def with_e0(params, preload: float) -> np.ndarray:
+    """The five law parameters followed by e_0 at the preload (N/m, Eq. 22)."""
+    p = np.asarray(params, float)
+    return np.append(p, float(stiction_shear_stiffness(preload, p[0], p[1])))
+
+
+def _scaled(p: np.ndarray) -> np.ndarray:
+    p = np.asarray(p, float)
+    return np.where(LOG_SCALE, np.log(np.maximum(np.abs(p), 1e-300)), p)
+
+
+def spread_sd(best: np.ndarray, alternatives, pairs: bool = False) -> np.ndarray:
+    """Model-form sd of each parameter on its scale: the rms change of ``alternatives`` (rows (6,)) from
+    ``best``, or with ``pairs`` (rows in +-pairs along axes) sqrt(sum ((plus - minus) / 2)^2). Zeros without
+    alternatives."""
+    alt = [np.asarray(a, float) for a in alternatives]
+    if not alt:
+        return np.zeros(len(NAMES))
+    z = np.array([_scaled(a) for a in alt])
+    if pairs:
+        half = (z[1::2] - z[0::2]) / 2.0
+        return np.sqrt(np.sum(half**2, axis=0))
+    return np.sqrt(np.mean((z - _scaled(best)) ** 2, axis=0))
+
+
+def widened_interval(profile: np.ndarray, sd: np.ndarray, confidence: float, bounds) -> np.ndarray:
+    """The profile interval (6, 2) widened by z sd on each side (z the normal quantile of ``confidence``) on
+    each parameter's scale, clipped to the search ``bounds`` ((5, 2) of the law; e_0 unclipped)."""
+    z = float(norm.ppf(0.5 + confidence / 2.0))
+    lo, hi = _scaled(profile[:, 0]) - z * sd, _scaled(profile[:, 1]) + z * sd
+    lo = np.where(LOG_SCALE, np.exp(np.minimum(lo, 700.0)), lo)
+    hi = np.where(LOG_SCALE, np.exp(np.minimum(hi, 700.0)), hi)
+    b = np.array(list(bounds) + [(0.0, np.inf)], float)
+    return np.column_stack([np.clip(lo, b[:, 0], b[:, 1]), np.clip(hi, b[:, 0], b[:, 1])])
+
+
+def _refit(model: IdentifiedModel, rec: RecordHarmonics, settings: FitSettings, seed: int, label: str,
+           intervals: bool = False):
+    forces = identified_forces(model, NONE, rec)
+    return fit_friction_law(forces.xi, forces.N_dyn, forces.S, rec.f0, model.preload, settings, int(seed),
+                            rec.acceleration.shape[1], intervals=intervals, label=label, start=model.friction)
+
+
+def friction_uncertainty(model: IdentifiedModel, records: Mapping, calibration: str, settings: FitSettings,
+                         seed: int, structures=()) -> FrictionUncertainty:
+    """The friction law of ``model`` (fitted on ``records[calibration]``) with its profile intervals and the
+    model-form spreads over the other load cases in ``records`` and over ``structures`` (see the module)."""
+    quiet = logging.getLogger("contactid.friction_fit")
+    level = quiet.level
+    cal = records[calibration]
+    fit = _refit(model, cal, settings, seed, "friction intervals", intervals=True)
+    value = with_e0(fit.params, model.preload)
+    profile = np.vstack([fit.intervals, np.array(fit.e0_interval)[None, :]])
+    quiet.setLevel(logging.ERROR)  # the refits' progress lines (and bound warnings the fit itself gave) would bury the log
+    try:
+        cases = {c: with_e0(_refit(model, r, settings, seed, f"refit on {c}").params, model.preload)
+                 for c, r in records.items() if c != calibration}
+        structs = [with_e0(_refit(dataclasses.replace(model, structure=p), cal, settings, seed,
+                                  "refit on a posterior structure").params, model.preload) for p in structures]
+    finally:
+        quiet.setLevel(level)
+    sd_c = spread_sd(value, list(cases.values()))
+    sd_s = spread_sd(value, structs, pairs=True)
+    interval = widened_interval(profile, np.hypot(sd_c, sd_s), settings.confidence, settings.bounds)
+    for i, n in enumerate(NAMES):
+        log.info("friction intervals: %s = %.4g, profile [%.4g, %.4g], model-form sd %.3g (cases) %.3g (structure)%s"
+                 " -> [%.4g, %.4g]", n, value[i], *profile[i], sd_c[i], sd_s[i], " on ln" if LOG_SCALE[i] else "",
+                 *interval[i])
+    return FrictionUncertainty(value, profile, sd_c, sd_s, interval, float(settings.confidence), cases, structs)
