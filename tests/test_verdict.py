@@ -205,8 +205,9 @@ def test_an_unobservable_eta_leaves_the_contact_direction_open():
 # ----------------------------------------------------------------------------------------------
 
 class _Cal:
-    def __init__(self, name, theta):
+    def __init__(self, name, theta, earlier=()):
         self.candidate, self.theta = name, np.atleast_1d(theta)
+        self.steps = tuple(earlier) + ((name, self.theta),)
 
 
 def _explain(first, passes, before=0.04, scatter=1e-4, settings=None):
@@ -317,3 +318,84 @@ def test_an_update_that_moves_only_the_transducer_masses_is_the_transducer_mass_
     assert V.updating_effect({"stiffness_scale": 1.0, "mass_scale": 1.0, "transducer_mass_scale": 1.1}, ident) is None
     # the stiffness alone moved: model form without an effect of its own
     assert V.updating_effect({"stiffness_scale": 1.2, "mass_scale": 1.0, "transducer_mass_scale": 1.0}, ident) is None
+
+
+def test_a_joint_refit_step_reports_the_earlier_steps_refitted_parameters():
+    from types import SimpleNamespace
+
+    from contactid.gap.diagnosis import explain
+
+    first = {"viscous_friction": (_Cal("viscous_friction", 1222.0), {"gap": 0.02}, None),
+             "normal_contact_damping": (_Cal("normal_contact_damping", 300.0), {"gap": 0.03}, None)}
+    # on top of viscous friction, the joint refit gives sigma_2 back (1222 -> 569) as alpha takes its share
+    second = {"normal_contact_damping": (_Cal("normal_contact_damping", 255.0, [("viscous_friction", np.array([569.0]))]),
+                                         {"gap": 0.007}, None)}
+    steps, left, _ = explain(first, list(first), 0.04, 1e-4, SimpleNamespace(**SETTINGS), lambda sims: sims["gap"],
+                             lambda remaining, cal: second)
+    assert [s["effect"] for s in steps] == ["viscous_friction", "normal_contact_damping"] and left == 0.007
+    assert "earlier_refitted" not in steps[0]
+    assert steps[1]["parameters"] == {"alpha": 255.0}
+    assert steps[1]["earlier_refitted"] == {"viscous_friction": {"sigma_2": 569.0}}
+
+
+def test_joint_candidate_starts_at_the_earlier_steps_values_and_splits_its_theta():
+    from contactid.gap.candidates import LIBRARY, joint_candidate
+
+    joint, split = joint_candidate(LIBRARY["normal_contact_damping"],
+                                   [(LIBRARY["viscous_friction"], np.array([1222.0])),
+                                    (LIBRARY["channel_time_skew"], np.array([1e-5, 2e-5, 3e-5]))], 3)
+    assert joint.name == "normal_contact_damping" and joint.acts_on == "normal_contact" and not joint.per_channel
+    assert [p.name for p in joint.parameters] == ["alpha", "sigma_2", "delay", "delay", "delay"]
+    assert joint.parameters[0].start == 0.0 and joint.parameters[1].start == 1222.0
+    assert [p.start for p in joint.parameters[2:]] == [1e-5, 2e-5, 3e-5]
+    theta = np.array([255.0, 569.0, 1e-5, 2e-5, 3e-5])
+    parts = split(theta)
+    assert [list(x) for x in parts] == [[255.0], [569.0], [1e-5, 2e-5, 3e-5]]
+    aug = joint.augmentation(theta)
+    assert (aug.hunt_crossley, aug.viscous, aug.delays) == (255.0, 569.0, (1e-5, 2e-5, 3e-5))
+
+
+# ----------------------------------------------------------------------------------------------
+# the detection ladder (gap.benchmark), on hand-made rows
+# ----------------------------------------------------------------------------------------------
+
+def test_ladder_items_put_every_effect_at_fractions_of_its_typical_magnitude():
+    from contactid.gap.benchmark import ladder_items
+    from contactid.rig.effects import EFFECTS
+
+    items = ladder_items({"seeds": [1, 2]}, 7)
+    assert len(items) == len(EFFECTS) * 3 * 2
+    assert items["ladder_viscous_friction-0-s1"]["magnitude"] == pytest.approx(30.0)  # a tenth of 300 N s/m
+    assert items["ladder_viscous_friction-2-s2"]["magnitude"] == pytest.approx(300.0)
+    assert items["ladder_contact_separation-2-s1"]["magnitude"] == pytest.approx(5.2)  # capped at the range's end
+    assert {s["kind"] for s in items.values()} == {"ladder"}
+
+
+def test_refitted_magnitude_maps_candidate_parameters_to_the_rigs_units():
+    from contactid.gap.benchmark import refitted_magnitude
+
+    assert refitted_magnitude("normal_contact_damping", {"alpha": 310.0}) == 310.0
+    # the rig delays channel k of 3 by m (k + 1) / 3: delays (1, 2, 3) e-5 are m = 3e-5
+    assert refitted_magnitude("channel_time_skew", {"delay_2": 3e-5, "delay_0": 1e-5, "delay_1": 2e-5}) == \
+        pytest.approx(3e-5)
+    assert refitted_magnitude("contact_separation", {"exponent": 1.5, "stiffness_factor": 1.0}) is None
+    assert refitted_magnitude("viscous_friction", None) is None
+
+
+def test_ladder_scores_only_where_the_gap_exceeds_twice_the_floor():
+    from contactid.gap.benchmark import ladder_score
+
+    def row(effect, m, gap, verdict, refit):
+        return {"effect": effect, "magnitude": m, "seed": 1, "heldout_gap_before": gap, "verdict": verdict,
+                "refitted_magnitude": refit, "fraction": 1.0, "item": f"{effect}-{m}"}
+
+    rows = [row("viscous_friction", 300.0, 0.05, "viscous_friction", 320.0),   # detectable, named, +7 %
+            row("viscous_friction", 30.0, 0.008, "none", None),                 # below twice the floor: not scored
+            row("structural_damping", 0.005, 0.03, "structural_damping", 0.007),  # named, +40 %: out
+            row("contact_separation", 5.2, 0.3, "contact_separation", None),    # named, magnitude not comparable
+            row("preload_drift", 0.1, 0.02, "none", 0.1)]                       # detectable, not named
+    s = ladder_score(rows, 0.006)
+    assert s["n"] == 5 and s["n_detectable"] == 4
+    assert s["named_where_detectable"] == 0.75
+    assert s["magnitude_within_where_detectable"] == pytest.approx(2 / 3)
+    assert not s["all_named_and_within"] and s["false_names_below_detectable"] == 0

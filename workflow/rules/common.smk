@@ -194,6 +194,13 @@ def benchmark_items():
     return items(config.get("gap_benchmark", {}), int(config["seed"]))
 
 
+def ladder_items():
+    """{item name: spec} of the detection ladder (gap_benchmark.ladder; `snakemake gap_ladder`)."""
+    from contactid.gap.benchmark import ladder_items as items
+
+    return items(config.get("gap_benchmark", {}), int(config["seed"]))
+
+
 def gap_report_inputs(wildcards):
     """The report's gap section: the diagnosis, and the blind benchmark when gap_benchmark.in_report."""
     inputs = {"diagnosis": "results/gap/diagnosis.json", "intervals": "results/gap/friction_intervals.json"}

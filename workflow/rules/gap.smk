@@ -116,7 +116,7 @@ rule gap_benchmark_item:
         item="results/gap_benchmark/items/{item}.json",
     params:
         code=CODE_DIGEST,
-        spec=lambda wc: benchmark_items()[wc.item],
+        spec=lambda wc: {**benchmark_items(), **ladder_items()}[wc.item],
         config=benchmark_base_config(),
     wildcard_constraints:
         item=r"[a-z_]+-[0-9]+-s[0-9]+",
@@ -147,6 +147,24 @@ rule gap_benchmark:
         "logs/gap_benchmark.log",
     script:
         "../scripts/gap_benchmark.py"
+
+
+rule gap_ladder:
+    """The detection ladder: every effect at a tenth, a third and the whole of its typical magnitude, scored where
+    its held-out gap exceeds twice gap.min_gap (results/gap_benchmark/ladder.json)."""
+    input:
+        rows=expand("results/gap_benchmark/items/{item}.json", item=list(ladder_items())),
+    output:
+        "results/gap_benchmark/ladder.json",
+    params:
+        code=CODE_DIGEST,
+        floor=config.get("gap", {}).get("min_gap", 0.006),
+    conda:
+        "../envs/contactid.yaml"
+    log:
+        "logs/gap_ladder.log",
+    script:
+        "../scripts/gap_ladder.py"
 
 
 rule gap_report_fragment:

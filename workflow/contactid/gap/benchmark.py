@@ -77,6 +77,49 @@ def benchmark_items(cfg: Mapping, seed: int) -> dict:
     return items
 
 
+LADDER_FRACTIONS = (0.1, 1.0 / 3.0, 1.0)
+
+
+def ladder_typical(effect: str, ranges: Mapping = RANGES) -> float:
+    """An effect's typical magnitude (``rig.effects``' typical value), kept inside its benchmark range's upper
+    end (contact separation's typical 7.2 makes lc3's impacts keep the motion from settling)."""
+    return float(min(EFFECTS[effect].typical, ranges[effect][1]))
+
+
+def ladder_items(cfg: Mapping, seed: int) -> dict:
+    """{name: spec} of the detection ladder (config gap_benchmark.ladder: fractions of each effect's typical
+    magnitude, for every seed): single-effect items named ``ladder_<effect>-<k>-s<seed>``."""
+    cfg = dict(cfg or {})
+    fractions = [float(f) for f in cfg.get("ladder", LADDER_FRACTIONS)]
+    effects = cfg.get("effects") or list(EFFECTS)
+    ranges = {**RANGES, **{k: tuple(v) for k, v in (cfg.get("ranges") or {}).items()}}
+    items = {}
+    for e in effects:
+        for s in [int(x) for x in cfg.get("seeds", [1, 2])]:
+            for k, f in enumerate(fractions):
+                items[f"ladder_{e}-{k}-s{s}"] = {"effect": e, "magnitude": f * ladder_typical(e, ranges), "seed": s,
+                                                 "library": None, "kind": "ladder", "fraction": f}
+    return items
+
+
+def refitted_magnitude(effect: str, parameters: Mapping | None) -> float | None:
+    """The rig magnitude a candidate's refitted parameters amount to (None where the two are not comparable:
+    contact separation's rig magnitude is a load factor, the candidate's a normal-law shape). Channel skew: the
+    rig delays channel k of n by m (k + 1) / n; m is the least-squares fit of the refitted per-channel delays."""
+    if not parameters:
+        return None
+    direct = {"structural_damping": "extra_damping_ratio", "normal_contact_damping": "alpha",
+              "viscous_friction": "sigma_2", "multi_asperity_friction": "iwan_share",
+              "transducer_mass_error": "mass_error", "preload_drift": "relative_drift"}
+    if effect in direct:
+        return float(parameters[direct[effect]])
+    if effect == "channel_time_skew":
+        d = np.array([parameters[k] for k in sorted(parameters, key=lambda k: int(k.rsplit("_", 1)[1]))])
+        shape = np.arange(1, d.size + 1) / d.size
+        return float(d @ shape / (shape @ shape))
+    return None
+
+
 def run_item(spec: Mapping, cfg: Mapping) -> dict:
     """Generate the item's rig records, identify the model from them, diagnose; the result row."""
     from ..friction_fit import settings_from_config
@@ -158,6 +201,7 @@ def run_item(spec: Mapping, cfg: Mapping) -> dict:
             if spec["kind"] != "leave_out" else diag.verdict == "none",
             "heldout_gap_before": diag.where["heldout_gap_before"],
             "heldout_gap_after_true": by[true]["heldout_gap_after"] if true in by else None,
+            "refitted_magnitude": refitted_magnitude(true, by[true].get("parameters")) if true in by else None,
             "shrink_true": by[true]["reduction"] if true in by else None,
             "ranking": [{k: r[k] for k in ("effect", "heldout_gap_before", "heldout_gap_after", "score", "reduction")}
                         for r in diag.ranking],
@@ -205,6 +249,35 @@ def score(rows: list) -> dict:
         **({"compound": compound_score(comp)} if comp else {}),
         "failed": [{k: r.get(k) for k in ("kind", "effect", "effects", "seed", "failed")} for r in failed],
     }
+
+
+def ladder_score(rows: list, floor: float, tolerance: float = 0.25) -> dict:
+    """The detection ladder: an item is detectable when its held-out gap before exceeds twice the floor
+    (``gap.min_gap``); there the effect must be the verdict and its refitted magnitude within ``tolerance`` of
+    the truth (where the two are comparable, ``refitted_magnitude``). Per item and overall."""
+    items = []
+    for r in rows:
+        if r.get("failed"):
+            items.append({"item": r.get("item"), "effect": r["effect"], "fraction": r.get("fraction"), "failed": r["failed"]})
+            continue
+        detectable = bool(r["heldout_gap_before"] > 2.0 * floor)
+        m = r.get("refitted_magnitude")
+        err = None if m is None or not r["magnitude"] else float(m / r["magnitude"] - 1.0)
+        items.append({"item": r.get("item"), "effect": r["effect"], "fraction": r.get("fraction"), "seed": r["seed"],
+                      "magnitude": r["magnitude"], "heldout_gap_before": r["heldout_gap_before"],
+                      "detectable": detectable, "verdict": r["verdict"], "named": r["verdict"] == r["effect"],
+                      "refitted_magnitude": m, "magnitude_error": err,
+                      "magnitude_within": None if err is None else bool(abs(err) <= tolerance)})
+    det = [i for i in items if i.get("detectable")]
+    comparable = [i for i in det if i["magnitude_within"] is not None]
+    share = lambda xs: float(np.mean(xs)) if xs else None  # noqa: E731
+    return {"n": len(items), "n_failed": sum("failed" in i for i in items), "floor": floor, "tolerance": tolerance,
+            "n_detectable": len(det), "named_where_detectable": share([i["named"] for i in det]),
+            "magnitude_within_where_detectable": share([i["magnitude_within"] for i in comparable]),
+            "all_named_and_within": bool(det) and all(i["named"] and i["magnitude_within"] is not False for i in det),
+            "false_names_below_detectable": sum(i["verdict"] not in ("none", i["effect"]) for i in items
+                                                if "failed" not in i and not i["detectable"]),
+            "items": items}
 
 
 def confusion_figure(result: dict, path: str) -> None:

@@ -106,6 +106,40 @@ register(Candidate("preload_drift", "static normal preload drifting linearly ove
 BUILTIN = tuple(LIBRARY)
 
 
+def joint_candidate(new: Candidate, earlier, n_channels: int) -> tuple[Candidate, Callable]:
+    """``new`` refitted together with the explanation's earlier steps ``earlier`` [(Candidate, theta), ...]: a
+    candidate whose parameters are new's (searched from their starts) followed by each earlier one's (starting at
+    its refitted theta, per-channel ones repeated per channel), so that an earlier step that absorbed part of a
+    second effect (viscous friction taking on a normal dashpot's dissipation) can give it back. Returns (the
+    candidate, split), split(theta) -> [theta of new, theta of each earlier step]. Every parameter has a start
+    (new's: off, zero or its range's low end, unless it gives one), so the search also starts from the earlier
+    step's optimum itself (``refit.calibrate``)."""
+    def expand(c: Candidate, theta=None):
+        params = c.parameters * (n_channels if c.per_channel else 1)
+        if theta is None:  # the new effect starts off (zero, or its range's low end), its own start where given
+            return tuple(Parameter(p.name, p.unit, p.low, p.high,
+                                   start=p.start if p.start is not None else (0.0 if p.low <= 0.0 <= p.high else p.low))
+                         for p in params)
+        return tuple(Parameter(p.name, p.unit, p.low, p.high, start=float(np.clip(t, p.low, p.high)))
+                     for p, t in zip(params, np.atleast_1d(theta)))
+
+    parts = [expand(new)] + [expand(c, th) for c, th in earlier]
+    sizes = np.cumsum([len(x) for x in parts])[:-1]
+    cands = [new] + [c for c, _ in earlier]
+
+    def split(theta):
+        return np.split(np.atleast_1d(np.asarray(theta, float)), sizes)
+
+    def augmentation(theta):
+        aug = Augmentation()
+        for c, th in zip(cands, split(theta)):
+            aug = aug.merge(c.augmentation(th))
+        return aug
+
+    joint = Candidate(new.name, new.meaning, tuple(p for x in parts for p in x), augmentation, False, new.acts_on)
+    return joint, split
+
+
 def load_plugins(modules) -> None:
     """Import the users' candidate modules (``gap.plugins``); each calls ``register``."""
     import importlib

@@ -11,6 +11,7 @@ says where the gap lies.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 from dataclasses import dataclass, field
 from typing import Mapping
@@ -23,7 +24,7 @@ from ..contact_laws import stiction_shear_stiffness
 from ..identification import modal_damping_vector
 from ..friction_fit import FitSettings
 from ..random_streams import generator
-from .candidates import LIBRARY
+from .candidates import LIBRARY, joint_candidate
 from .model import NONE, Augmentation, IdentifiedModel, fe_model
 from .records import RecordHarmonics
 from .refit import (baseline, calibrate, contact_grids, evaluate, gap_residual, gap_value,
@@ -69,6 +70,7 @@ class GapSettings:
     frequency_floor: float = 0.001
     updating_confidence: float = 0.95
     updating_prior_sd: tuple = ()  # ((factor, sd of its ln), ...) replacing contactid.updating.FACTORS' priors
+    joint_refit: bool = True  # the explanation's later steps refit the earlier steps' parameters with theirs
 
     @classmethod
     def from_config(cls, gap_cfg: Mapping | None, seed: int, n_harmonics_id: int) -> "GapSettings":
@@ -87,6 +89,7 @@ class GapSettings:
                 n_bootstrap=int(g.get("n_bootstrap", d.n_bootstrap)), seed=int(seed),
                 max_evaluations=int(g.get("max_evaluations", d.max_evaluations)),
                 eta_observability_limit=float(g.get("eta_observability_limit", d.eta_observability_limit)),
+                joint_refit=bool(g.get("joint_refit", d.joint_refit)),
                 **_updating_settings(g.get("model_updating"), d))
         if not 0.0 < s.min_reduction < 1.0:
             raise ValueError(f"gap.min_reduction = {s.min_reduction}: give a fraction in (0, 1)")
@@ -402,12 +405,38 @@ def _bootstrap_records(rec: RecordHarmonics, rng, n: int, H: int) -> np.ndarray:
 
 def _candidate(name: str, model: IdentifiedModel, records: Mapping[str, RecordHarmonics], calibration_case: str,
                score_cases: list, base_sims: dict, fit_settings: FitSettings, H: int, max_evaluations: int,
-               base: Augmentation = NONE):
-    """One candidate (added to the effects ``base``): calibrated on the calibration case, predicted on the
-    scored cases (each simulation warm-started from the baseline's). Returns (calibration, sims, residuals)
-    by case."""
-    cal = calibrate(model, LIBRARY[name], records[calibration_case], fit_settings, H, max_evaluations,
-                    start=base_sims[calibration_case], base=base)
+               base_steps: tuple = (), joint: bool = True, alone: dict | None = None):
+    """One candidate added to the explanation's earlier steps ``base_steps`` ((name, theta), ...): calibrated on
+    the calibration case (with ``joint``, together with the earlier steps' parameters, ``joint_candidate``;
+    otherwise with them held), predicted on the scored cases (each simulation warm-started from the baseline's).
+    ``alone``: {name: theta} of the first pass (each candidate alone); a joint refit also starts between the
+    earlier steps' optimum and this candidate's own (two effects that can stand in for each other, viscous friction
+    and a normal dashpot, leave a ridge between the one-effect optimum and the truth). Returns (calibration, sims,
+    residuals) by case."""
+    rec = records[calibration_case]
+    earlier = [(LIBRARY[n], th) for n, th in base_steps]
+    if earlier and joint:
+        cand, split = joint_candidate(LIBRARY[name], earlier, rec.acceleration.shape[0])
+        mixes = ()
+        if alone and name in alone:
+            first = np.array([p.start for p in cand.parameters])  # the earlier optimum, this effect off
+            own = first.copy()  # this effect at its one-effect optimum, the earlier ones off
+            n_new = len(np.atleast_1d(alone[name]))
+            own[:n_new] = np.atleast_1d(alone[name])
+            own[n_new:] = [0.0 if p.low <= 0.0 <= p.high else p.low for p in cand.parameters[n_new:]]
+            mixes = tuple((1 - t) * first + t * own for t in (1 / 3, 2 / 3))
+        cal = calibrate(model, cand, rec, fit_settings, H, max_evaluations, start=base_sims[calibration_case],
+                        starts=mixes)
+        parts = split(cal.theta)
+        cal = dataclasses.replace(cal, theta=parts[0], steps=tuple((n, th) for (n, _), th in zip(base_steps, parts[1:]))
+                                  + ((name, parts[0]),))
+    else:
+        base = NONE
+        for c, th in earlier:
+            base = base.merge(c.augmentation(th))
+        cal = calibrate(model, LIBRARY[name], rec, fit_settings, H, max_evaluations, start=base_sims[calibration_case],
+                        base=base)
+        cal = dataclasses.replace(cal, steps=tuple(base_steps) + ((name, cal.theta),))
     sims = {calibration_case: None}
     res = {}
     for c in score_cases:
@@ -475,11 +504,13 @@ def _candidates(names, workers: int, **common):
     return lambda: dict(zip(names, pending.get()))
 
 
-def _parameter_values(name: str, cal) -> dict:
-    """{parameter name: refitted value} of a calibrated candidate (per-channel ones numbered by channel)."""
+def _parameter_values(name: str, cal=None, theta=None) -> dict:
+    """{parameter name: refitted value} of a calibrated candidate, or of ``theta`` (per-channel ones numbered by
+    channel)."""
     cand = LIBRARY[name]
+    theta = np.atleast_1d(cal.theta if theta is None else theta)
     return {p.name if not cand.per_channel else f"{p.name}_{i}": float(v)
-            for i, (p, v) in enumerate(zip(cand.parameters * len(cal.theta), cal.theta))}
+            for i, (p, v) in enumerate(zip(cand.parameters * len(theta), theta))}
 
 
 def explain(first: dict, names: list, before: float, scatter: float, settings: GapSettings, heldout_gap,
@@ -505,6 +536,8 @@ def explain(first: dict, names: list, before: float, scatter: float, settings: G
         cal, sims, _ = results[best]
         steps.append({"effect": best, "parameters": _parameter_values(best, cal), "heldout_gap_before": gap,
                       "heldout_gap_after": gaps[best]})
+        if len(cal.steps) > 1:  # the earlier steps' parameters as refitted with this one (gap.joint_refit)
+            steps[-1]["earlier_refitted"] = {n: _parameter_values(n, theta=th) for n, th in cal.steps[:-1]}
         log.info("explanation step %d: %s leaves a held-out gap of %.4g (from %.4g)", len(steps), best,
                  gaps[best], gap)
         gap, last = gaps[best], (cal, sims)
@@ -611,7 +644,8 @@ def diagnose(model: IdentifiedModel, records: Mapping[str, RecordHarmonics], cal
                   **{c: s for c, s in results[cal.candidate][1].items() if s is not None}}
         return _candidates(remaining, workers, model=cal.model, records=records, calibration_case=calibration_case,
                            score_cases=score_cases, base_sims=starts, fit_settings=fit_settings, H=H,
-                           max_evaluations=settings.max_evaluations, base=cal.augmentation)()
+                           max_evaluations=settings.max_evaluations, base_steps=cal.steps,
+                           joint=settings.joint_refit, alone={n: r[0].theta for n, r in results.items()})()
 
     steps, left, last = explain(results, names, before, scatter, settings, heldout_gap, next_pass)
     first_before = before

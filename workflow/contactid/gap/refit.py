@@ -221,6 +221,7 @@ class Calibration:
     evaluations: int
     friction_misfit: float
     simulation: SimResult | None = None
+    steps: tuple = ()  # ((name, theta), ...) of every effect in the augmentation, the explanation's order
 
 
 def evaluate(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, bounds, n_harmonics: int,
@@ -238,10 +239,11 @@ def evaluate(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, bo
 
 def calibrate(model: IdentifiedModel, cand: Candidate, rec: RecordHarmonics, settings: FitSettings,
               n_harmonics: int, max_evaluations: int = 12, start: SimResult | None = None,
-              base: Augmentation = NONE) -> Calibration:
+              base: Augmentation = NONE, starts=()) -> Calibration:
     """theta of ``cand`` minimising the calibration case's gap (friction law refitted at each theta);
     each simulation starts from the previous one's steady state (``start``: the model's own). ``base``:
-    effects already added (the additive explanation's earlier steps); the candidate's are added to them."""
+    effects already added (the additive explanation's earlier steps); the candidate's are added to them. ``starts``:
+    more points (theta) a search over several parameters starts from if they are better than its scan's best."""
     bounds = settings.bounds
     n_eval = 0
     cache = {}
@@ -304,8 +306,13 @@ def calibrate(model: IdentifiedModel, cand: Candidate, rec: RecordHarmonics, set
         # a gap that jumps where the contact starts to open has more than one basin (the blind benchmark's
         # contact-separation items: found from the middle of the range in 2 of 6)
         scan = [np.concatenate([[q], x0[1:]]) for q in (0.125, 0.375, 0.625, 0.875)]
+        joint = all(p.start is not None for p in cand.parameters)
+        if joint:  # a joint refit: also from the earlier optimum itself, with a finer simplex (an oblique valley)
+            scan.append(x0)
+        scan += [np.clip((np.asarray(t, float) - lo) / (hi - lo), 0.0, 1.0) for t in starts]
         x0 = min(scan, key=lambda x: run(lo + x * (hi - lo))[0])
-        step = np.where(x0 + 0.25 <= 1.0, 0.25, -0.25)
+        size = 0.1 if joint else 0.25
+        step = np.where(x0 + size <= 1.0, size, -size)
         simplex = np.vstack([x0, x0 + np.diag(step)])
         res = minimize(lambda x: run(lo + np.clip(x, 0, 1) * (hi - lo))[0], x0, method="Nelder-Mead",
                        options={"initial_simplex": simplex, "maxfev": max_evaluations * lo.size, "xatol": 1e-3,
@@ -316,7 +323,8 @@ def calibrate(model: IdentifiedModel, cand: Candidate, rec: RecordHarmonics, set
         theta = np.array([0.0 if p.low <= 0.0 <= p.high else p.low for p in cand.parameters]) \
             if not cand.per_channel else np.zeros_like(np.atleast_1d(theta))
         g, m2, sim, misfit, aug = run(theta)
-    return Calibration(cand.name, np.atleast_1d(theta), np.asarray(m2.friction), g, m2, aug, n_eval, misfit, sim)
+    theta = np.atleast_1d(theta)
+    return Calibration(cand.name, theta, np.asarray(m2.friction), g, m2, aug, n_eval, misfit, sim, ((cand.name, theta),))
 
 
 def baseline(model: IdentifiedModel, rec: RecordHarmonics, n_harmonics: int) -> tuple[float, SimResult]:
