@@ -414,9 +414,15 @@ def _candidate(name: str, model: IdentifiedModel, records: Mapping[str, RecordHa
     and a normal dashpot, leave a ridge between the one-effect optimum and the truth). Returns (calibration, sims,
     residuals) by case."""
     rec = records[calibration_case]
-    earlier = [(LIBRARY[n], th) for n, th in base_steps]
-    if earlier and joint:
-        cand, split = joint_candidate(LIBRARY[name], earlier, rec.acceleration.shape[0])
+    # per-channel effects (channel delays) trade off with no contact effect and would add a dimension per channel:
+    # they are held, and a per-channel candidate is refitted on the earlier steps held
+    free = [(LIBRARY[n], th) for n, th in base_steps if not LIBRARY[n].per_channel]
+    held = [(n, th) for n, th in base_steps if LIBRARY[n].per_channel]
+    if free and joint and not LIBRARY[name].per_channel:
+        base = NONE
+        for n, th in held:
+            base = base.merge(LIBRARY[n].augmentation(th))
+        cand, split = joint_candidate(LIBRARY[name], free, rec.acceleration.shape[0])
         mixes = ()
         if alone and name in alone:
             first = np.array([p.start for p in cand.parameters])  # the earlier optimum, this effect off
@@ -426,14 +432,15 @@ def _candidate(name: str, model: IdentifiedModel, records: Mapping[str, RecordHa
             own[n_new:] = [0.0 if p.low <= 0.0 <= p.high else p.low for p in cand.parameters[n_new:]]
             mixes = tuple((1 - t) * first + t * own for t in (1 / 3, 2 / 3))
         cal = calibrate(model, cand, rec, fit_settings, H, max_evaluations, start=base_sims[calibration_case],
-                        starts=mixes)
-        parts = split(cal.theta)
-        cal = dataclasses.replace(cal, theta=parts[0], steps=tuple((n, th) for (n, _), th in zip(base_steps, parts[1:]))
-                                  + ((name, parts[0]),))
+                        starts=mixes, base=base)
+        own_theta, *refitted = split(cal.theta)
+        refitted = dict(zip([n for n, _ in base_steps if not LIBRARY[n].per_channel], refitted))
+        cal = dataclasses.replace(cal, theta=own_theta, steps=tuple((n, refitted.get(n, th)) for n, th in base_steps)
+                                  + ((name, own_theta),))
     else:
         base = NONE
-        for c, th in earlier:
-            base = base.merge(c.augmentation(th))
+        for n, th in base_steps:
+            base = base.merge(LIBRARY[n].augmentation(th))
         cal = calibrate(model, LIBRARY[name], rec, fit_settings, H, max_evaluations, start=base_sims[calibration_case],
                         base=base)
         cal = dataclasses.replace(cal, steps=tuple(base_steps) + ((name, cal.theta),))
