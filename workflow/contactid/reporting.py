@@ -216,7 +216,8 @@ def contact_force_summary(forces: Mapping[str, xr.Dataset], nnms: Mapping[str, x
     work, paper = {}, {}
     for case, ds in forces.items():
         a = ds.attrs
-        w = {"eta_observable": bool(a["eta_observable"]), "normal_stiffness_from_n_eta_n_per_m": a["normal_stiffness_from_n_eta_n_per_m"],
+        w = {"eta_observable": bool(a["eta_observable"]), "eta_spread_over_structures": a.get("eta_spread_over_structures"),
+             "normal_stiffness_from_n_eta_n_per_m": a["normal_stiffness_from_n_eta_n_per_m"],
              "normal_hardening_n_per_m2": a["normal_hardening_n_per_m2"], "n_harmonics": a["n_harmonics"]}
         p = {"nnm_phase_spread_deg": [float(v) for v in nnms[case]["phase_spread"].values],
              "complex_modes": bool(nnms[case].attrs["complex_modes"]),

@@ -113,7 +113,7 @@ def figure_case():
 def contact_forces_inputs(wildcards):
     inputs = {"raw": raw_record(wildcards.case), "reduced": f"results/{wildcards.case}/reduced_model.nc",
               "modes": "results/linear/linear_modes.nc", "modal": "results/linear/modal.nc",
-              "stiction": "results/linear/stiction.nc"}
+              "stiction": "results/linear/stiction.nc", "updating": "results/gap/model_updating.json"}
     if wildcards.case in rig_cases():
         inputs["truth"] = f"data/truth/{wildcards.case}.nc"
     return inputs
