@@ -167,9 +167,11 @@ def test_report_section_is_plain_latex_with_and_without_the_benchmark():
                           "two_effects_one_named": 0.9, "remaining_gap_median": 0.005,
                           "perturbation_only_median_abs_error": {"mu": 0.05, "kappa": 0.2, "e0": 0.1},
                           "perturbation_only_interval_coverage": {"mu": 1.0, "kappa": 0.9286, "e0": 1.0},
+                          "perturbation_only_median_abs_bound_error": {"mu_a": 0.004, "e0_a2": 0.012},
                           "perturbation_only_median_interval_halfwidth": {"mu": 0.16, "kappa": 0.6, "e0": 0.37}}}
     assert "Compound benchmark" in gap_section(diag, bench) and "14 with 0" in gap_section(diag, bench)
     assert "$\\kappa$ $92.9$\\,\\%" in gap_section(diag, bench)  # interval coverage, three digits
+    assert "$e_0 a^2$ $1.20$\\,\\%" in gap_section(diag, bench)
     par = {n: {"value": 0.4, "profile_interval": [0.39, 0.41], "sd_cases": 0.01, "sd_structure": 0.08,
                "interval": [0.33, 0.48], "scale": "log"} for n in ("e_f", "k_c", "e_t", "kappa", "mu", "e0")}
     intervals = {"model": "updated", "n_structures": 12, "parameters": {**par, "confidence": 0.95}}

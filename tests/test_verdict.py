@@ -309,6 +309,21 @@ def test_compound_score_counts_named_effects_against_the_truth():
     assert s["perturbation_only_median_abs_error"]["mu"] == pytest.approx(0.01)
 
 
+def test_bound_errors_take_the_lever_arm_out_of_mu_and_e0():
+    from types import SimpleNamespace
+
+    from contactid.contact_laws import stiction_shear_stiffness
+    from contactid.gap.benchmark import bound_errors
+
+    truth = {"e_f_n_per_m": 3.857e7, "k_c_per_m": 2.547e5, "e_t_n_per_m": 0.0, "kappa": 0.284, "mu": 0.397}
+    # the model's lever arm is 8 % short of the rig's: S, hence mu, comes out 8 % high, e_0 (1.08)^2 high
+    e0 = stiction_shear_stiffness(70.0, truth["e_f_n_per_m"], truth["k_c_per_m"]) * 1.08**2
+    model = SimpleNamespace(structure=SimpleNamespace(tangential_lever_arm=0.006),
+                            friction=(1e12, e0 / 70.0, 0.0, 0.284, 0.397 * 1.08))  # e_f large: e_0 = k_c N0
+    b = bound_errors(model, truth, 70.0, 0.006 * 1.08)
+    assert b["mu_a"] == pytest.approx(0.0, abs=1e-9) and b["e0_a2"] == pytest.approx(0.0, abs=1e-4)
+
+
 def test_an_update_that_moves_only_the_transducer_masses_is_the_transducer_mass_error():
     ident = {f: {"posterior_sd": 0.05} for f in ("stiffness_scale", "mass_scale", "transducer_mass_scale")}
     assert V.updating_effect({"stiffness_scale": 1.01, "mass_scale": 0.99, "transducer_mass_scale": 1.3},

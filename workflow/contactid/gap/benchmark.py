@@ -183,6 +183,8 @@ def run_item(spec: Mapping, cfg: Mapping) -> dict:
                "heldout_gap_before": diag.where.get("heldout_gap_identified", diag.where["heldout_gap_before"]),
                "friction_errors": friction_errors(model, cfg["rig"]["truth"]["friction"], preload),
                "friction_errors_chain": friction_errors(chain_model, cfg["rig"]["truth"]["friction"], preload),
+               "bound_errors": bound_errors(model, cfg["rig"]["truth"]["friction"], preload,
+                                            cfg["rig"]["true_structure"]["contact_geometry"]["tangential_lever_arm_m"]),
                "friction_intervals": {n: unc.summary()[n]["interval"] for n in ("mu", "kappa", "e0")},
                "friction_covered": unc.covers(friction_truth(cfg["rig"]["truth"]["friction"], preload)),
                "friction_interval_halfwidth": unc.relative_halfwidth(("mu", "kappa", "e0")),
@@ -396,6 +398,14 @@ def friction_errors(model, truth_friction: Mapping, preload: float) -> dict:
     return {"mu": float(mu / t["mu"] - 1), "kappa": float(kappa / t["kappa"] - 1), "e0": float(e0 / e0_t - 1)}
 
 
+def bound_errors(model, truth_friction: Mapping, preload: float, true_lever_arm: float) -> dict:
+    """Relative errors of what the data bind when the tangential lever arm a is unknown (``contactid.gap.uncertainty``):
+    mu a and e_0 a^2, the model's a against the rig's true a."""
+    err = friction_errors(model, truth_friction, preload)
+    r = model.structure.tangential_lever_arm / float(true_lever_arm)
+    return {"mu_a": float((1 + err["mu"]) * r - 1), "e0_a2": float((1 + err["e0"]) * r**2 - 1)}
+
+
 def compound_score(rows: list) -> dict:
     """Scores of the compound items (see config/README.md, gap_benchmark.compound)."""
     def named(r):
@@ -412,6 +422,7 @@ def compound_score(rows: list) -> dict:
         per_effect[e] = {"recall": tp / (tp + fn) if tp + fn else None, "precision": tp / (tp + fp) if tp + fp else None,
                          "true": tp + fn, "named": tp + fp}
     errors = {k: [abs(r["friction_errors"][k]) for r in by_n[0]] for k in ("mu", "kappa", "e0")}
+    bound = {k: [abs(r["bound_errors"][k]) for r in by_n[0] if r.get("bound_errors")] for k in ("mu_a", "e0_a2")}
     covered = {k: [bool(r["friction_covered"][k]) for r in by_n[0] if k in (r.get("friction_covered") or {})]
                for k in ("mu", "kappa", "e0")}
     width = {k: [r["friction_interval_halfwidth"][k] for r in by_n[0] if r.get("friction_interval_halfwidth")]
@@ -428,6 +439,7 @@ def compound_score(rows: list) -> dict:
         "remaining_gap_median": float(np.median([r["remaining_gap"]["heldout_gap"] for r in rows])) if rows else None,
         "updating_accepted": share([bool(r["updating_accepted"]) for r in rows]),
         "perturbation_only_median_abs_error": {k: float(np.median(v)) if v else None for k, v in errors.items()},
+        "perturbation_only_median_abs_bound_error": {k: float(np.median(v)) if v else None for k, v in bound.items()},
         "perturbation_only_interval_coverage": {k: share(v) for k, v in covered.items()},
         "perturbation_only_median_interval_halfwidth": {k: float(np.median(v)) if v else None for k, v in width.items()},
     }

@@ -8,6 +8,15 @@ import pandas as pd
 from ..latex import _fmt, plain_text as _t, tabular
 
 
+def _bound_text(c: dict) -> str:
+    """The compound benchmark's errors of what the data bind (mu a, e_0 a^2), when scored."""
+    b = c.get("perturbation_only_median_abs_bound_error")
+    if not b or any(v is None for v in b.values()):
+        return ""
+    return (r" What the data bind, with the model's lever arm $a$ against the rig's: median errors $\mu a$ " +
+            _pct(b["mu_a"]) + r", $e_0 a^2$ " + _pct(b["e0_a2"]) + ".")
+
+
 def _coverage_text(c: dict) -> str:
     """The compound benchmark's interval coverage (intervals with the model-form term), when scored."""
     cov, hw = c.get("perturbation_only_interval_coverage"), c.get("perturbation_only_median_interval_halfwidth")
@@ -150,7 +159,7 @@ def gap_section(diag: dict, bench: dict | None, intervals: dict | None = None) -
                 _pct(c["two_effects_one_named"]) + r". Median remaining held-out gap " + _pct(c["remaining_gap_median"]) +
                 r". Perturbation only, after updating, median errors: $\mu$ " + _pct(err["mu"]) + r", $\kappa$ " +
                 _pct(err["kappa"]) + r", $e_0$ " + _pct(err["e0"]) + r" (the tangential lever arm, which linear data do not "
-                r"bound, scales the identified $S$ and so $\mu$)." + _coverage_text(c)) + "\n"
+                r"bound, scales the identified $S$ and so $\mu$)." + _bound_text(c) + _coverage_text(c)) + "\n"
     acc = pd.DataFrame([{"effect": e, "accuracy": 100 * a} for e, a in bench["per_effect_accuracy"].items()])
     out += tabular(acc, {"effect": "effect", "accuracy": "top-1 (\\%)"}, "Blind benchmark: accuracy per effect.",
                    "tab:bench")
