@@ -675,9 +675,9 @@ def diagnose(model: IdentifiedModel, records: Mapping[str, RecordHarmonics], cal
         s["share"] = share
     if steps and steps[0]["effect"] == "model_updating" and verdict == "none" and shares[0] == max(shares) \
             and explains_materially(first_before, before, scatter, settings):
-        # the update explains most of the gap: if it amounts to one library effect, that is the verdict
+        # the update explains most of the gap: if it amounts to one effect of the library in use, that is the verdict
         effect = updating_effect(updating.factors, updating.identifiability)
-        if effect is not None:
+        if effect is not None and effect in names:
             verdict = effect
             reason = (f"model updating ({', '.join(f'{k} {v:.3g}' for k, v in updating.factors.items())}) takes the "
                       f"held-out gap from {first_before:.3g} to {before:.3g} ({shares[0]:.0%} of its power); only "
