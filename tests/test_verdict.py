@@ -418,3 +418,24 @@ def test_ladder_scores_only_where_the_gap_exceeds_twice_the_floor():
     assert s["named_where_detectable"] == 0.75
     assert s["magnitude_within_where_detectable"] == pytest.approx(2 / 3)
     assert not s["all_named_and_within"] and s["false_names_below_detectable"] == 0
+
+
+def test_a_pair_that_together_shrinks_the_gap_materially_is_added():
+    # alone, the best candidate leaves 70 % of the gap (not material); on top of it a second leaves 30 %
+    first = {"normal_contact_damping": 0.028, "preload_drift": 0.031, "structural_damping": 0.039}
+    second = {"preload_drift": 0.012, "structural_damping": 0.027}
+    third = {"structural_damping": 0.0119}
+    on = {**SETTINGS, "pair_lookahead": 3.0}
+    steps, left, tried = _explain(first, [second, third], settings=on)
+    assert [s["effect"] for s in steps] == ["normal_contact_damping", "preload_drift"] and left == 0.012
+    assert tried[0] == ("normal_contact_damping", ("preload_drift", "structural_damping"))
+    # without the lookahead, or when the pair still leaves more than half, nothing is added
+    assert _explain(first, [second, third])[0] == []
+    steps, left, _ = _explain(first, [{"preload_drift": 0.021, "structural_damping": 0.027}], settings=on)
+    assert steps == [] and left == 0.04
+    # nor when the best alone shrinks the gap only within the records' scatter
+    steps, _, tried = _explain({"normal_contact_damping": 0.0399}, [second], settings=on, scatter=1e-3)
+    assert steps == [] and tried == []
+    # nor where what is left is within 3 x min_gap (0.018): model form, mostly
+    steps, _, tried = _explain({"normal_contact_damping": 0.012}, [second], before=0.017, settings=on)
+    assert steps == [] and tried == []
