@@ -210,7 +210,8 @@ def simulate(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, re
     neighbouring simulation of the same record). That state is within about 1e-3 of the integrator's
     own periodic orbit (the harmonics it leaves out); with ``polish`` the integrator then runs from
     it until its harmonics settle by the reference's own test (8-period chunks changing by less than
-    ``tol``, two chunks at least) and records ``record_periods`` periods, so the result is the
+    ``tol``, two chunks at least) and records the last settled chunk (``record_periods`` periods, or the
+    record's length, where it does not settle), so the result is the
     reference's to its tolerance at a fraction of its cost. Where Newton does not converge (a response
     that does not settle), and for a contact that may open, the integrator starts from the linear state
     instead. "time_marching" (the
@@ -312,13 +313,19 @@ def _marched_result(sim, model: IdentifiedModel, aug: Augmentation, rec: RecordH
         # the motion does not settle (impacts): average over as many periods as the record holds, as the
         # record's harmonics do
         record_periods = max(int(record_periods), rec.periods)
-    if aug.preload_drift:
-        n_rec = rec.periods * n_per
-        sim.drift_t0 = sim.t
-        sim.drift_rate = aug.preload_drift / (n_rec * sim.dt)
+    chunk = getattr(sim, "last_chunk", None)
+    if settled and not aug.preload_drift and chunk is not None and chunk["t"].size % n_per == 0:
+        # a settled periodic response: its last settling chunk (whole periods, changing by less than the settling
+        # tolerance from the one before) is the record; 16 more periods gave the same harmonics within 1e-6
+        out, n_rec = chunk, chunk["t"].size
     else:
-        n_rec = int(record_periods) * n_per
-    out = sim.run(coef, None, w, n_rec, store_from=0)
+        if aug.preload_drift:
+            n_rec = rec.periods * n_per
+            sim.drift_t0 = sim.t
+            sim.drift_rate = aug.preload_drift / (n_rec * sim.dt)
+        else:
+            n_rec = int(record_periods) * n_per
+        out = sim.run(coef, None, w, n_rec, store_from=0)
     acc = (out["a"] @ sim.red.sensors.T).T
     t1 = out["t"][0]
     if aug.preload_drift:

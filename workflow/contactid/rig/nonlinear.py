@@ -329,6 +329,7 @@ class DualSineSimulator:
         self.state = np.zeros(3)
         self.x_sl = np.zeros(self.iw_w.size)
         self.t = 0.0
+        self.last_chunk = None
         self.drift_rate = 0.0
         self.drift_t0 = 0.0
 
@@ -393,12 +394,14 @@ class DualSineSimulator:
                min_chunks: int = 3, max_chunks: int = 200) -> tuple[np.ndarray, SteadyStateLog, bool]:
         """Run chunks of ``chunk_periods`` periods until the driving-point harmonics
         at w and 3w change by less than ``tol`` (relative) from one chunk to the next.
-        Returns ([A1, A3] complex of the last chunk, log, converged)."""
+        Returns ([A1, A3] complex of the last chunk, log, converged); the last chunk's signals (``run``'s dict)
+        stay in ``last_chunk``, so that a settled response can be recorded from them."""
         n = int(round(chunk_periods * 2 * np.pi / w / self.dt))
         log = SteadyStateLog()
         prev = None
         for k in range(max_chunks):
             out = self.run(F1, F3, w, n, store_from=0)
+            self.last_chunk = out
             acc = out["a"] @ self.red.drive
             c = harmonic_amplitudes(acc, out["t"], w, (1, 3))
             log.a1.append(abs(c[0]))
