@@ -120,6 +120,17 @@ def refitted_magnitude(effect: str, parameters: Mapping | None) -> float | None:
     return None
 
 
+def _refitted(effect, ranking: Mapping, updating) -> float | None:
+    """The rig magnitude the diagnosis refitted for ``effect`` (``refitted_magnitude`` of its candidate); an accepted
+    model update's transducer-mass factor counts for transducer_mass_error (the candidate refits what is left)."""
+    if effect not in ranking:
+        return None
+    m = refitted_magnitude(effect, ranking[effect].get("parameters"))
+    if effect == "transducer_mass_error" and m is not None and updating is not None and updating.accepted:
+        m = updating.factors.get("transducer_mass_scale", 1.0) * (1.0 + m) - 1.0
+    return m
+
+
 def run_item(spec: Mapping, cfg: Mapping) -> dict:
     """Generate the item's rig records, identify the model from them, diagnose; the result row."""
     from ..friction_fit import settings_from_config
@@ -202,8 +213,9 @@ def run_item(spec: Mapping, cfg: Mapping) -> dict:
     return {**dict(spec), "verdict": diag.verdict, "reason": diag.reason, "correct": (diag.verdict == (true or "none"))
             if spec["kind"] != "leave_out" else diag.verdict == "none",
             "heldout_gap_before": diag.where["heldout_gap_before"],
+            "heldout_gap_identified": diag.where.get("heldout_gap_identified", diag.where["heldout_gap_before"]),
             "heldout_gap_after_true": by[true]["heldout_gap_after"] if true in by else None,
-            "refitted_magnitude": refitted_magnitude(true, by[true].get("parameters")) if true in by else None,
+            "refitted_magnitude": _refitted(true, by, updating),
             "shrink_true": by[true]["reduction"] if true in by else None,
             "ranking": [{k: r[k] for k in ("effect", "heldout_gap_before", "heldout_gap_after", "score", "reduction")}
                         for r in diag.ranking],
@@ -254,19 +266,21 @@ def score(rows: list) -> dict:
 
 
 def ladder_score(rows: list, floor: float, tolerance: float = 0.25) -> dict:
-    """The detection ladder: an item is detectable when its held-out gap before exceeds twice the floor
-    (``gap.min_gap``); there the effect must be the verdict and its refitted magnitude within ``tolerance`` of
-    the truth (where the two are comparable, ``refitted_magnitude``). Per item and overall."""
+    """The detection ladder: an item is detectable when the identified model's held-out gap (before model updating,
+    which may take up a transducer-mass effect) exceeds twice the floor (``gap.min_gap``); there the effect must
+    be the verdict and its refitted magnitude within ``tolerance`` of the truth (where the two are comparable,
+    ``refitted_magnitude``). Per item and overall."""
     items = []
     for r in rows:
         if r.get("failed"):
             items.append({"item": r.get("item"), "effect": r["effect"], "fraction": r.get("fraction"), "failed": r["failed"]})
             continue
-        detectable = bool(r["heldout_gap_before"] > 2.0 * floor)
+        gap = r.get("heldout_gap_identified", r["heldout_gap_before"])
+        detectable = bool(gap > 2.0 * floor)
         m = r.get("refitted_magnitude")
         err = None if m is None or not r["magnitude"] else float(m / r["magnitude"] - 1.0)
         items.append({"item": r.get("item"), "effect": r["effect"], "fraction": r.get("fraction"), "seed": r["seed"],
-                      "magnitude": r["magnitude"], "heldout_gap_before": r["heldout_gap_before"],
+                      "magnitude": r["magnitude"], "heldout_gap_before": gap,
                       "detectable": detectable, "verdict": r["verdict"], "named": r["verdict"] == r["effect"],
                       "refitted_magnitude": m, "magnitude_error": err,
                       "magnitude_within": None if err is None else bool(abs(err) <= tolerance)})
