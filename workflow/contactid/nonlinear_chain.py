@@ -147,14 +147,11 @@ def contact_forces_dataset(raw: xr.Dataset, paper: xr.Dataset, linear_modes: xr.
         # (the relative norm of the coefficients is the NRMSE of the periodic signals; no time synthesis needed)
         F_coef = fourier_series(force, fs, f0, n_harmonics)[0]
         A_coef = fourier_series(acc, fs, f0, n_harmonics)
-
-        def harmonics(m):
-            h = inverse_harmonics(m, modal_damping_vector(m, modal["damping_ratio"].values), F_coef, A_coef, f0)
-            return {"S": h.S, "N_dyn": h.N_dyn, "xi": m.xi_vector @ h.q, "eta": h.eta}
-
-        own = harmonics(model)
+        own = {"S": inv.S_coef, "N_dyn": inv.N_coef, "xi": inv.xi_coef, "eta": inv.eta_coef}
         for p in structures:
-            other = harmonics(assemble(p))
+            m = assemble(p)
+            h = inverse_harmonics(m, modal_damping_vector(m, modal["damping_ratio"].values), F_coef, A_coef, f0)
+            other = {"S": h.S, "N_dyn": h.N_dyn, "xi": m.xi_vector @ h.q, "eta": h.eta}
             for q, c in own.items():
                 change = float(np.linalg.norm(other[q] - c) / max(np.linalg.norm(c), 1e-300))
                 structure_spread[q] = max(structure_spread.get(q, 0.0), change)

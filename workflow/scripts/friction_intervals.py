@@ -4,13 +4,11 @@ import json
 
 from contactid.friction_fit import settings_from_config
 from contactid.gap.diagnosis import GapSettings
-from contactid.gap.model import identified_model
-from contactid.gap.pipeline import updated_model
+from contactid.gap.pipeline import diagnosed_model
 from contactid.gap.records import record_harmonics
 from contactid.gap.uncertainty import friction_uncertainty
 from contactid.io import load_dataset, read_raw, write_text
 from contactid.logs import setup_logging
-from contactid.updating import UpdatingResult
 
 log = setup_logging(snakemake.log[0])
 p = snakemake.params
@@ -18,18 +16,17 @@ inp = snakemake.input
 K = int(p.n_harmonics)
 settings = GapSettings.from_config(p.gap, int(p.seed), K)
 modal = load_dataset(inp.modal)
-chain_model = identified_model(p.structure, load_dataset(inp.modes), modal, load_dataset(inp.fit))
 records = {c: record_harmonics(read_raw(path, dual_sine=True), c, K) for c, path in zip(p.cases, inp.raw)}
 fit_settings = settings_from_config(p.friction)
 with open(inp.updating) as fh:
     upd_summary = json.load(fh)
-upd = UpdatingResult.from_summary(upd_summary, chain_model.structure) if upd_summary["enabled"] else None
-model, upd = (updated_model(chain_model, modal, records[p.calibration_case], fit_settings, settings, int(p.seed), upd)
-              if upd is not None else (chain_model, None))
+_, model, upd = diagnosed_model(p.structure, load_dataset(inp.modes), modal, load_dataset(inp.fit),
+                                records[p.calibration_case], upd_summary, fit_settings, settings, int(p.seed))
 unc = friction_uncertainty(model, records, p.calibration_case, fit_settings, int(p.seed),
                            upd.posterior_structures() if upd is not None else ())
+par = unc.summary()
 out = {"model": "updated" if upd is not None and upd.accepted else "chain", "calibration_case": p.calibration_case,
-       "load_cases": list(p.cases), "n_structures": len(unc.structure_fits), "parameters": unc.summary()}
+       "load_cases": list(p.cases), "n_structures": len(unc.structure_fits), "parameters": par}
 write_text(snakemake.output[0], json.dumps(out, indent=2, default=float))
 log.info("friction intervals with model form: %s", ", ".join(
-    f"{n} [{v['interval'][0]:.4g}, {v['interval'][1]:.4g}]" for n, v in unc.summary().items() if n != "confidence"))
+    f"{n} [{v['interval'][0]:.4g}, {v['interval'][1]:.4g}]" for n, v in par.items() if n != "confidence"))

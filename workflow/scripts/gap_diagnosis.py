@@ -6,13 +6,11 @@ import time
 from contactid.friction_fit import settings_from_config
 from contactid.gap.candidates import load_plugins
 from contactid.gap.diagnosis import GapSettings, diagnose, linear_stage, prepare_workers
-from contactid.gap.model import identified_model
-from contactid.gap.pipeline import updated_model
+from contactid.gap.pipeline import diagnosed_model
 from contactid.gap.output import diagnosis_json, gap_dataset
 from contactid.gap.records import record_harmonics
 from contactid.io import load_dataset, provenance, read_raw, write_dataset, write_text
 from contactid.logs import setup_logging
-from contactid.updating import UpdatingResult
 
 log = setup_logging(snakemake.log[0])
 p = snakemake.params
@@ -24,14 +22,13 @@ settings = GapSettings.from_config(p.gap, int(p.seed), K)
 workers = int(snakemake.resources.workers)
 prepare_workers(workers)  # before the friction fit after updating starts numba's threads
 modal = load_dataset(inp.modal)
-chain_model = identified_model(p.structure, load_dataset(inp.modes), modal, load_dataset(inp.fit))
 records = {c: record_harmonics(read_raw(path, dual_sine=True), c, K) for c, path in zip(p.cases, inp.raw)}
 fit_settings = settings_from_config(p.friction)
 with open(inp.updating) as fh:
     upd_summary = json.load(fh)
-upd = UpdatingResult.from_summary(upd_summary, chain_model.structure) if upd_summary["enabled"] else None
-model, updating = updated_model(chain_model, modal, records[p.calibration_case], fit_settings, settings, int(p.seed),
-                                upd) if upd is not None else (chain_model, None)
+chain_model, model, updating = diagnosed_model(p.structure, load_dataset(inp.modes), modal, load_dataset(inp.fit),
+                                               records[p.calibration_case], upd_summary, fit_settings, settings,
+                                               int(p.seed))
 linear = linear_stage(model, load_dataset(inp.frf), modal)
 diag = diagnose(model, records, p.calibration_case, settings, fit_settings, linear, workers=workers,
                 identified=chain_model, updating=updating)

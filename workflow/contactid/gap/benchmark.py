@@ -180,7 +180,7 @@ def run_item(spec: Mapping, cfg: Mapping) -> dict:
     t_diag = time.perf_counter() - t1
     by = {r["effect"]: r for r in diag.ranking}
     if compound:
-        from .uncertainty import friction_uncertainty
+        from .uncertainty import NAMES, friction_uncertainty
 
         named = [s["effect"] for s in diag.explanation if s["effect"] != "model_updating"]
         preload = float(cfg["structure"]["preload_n"])
@@ -196,7 +196,7 @@ def run_item(spec: Mapping, cfg: Mapping) -> dict:
                "friction_errors_chain": friction_errors(chain_model, cfg["rig"]["truth"]["friction"], preload),
                "bound_errors": bound_errors(model, cfg["rig"]["truth"]["friction"], preload,
                                             cfg["rig"]["true_structure"]["contact_geometry"]["tangential_lever_arm_m"]),
-               "friction_intervals": {n: unc.summary()[n]["interval"] for n in ("mu", "kappa", "e0")},
+               "friction_intervals": {n: [float(v) for v in unc.interval[NAMES.index(n)]] for n in ("mu", "kappa", "e0")},
                "friction_covered": unc.covers(friction_truth(cfg["rig"]["truth"]["friction"], preload)),
                "friction_interval_halfwidth": unc.relative_halfwidth(("mu", "kappa", "e0")),
                "where": diag.where, "control_converged": converged,
@@ -406,10 +406,9 @@ def friction_errors(model, truth_friction: Mapping, preload: float) -> dict:
     from ..contact_laws import stiction_shear_stiffness
 
     e_f, k_c, _, kappa, mu = model.friction
-    t = truth_friction
+    t = friction_truth(truth_friction, preload)
     e0 = stiction_shear_stiffness(preload, e_f, k_c)
-    e0_t = stiction_shear_stiffness(preload, t["e_f_n_per_m"], t["k_c_per_m"])
-    return {"mu": float(mu / t["mu"] - 1), "kappa": float(kappa / t["kappa"] - 1), "e0": float(e0 / e0_t - 1)}
+    return {"mu": float(mu / t["mu"] - 1), "kappa": float(kappa / t["kappa"] - 1), "e0": float(e0 / t["e0"] - 1)}
 
 
 def bound_errors(model, truth_friction: Mapping, preload: float, true_lever_arm: float) -> dict:

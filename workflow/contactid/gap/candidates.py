@@ -33,6 +33,11 @@ class Parameter:
     high: float
     start: float | None = None
 
+    @property
+    def off(self) -> float:
+        """The value that leaves the model as it is: zero, or the range's low end where zero is outside it."""
+        return 0.0 if self.low <= 0.0 <= self.high else self.low
+
 
 @dataclass(frozen=True)
 class Candidate:
@@ -106,6 +111,14 @@ register(Candidate("preload_drift", "static normal preload drifting linearly ove
 BUILTIN = tuple(LIBRARY)
 
 
+def merged_augmentation(steps) -> Augmentation:
+    """The augmentation of several effects together, ``steps`` [(Candidate, theta), ...] (later ones win a field)."""
+    aug = Augmentation()
+    for c, th in steps:
+        aug = aug.merge(c.augmentation(th))
+    return aug
+
+
 def joint_candidate(new: Candidate, earlier, n_channels: int) -> tuple[Candidate, Callable]:
     """``new`` refitted together with the explanation's earlier steps ``earlier`` [(Candidate, theta), ...]: a
     candidate whose parameters are new's (searched from their starts) followed by each earlier one's (starting at
@@ -116,9 +129,8 @@ def joint_candidate(new: Candidate, earlier, n_channels: int) -> tuple[Candidate
     step's optimum itself (``refit.calibrate``)."""
     def expand(c: Candidate, theta=None):
         params = c.parameters * (n_channels if c.per_channel else 1)
-        if theta is None:  # the new effect starts off (zero, or its range's low end), its own start where given
-            return tuple(Parameter(p.name, p.unit, p.low, p.high,
-                                   start=p.start if p.start is not None else (0.0 if p.low <= 0.0 <= p.high else p.low))
+        if theta is None:  # the new effect starts off, at its own start where it gives one
+            return tuple(Parameter(p.name, p.unit, p.low, p.high, start=p.off if p.start is None else p.start)
                          for p in params)
         return tuple(Parameter(p.name, p.unit, p.low, p.high, start=float(np.clip(t, p.low, p.high)))
                      for p, t in zip(params, np.atleast_1d(theta)))
@@ -131,10 +143,7 @@ def joint_candidate(new: Candidate, earlier, n_channels: int) -> tuple[Candidate
         return np.split(np.atleast_1d(np.asarray(theta, float)), sizes)
 
     def augmentation(theta):
-        aug = Augmentation()
-        for c, th in zip(cands, split(theta)):
-            aug = aug.merge(c.augmentation(th))
-        return aug
+        return merged_augmentation(zip(cands, split(theta)))
 
     joint = Candidate(new.name, new.meaning, tuple(p for x in parts for p in x), augmentation, False, new.acts_on)
     return joint, split

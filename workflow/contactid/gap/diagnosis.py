@@ -24,7 +24,7 @@ from ..contact_laws import stiction_shear_stiffness
 from ..identification import modal_damping_vector
 from ..friction_fit import FitSettings
 from ..random_streams import generator
-from .candidates import LIBRARY, joint_candidate
+from .candidates import LIBRARY, joint_candidate, merged_augmentation
 from .model import NONE, Augmentation, IdentifiedModel, fe_model
 from .records import RecordHarmonics
 from .refit import (baseline, calibrate, contact_grids, evaluate, gap_residual, gap_value,
@@ -418,31 +418,27 @@ def _candidate(name: str, model: IdentifiedModel, records: Mapping[str, RecordHa
     rec = records[calibration_case]
     # per-channel effects (channel delays) trade off with no contact effect and would add a dimension per channel:
     # they are held, and a per-channel candidate is refitted on the earlier steps held
-    free = [(LIBRARY[n], th) for n, th in base_steps if not LIBRARY[n].per_channel]
-    held = [(n, th) for n, th in base_steps if LIBRARY[n].per_channel]
+    free = [n for n, _ in base_steps if not LIBRARY[n].per_channel]
     if free and joint and not LIBRARY[name].per_channel:
-        base = NONE
-        for n, th in held:
-            base = base.merge(LIBRARY[n].augmentation(th))
-        cand, split = joint_candidate(LIBRARY[name], free, rec.acceleration.shape[0])
+        base = merged_augmentation((LIBRARY[n], th) for n, th in base_steps if n not in free)
+        cand, split = joint_candidate(LIBRARY[name], [(LIBRARY[n], th) for n, th in base_steps if n in free],
+                                      rec.acceleration.shape[0])
         mixes = ()
         if alone and name in alone:
             first = np.array([p.start for p in cand.parameters])  # the earlier optimum, this effect off
             own = first.copy()  # this effect at its one-effect optimum, the earlier ones off
             n_new = len(np.atleast_1d(alone[name]))
             own[:n_new] = np.atleast_1d(alone[name])
-            own[n_new:] = [0.0 if p.low <= 0.0 <= p.high else p.low for p in cand.parameters[n_new:]]
+            own[n_new:] = [p.off for p in cand.parameters[n_new:]]
             mixes = tuple((1 - t) * first + t * own for t in (1 / 3, 2 / 3))
         cal = calibrate(model, cand, rec, fit_settings, H, max_evaluations, start=base_sims[calibration_case],
                         starts=mixes, base=base)
         own_theta, *refitted = split(cal.theta)
-        refitted = dict(zip([n for n, _ in base_steps if not LIBRARY[n].per_channel], refitted))
+        refitted = dict(zip(free, refitted))
         cal = dataclasses.replace(cal, theta=own_theta, steps=tuple((n, refitted.get(n, th)) for n, th in base_steps)
                                   + ((name, own_theta),))
     else:
-        base = NONE
-        for n, th in base_steps:
-            base = base.merge(LIBRARY[n].augmentation(th))
+        base = merged_augmentation((LIBRARY[n], th) for n, th in base_steps)
         cal = calibrate(model, LIBRARY[name], rec, fit_settings, H, max_evaluations, start=base_sims[calibration_case],
                         base=base)
         cal = dataclasses.replace(cal, steps=tuple(base_steps) + ((name, cal.theta),))
@@ -552,7 +548,7 @@ def explain(first: dict, names: list, before: float, scatter: float, settings: G
         chosen = [(best, results[best], gaps[best])]
         if not explains_materially(gap, gaps[best], scatter, settings):
             others = [n for n in remaining if n != best]
-            lookahead = getattr(settings, "pair_lookahead", 0.0)
+            lookahead = settings.pair_lookahead
             if not (lookahead and gap > lookahead * settings.min_gap and others and gaps[best] < gap - beyond_scatter):
                 break
             results2 = next_pass(others, results[best][0])

@@ -313,7 +313,7 @@ def _marched_result(sim, model: IdentifiedModel, aug: Augmentation, rec: RecordH
         # the motion does not settle (impacts): average over as many periods as the record holds, as the
         # record's harmonics do
         record_periods = max(int(record_periods), rec.periods)
-    chunk = getattr(sim, "last_chunk", None)
+    chunk = sim.last_chunk
     if settled and not aug.preload_drift and chunk is not None and chunk["t"].size % n_per == 0:
         # a settled periodic response: its last settling chunk (whole periods, changing by less than the settling
         # tolerance from the one before) is the record; 16 more periods gave the same harmonics within 1e-6

@@ -84,6 +84,21 @@ def structure_update(structure, modal: xr.Dataset, settings):
                             prior_sd=dict(settings.updating_prior_sd))
 
 
+def diagnosed_model(structure_cfg: Mapping, modes: xr.Dataset, modal: xr.Dataset, fit: xr.Dataset, calibration,
+                    updating_summary: Mapping, fit_settings, settings, seed: int):
+    """The models a diagnosis of the workflow's datasets works with: (the chain's own model from linear_modes.nc,
+    modal.nc and friction_fit.nc; the model to diagnose, the chain's updated by model_updating.json's summary
+    (``updated_model``) or the chain's own when updating is off; the UpdatingResult or None)."""
+    from ..updating import UpdatingResult
+
+    chain = identified_model(structure_cfg, modes, modal, fit)
+    if not updating_summary["enabled"]:
+        return chain, chain, None
+    upd = UpdatingResult.from_summary(updating_summary, chain.structure)
+    model, upd = updated_model(chain, modal, calibration, fit_settings, settings, seed, upd)
+    return chain, model, upd
+
+
 def updated_model(model, modal: xr.Dataset, calibration, fit_settings, settings, seed: int, upd=None):
     """The base model updated from the random test before the candidates (``structure_update``, or ``upd`` when
     already computed), with the inverse identification and the friction fit redone on the calibration record

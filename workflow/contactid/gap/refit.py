@@ -296,7 +296,7 @@ def calibrate(model: IdentifiedModel, cand: Candidate, rec: RecordHarmonics, set
         theta = np.array([res.x]) if run(np.array([res.x]))[0] <= run(np.array([grid[best]]))[0] \
             else np.array([grid[best]])
         # the bounded search never tries the ends: compare with "off" (the low end or zero)
-        off = np.array([0.0 if p.low <= 0.0 <= p.high else p.low])
+        off = np.array([p.off])
         if run(off)[0] < run(theta)[0]:
             theta = off
     else:
@@ -323,7 +323,7 @@ def calibrate(model: IdentifiedModel, cand: Candidate, rec: RecordHarmonics, set
         theta = lo + np.clip(res.x, 0, 1) * (hi - lo)
     g, m2, sim, misfit, aug = run(theta)
     if not np.isfinite(g):  # nothing in the range could be simulated: the effect off
-        theta = np.array([0.0 if p.low <= 0.0 <= p.high else p.low for p in cand.parameters]) \
+        theta = np.array([p.off for p in cand.parameters]) \
             if not cand.per_channel else np.zeros_like(np.atleast_1d(theta))
         g, m2, sim, misfit, aug = run(theta)
     theta = np.atleast_1d(theta)
