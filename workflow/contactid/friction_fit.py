@@ -13,7 +13,6 @@ from dataclasses import dataclass, field
 import numba
 import numpy as np
 from scipy.optimize import least_squares
-from scipy.stats import chi2 as chi2_dist
 
 from .contact_laws import stiction_shear_stiffness
 from .friction import PARAMETER_NAMES, REGULARIZATIONS, valanis_friction_force
@@ -245,6 +244,8 @@ def fit_friction_law(coef_xi, coef_n, coef_s, f0: float, preload: float, setting
     ssr_min = ssr
     m_pts = problem.S.size
     sigma2 = max(ssr_min / m_pts * n_data / max(n_data - 5, 1), settings.misfit_floor**2)
+    from scipy.stats import chi2 as chi2_dist  # here: scipy.stats takes 0.3 s to import
+
     thr = ssr_min + chi2_dist.ppf(settings.confidence, 1) * sigma2 * m_pts / n_data
     want_intervals = intervals
     intervals = np.full((5, 2), np.nan)

@@ -5,7 +5,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.signal
 
 
 @dataclass(frozen=True)
@@ -37,6 +36,8 @@ def h1_frf(force: np.ndarray, responses: np.ndarray, sampling_rate_hz: float,
         raise ValueError(f"FRF segment length {segment_length} exceeds the record length {n} samples")
     noverlap = int(round(overlap * segment_length))
     kw = dict(fs=sampling_rate_hz, window=window, nperseg=segment_length, noverlap=noverlap, detrend="constant")
+    import scipy.signal  # here: it takes about 0.5 s to import, and most rules never need it
+
     f, gff = scipy.signal.welch(force, **kw)
     h1 = np.empty((responses.shape[0], f.size), dtype=complex)
     coh = np.empty((responses.shape[0], f.size))

@@ -10,7 +10,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import brentq, least_squares
-from scipy.stats import chi2
 
 from .beam_model import ContactFrequencyMap
 from .parameters import StructureParameters
@@ -139,6 +138,8 @@ def stiction_stiffness(params: StructureParameters, f_id_hz, sigma_hz, k_t_bound
             best, chi2_min = x1, c1
             prof = _profiles(params, f_id, sigma, best, lt, ln, n_profile)
     chi2_min = min([chi2_min] + [float(p[1].min()) for p in prof.values()])
+    from scipy.stats import chi2  # here: scipy.stats takes 0.3 s to import
+
     thr = chi2.ppf(confidence, 1)
 
     profiles, lo_hi, flags, notes = {}, {}, {}, {}

@@ -26,7 +26,6 @@ from typing import Callable
 
 import numpy as np
 from scipy.optimize import least_squares
-from scipy.stats import chi2 as chi2_dist
 
 from .beam_model import assemble, structural_modes
 from .parameters import StructureParameters
@@ -200,6 +199,8 @@ def update_structure(params: StructureParameters, f_id_hz, f_sigma_hz, residues,
     x1, sol = fit(free)
     x_nom = x_nom_saved
     chi2_updated = float(np.sum(data_residuals(x1) ** 2))
+    from scipy.stats import chi2 as chi2_dist  # here: scipy.stats takes 0.3 s to import
+
     accepted = bool(names) and bool(chi2_nominal - chi2_updated > chi2_dist.ppf(confidence, len(names)))
     # linearised posterior: J of the residuals (data + prior) in x
     J = sol.jac

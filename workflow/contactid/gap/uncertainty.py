@@ -27,7 +27,6 @@ from dataclasses import dataclass
 from typing import Mapping
 
 import numpy as np
-from scipy.stats import norm
 
 from ..contact_laws import stiction_shear_stiffness
 from ..friction import PARAMETER_NAMES
@@ -110,6 +109,8 @@ def spread_sd(best: np.ndarray, alternatives, pairs: bool = False) -> np.ndarray
 def widened_interval(profile: np.ndarray, sd: np.ndarray, confidence: float, bounds) -> np.ndarray:
     """The profile interval (6, 2) widened by z sd on each side (z the normal quantile of ``confidence``) on
     each parameter's scale, clipped to the search ``bounds`` ((5, 2) of the law; e_0 unclipped)."""
+    from scipy.stats import norm  # here: scipy.stats takes 0.3 s to import
+
     z = float(norm.ppf(0.5 + confidence / 2.0))
     lo, hi = _scaled(profile[:, 0]) - z * sd, _scaled(profile[:, 1]) + z * sd
     lo = np.where(LOG_SCALE, np.exp(np.minimum(lo, 700.0)), lo)

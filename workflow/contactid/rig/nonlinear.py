@@ -27,7 +27,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.linalg
-import scipy.signal
 from numba import njit
 
 from ..beam_model import FEModel, all_modes, fix_signs, shortening_matrix
