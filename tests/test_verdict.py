@@ -210,7 +210,7 @@ class _Cal:
         self.steps = tuple(earlier) + ((name, self.theta),)
 
 
-def _explain(first, passes, before=0.04, scatter=1e-4, settings=None):
+def _explain(first, passes, before=0.04, scatter=1e-4, settings=None, later=None):
     """diagnosis.explain with results {name: gap}; passes: the results of each later pass, keyed by the
     names tried (so that a test fails if the wrong candidates are tried on top)."""
     from types import SimpleNamespace
@@ -225,7 +225,8 @@ def _explain(first, passes, before=0.04, scatter=1e-4, settings=None):
         tried.append((cal.candidate, tuple(remaining)))
         return wrap(passes[len(tried) - 1])
 
-    steps, left, last = explain(wrap(first), list(first), before, scatter, s, lambda sims: sims["gap"], next_pass)
+    steps, left, last = explain(wrap(first), list(first), before, scatter, s, lambda sims: sims["gap"], next_pass,
+                                later)
     return steps, left, tried
 
 
@@ -259,6 +260,26 @@ def test_explanation_is_empty_when_nothing_shrinks_the_gap_materially():
     # nor is anything when the gap before is already at the floor
     steps, left, _ = _explain({"viscous_friction": 0.001}, [], before=0.005)
     assert steps == [] and left == 0.005
+
+
+def test_later_passes_try_only_the_candidates_that_moved_alone():
+    from types import SimpleNamespace
+
+    from contactid.gap.candidates import LIBRARY
+
+    first = {"viscous_friction": [350.0], "structural_damping": [0.0], "channel_time_skew": [0.0, 2e-6, 0.0],
+             "normal_contact_damping": [0.0], "transducer_mass_error": [-1e-13]}
+    moved = V.retried(first, LIBRARY, SimpleNamespace(retry_unmoved=False))
+    assert moved == ["viscous_friction", "channel_time_skew"]  # one channel's delay moved: the candidate did
+    assert V.retried(first, LIBRARY, SimpleNamespace(retry_unmoved=True)) == list(first)
+    # the explanation tries on top only those (and the pair lookahead draws its second from them too)
+    gaps = {"viscous_friction": 0.02, "normal_contact_damping": 0.03, "structural_damping": 0.039}
+    steps, left, tried = _explain(gaps, [{"normal_contact_damping": 0.008}],
+                                  later=["viscous_friction", "normal_contact_damping"])
+    assert tried == [("viscous_friction", ("normal_contact_damping",))]
+    assert [s["effect"] for s in steps] == ["viscous_friction", "normal_contact_damping"] and left == 0.008
+    steps, left, tried = _explain(gaps, [], later=["viscous_friction"])
+    assert tried == [] and [s["effect"] for s in steps] == ["viscous_friction"] and left == 0.02
 
 
 def test_material_and_floor_rules():

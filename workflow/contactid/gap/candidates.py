@@ -38,6 +38,10 @@ class Parameter:
         """The value that leaves the model as it is: zero, or the range's low end where zero is outside it."""
         return 0.0 if self.low <= 0.0 <= self.high else self.low
 
+    def is_off(self, value: float) -> bool:
+        """Whether ``value`` leaves the model as it is (within 1e-9 of the range)."""
+        return abs(float(value) - self.off) <= 1e-9 * (self.high - self.low)
+
 
 @dataclass(frozen=True)
 class Candidate:

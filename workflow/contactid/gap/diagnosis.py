@@ -31,7 +31,7 @@ from .refit import (baseline, calibrate, contact_grids, evaluate, gap_residual, 
                     identified_forces, law_friction_force)
 from .verdict import DRIFT_FACTOR, NORMAL_LIMIT, OPEN_LIMIT, RESIDUAL_FACTOR  # noqa: F401 (thresholds of the place)
 from .verdict import UPDATING_Z
-from .verdict import (acts_where, at_floor, explains_materially, gap_shares, open_fraction, place as _place_of,
+from .verdict import (acts_where, at_floor, retried, explains_materially, gap_shares, open_fraction, place as _place_of,
                       updating_effect)
 from .verdict import verdict as _verdict
 
@@ -72,6 +72,7 @@ class GapSettings:
     updating_prior_sd: tuple = ()  # ((factor, sd of its ln), ...) replacing contactid.updating.FACTORS' priors
     joint_refit: bool = True  # the explanation's later steps refit the earlier steps' parameters with theirs
     pair_lookahead: float = 3.0  # where no candidate shrinks a gap above this many min_gap materially, try a pair
+    retry_unmoved: bool = False  # later passes also try the candidates whose refit alone left them off
 
     @classmethod
     def from_config(cls, gap_cfg: Mapping | None, seed: int, n_harmonics_id: int) -> "GapSettings":
@@ -92,6 +93,7 @@ class GapSettings:
                 eta_observability_limit=float(g.get("eta_observability_limit", d.eta_observability_limit)),
                 joint_refit=bool(g.get("joint_refit", d.joint_refit)),
                 pair_lookahead=float(g.get("pair_lookahead", d.pair_lookahead)),
+                retry_unmoved=bool(g.get("retry_unmoved", d.retry_unmoved)),
                 **_updating_settings(g.get("model_updating"), d))
         if not 0.0 < s.min_reduction < 1.0:
             raise ValueError(f"gap.min_reduction = {s.min_reduction}: give a fraction in (0, 1)")
@@ -519,7 +521,7 @@ def _parameter_values(name: str, cal=None, theta=None) -> dict:
 
 
 def explain(first: dict, names: list, before: float, scatter: float, settings: GapSettings, heldout_gap,
-            next_pass) -> tuple[list, float, tuple | None]:
+            next_pass, later: list | None = None) -> tuple[list, float, tuple | None]:
     """The additive explanation of the held-out gap: add the candidate that leaves the smallest held-out gap
     (its refit included), then try the remaining candidates on top of it (``next_pass(remaining, calibration)``
     gives their results), and so on; stop when no candidate shrinks what is left materially
@@ -530,7 +532,7 @@ def explain(first: dict, names: list, before: float, scatter: float, settings: G
     pair is added when together they shrink it materially and the second shrinks it further beyond the scatter.
 
     first: {name: (calibration, sims, residuals)} of the first pass; heldout_gap(sims) the held-out gap of a
-    model's simulations. Returns (steps [{effect, parameters, heldout_gap_before, heldout_gap_after, share}],
+    model's simulations; later: the candidates tried after the first pass (``verdict.retried``; None: all). Returns (steps [{effect, parameters, heldout_gap_before, heldout_gap_after, share}],
     the gap left, (calibration, sims) of the last step or None). share: the part of the held-out gap's power
     (its square) the step removes; the shares and the remaining share sum to 1."""
     steps, gap, last, results, remaining = [], before, None, first, list(names)
@@ -547,7 +549,7 @@ def explain(first: dict, names: list, before: float, scatter: float, settings: G
         best = min(gaps, key=gaps.get)  # ties: library order
         chosen = [(best, results[best], gaps[best])]
         if not explains_materially(gap, gaps[best], scatter, settings):
-            others = [n for n in remaining if n != best]
+            others = [n for n in remaining if n != best and (later is None or n in later)]
             lookahead = settings.pair_lookahead
             if not (lookahead and gap > lookahead * settings.min_gap and others and gaps[best] < gap - beyond_scatter):
                 break
@@ -568,6 +570,7 @@ def explain(first: dict, names: list, before: float, scatter: float, settings: G
             log.info("explanation step %d: %s leaves a held-out gap of %.4g (from %.4g)", len(steps), name, after, gap)
             gap, last = after, (cal, sims)
             remaining.remove(name)
+        remaining = [n for n in remaining if later is None or n in later]
         if remaining and not at_floor(gap, settings):
             results = next_pass(remaining, last[0])
     shares, _ = gap_shares(before, [s["heldout_gap_after"] for s in steps])
@@ -673,7 +676,8 @@ def diagnose(model: IdentifiedModel, records: Mapping[str, RecordHarmonics], cal
                            max_evaluations=settings.max_evaluations, base_steps=cal.steps,
                            joint=settings.joint_refit, alone={n: r[0].theta for n, r in results.items()})()
 
-    steps, left, last = explain(results, names, before, scatter, settings, heldout_gap, next_pass)
+    later = retried({n: r[0].theta for n, r in results.items()}, LIBRARY, settings)
+    steps, left, last = explain(results, names, before, scatter, settings, heldout_gap, next_pass, later)
     first_before = before
     if updating is not None:
         where["model_updating"] = updating.summary()
