@@ -220,7 +220,7 @@ def simulate(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, re
     stays closed, N above a tenth of the preload all period long (``CLOSED_CONTACT_HB``). "time_marching" (the
     reference) integrates from the stuck linear system's state until the harmonics settle. With a
     preload drift the whole record's length is integrated, as measured, from the settled state at the
-    record's start."""
+    record's start (in a search, unpolished: from the periodic state itself, 0.17 -> 0.13 s a simulation)."""
     method = method or STEADY_STATE.get()
     if method not in ("harmonic_balance", "time_marching"):
         raise ValueError(f"simulate: method {method!r}; give 'harmonic_balance' or 'time_marching'")
@@ -245,7 +245,10 @@ def simulate(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, re
         closed = _periodic_state(sim, coef, w, min(n_per // 4, hb_harmonics or H), n_per, start)
         if closed is not None and np.min(closed.grid["N"]) > 0.1 * model.preload:
             return _periodic_result(closed, sim, model, aug, rec, grid)
-    if periodic is not None:
+    if periodic is not None and not polish and aug.preload_drift:
+        _load_state(sim, periodic)  # a search's drifting record starts from the periodic state itself
+        settled = True
+    elif periodic is not None:
         _load_state(sim, periodic)
         _, _, settled = sim.settle(coef, None, w, tol=tol, min_chunks=2, max_chunks=30)
     else:
