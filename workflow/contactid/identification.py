@@ -36,6 +36,12 @@ class IdentificationError(ValueError):
     """The identification cannot run with these settings (for example m > j)."""
 
 
+
+def _column_forms(q: np.ndarray, G: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """q[:, t]^T G p[:, t] for every column t, (n_t,), through one matrix product (the three-operand einsum it
+    replaces does not use BLAS: one case's contact_forces_dataset took 4.2 s instead of 1.4 s)."""
+    return np.einsum("it,it->t", q, G @ p)
+
 def fourier_series(signals: np.ndarray, fs: float, f0: float, n_harmonics: int) -> np.ndarray:
     """Complex harmonic amplitudes c_h (h = 1..K) of each row, signal ~ mean + sum Im(c_h e^{i h w t}) (Eq. 16)."""
     h = np.arange(1, n_harmonics + 1)
@@ -129,7 +135,7 @@ def galerkin_contact_forces(model: FEModel, nnm: np.ndarray, q: np.ndarray, qdd:
     for k in range(n_t):
         A = np.column_stack([xi_r - G @ q[:, k], -eta_r])
         S[k], N[k] = np.linalg.lstsq(A, lhs[:, k], rcond=None)[0][:2]
-    xi = xi_r @ q - 0.5 * np.einsum("it,ij,jt->t", q, G, q)
+    xi = xi_r @ q - 0.5 * _column_forms(q, G, q)
     eta = eta_r @ q
     return {"S": S, "N_dyn": N, "xi": xi, "eta": eta, "reduced_mass": Mr, "reduced_stiffness": Kr,
             "reduced_force": Fr}
@@ -242,8 +248,8 @@ def inverse_harmonics(model: FEModel, zeta: np.ndarray, F_coef: np.ndarray, A_co
     qg = synthesize(q_coef, f0, t_grid, 0)
     qdg = synthesize(q_coef, f0, t_grid, 1)
     xi_lin = model.xi_vector @ q_coef
-    xi = xi_lin - 0.5 * period_coefficients(np.einsum("it,ij,jt->t", qg, G, qg), K)
-    xi_dot = period_coefficients(model.xi_vector @ qdg - np.einsum("it,ij,jt->t", qg, G, qdg), K)
+    xi = xi_lin - 0.5 * period_coefficients(_column_forms(qg, G, qg), K)
+    xi_dot = period_coefficients(model.xi_vector @ qdg - _column_forms(qg, G, qdg), K)
     eta = model.eta_vector @ q_coef
     h = np.arange(1, K + 1)
     return InverseHarmonics(S=r_coef[0] + p.k_t * xi_lin, N_dyn=r_coef[1] - p.k_n * eta, xi=xi, eta=eta,
@@ -264,13 +270,13 @@ def inverse_identification(model: FEModel, zeta: np.ndarray, force: np.ndarray, 
     t = np.arange(acceleration.shape[1]) / fs
     q = synthesize(q_coef, f0, t, 0)  # (n_dof, n_t)
     qd = synthesize(q_coef, f0, t, 1)
-    xi = model.xi_vector @ q - 0.5 * np.einsum("it,ij,jt->t", q, G, q)
+    xi = model.xi_vector @ q - 0.5 * _column_forms(q, G, q)
     xi_lin = model.xi_vector @ q
     eta = model.eta_vector @ q
     r = synthesize(r_coef, f0, t, 0)
     S = r[0] + p.k_t * xi_lin
     N_dyn = r[1] - p.k_n * eta
-    xi_dot = model.xi_vector @ qd - np.einsum("it,ij,jt->t", q, G, qd)
+    xi_dot = model.xi_vector @ qd - _column_forms(q, G, qd)
     eta_dot = model.eta_vector @ qd
     return InverseResult(S - S.mean(), N_dyn - N_dyn.mean(), xi - xi.mean(), eta - eta.mean(), xi_dot, eta_dot,
                          res.S, res.N_dyn, model.xi_vector @ q_coef, res.eta, res.residual)
