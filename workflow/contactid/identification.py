@@ -36,11 +36,11 @@ class IdentificationError(ValueError):
     """The identification cannot run with these settings (for example m > j)."""
 
 
-
 def _column_forms(q: np.ndarray, G: np.ndarray, p: np.ndarray) -> np.ndarray:
     """q[:, t]^T G p[:, t] for every column t, (n_t,), through one matrix product (the three-operand einsum it
     replaces does not use BLAS: one case's contact_forces_dataset took 4.2 s instead of 1.4 s)."""
     return np.einsum("it,it->t", q, G @ p)
+
 
 def fourier_series(signals: np.ndarray, fs: float, f0: float, n_harmonics: int) -> np.ndarray:
     """Complex harmonic amplitudes c_h (h = 1..K) of each row, signal ~ mean + sum Im(c_h e^{i h w t}) (Eq. 16)."""

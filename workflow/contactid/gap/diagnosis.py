@@ -31,8 +31,8 @@ from .refit import (baseline, calibrate, contact_grids, evaluate, gap_residual, 
                     identified_forces, law_friction_force)
 from .verdict import DRIFT_FACTOR, NORMAL_LIMIT, OPEN_LIMIT, RESIDUAL_FACTOR  # noqa: F401 (thresholds of the place)
 from .verdict import UPDATING_Z
-from .verdict import (acts_where, at_floor, retried, explains_materially, gap_shares, open_fraction, place as _place_of,
-                      updating_effect)
+from .verdict import (acts_where, at_floor, explains_materially, gap_shares, open_fraction, place as _place_of,
+                      retried, updating_effect)
 from .verdict import verdict as _verdict
 
 log = logging.getLogger(__name__)
@@ -532,9 +532,10 @@ def explain(first: dict, names: list, before: float, scatter: float, settings: G
     pair is added when together they shrink it materially and the second shrinks it further beyond the scatter.
 
     first: {name: (calibration, sims, residuals)} of the first pass; heldout_gap(sims) the held-out gap of a
-    model's simulations; later: the candidates tried after the first pass (``verdict.retried``; None: all). Returns (steps [{effect, parameters, heldout_gap_before, heldout_gap_after, share}],
-    the gap left, (calibration, sims) of the last step or None). share: the part of the held-out gap's power
-    (its square) the step removes; the shares and the remaining share sum to 1."""
+    model's simulations; later: the candidates tried after the first pass (``verdict.retried``; None: all).
+    Returns (steps [{effect, parameters, heldout_gap_before, heldout_gap_after, share}], the gap left,
+    (calibration, sims) of the last step or None). share: the part of the held-out gap's power (its square) the step
+    removes; the shares and the remaining share sum to 1."""
     steps, gap, last, results, remaining = [], before, None, first, list(names)
     beyond_scatter = settings.noise_factor * scatter
 

@@ -261,13 +261,13 @@ def calibrate(model: IdentifiedModel, cand: Candidate, rec: RecordHarmonics, set
 
     def run(theta, polish=False):
         nonlocal n_eval
+        polish = polish or POLISH_SEARCH.get()  # the key holds what is run: a polished search's optimum is not rerun
         key = (*np.round(np.atleast_1d(theta), 12), polish)
         if key not in cache:
             n_eval += 1
             aug = base.merge(cand.augmentation(np.atleast_1d(theta)))
             try:
-                out = evaluate(model, aug, rec, bounds, n_harmonics, start=last["sim"],
-                               polish=polish or POLISH_SEARCH.get())
+                out = evaluate(model, aug, rec, bounds, n_harmonics, start=last["sim"], polish=polish)
                 last["sim"] = out[2]  # the next theta is a neighbour: start from here
                 if not np.isfinite(out[0]):
                     raise FloatingPointError("the simulation diverged")

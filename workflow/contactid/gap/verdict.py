@@ -140,13 +140,13 @@ def retried(first_thetas: Mapping[str, Sequence], library: Mapping, settings) ->
     with ``settings.retry_unmoved``. Measured on the compound benchmark's logs (40 items): every effect named at a
     later step had moved alone; of the unmoved, one was later named, falsely, on a perturbation-only set; they took
     a sixth of the later passes' time."""
-    if getattr(settings, "retry_unmoved", False):
+    if settings.retry_unmoved:
         return list(first_thetas)
     out = []
     for name, theta in first_thetas.items():
         params = library[name].parameters
         values = np.atleast_1d(theta)
-        if not all((params[min(i, len(params) - 1)]).is_off(v) for i, v in enumerate(values)):
+        if not all(params[min(i, len(params) - 1)].is_off(v) for i, v in enumerate(values)):
             out.append(name)
     return out
 
