@@ -17,6 +17,12 @@ sys.path.insert(0, os.path.join(workflow.basedir, "workflow"))
 configfile: "config/config.yaml"
 
 
+from contactid.config import numbers_written_as_text
+
+# 4e-05 is text to YAML 1.1 (4.0e-05 is a number): such values where the schema wants a number are read as numbers
+for _key, _value in numbers_written_as_text(config, "workflow/schemas/config.schema.yaml"):
+    print(f"config: {_key}: read as the number {_value!r} (YAML 1.1 reads exponent notation "
+          "without a decimal point as text; 4.0e-05 is a number to every reader)", file=sys.stderr)
 validate(config, "workflow/schemas/config.schema.yaml")
 
 

@@ -49,3 +49,23 @@ def test_measured_source_needs_a_file(default_config):
     cfg["random_test"]["source"] = "measured"
     with pytest.raises(ConfigError, match="random_test.file"):
         check_config(cfg)
+
+
+def test_exponent_notation_without_a_point_is_read_as_a_number(default_config):
+    """YAML 1.1 (PyYAML, Snakemake) reads 4e-05 as text: where the schema wants a number it becomes one, and the
+    config validates; text of that form where text is wanted (a sensor's name) stays text."""
+    import yaml
+
+    from contactid.config import numbers_written_as_text
+
+    cfg = copy.deepcopy(default_config)
+    cfg["rig"]["effects"] = yaml.safe_load("channel_time_skew: 4e-05")
+    cfg["structure"]["sensors"]["names"] = ["1e3", "a2", "a3"]
+    cfg["gap"]["n_bootstrap"] = "2e2"  # an integer
+    assert cfg["rig"]["effects"]["channel_time_skew"] == "4e-05"
+    changed = numbers_written_as_text(cfg, SCHEMA)
+    assert sorted(changed) == [("gap.n_bootstrap", 200), ("rig.effects.channel_time_skew", 4e-05)]
+    assert isinstance(cfg["gap"]["n_bootstrap"], int) and cfg["structure"]["sensors"]["names"][0] == "1e3"
+    cfg["structure"]["sensors"]["names"] = default_config["structure"]["sensors"]["names"]  # (names start with a letter)
+    validate(cfg, SCHEMA)
+    assert numbers_written_as_text(cfg, SCHEMA) == []

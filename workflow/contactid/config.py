@@ -6,11 +6,48 @@ Snakefile calls :func:`check_config` before any rule runs.
 
 from __future__ import annotations
 
+import re
 from typing import Mapping
 
 
 class ConfigError(ValueError):
     """An inconsistent configuration."""
+
+
+# a number in exponent notation without a decimal point (4e-05): YAML 1.1, which PyYAML and Snakemake read, takes it
+# for text; YAML 1.2 and every other reader for a number
+_EXPONENT_NUMBER = re.compile(r"^[-+]?(\d+|\d+\.\d*|\.\d+)[eE][-+]?\d+$")
+
+
+def numbers_written_as_text(cfg: dict, schema) -> list:
+    """Make numbers, in place, of the values YAML 1.1 read as text where the schema (a path or a mapping) wants a
+    number: ``channel_time_skew: 4e-05`` is the text '4e-05' to PyYAML (it wants 4.0e-05), which the schema would
+    refuse as "not of type 'number'". Returns [(dotted key, number)] of the values changed. Only values of that form where a number
+    is wanted: a name or a path that looks like one elsewhere stays text."""
+    import jsonschema
+    import yaml
+
+    if not isinstance(schema, Mapping):
+        with open(schema) as fh:
+            schema = yaml.safe_load(fh)
+    changed = []
+    for err in jsonschema.Draft202012Validator(schema).iter_errors(cfg):
+        wanted = err.validator_value if isinstance(err.validator_value, list) else [err.validator_value]
+        if err.validator != "type" or not isinstance(err.instance, str) or not (
+                {"number", "integer"} & set(wanted)) or not _EXPONENT_NUMBER.match(err.instance.strip()):
+            continue
+        value = float(err.instance)
+        if "number" not in wanted:  # an integer
+            if not value.is_integer():
+                continue
+            value = int(value)
+        *parents, last = list(err.absolute_path)
+        node = cfg
+        for key in parents:
+            node = node[key]
+        node[last] = value
+        changed.append((".".join(str(k) for k in err.absolute_path), value))
+    return changed
 
 
 def _true_structure_errors(structure: Mapping, changes: Mapping, path: str = "rig.true_structure") -> list:
