@@ -5,7 +5,7 @@ import pytest
 
 from contactid.analytic import beam_frequencies_hz, clamped_free_eigenvalues, clamped_pinned_eigenvalues
 from contactid.beam_model import ContactFrequencyMap, assemble, natural_frequencies, shape_on_grid, structural_modes
-from contactid.parameters import StructureParameters
+from structures import configured_structure
 
 
 def bare_beam(**kw):
@@ -14,7 +14,7 @@ def bare_beam(**kw):
                 block_inertia=0.0, string_stiffness=0.0, gravity=0.0, k_t=0.0, k_n=0.0, normal_lever_arm=0.0,
                 tangential_lever_arm=0.0, hanger_lever_arm=0.0, axial_inertia=True, n_elements=60)
     base.update(kw)
-    return StructureParameters(**base)
+    return configured_structure(**base)
 
 
 def test_clamped_free_limit_matches_analytic():
@@ -37,7 +37,7 @@ def test_analytic_eigenvalues_known_values():
 
 
 def test_modes_are_mass_normalised_and_structural():
-    m = assemble(StructureParameters())
+    m = assemble(configured_structure())
     modes = structural_modes(m, 3)
     gen_mass = modes.shapes.T @ m.mass @ modes.shapes
     assert np.allclose(gen_mass, np.eye(3), atol=1e-9)
@@ -48,7 +48,7 @@ def test_modes_are_mass_normalised_and_structural():
 def test_contact_springs_follow_the_energies():
     """N_dyn = -k_n eta: the contact stiffness matrix is k_t xi xi^T + k_n eta eta^T (positive semi-definite),
     and a static tip deflection pushing the contact closed (eta < 0) raises the compression."""
-    p = StructureParameters()
+    p = configured_structure()
     m = assemble(p)
     kc = m.contact_stiffness_matrix
     assert np.min(np.linalg.eigvalsh(kc)) > -1e-6 * np.max(np.abs(kc))
@@ -63,7 +63,7 @@ def test_contact_springs_follow_the_energies():
 
 
 def test_frequency_map_agrees_with_full_solution():
-    p = StructureParameters()
+    p = configured_structure()
     fmap = ContactFrequencyMap(p, 3)
     assert fmap._basis is not None  # the Ritz basis (modes of K_0 and the static contact shapes)
     # over the stiffness fit's whole search box, as exact as the full eigenproblem to 1e-8
@@ -73,7 +73,7 @@ def test_frequency_map_agrees_with_full_solution():
 
 
 def test_shape_on_grid_interpolates_nodes():
-    m = assemble(StructureParameters())
+    m = assemble(configured_structure())
     modes = structural_modes(m, 2)
     w, dw = shape_on_grid(m, modes.shapes[:, 0], m.nodes)
     assert w[0] == 0 and dw[0] == 0
@@ -83,11 +83,11 @@ def test_shape_on_grid_interpolates_nodes():
 
 def test_positions_outside_beam_are_refused():
     with pytest.raises(ValueError, match="outside the beam"):
-        assemble(StructureParameters(sensor_positions=(0.55, 0.3, 0.7)))
+        assemble(configured_structure(sensor_positions=(0.55, 0.3, 0.7)))
 
 
 def test_stiffer_tangential_contact_raises_frequencies():
-    p = StructureParameters()
+    p = configured_structure()
     f_soft = natural_frequencies(p.with_contact(1e6, 2.37e7))
     f_stiff = natural_frequencies(p.with_contact(1e8, 2.37e7))
     assert np.all(f_stiff > f_soft)

@@ -69,3 +69,34 @@ def test_exponent_notation_without_a_point_is_read_as_a_number(default_config):
     cfg["structure"]["sensors"]["names"] = default_config["structure"]["sensors"]["names"]  # (names start with a letter)
     validate(cfg, SCHEMA)
     assert numbers_written_as_text(cfg, SCHEMA) == []
+
+
+def test_a_config_without_its_optional_blocks_runs_at_the_schemas_defaults(default_config, monkeypatch):
+    """The schema is the one home of the defaults: a config of the required keys alone gets every optional block
+    at its documented defaults, the same from the Snakefile's validation and from ``with_defaults`` (code run
+    outside Snakemake), and the linear chain uses them (frf.segment_length 65536, not an older fallback)."""
+    from contactid.config import with_defaults
+    from contactid.gap import pipeline
+
+    minimal = {"seed": default_config["seed"], "structure": copy.deepcopy(default_config["structure"])}
+    filled = with_defaults(minimal)
+    assert "frf" not in minimal  # a copy
+    validated = copy.deepcopy(minimal)
+    validate(validated, SCHEMA)
+    assert filled == validated
+    assert filled["frf"] == {"segment_length": 65536, "overlap": 0.5, "window": "hann"}
+    assert filled["random_test"]["duration_s"] == 128.0 and filled["nonlinear"]["n_harmonics"] == 25
+    assert filled["gap"]["min_gap"] == 0.006 and filled["modal"]["uncertainty_blocks"] == 4
+    assert with_defaults(filled) == filled  # a complete config comes back equal
+    check_config(minimal)  # the cross-field checks hold at the defaults
+
+    seen = {}
+
+    def frf_dataset(raw, segment_length, overlap, window, blocks):
+        seen.update(segment_length=segment_length, overlap=overlap, window=window, blocks=blocks)
+        raise StopIteration
+
+    monkeypatch.setattr(pipeline, "frf_dataset", frf_dataset)
+    with pytest.raises(StopIteration):
+        pipeline.linear_chain(minimal, None)
+    assert seen == {"segment_length": 65536, "overlap": 0.5, "window": "hann", "blocks": 4}

@@ -13,10 +13,10 @@ from contactid.identification import (
     nonlinear_mode_coefficients,
     nrmse,
 )
-from contactid.parameters import StructureParameters
 from contactid.rig.nonlinear import ContactParameters, DualSineSimulator, reduced_model
+from structures import configured_structure
 
-P = StructureParameters(tangential_lever_arm=0.00458, youngs_modulus=2.164e11, k_t=1.4276e7, k_n=2.37e7, n_elements=24)
+P = configured_structure(tangential_lever_arm=0.00458, youngs_modulus=2.164e11, k_t=1.4276e7, k_n=2.37e7, n_elements=24)
 
 
 def test_paper_algebra_returns_the_truth_on_an_exact_basis():

@@ -130,11 +130,11 @@ def stiction_dataset(modal: xr.Dataset, structure_cfg: Mapping, stiction_cfg: Ma
     confidence intervals and the profile misfits."""
     f_id = modal["natural_frequency"].values
     stat = np.nan_to_num(modal["natural_frequency_std"].values, nan=0.0)
-    sigma = frequency_sigma(f_id, stat, float(stiction_cfg.get("frequency_uncertainty_floor", 1e-3)))
+    sigma = frequency_sigma(f_id, stat, float(stiction_cfg["frequency_uncertainty_floor"]))
     params = structure_from_config(structure_cfg, 1e7, 1e8)
     fit = stiction_stiffness(params, f_id, sigma, tuple(stiction_cfg.get("k_t_bounds_n_per_m", (1e5, 1e9))),
                              tuple(stiction_cfg.get("k_n_bounds_n_per_m", (1e5, 1e11))),
-                             float(stiction_cfg.get("confidence", 0.95)))
+                             float(stiction_cfg["confidence"]))
     gt, pt = fit.profiles["k_t"]
     gn, pn = fit.profiles["k_n"]
     return xr.Dataset(

@@ -40,33 +40,36 @@ class StructureParameters:
         axial_inertia: include the beam's (rho A L / 3) and the pin's axial
             inertia on u (the paper neglects axial inertia).
         n_elements: target number of beam finite elements.
+
+    No field has a default: the configured structure (``structure_from_config``) is the one source of the values,
+    and a structure built in code names every one of them.
     """
 
-    length: float = 0.6
-    width: float = 0.04
-    thickness: float = 0.005
-    youngs_modulus: float = 2.1e11
-    density: float = 7850.0
-    pin_radius: float = 0.006
-    pin_mass: float = 0.0355
-    pin_inertia: float = 6.4e-7
-    tangential_lever_arm: float = 0.006
-    normal_lever_arm: float = 0.006
-    hanger_lever_arm: float = 0.006
-    block_mass: float = 7.0
-    block_inertia: float = 0.0117
-    string_length: float = 0.3
-    string_stiffness: float = 2.0e4
-    gravity: float = STANDARD_GRAVITY
-    excitation_position: float = 0.55
-    force_transducer_mass: float = 0.021
-    sensor_positions: tuple[float, ...] = (0.55, 0.30, 0.05)
-    sensor_masses: tuple[float, ...] = (0.0058, 0.0058, 0.0058)
-    k_t: float = 3.95e6
-    k_n: float = 2.37e7
-    clamp_rotational_stiffness: float = math.inf
-    axial_inertia: bool = True
-    n_elements: int = 48
+    length: float
+    width: float
+    thickness: float
+    youngs_modulus: float
+    density: float
+    pin_radius: float
+    pin_mass: float
+    pin_inertia: float
+    tangential_lever_arm: float
+    normal_lever_arm: float
+    hanger_lever_arm: float
+    block_mass: float
+    block_inertia: float
+    string_length: float
+    string_stiffness: float
+    gravity: float
+    excitation_position: float
+    force_transducer_mass: float
+    sensor_positions: tuple[float, ...]
+    sensor_masses: tuple[float, ...]
+    k_t: float
+    k_n: float
+    clamp_rotational_stiffness: float
+    axial_inertia: bool
+    n_elements: int
 
     @property
     def area(self) -> float:
@@ -104,7 +107,7 @@ class StructureParameters:
 def structure_from_config(cfg: Mapping, k_t: float, k_n: float, n_elements: int | None = None) -> StructureParameters:
     """Build :class:`StructureParameters` from the ``structure`` block of the config.
 
-    ``cfg`` is the ``structure`` mapping (already validated by the schema);
+    ``cfg`` is the ``structure`` mapping (validated by the schema, which fills its defaults);
     ``k_t``, ``k_n`` the contact stiffnesses (N/m); ``n_elements`` overrides
     the mesh size (the rig uses a finer mesh).
     """
@@ -130,7 +133,7 @@ def structure_from_config(cfg: Mapping, k_t: float, k_n: float, n_elements: int 
         block_inertia=float(block["rotary_inertia_kg_m2"]),
         string_length=float(block["string_length_m"]),
         string_stiffness=float(block["string_stiffness_n_per_m"]),
-        gravity=float(cfg.get("gravity_m_per_s2", STANDARD_GRAVITY)),
+        gravity=float(cfg["gravity_m_per_s2"]),
         excitation_position=float(cfg["excitation_position_m"]),
         force_transducer_mass=float(cfg["force_transducer_mass_kg"]),
         sensor_positions=tuple(float(x) for x in sensors["positions_m"]),
@@ -138,6 +141,6 @@ def structure_from_config(cfg: Mapping, k_t: float, k_n: float, n_elements: int 
         k_t=float(k_t),
         k_n=float(k_n),
         clamp_rotational_stiffness=math.inf if clamp is None else float(clamp),
-        axial_inertia=bool(cfg.get("axial_inertia", True)),
-        n_elements=int(n_elements if n_elements is not None else cfg.get("fe_elements", 48)),
+        axial_inertia=True,  # always in the model (a switch for the analytic checks of the bare beam)
+        n_elements=int(n_elements if n_elements is not None else cfg["fe_elements"]),
     )

@@ -9,7 +9,6 @@ returned. The gathering step stacks the points into a dataset and draws the erro
 
 from __future__ import annotations
 
-import copy
 import itertools
 import time
 from typing import Mapping
@@ -45,21 +44,22 @@ def e0_at(e_f: float, k_c: float, normal_force: float) -> float:
 def run_point(cfg: Mapping, noise_fraction: float, record_samples: int, seed: int) -> dict:
     """One point: rig records at this noise and length (rig seed = config seed + ``seed``), the
     identification, and the relative errors of mu, e_0 (at the preload) and k_t against the rig's truth."""
+    from .config import with_defaults
     from .gap.pipeline import identify
     from .rig.dual_sine import dual_sine_test
     from .rig.random_test import random_test_datasets
     from .rig.structure import random_test_rig_config
 
     t0 = time.perf_counter()
-    cfg = copy.deepcopy(dict(cfg))
+    cfg = with_defaults(cfg)  # a copy, at the schema's defaults where keys are left out
     rig = cfg["rig"]
     rig["noise_fraction"] = float(noise_fraction)
     rig.setdefault("dual_sine", {})["record_samples"] = int(record_samples)
     rig["effects"] = {}
     rig_seed = int(cfg["seed"]) + int(seed)
-    cal = cfg.get("nonlinear", {}).get("calibration_case", "lc1")
+    cal = cfg["nonlinear"]["calibration_case"]
     raw_rt, truth_rt = random_test_datasets(cfg["structure"], random_test_rig_config(rig), cfg["random_test"], rig_seed)
-    fs = float(cfg["random_test"].get("sampling_rate_hz", 5120.0))
+    fs = float(cfg["random_test"]["sampling_rate_hz"])
     raw_cal, truth_cal = dual_sine_test(cfg["structure"], rig, cfg["load_cases"][cal], fs, float(noise_fraction), rig_seed,
                                         cal, cfg["structure"]["sensors"]["names"])
     t_rig = time.perf_counter() - t0

@@ -27,7 +27,7 @@ def _import_format(block):
 
 def record_block(record):
     """The config block of a record: a load case, or the random test."""
-    return config.get("random_test", {}) if record == "random_test" else config["load_cases"][record]
+    return config["random_test"] if record == "random_test" else config["load_cases"][record]
 
 
 def imported_records(fmt):
@@ -74,7 +74,7 @@ def rig_case_pattern():
 
 def random_test_raw():
     """The random-test record: the rig's output or the user's measured file."""
-    rt = config.get("random_test", {})
+    rt = config["random_test"]
     return _measured_path("random_test") if _is_measured(rt) else "data/raw/random_test.nc"
 
 
@@ -102,12 +102,12 @@ def rig_outputs():
 
 def calibration_case():
     """The load case the friction law is fitted on (and the harmonic study uses)."""
-    return config.get("nonlinear", {}).get("calibration_case", "lc1")
+    return config["nonlinear"]["calibration_case"]
 
 
 def figure_case():
     """The load case of Figs. 4 and 5 (the paper shows its largest, load case 3)."""
-    return config.get("nonlinear", {}).get("figure_case") or load_cases()[-1]
+    return config["nonlinear"].get("figure_case") or load_cases()[-1]
 
 
 def contact_forces_inputs(wildcards):
@@ -191,14 +191,14 @@ def benchmark_items():
     """{item name: spec} of the blind gap benchmark (see config/README.md, gap_benchmark)."""
     from contactid.gap.benchmark import benchmark_items as items
 
-    return items(config.get("gap_benchmark", {}), int(config["seed"]))
+    return items(config["gap_benchmark"], int(config["seed"]))
 
 
 def ladder_items():
     """{item name: spec} of the detection ladder (gap_benchmark.ladder; `snakemake gap_ladder`)."""
     from contactid.gap.benchmark import ladder_items as items
 
-    return items(config.get("gap_benchmark", {}), int(config["seed"]))
+    return items(config["gap_benchmark"], int(config["seed"]))
 
 
 def gap_report_inputs(wildcards):

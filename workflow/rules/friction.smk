@@ -9,10 +9,10 @@ rule friction_fit:
         fit="results/friction/friction_fit.nc",
     params:
         code=CODE_DIGEST,
-        friction=config.get("friction", {}),
+        friction=config["friction"],
         preload=config["structure"]["preload_n"],
         seed=config["seed"],
-        n_harmonics=config.get("nonlinear", {}).get("n_harmonics", 25),
+        n_harmonics=config["nonlinear"]["n_harmonics"],
     conda:
         "../envs/contactid.yaml"
     log:
@@ -31,7 +31,7 @@ rule validate:
     params:
         code=CODE_DIGEST,
         preload=config["structure"]["preload_n"],
-        n_harmonics=config.get("nonlinear", {}).get("n_harmonics", 25),
+        n_harmonics=config["nonlinear"]["n_harmonics"],
     conda:
         "../envs/contactid.yaml"
     log:

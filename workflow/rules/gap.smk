@@ -16,9 +16,9 @@ rule model_updating:
     params:
         code=CODE_DIGEST,
         structure=config["structure"],
-        gap=config.get("gap", {}),
+        gap=config["gap"],
         seed=config["seed"],
-        n_harmonics=config.get("nonlinear", {}).get("n_harmonics", 25),
+        n_harmonics=config["nonlinear"]["n_harmonics"],
     threads: 1
     conda:
         "../envs/contactid.yaml"
@@ -38,10 +38,10 @@ rule friction_intervals:
     params:
         code=CODE_DIGEST,
         structure=config["structure"],
-        gap=config.get("gap", {}),
-        friction=config.get("friction", {}),
+        gap=config["gap"],
+        friction=config["friction"],
         seed=config["seed"],
-        n_harmonics=config.get("nonlinear", {}).get("n_harmonics", 25),
+        n_harmonics=config["nonlinear"]["n_harmonics"],
         calibration_case=calibration_case(),
         cases=load_cases(),
     threads: 1
@@ -63,10 +63,10 @@ rule gap_diagnosis:
     params:
         code=CODE_DIGEST,
         structure=config["structure"],
-        gap=config.get("gap", {}),
-        friction=config.get("friction", {}),
+        gap=config["gap"],
+        friction=config["friction"],
         seed=config["seed"],
-        n_harmonics=config.get("nonlinear", {}).get("n_harmonics", 25),
+        n_harmonics=config["nonlinear"]["n_harmonics"],
         calibration_case=calibration_case(),
         cases=load_cases(),
     # one thread for the scheduler, so that the job starts as soon as the fit is done (a two-thread job waits
@@ -158,7 +158,7 @@ rule gap_ladder:
         "results/gap_benchmark/ladder.json",
     params:
         code=CODE_DIGEST,
-        floor=config.get("gap", {}).get("min_gap", 0.006),
+        floor=config["gap"]["min_gap"],
     conda:
         "../envs/contactid.yaml"
     log:

@@ -9,11 +9,11 @@ rule frf:
         frf="results/linear/frf.nc",
     params:
         code=CODE_DIGEST,
-        frf=config.get("frf", {}),
+        frf=config["frf"],
         structure=config["structure"],
-        blocks=config.get("modal", {}).get("uncertainty_blocks", 4),
-        band_hz=config.get("modal", {}).get("band_hz", [20.0, 450.0]),
-        checks=config.get("raw_checks", {}),
+        blocks=config["modal"]["uncertainty_blocks"],
+        band_hz=config["modal"]["band_hz"],
+        checks=config["raw_checks"],
     conda:
         "../envs/contactid.yaml"
     log:
@@ -32,7 +32,7 @@ rule modal:
         modal="results/linear/modal.nc",
     params:
         code=CODE_DIGEST,
-        modal=config.get("modal", {}),
+        modal=config["modal"],
     conda:
         "../envs/contactid.yaml"
     log:
@@ -52,7 +52,7 @@ rule stiction_stiffness:
     params:
         code=CODE_DIGEST,
         structure=config["structure"],
-        stiction=config.get("stiction", {}),
+        stiction=config["stiction"],
     conda:
         "../envs/contactid.yaml"
     log:
@@ -72,8 +72,8 @@ rule linear_modes:
     params:
         code=CODE_DIGEST,
         structure=config["structure"],
-        linear_modes=config.get("linear_modes", {}),
-        k_n_prior=config.get("stiction", {}).get("k_n_prior_n_per_m", 2.37e7),
+        linear_modes=config["linear_modes"],
+        k_n_prior=config["stiction"]["k_n_prior_n_per_m"],
     conda:
         "../envs/contactid.yaml"
     log:

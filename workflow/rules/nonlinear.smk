@@ -9,8 +9,8 @@ rule raw_check:
     params:
         code=CODE_DIGEST,
         structure=config["structure"],
-        checks=config.get("raw_checks", {}),
-        n_harmonics=config.get("nonlinear", {}).get("n_harmonics", 25),
+        checks=config["raw_checks"],
+        n_harmonics=config["nonlinear"]["n_harmonics"],
     conda:
         "../envs/contactid.yaml"
     log:
@@ -29,7 +29,7 @@ rule generalized_coordinates:
         gc="results/{case}/generalized_coordinates.nc",
     params:
         code=CODE_DIGEST,
-        nonlinear=config.get("nonlinear", {}),
+        nonlinear=config["nonlinear"],
     conda:
         "../envs/contactid.yaml"
     log:
@@ -49,7 +49,7 @@ rule nonlinear_modes:
     params:
         code=CODE_DIGEST,
         structure=config["structure"],
-        nonlinear=config.get("nonlinear", {}),
+        nonlinear=config["nonlinear"],
     conda:
         "../envs/contactid.yaml"
     log:
@@ -69,7 +69,7 @@ rule reduced_model:
     params:
         code=CODE_DIGEST,
         structure=config["structure"],
-        nonlinear=config.get("nonlinear", {}),
+        nonlinear=config["nonlinear"],
     conda:
         "../envs/contactid.yaml"
     log:
@@ -87,7 +87,7 @@ rule contact_forces:
     params:
         code=CODE_DIGEST,
         structure=config["structure"],
-        nonlinear=config.get("nonlinear", {}),
+        nonlinear=config["nonlinear"],
     conda:
         "../envs/contactid.yaml"
     log:
@@ -109,7 +109,7 @@ rule harmonic_study:
     params:
         code=CODE_DIGEST,
         structure=config["structure"],
-        counts=config.get("nonlinear", {}).get("harmonic_study", [5, 10, 15, 20, 25, 30]),
+        counts=config["nonlinear"].get("harmonic_study", [5, 10, 15, 20, 25, 30]),
     conda:
         "../envs/contactid.yaml"
     log:

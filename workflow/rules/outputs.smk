@@ -11,7 +11,7 @@ rule paper_consistency:
     params:
         code=CODE_DIGEST,
         structure=config["structure"],
-        truth=config.get("rig", {}).get("truth", {}),
+        truth=config["rig"].get("truth", {}),
     conda:
         "../envs/contactid.yaml"
     log:
@@ -140,7 +140,7 @@ rule friction_outputs:
     params:
         code=CODE_DIGEST,
         cases=load_cases(),
-        truth_friction=None if _is_measured(config["load_cases"].get(calibration_case())) else config.get("rig", {}).get("truth", {}).get("friction"),
+        truth_friction=None if _is_measured(config["load_cases"].get(calibration_case())) else config["rig"].get("truth", {}).get("friction"),
     conda:
         "../envs/contactid.yaml"
     log:

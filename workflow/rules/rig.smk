@@ -15,8 +15,8 @@ rule rig_random_test:
         code=CODE_DIGEST,
         seed=config["seed"],
         structure=config["structure"],
-        rig=random_test_rig_config(config.get("rig", {})),
-        random_test=config.get("random_test", {}),
+        rig=random_test_rig_config(config["rig"]),
+        random_test=config["random_test"],
     conda:
         "../envs/contactid.yaml"
     log:
@@ -38,9 +38,9 @@ rule rig_dual_sine:
         code=CODE_DIGEST,
         seed=config["seed"],
         structure=config["structure"],
-        rig=config.get("rig", {}),
+        rig=config["rig"],
         case_cfg=lambda wc: config["load_cases"][wc.case],
-        sampling_rate_hz=config.get("random_test", {}).get("sampling_rate_hz", 5120.0),
+        sampling_rate_hz=config["random_test"]["sampling_rate_hz"],
     conda:
         "../envs/contactid.yaml"
     log:

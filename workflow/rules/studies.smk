@@ -31,7 +31,7 @@ rule noise_study:
         pdf="results/figures/noise_study.pdf",
     params:
         code=CODE_DIGEST,
-        default_noise=config.get("rig", {}).get("noise_fraction", 0.005),
+        default_noise=config["rig"]["noise_fraction"],
     resources:
         runtime=5,
         mem_mb=1000,

@@ -10,7 +10,7 @@ from contactid.updating import UpdatingResult
 
 log = setup_logging(snakemake.log[0])
 inp, nl = snakemake.input, snakemake.params.nonlinear
-K = int(nl.get("n_harmonics", 25))
+K = int(nl["n_harmonics"])
 truth = load_dataset(inp.truth) if "truth" in inp.keys() else None
 modes = load_dataset(inp.modes)
 structures = ()
@@ -22,7 +22,7 @@ if "updating" in inp.keys():  # the structures the random test allows (model upd
         structures = UpdatingResult.from_summary(upd, nominal).posterior_structures()
 ds = contact_forces_dataset(read_raw(inp.raw, dual_sine=True), load_dataset(inp.reduced), modes,
                             load_dataset(inp.modal), load_dataset(inp.stiction), snakemake.params.structure, K, truth,
-                            float(nl.get("observability_limit", 0.1)), structures)
+                            float(nl["observability_limit"]), structures)
 if not ds.attrs["eta_observable"]:
     log.warning("eta moves by %.0f %% across the linear chain's stiffness intervals and by %.0f %% across the "
                 "structures the random test allows: it is not observable from these sensors; N(t) is (spread %.2g)",

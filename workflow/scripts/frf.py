@@ -14,11 +14,11 @@ log = setup_logging(snakemake.log[0])
 p = snakemake.params
 path = snakemake.input.raw
 checks = check_settings(p.checks)
-seg = int(p.frf.get("segment_length", 16384))
+seg = int(p.frf["segment_length"])  # the validated config holds the schema's defaults
 raw = read_raw(path)
 check_sensor_layout(raw, p.structure, path)
 warnings = validate_random_test(raw, path, checks, seg, int(p.blocks))
-ds = frf_dataset(raw, seg, float(p.frf.get("overlap", 0.5)), p.frf.get("window", "hann"), int(p.blocks))
+ds = frf_dataset(raw, seg, float(p.frf["overlap"]), p.frf["window"], int(p.blocks))
 shares, coherence_warnings = validate_coherence(ds, p.band_hz, path, checks)
 warnings += coherence_warnings
 ds.attrs["warnings"] = json.dumps(warnings)

@@ -5,7 +5,7 @@ from contactid.logs import setup_logging
 from contactid.nonlinear_chain import generalized_coordinates_dataset
 
 log = setup_logging(snakemake.log[0])
-K = int(snakemake.params.nonlinear.get("n_harmonics", 25))
+K = int(snakemake.params.nonlinear["n_harmonics"])
 raw = read_raw(snakemake.input.raw, dual_sine=True)
 ds = generalized_coordinates_dataset(raw, load_dataset(snakemake.input.modes), K)
 ds.attrs.update(provenance("generalized_coordinates", {"n_harmonics": K},

@@ -6,7 +6,7 @@ from contactid.nonlinear_chain import nonlinear_modes_dataset
 
 log = setup_logging(snakemake.log[0])
 nl = snakemake.params.nonlinear
-K, limit = int(nl.get("n_harmonics", 25)), float(nl.get("phase_limit_deg", 10.0))
+K, limit = int(nl["n_harmonics"]), float(nl["phase_limit_deg"])
 raw = read_raw(snakemake.input.raw, dual_sine=True)
 ds = nonlinear_modes_dataset(load_dataset(snakemake.input.gc), load_dataset(snakemake.input.modes), raw,
                              snakemake.params.structure, K, limit)

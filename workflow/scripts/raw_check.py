@@ -14,8 +14,8 @@ log = setup_logging(snakemake.log[0])
 p = snakemake.params
 path = snakemake.input.raw
 checks = check_settings(p.checks)
-max_h = int(checks.get("max_harmonic", 15))
-raw = read_raw(path, dual_sine=True, min_periods=int(checks.get("min_periods", 8)),
+max_h = int(checks["max_harmonic"])
+raw = read_raw(path, dual_sine=True, min_periods=int(checks["min_periods"]),
                max_harmonic=max(max_h, int(p.n_harmonics)))
 check_sensor_layout(raw, p.structure, path)
 warnings = validate_dual_sine(raw, path, checks)

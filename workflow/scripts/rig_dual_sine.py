@@ -8,7 +8,7 @@ log = setup_logging(snakemake.log[0])
 p = snakemake.params
 case = snakemake.wildcards.case
 raw, truth = dual_sine_test(p.structure, p.rig, p.case_cfg, float(p.sampling_rate_hz),
-                            float(p.rig.get("noise_fraction", 0.005)), int(p.seed), case,
+                            float(p.rig["noise_fraction"]), int(p.seed), case,
                             p.structure["sensors"]["names"])
 cfg = {"seed": p.seed, "structure": p.structure, "rig": p.rig, "case": p.case_cfg, "fs": p.sampling_rate_hz}
 raw.attrs.update(provenance("rig_dual_sine", cfg))

@@ -10,6 +10,7 @@ from typing import Mapping
 import numpy as np
 import xarray as xr
 
+from ..config import with_defaults
 from ..friction_fit import fit_friction_law, settings_from_config
 from ..linear_chain import frf_dataset, linear_modes_dataset, modal_dataset, stiction_dataset
 from .model import identified_model
@@ -18,14 +19,16 @@ from .refit import identified_forces
 
 
 def linear_chain(cfg: Mapping, raw_random: xr.Dataset, return_frf: bool = False):
-    """random test -> FRF -> modal -> stiction -> linear modes; returns (linear_modes, modal[, frf])."""
-    f, m, st, lm = (cfg.get(k, {}) for k in ("frf", "modal", "stiction", "linear_modes"))
-    frf = frf_dataset(raw_random, int(f.get("segment_length", 16384)), float(f.get("overlap", 0.5)),
-                      f.get("window", "hann"), int(m.get("uncertainty_blocks", 4)))
-    modal = modal_dataset(frf, int(m.get("n_modes", 3)), m.get("band_hz", [20.0, 450.0]), int(m.get("order", 16)))
+    """random test -> FRF -> modal -> stiction -> linear modes; returns (linear_modes, modal[, frf]). Settings left
+    out of ``cfg`` take the schema's defaults (``config.with_defaults``), as in the workflow."""
+    cfg = with_defaults(cfg)
+    f, m, st, lm = (cfg[k] for k in ("frf", "modal", "stiction", "linear_modes"))
+    frf = frf_dataset(raw_random, int(f["segment_length"]), float(f["overlap"]), f["window"],
+                      int(m["uncertainty_blocks"]))
+    modal = modal_dataset(frf, int(m["n_modes"]), m["band_hz"], int(m["order"]))
     stiction = stiction_dataset(modal, cfg["structure"], st)
-    modes = linear_modes_dataset(stiction, cfg["structure"], int(lm.get("n_modes", 3)), int(lm.get("grid_points", 301)),
-                                 float(st.get("k_n_prior_n_per_m", 2.37e7)))
+    modes = linear_modes_dataset(stiction, cfg["structure"], int(lm["n_modes"]), int(lm["grid_points"]),
+                                 float(st["k_n_prior_n_per_m"]))
     return (modes, modal, frf) if return_frf else (modes, modal)
 
 
@@ -35,9 +38,10 @@ def identify(cfg: Mapping, raw_random: xr.Dataset, raw_calibration: xr.Dataset, 
     (model, linear_modes, modal, frf)."""
     from .model import NONE
 
+    cfg = with_defaults(cfg)
     modes, modal, frf = linear_chain(cfg, raw_random, return_frf=True)
-    K = int(cfg.get("nonlinear", {}).get("n_harmonics", 25))
-    settings = settings_from_config(cfg.get("friction", {}))
+    K = int(cfg["nonlinear"]["n_harmonics"])
+    settings = settings_from_config(cfg["friction"])
     unfitted = xr.Dataset({"parameter_value": ("parameter", np.ones(5))},
                           attrs={"regularization": settings.regularization})
     model = identified_model(cfg["structure"], modes, modal, unfitted, n_modes=n_modes)
@@ -55,14 +59,15 @@ def rig_records(cfg: Mapping, effects: Mapping, seed: int, cases, random_test: b
     from ..rig.random_test import random_test_datasets
     from ..rig.structure import random_test_rig_config
 
+    cfg = with_defaults(cfg)
     rig = copy.deepcopy(dict(cfg["rig"]))
     rig["effects"] = dict(effects)
     out, converged = {}, {}
     if random_test:
         out["random_test"] = random_test_datasets(cfg["structure"], random_test_rig_config(rig), cfg["random_test"], seed)[0]
-    fs = float(cfg["random_test"].get("sampling_rate_hz", 5120.0))
+    fs = float(cfg["random_test"]["sampling_rate_hz"])
     for case in cases:
-        raw, truth = dual_sine_test(cfg["structure"], rig, cfg["load_cases"][case], fs, float(rig.get("noise_fraction", 0.005)),
+        raw, truth = dual_sine_test(cfg["structure"], rig, cfg["load_cases"][case], fs, float(rig["noise_fraction"]),
                                     seed, case, cfg["structure"]["sensors"]["names"])
         converged[case] = int(truth.attrs["control_converged"])
         out[case] = raw
