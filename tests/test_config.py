@@ -100,3 +100,17 @@ def test_a_config_without_its_optional_blocks_runs_at_the_schemas_defaults(defau
     with pytest.raises(StopIteration):
         pipeline.linear_chain(minimal, None)
     assert seen == {"segment_length": 65536, "overlap": 0.5, "window": "hann", "blocks": 4}
+
+
+def test_the_settings_records_left_empty_equal_the_schemas_defaults(default_config):
+    """The settings records still fall back to their own field defaults where a key is missing: those must be the
+    schema's (the gap diagnosis, the friction fit, the rig's random test)."""
+    from contactid.config import with_defaults
+    from contactid.friction_fit import settings_from_config as fit_settings
+    from contactid.gap.diagnosis import GapSettings
+    from contactid.rig.random_test import settings_from_config as random_test_settings
+
+    filled = with_defaults({"seed": default_config["seed"], "structure": default_config["structure"]})
+    assert GapSettings.from_config({}, 1, 25) == GapSettings.from_config(filled["gap"], 1, 25)
+    assert fit_settings({}) == fit_settings(filled["friction"])
+    assert random_test_settings({}, {}) == random_test_settings(filled["random_test"], filled["rig"])

@@ -35,7 +35,7 @@ class RandomTestSettings:
     """
 
     sampling_rate_hz: float = 5120.0
-    duration_s: float = 64.0
+    duration_s: float = 128.0  # the schema's default (tests/test_config.py checks they agree)
     band_hz: tuple[float, float] = (5.0, 1000.0)
     force_rms_n: float = 0.5
     noise_fraction: float = 0.005
