@@ -33,7 +33,10 @@ def stiction_shear_stiffness(normal_force, e_f: float, k_c: float):
 
     normal_force: total normal force N (N), compression positive.
     """
-    return e_f * (1.0 - np.exp(-k_c * np.asarray(normal_force) / e_f))
+    from .friction import initial_stiffness  # the one implementation of Eq. 22 (compiled; the kernels call it)
+
+    n = np.asarray(normal_force, dtype=float)
+    return initial_stiffness(float(n), float(e_f), float(k_c)) if n.ndim == 0 else initial_stiffness(n, float(e_f), float(k_c))
 
 
 @dataclass(frozen=True)

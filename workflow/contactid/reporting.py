@@ -11,6 +11,7 @@ import pandas as pd
 import xarray as xr
 
 from .consistency import TABLE1_HZ, TABLE3
+from .contact_laws import stiction_shear_stiffness
 
 
 def _pct(a, b):
@@ -254,8 +255,8 @@ def table4(fit: xr.Dataset, truth_friction: Mapping | None) -> pd.DataFrame:
                      "truth_inside_interval": bool(lo <= tr <= hi) if np.isfinite(tr) else None})
     e0 = fit.attrs["e0_at_preload_n_per_m"]
     e0_paper = float(stiction_shear_stiffness_paper(fit.attrs["preload_n"]))
-    e0_truth = (float(truth_friction["e_f_n_per_m"]) * (1 - np.exp(-float(truth_friction["k_c_per_m"]) * fit.attrs["preload_n"]
-                                                                 / float(truth_friction["e_f_n_per_m"])))
+    e0_truth = (float(stiction_shear_stiffness(fit.attrs["preload_n"], float(truth_friction["e_f_n_per_m"]),
+                                               float(truth_friction["k_c_per_m"])))
                 if truth_friction else np.nan)
     rows.append({"parameter": "e0_at_preload", "identified": e0, "interval_low": fit.attrs["e0_interval_low"],
                  "interval_high": fit.attrs["e0_interval_high"], "reported_as": "value",
@@ -267,7 +268,8 @@ def table4(fit: xr.Dataset, truth_friction: Mapping | None) -> pd.DataFrame:
 
 
 def stiction_shear_stiffness_paper(preload: float) -> float:
-    return TABLE4["e_f"] * (1 - np.exp(-TABLE4["k_c"] * preload / TABLE4["e_f"]))
+    """e_0 (N/m) of the paper's Table 4 law at the preload (N), Eq. 22."""
+    return float(stiction_shear_stiffness(preload, TABLE4["e_f"], TABLE4["k_c"]))
 
 
 def friction_summary(fit: xr.Dataset, validations: Mapping[str, xr.Dataset]) -> dict:
@@ -309,11 +311,11 @@ def plot_friction_figures(fit: xr.Dataset, validations: Mapping[str, xr.Dataset]
     N = np.linspace(0, 2.5 * n0, 200)
     p = dict(zip(fit["parameter"].values, fit["parameter_value"].values))
     fig, ax = plt.subplots(figsize=(6.0, 4.0))
-    ax.plot(N, 1e-6 * p["e_f"] * (1 - np.exp(-p["k_c"] * N / p["e_f"])), "-", color="C0", label="identified")
-    ax.plot(N, 1e-6 * TABLE4["e_f"] * (1 - np.exp(-TABLE4["k_c"] * N / TABLE4["e_f"])), "--", color="C1", label="paper, Table 4")
+    ax.plot(N, 1e-6 * stiction_shear_stiffness(N, p["e_f"], p["k_c"]), "-", color="C0", label="identified")
+    ax.plot(N, 1e-6 * stiction_shear_stiffness(N, TABLE4["e_f"], TABLE4["k_c"]), "--", color="C1", label="paper, Table 4")
     if truth_friction:
         ef, kc = float(truth_friction["e_f_n_per_m"]), float(truth_friction["k_c_per_m"])
-        ax.plot(N, 1e-6 * ef * (1 - np.exp(-kc * N / ef)), ":", color="0.3", lw=2, label="rig truth")
+        ax.plot(N, 1e-6 * stiction_shear_stiffness(N, ef, kc), ":", color="0.3", lw=2, label="rig truth")
     for k, (case, v) in enumerate(validations.items()):
         ax.axvspan(v["N"].values.min(), v["N"].values.max(), color=f"C{k + 2}", alpha=0.15, label=f"N range, {case}")
     ax.set_xlabel("normal force N (N)")

@@ -17,6 +17,8 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
+from .contact_laws import stiction_shear_stiffness
+
 DEFAULTS = {"noise_fractions": [0.0025, 0.005, 0.01, 0.02, 0.04], "record_samples": [8192, 16384], "seeds": [1, 2, 3]}
 QUANTITIES = ("mu", "e0", "k_t")
 
@@ -38,7 +40,7 @@ def noise_study_table(study_cfg: Mapping | None) -> pd.DataFrame:
 
 def e0_at(e_f: float, k_c: float, normal_force: float) -> float:
     """Tangential stiffness e_0 (N/m) of the modified Valanis law at the normal force N (N): e_f (1 - exp(-k_c N / e_f)) (Eq. 22)."""
-    return float(e_f * (1.0 - np.exp(-k_c * normal_force / e_f)))
+    return float(stiction_shear_stiffness(normal_force, e_f, k_c))
 
 
 def run_point(cfg: Mapping, noise_fraction: float, record_samples: int, seed: int) -> dict:

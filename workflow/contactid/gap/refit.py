@@ -20,7 +20,7 @@ from numba import njit
 from scipy.optimize import minimize_scalar
 
 from ..beam_model import all_modes
-from ..friction import valanis_friction_force
+from ..friction import initial_stiffness, valanis_friction_force
 from ..friction_fit import FitSettings, _polish, _Problem, periodic_grid
 from ..identification import InverseHarmonics, inverse_harmonics, modal_damping_vector
 from ..rig.nonlinear import iwan_slip_weights
@@ -133,7 +133,7 @@ def _iwan_periodic(xi, N, e_f, k_c, mu, weights, periods):
                     x_sl[i] = xi[t]
                 out[t] = 0.0
                 continue
-            e0 = e_f * (1.0 - np.exp(-k_c * N[t] / e_f))
+            e0 = initial_stiffness(N[t], e_f, k_c)
             total = 0.0
             for i in range(n):
                 k = e0 / n

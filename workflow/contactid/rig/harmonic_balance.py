@@ -30,7 +30,7 @@ import numpy as np
 import scipy.linalg
 from numba import njit
 
-from ..friction import valanis_step
+from ..friction import initial_stiffness, valanis_step
 from .nonlinear import ContactParameters, ReducedModel, _normal_force, friction_record
 
 
@@ -74,7 +74,7 @@ def _periodic_friction(xi, N_from, N, fr, n_min, iw_share, iw_w, tol, max_period
             s_iw = 0.0
             if iw_share > 0.0:
                 if N[i] > 0.0:
-                    e0 = e_f * (1.0 - np.exp(-k_c * N[i] / e_f))
+                    e0 = initial_stiffness(N[i], e_f, k_c)
                     k = e0 / n_sl
                     for q in range(n_sl):  # the integrator's _iwan_force, slider by slider
                         lim = mu * N[i] * iw_w[q]
@@ -129,8 +129,8 @@ def _iwan_propagate(xi, N, iw_x, iw_flag, iw_w, e_f, k_c, mu, dxi, dN, out):
                     for c in range(n_cols):
                         dx[c] = dxi[i, c]
                     continue
-                ex = np.exp(-k_c * N[i] / e_f)
-                k = e_f * (1.0 - ex) / n_sl
+                ex = np.exp(-k_c * N[i] / e_f)  # d e_0 / dN = k_c ex (Eq. 22)
+                k = initial_stiffness(N[i], e_f, k_c) / n_sl
                 lim = mu * N[i] * iw_w[q]
                 for c in range(n_cols):
                     dk = k_c * ex * dN[i, c] / n_sl

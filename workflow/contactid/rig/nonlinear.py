@@ -30,7 +30,7 @@ import scipy.linalg
 from numba import njit
 
 from ..beam_model import FEModel, all_modes, fix_signs, shortening_matrix
-from ..friction import slip_limit_flag, valanis_step
+from ..friction import initial_stiffness, slip_limit_flag, valanis_step
 from ..signals import harmonic_amplitudes
 
 
@@ -210,7 +210,7 @@ def integrate(z, v, state, t0, n_steps, dt, omega, zeta, xi_v, eta_v, G, bF, k_t
     t = t0
 
     # acceleration at the start
-    e0 = e_f * (1.0 - np.exp(-k_c * max(N, 1e-12) / e_f))
+    e0 = initial_stiffness(max(N, 1e-12), e_f, k_c)
     s_iw = 0.0
     if iw_share > 0.0 and N > 0.0:
         s_iw = _iwan_force(xi, x_sl, iw_w, e0, mu * N)
@@ -231,7 +231,7 @@ def integrate(z, v, state, t0, n_steps, dt, omega, zeta, xi_v, eta_v, G, bF, k_t
         N = _normal_force(eta, deta, n0, delta0, p, hc, unilateral, cubic)  # explicit estimate for the friction law
         S_val = valanis_step(S_val, xi_old, xi, N_old, N, e_f, k_c, e_t, kappa, mu, 1e-6, slip_limit)
         if N > 0.0:
-            e0 = e_f * (1.0 - np.exp(-k_c * N / e_f))
+            e0 = initial_stiffness(N, e_f, k_c)
             s_iw = _iwan_force(xi, x_sl, iw_w, e0, mu * N) if iw_share > 0.0 else 0.0
             S_tot = (1.0 - iw_share) * S_val + iw_share * s_iw + visc * dxi
         else:
