@@ -50,6 +50,33 @@ def initial_stiffness(normal_force, e_f, k_c):
 
 
 @njit(cache=True)
+def iwan_force(xi, anchors, weights, e0_total, mu_n, flags):
+    """The Iwan (Maxwell-slip) element's shear force (N) at the slip xi (m): n sliders of stiffness e_0 / n (Eq. 22's
+    e_0, N/m) and slip limits mu N w_i (weights w_i summing to 1), the multi-asperity friction candidate. A slider
+    that would exceed its limit slips: its anchor (m, ``anchors``, updated in place) follows xi. ``flags`` (int8,
+    one per slider, or empty): set to 0 where the slider sticks, 1 / -1 where it slips forwards / backwards."""
+    total = 0.0
+    n = weights.size
+    for i in range(n):
+        k = e0_total / n
+        lim = mu_n * weights[i]
+        f = k * (xi - anchors[i])
+        flag = 0
+        if f > lim:
+            anchors[i] = xi - lim / k
+            f = lim
+            flag = 1
+        elif f < -lim:
+            anchors[i] = xi + lim / k
+            f = -lim
+            flag = -1
+        if flags.size:
+            flags[i] = flag
+        total += f
+    return total
+
+
+@njit(cache=True)
 def slip_width(normal_force, e0, e_t, kappa, mu):
     """alpha_0 (1 - kappa e_t / e_0) = e_0 / lambda (N), Eq. 21, with alpha_0 = mu N: the scale of
     |S - e_t xi| (the slip-limit bound of the ``slip_limit`` reading)."""

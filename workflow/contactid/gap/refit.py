@@ -20,7 +20,7 @@ from numba import njit
 from scipy.optimize import minimize_scalar
 
 from ..beam_model import all_modes
-from ..friction import initial_stiffness, valanis_friction_force
+from ..friction import initial_stiffness, iwan_force, valanis_friction_force
 from ..friction_fit import FitSettings, _polish, _Problem, periodic_grid
 from ..identification import InverseHarmonics, inverse_harmonics, modal_damping_vector
 from ..rig.nonlinear import iwan_slip_weights
@@ -126,6 +126,7 @@ def _iwan_periodic(xi, N, e_f, k_c, mu, weights, periods):
     n = weights.size
     x_sl = np.zeros(n)
     out = np.zeros(xi.size)
+    no_flags = np.empty(0, dtype=np.int8)
     for _ in range(periods):
         for t in range(xi.size):
             if N[t] <= 0.0:
@@ -133,20 +134,7 @@ def _iwan_periodic(xi, N, e_f, k_c, mu, weights, periods):
                     x_sl[i] = xi[t]
                 out[t] = 0.0
                 continue
-            e0 = initial_stiffness(N[t], e_f, k_c)
-            total = 0.0
-            for i in range(n):
-                k = e0 / n
-                lim = mu * N[t] * weights[i]
-                f = k * (xi[t] - x_sl[i])
-                if f > lim:
-                    x_sl[i] = xi[t] - lim / k
-                    f = lim
-                elif f < -lim:
-                    x_sl[i] = xi[t] + lim / k
-                    f = -lim
-                total += f
-            out[t] = total
+            out[t] = iwan_force(xi[t], x_sl, weights, initial_stiffness(N[t], e_f, k_c), mu * N[t], no_flags)
     return out
 
 

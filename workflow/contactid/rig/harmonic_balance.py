@@ -30,7 +30,7 @@ import numpy as np
 import scipy.linalg
 from numba import njit
 
-from ..friction import initial_stiffness, valanis_step
+from ..friction import initial_stiffness, iwan_force, valanis_step
 from .nonlinear import ContactParameters, ReducedModel, _normal_force, friction_record
 
 
@@ -57,7 +57,7 @@ def _periodic_friction(xi, N_from, N, fr, n_min, iw_share, iw_w, tol, max_period
     moves N_from[i] -> N[i] (the integrator's pair: the last step's final normal force and this step's
     explicit estimate). The Valanis state is stepped with the integrator's ``valanis_step`` around the
     loop until it repeats (change below tol x max|S|), the Iwan share's sliders as the integrator's
-    ``_iwan_force`` steps them; S_val_out the Valanis state, S_out (1 - s) S_val + s S_iwan (zero where
+    ``friction.iwan_force`` steps them; S_val_out the Valanis state, S_out (1 - s) S_val + s S_iwan (zero where
     N <= 0, the contact open); iw_x (M, sliders) the anchors after each step and iw_flag how each slider
     moved (0 stuck, +1 / -1 slipping, 2 reset by an open contact)."""
     e_f, k_c, e_t, kappa, mu, slip_limit = fr[0], fr[1], fr[2], fr[3], fr[4], fr[5] > 0.5
@@ -74,21 +74,8 @@ def _periodic_friction(xi, N_from, N, fr, n_min, iw_share, iw_w, tol, max_period
             s_iw = 0.0
             if iw_share > 0.0:
                 if N[i] > 0.0:
-                    e0 = initial_stiffness(N[i], e_f, k_c)
-                    k = e0 / n_sl
-                    for q in range(n_sl):  # the integrator's _iwan_force, slider by slider
-                        lim = mu * N[i] * iw_w[q]
-                        f = k * (xi[i] - x_sl[q])
-                        iw_flag[i, q] = 0
-                        if f > lim:
-                            x_sl[q] = xi[i] - lim / k
-                            f = lim
-                            iw_flag[i, q] = 1
-                        elif f < -lim:
-                            x_sl[q] = xi[i] + lim / k
-                            f = -lim
-                            iw_flag[i, q] = -1
-                        s_iw += f
+                    s_iw = iwan_force(xi[i], x_sl, iw_w, initial_stiffness(N[i], e_f, k_c), mu * N[i], iw_flag[i])
+                    for q in range(n_sl):
                         iw_x[i, q] = x_sl[q]
                 else:
                     for q in range(n_sl):

@@ -30,7 +30,7 @@ import scipy.linalg
 from numba import njit
 
 from ..beam_model import FEModel, all_modes, fix_signs, shortening_matrix
-from ..friction import initial_stiffness, slip_limit_flag, valanis_step
+from ..friction import initial_stiffness, iwan_force, slip_limit_flag, valanis_step
 from ..signals import harmonic_amplitudes
 
 
@@ -170,24 +170,6 @@ def _excitation(f_sin, f_cos, w, t):
 
 
 @njit(cache=True)
-def _iwan_force(xi, x_sl, weights, e0_total, mu_n):
-    """Maxwell-slip sliders: stiffness e0 w_i, limit mu N w_i; x_sl (slider anchors) updated in place."""
-    total = 0.0
-    for i in range(weights.size):
-        k = e0_total / weights.size
-        lim = mu_n * weights[i]
-        f = k * (xi - x_sl[i])
-        if f > lim:
-            x_sl[i] = xi - lim / k
-            f = lim
-        elif f < -lim:
-            x_sl[i] = xi + lim / k
-            f = -lim
-        total += f
-    return total
-
-
-@njit(cache=True)
 def integrate(z, v, state, t0, n_steps, dt, omega, zeta, xi_v, eta_v, G, bF, k_t, k_n,
               f_sin, f_cos, w, fr, n0, delta0, p, cubic, hc, unilateral, visc, iw_share, iw_w, x_sl, drift_rate, drift_t0,
               store_from, out_a, out_z, out_v, out_s, out_n, out_xi, out_eta, out_f, out_dxi, out_deta):
@@ -208,12 +190,13 @@ def integrate(z, v, state, t0, n_steps, dt, omega, zeta, xi_v, eta_v, G, bF, k_t
     P = n0
     a = np.empty(n)
     t = t0
+    no_flags = np.empty(0, dtype=np.int8)  # the Iwan sliders' flags are not kept here
 
     # acceleration at the start
     e0 = initial_stiffness(max(N, 1e-12), e_f, k_c)
     s_iw = 0.0
     if iw_share > 0.0 and N > 0.0:
-        s_iw = _iwan_force(xi, x_sl, iw_w, e0, mu * N)
+        s_iw = iwan_force(xi, x_sl, iw_w, e0, mu * N, no_flags)
     S_tot = (1.0 - iw_share) * S_val + iw_share * s_iw + (visc * dxi if N > 0.0 else 0.0)
     f = _excitation(f_sin, f_cos, w, t)
     for i in range(n):
@@ -232,7 +215,7 @@ def integrate(z, v, state, t0, n_steps, dt, omega, zeta, xi_v, eta_v, G, bF, k_t
         S_val = valanis_step(S_val, xi_old, xi, N_old, N, e_f, k_c, e_t, kappa, mu, 1e-6, slip_limit)
         if N > 0.0:
             e0 = initial_stiffness(N, e_f, k_c)
-            s_iw = _iwan_force(xi, x_sl, iw_w, e0, mu * N) if iw_share > 0.0 else 0.0
+            s_iw = iwan_force(xi, x_sl, iw_w, e0, mu * N, no_flags) if iw_share > 0.0 else 0.0
             S_tot = (1.0 - iw_share) * S_val + iw_share * s_iw + visc * dxi
         else:
             S_tot = 0.0
