@@ -17,7 +17,7 @@ sys.path.insert(0, str(ROOT / "workflow"))
 
 from contactid.contact_laws import stiction_shear_stiffness  # noqa: E402
 from contactid.friction_fit import FitSettings, fit_friction_law  # noqa: E402
-from contactid.identification import fourier_series  # noqa: E402
+from contactid.harmonics import fourier_series  # noqa: E402
 
 
 def main():

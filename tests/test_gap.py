@@ -8,7 +8,8 @@ import pytest
 
 from contactid.gap.candidates import LIBRARY, Candidate, Parameter, register
 from contactid.gap.diagnosis import GapSettings, diagnose, linear_stage
-from contactid.gap.model import Augmentation, periodic_harmonics
+from contactid.gap.model import Augmentation
+from contactid.harmonics import periodic_harmonics
 from contactid.gap.pipeline import identify, rig_records
 from contactid.gap.records import record_harmonics
 from contactid.io import raw_dataset

@@ -16,6 +16,7 @@ from scipy.optimize import least_squares
 
 from .contact_laws import stiction_shear_stiffness
 from .friction import PARAMETER_NAMES, REGULARIZATIONS, valanis_friction_force
+from .harmonics import periodic_grid
 from .random_streams import generator
 
 log = logging.getLogger(__name__)
@@ -59,15 +60,6 @@ class FitResult:
     grid_points: int
     profiles: dict = field(default_factory=dict)
     warnings: list = field(default_factory=list)
-
-
-def periodic_grid(coef: np.ndarray, f0: float, m: int) -> np.ndarray:
-    """Synthesize K-harmonic periodic signals (rows of complex coefficients, x ~ sum Im(c e^{ihwt}))
-    on ``m`` points of one period (Fourier interpolation)."""
-    coef = np.atleast_2d(coef)
-    h = np.arange(1, coef.shape[1] + 1)
-    t = np.arange(m) / (m * f0)
-    return np.imag(coef @ np.exp(1j * np.outer(2 * np.pi * f0 * h, t)))
 
 
 N_OPEN = 1.0e-3  # N: where the identified normal force is lower, the contact is taken as open (S = 0)
@@ -329,7 +321,7 @@ def friction_fit_dataset(forces, preload: float, settings: FitSettings, seed: in
     paper's chain's forces fitted beside it when given (reproduction)."""
     import xarray as xr
 
-    from .identification import fourier_series
+    from .harmonics import fourier_series
 
     fs = 1.0 / float(forces["time"].values[1] - forces["time"].values[0])
     f0 = float(forces.attrs["excitation_frequency_hz"])
@@ -385,7 +377,8 @@ def validation_dataset(forces, fit, preload: float, n_harmonics: int, truth=None
     on a fine periodic grid; NRMSE against the identified S and against the truth."""
     import xarray as xr
 
-    from .identification import fourier_series, nrmse
+    from .harmonics import fourier_series
+    from .identification import nrmse
 
     fs = 1.0 / float(forces["time"].values[1] - forces["time"].values[0])
     f0 = float(forces.attrs["excitation_frequency_hz"])

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .beam_model import FEModel, all_modes, shortening_matrix
-from .signals import harmonic_content
+from .harmonics import fourier_series, synthesize
 
 
 class IdentificationError(ValueError):
@@ -40,22 +40,6 @@ def _column_forms(q: np.ndarray, G: np.ndarray, p: np.ndarray) -> np.ndarray:
     """q[:, t]^T G p[:, t] for every column t, (n_t,), through one matrix product (the three-operand einsum it
     replaces does not use BLAS: one case's contact_forces_dataset took 4.2 s instead of 1.4 s)."""
     return np.einsum("it,it->t", q, G @ p)
-
-
-def fourier_series(signals: np.ndarray, fs: float, f0: float, n_harmonics: int) -> np.ndarray:
-    """Complex harmonic amplitudes c_h (h = 1..K) of each row, signal ~ mean + sum Im(c_h e^{i h w t}) (Eq. 16)."""
-    h = np.arange(1, n_harmonics + 1)
-    return np.array([harmonic_content(x, fs, f0, h) for x in np.atleast_2d(signals)])
-
-
-def synthesize(coef: np.ndarray, f0: float, t: np.ndarray, derivative: int = 0) -> np.ndarray:
-    """Time signals sum_h Im(c_h (i h w)^d e^{i h w t}) of coefficients (rows, K); d = -2 integrates
-    twice analytically (Eq. 17)."""
-    coef = np.atleast_2d(coef)
-    h = np.arange(1, coef.shape[1] + 1)
-    w = 2 * np.pi * f0
-    factor = (1j * h * w) ** derivative
-    return np.imag((coef * factor) @ np.exp(1j * np.outer(h * w, t)))
 
 
 def nrmse(estimate: np.ndarray, truth: np.ndarray) -> float:

@@ -10,8 +10,8 @@ import numpy as np
 import xarray as xr
 
 from .beam_model import FEModel, assemble, structural_modes
+from .harmonics import fourier_series, synthesize
 from .identification import (
-    fourier_series,
     galerkin_contact_forces,
     generalized_coordinates,
     inverse_harmonics,
@@ -20,7 +20,6 @@ from .identification import (
     nnm_coordinates,
     nonlinear_mode_coefficients,
     nrmse,
-    synthesize,
 )
 from .parameters import structure_from_config
 from .raw_checks import driving_point_index

@@ -9,7 +9,7 @@ import numpy as np
 import xarray as xr
 
 from .io import RawDataError
-from .signals import harmonic_content
+from .harmonics import harmonic_content
 
 
 def driving_point_index(raw: xr.Dataset, excitation_position_m: float, path: str, tol_m: float = 1e-3) -> int:

@@ -49,23 +49,3 @@ def h1_frf(force: np.ndarray, responses: np.ndarray, sampling_rate_hz: float,
     step = segment_length - noverlap
     n_avg = 1 + (n - segment_length) // step
     return FRFEstimate(f, h1, coh, int(n_avg))
-
-
-
-def harmonic_amplitudes(signal: np.ndarray, t: np.ndarray, w: float, harmonics) -> np.ndarray:
-    """Complex amplitudes c_h of signal ~ mean + sum_h Im(c_h exp(i h w t)) by least squares
-    (t in s, w in rad/s; valid on any window, whole number of periods or not)."""
-    harmonics = list(harmonics)
-    cols = [np.ones_like(t)]
-    for h in harmonics:
-        cols += [np.sin(h * w * t), np.cos(h * w * t)]
-    coef = np.linalg.lstsq(np.column_stack(cols), signal, rcond=None)[0]
-    # Im(c e^{i h w t}) = Re(c) sin + Im(c) cos
-    return coef[1::2] + 1j * coef[2::2]
-
-
-def harmonic_content(signal: np.ndarray, sampling_rate_hz: float, frequency_hz: float, harmonics) -> np.ndarray:
-    """Complex harmonic amplitudes of a record sampled from t = 0 (see :func:`harmonic_amplitudes`);
-    |c_h| is the amplitude of harmonic h of ``frequency_hz``."""
-    t = np.arange(len(signal)) / sampling_rate_hz
-    return harmonic_amplitudes(signal, t, 2 * np.pi * frequency_hz, harmonics)

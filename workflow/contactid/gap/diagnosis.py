@@ -23,6 +23,7 @@ from ..beam_model import all_modes, structural_modes
 from ..contact_laws import stiction_shear_stiffness
 from ..identification import modal_damping_vector
 from ..friction_fit import FitSettings
+from ..harmonics import periodic_grid
 from ..random_streams import generator
 from .candidates import LIBRARY, joint_candidate, merged_augmentation
 from .model import NONE, Augmentation, IdentifiedModel, fe_model
@@ -215,10 +216,8 @@ def localise(model: IdentifiedModel, records: dict, sims: dict, n_harmonics: int
         e_t.append((et_id, sims[c].energy["tangential_j"]))
         e_n.append((en_id, sims[c].energy["normal_j"]))
         # part of the cycle: driving-point acceleration residual over one period
-        t = np.arange(256) / (256 * rec.f0)
-        E = np.exp(1j * np.outer(np.arange(1, H + 1) * 2 * np.pi * rec.f0, t))
-        r_t = np.imag((sims[c].acceleration[0, :H] - rec.acceleration[0, :H]) @ E)
-        a_rms = np.sqrt(np.mean(np.imag(rec.acceleration[0, :H] @ E) ** 2))
+        r_t = periodic_grid(sims[c].acceleration[0, :H] - rec.acceleration[0, :H], rec.f0, 256)[0]
+        a_rms = np.sqrt(np.mean(periodic_grid(rec.acceleration[0, :H], rec.f0, 256)[0] ** 2))
         parts = cycle_parts(g, model.structure.k_t)
         parts_rms.append([float(np.sqrt(np.mean(r_t[parts[p]] ** 2)) / a_rms) if parts[p].any() else 0.0
                           for p in part_names])

@@ -22,6 +22,7 @@ import numpy as np
 import xarray as xr
 
 from ..beam_model import assemble
+from ..harmonics import periodic_grid, periodic_harmonics
 from ..parameters import StructureParameters, structure_from_config
 from ..rig.nonlinear import ContactParameters, DualSineSimulator, reduced_model
 from .records import RecordHarmonics
@@ -158,17 +159,6 @@ def simulator(model: IdentifiedModel, aug: Augmentation, fs: float, f0: float | 
     return sim
 
 
-def periodic_harmonics(x: np.ndarray, t_first: float, w: float, n_per: int, H: int) -> np.ndarray:
-    """Harmonics 1..H (x ~ mean + sum Im(c_h e^{i h w t})) of rows sampled uniformly over a whole
-    number of periods of n_per samples each, the first at t_first (exact, by FFT of the period mean)."""
-    x = np.atleast_2d(x)
-    periods = x.shape[1] // n_per
-    mean_period = x[:, : periods * n_per].reshape(x.shape[0], periods, n_per).mean(axis=1)
-    X = np.fft.fft(mean_period, axis=1)[:, 1:H + 1]
-    h = np.arange(1, H + 1)
-    return 2j * X / n_per * np.exp(-1j * h * w * t_first)
-
-
 @dataclass
 class SimResult:
     """A forward simulation's harmonics (same convention and time origin as RecordHarmonics):
@@ -294,10 +284,8 @@ def _contact_harmonics(sig: dict, t_first: float, w: float, n_per: int, H: int) 
 
 def _period_grid(contact: dict, means: dict, f0: float, H: int, grid: int) -> dict:
     """One period on a uniform grid (Fourier synthesis of the harmonics + mean)."""
-    tg = np.arange(grid) / (grid * f0)
-    E = np.exp(1j * np.outer(np.arange(1, H + 1) * 2 * np.pi * f0, tg))
-    grids = {k: means[k] + np.imag(c @ E) for k, c in contact.items()}
-    grids["t"] = tg
+    grids = {k: means[k] + periodic_grid(c[:H], f0, grid)[0] for k, c in contact.items()}
+    grids["t"] = np.arange(grid) / (grid * f0)
     return grids
 
 

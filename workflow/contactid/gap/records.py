@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
-from ..signals import harmonic_amplitudes
+from ..harmonics import harmonic_amplitudes
 
 
 @dataclass(frozen=True)

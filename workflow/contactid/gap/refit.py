@@ -21,7 +21,8 @@ from scipy.optimize import minimize_scalar
 
 from ..beam_model import all_modes
 from ..friction import initial_stiffness, iwan_force, valanis_friction_force
-from ..friction_fit import FitSettings, _polish, _Problem, periodic_grid
+from ..friction_fit import FitSettings, _polish, _Problem
+from ..harmonics import periodic_grid
 from ..identification import InverseHarmonics, inverse_harmonics, modal_damping_vector
 from ..rig.nonlinear import iwan_slip_weights
 from .candidates import Candidate

@@ -10,7 +10,7 @@ import numpy as np
 import pandas as pd
 
 from ..beam_model import assemble, all_modes
-from ..signals import harmonic_amplitudes
+from ..harmonics import harmonic_amplitudes
 from .damping import rig_damping_ratios
 from .dual_sine import build_simulator, dual_sine_settings, dual_sine_test
 from .effects import EFFECTS

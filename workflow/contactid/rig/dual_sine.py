@@ -7,7 +7,6 @@ f = k fs / n_samples with k integer, so that the record holds exactly k periods
 
 from __future__ import annotations
 
-import dataclasses
 import logging
 from typing import Mapping
 
@@ -21,7 +20,7 @@ from ..random_streams import generator
 from .damping import rig_damping_ratios
 from .effects import effect_magnitudes
 from .frontend import add_noise, anti_alias_decimate, delay_channels
-from ..signals import harmonic_amplitudes
+from ..harmonics import harmonic_amplitudes
 from .nonlinear import ContactParameters, DualSineSimulator, control_response, reduced_model
 from .structure import channel_delays, rig_structure, true_structure_config
 

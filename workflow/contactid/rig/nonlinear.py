@@ -31,7 +31,7 @@ from numba import njit
 
 from ..beam_model import FEModel, all_modes, fix_signs, shortening_matrix
 from ..friction import initial_stiffness, iwan_force, slip_limit_flag, valanis_step
-from ..signals import harmonic_amplitudes
+from ..harmonics import harmonic_amplitudes
 
 
 @dataclass(frozen=True)

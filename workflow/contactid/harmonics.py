@@ -1,0 +1,61 @@
+"""Harmonics of periodic signals, in one convention: x(t) ~ mean + sum_h Im(c_h e^{i h w t}), h = 1, 2, ...
+(w = 2 pi f0 rad/s, c_h complex, in the signal's units). Analysis by least squares on any window
+(``harmonic_amplitudes``, ``harmonic_content``, ``fourier_series``, Eq. 16) or by FFT of whole periods
+(``periodic_harmonics``); synthesis at any times, with analytic derivatives and integrals (``synthesize``, Eq. 17),
+or on a grid over one period (``periodic_grid``). Every module that analyses or synthesises harmonics uses these."""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def harmonic_amplitudes(signal: np.ndarray, t: np.ndarray, w: float, harmonics) -> np.ndarray:
+    """Complex amplitudes c_h of signal ~ mean + sum_h Im(c_h exp(i h w t)) by least squares
+    (t in s, w in rad/s; valid on any window, whole number of periods or not)."""
+    harmonics = list(harmonics)
+    cols = [np.ones_like(t)]
+    for h in harmonics:
+        cols += [np.sin(h * w * t), np.cos(h * w * t)]
+    coef = np.linalg.lstsq(np.column_stack(cols), signal, rcond=None)[0]
+    # Im(c e^{i h w t}) = Re(c) sin + Im(c) cos
+    return coef[1::2] + 1j * coef[2::2]
+
+
+def harmonic_content(signal: np.ndarray, sampling_rate_hz: float, frequency_hz: float, harmonics) -> np.ndarray:
+    """Complex harmonic amplitudes of a record sampled from t = 0 (see :func:`harmonic_amplitudes`);
+    |c_h| is the amplitude of harmonic h of ``frequency_hz``."""
+    t = np.arange(len(signal)) / sampling_rate_hz
+    return harmonic_amplitudes(signal, t, 2 * np.pi * frequency_hz, harmonics)
+
+
+def fourier_series(signals: np.ndarray, fs: float, f0: float, n_harmonics: int) -> np.ndarray:
+    """Complex harmonic amplitudes c_h (h = 1..K) of each row, signal ~ mean + sum Im(c_h e^{i h w t}) (Eq. 16)."""
+    h = np.arange(1, n_harmonics + 1)
+    return np.array([harmonic_content(x, fs, f0, h) for x in np.atleast_2d(signals)])
+
+
+def periodic_harmonics(x: np.ndarray, t_first: float, w: float, n_per: int, H: int) -> np.ndarray:
+    """Harmonics 1..H (x ~ mean + sum Im(c_h e^{i h w t})) of rows sampled uniformly over a whole
+    number of periods of n_per samples each, the first at t_first (exact, by FFT of the period mean)."""
+    x = np.atleast_2d(x)
+    periods = x.shape[1] // n_per
+    mean_period = x[:, : periods * n_per].reshape(x.shape[0], periods, n_per).mean(axis=1)
+    X = np.fft.fft(mean_period, axis=1)[:, 1:H + 1]
+    h = np.arange(1, H + 1)
+    return 2j * X / n_per * np.exp(-1j * h * w * t_first)
+
+
+def synthesize(coef: np.ndarray, f0: float, t: np.ndarray, derivative: int = 0) -> np.ndarray:
+    """Time signals sum_h Im(c_h (i h w)^d e^{i h w t}) of coefficients (rows, K); d = -2 integrates
+    twice analytically (Eq. 17)."""
+    coef = np.atleast_2d(coef)
+    h = np.arange(1, coef.shape[1] + 1)
+    w = 2 * np.pi * f0
+    factor = (1j * h * w) ** derivative
+    return np.imag((coef * factor) @ np.exp(1j * np.outer(h * w, t)))
+
+
+def periodic_grid(coef: np.ndarray, f0: float, m: int) -> np.ndarray:
+    """Synthesize K-harmonic periodic signals (rows of complex coefficients, x ~ sum Im(c e^{ihwt}))
+    on ``m`` points of one period (Fourier interpolation)."""
+    return synthesize(coef, f0, np.arange(m) / (m * f0))
