@@ -10,7 +10,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from .consistency import TABLE1_HZ, TABLE3
+from .consistency import TABLE1_HZ, TABLE3, TABLE4
 from .contact_laws import stiction_shear_stiffness
 
 
@@ -231,9 +231,6 @@ def contact_force_summary(forces: Mapping[str, xr.Dataset], nnms: Mapping[str, x
                 p[f"{q}_nrmse"] = a[f"paper_{q}_nrmse"]
         work[case], paper[case] = w, p
     return {"contact_forces": work, "contact_forces_paper": paper}
-
-
-TABLE4 = {"e_f": 3.857e7, "k_c": 2.547e5, "e_t": 0.0, "kappa": 0.284, "mu": 0.397}
 
 
 def table4(fit: xr.Dataset, truth_friction: Mapping | None) -> pd.DataFrame:
