@@ -149,16 +149,19 @@ class InverseResult:
     residual: np.ndarray
 
 
-def modal_damping_vector(model: FEModel, identified_zeta: np.ndarray) -> np.ndarray:
-    """Damping ratio of every FE mode: the identified ratios for the structural modes they
-    belong to (by order), the last identified one above, and the first below (suspension modes)."""
-    modes = all_modes(model)
-    zeta = np.empty(modes.frequencies_hz.size)
-    structural = np.flatnonzero(modes.block_energy_fraction < 0.5)
-    zeta[:] = identified_zeta[0]
-    for k, idx in enumerate(structural):
+def damping_by_mode(structural: np.ndarray, identified_zeta) -> np.ndarray:
+    """Damping ratio of every mode of a model whose modes ``structural`` (bool, ascending frequency) marks as the
+    beam's: the identified ratios for the structural modes in order, the last identified one above them, and the
+    first for the other modes (the block's suspension)."""
+    zeta = np.full(np.size(structural), float(identified_zeta[0]))
+    for k, idx in enumerate(np.flatnonzero(structural)):
         zeta[idx] = identified_zeta[min(k, len(identified_zeta) - 1)]
     return zeta
+
+
+def modal_damping_vector(model: FEModel, identified_zeta: np.ndarray) -> np.ndarray:
+    """Damping ratio of every FE mode (``damping_by_mode``; structural: less than half the energy in the block)."""
+    return damping_by_mode(all_modes(model).block_energy_fraction < 0.5, identified_zeta)
 
 
 def period_coefficients(x_grid: np.ndarray, n_harmonics: int) -> np.ndarray:

@@ -23,6 +23,7 @@ import xarray as xr
 
 from ..beam_model import assemble
 from ..harmonics import periodic_grid, periodic_harmonics
+from ..identification import damping_by_mode
 from ..parameters import StructureParameters, structure_from_config
 from ..rig.nonlinear import ContactParameters, DualSineSimulator, reduced_model
 from .records import RecordHarmonics
@@ -137,11 +138,7 @@ def simulator(model: IdentifiedModel, aug: Augmentation, fs: float, f0: float | 
     """The reduced identified model with the augmentation, ready to integrate (step as the rig's,
     shortened to a whole number of steps per period of ``f0`` when given)."""
     red = _reduced(model.structure_with(aug), model.n_modes)[1]
-    zeta = np.empty(red.omega.size)
-    beam = np.flatnonzero(red.beam_mode)
-    zeta[:] = model.damping[0]
-    for k, idx in enumerate(beam):
-        zeta[idx] = model.damping[min(k, len(model.damping) - 1)]
+    zeta = damping_by_mode(red.beam_mode, model.damping)
     zeta[red.beam_mode] += aug.extra_damping
     k_n = red.k_n * aug.normal_stiffness_factor
     p = aug.unilateral_exponent if aug.unilateral_exponent >= 1.0 else 1.0
