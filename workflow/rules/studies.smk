@@ -1,6 +1,6 @@
 # Parameter studies as Snakemake jobs: one small, independent job per point of a parameter table
 # (snakemake.utils.Paramspace), with declared resources, and a gathering rule. Run them on one
-# machine or through a cluster executor (profiles/default, profiles/slurm; README "Running on a cluster").
+# machine or through a cluster executor (profiles/default, profiles/slurm; docs/studies.md, "Running on a cluster").
 
 rule noise_study_point:
     output:

@@ -11,7 +11,7 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
-# thresholds of the place (measured on rig data with each effect; see README): the records drift when
+# thresholds of the place (measured on rig data with each effect; see docs/gap.md): the records drift when
 # their trend exceeds DRIFT_FACTOR standard errors; the structure and sensor model disagrees with the
 # records when the inverse identification's sensor misfit exceeds RESIDUAL_FACTOR standard errors; the
 # normal contact is not elastic when the best elastic normal law leaves more than NORMAL_LIMIT of N
