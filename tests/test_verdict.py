@@ -136,14 +136,14 @@ def test_consistent_records_put_the_gap_in_the_tangential_contact():
 
 
 def test_drift_beyond_drift_factor_is_non_stationary():
-    assert V.DRIFT_FACTOR == 8.0
+    assert V.DEFAULT_PLACE.drift_z == 8.0
     name, reason = place(drift(1.0, 9.0, 12.0, change=0.05), quiet_stage(), ID_RES, SCATTER)  # median 9 > 8
     assert name == "non_stationary" and reason == "the records' harmonics drift by 0.05 over a record (9 standard errors)"
     assert place(drift(1.0, 8.0, 12.0), quiet_stage(), ID_RES, SCATTER)[0] == "tangential_contact"  # median 8: not > 8
 
 
 def test_sensor_misfit_beyond_residual_factor_is_structure_or_measurement():
-    assert V.RESIDUAL_FACTOR == 20.0
+    assert V.DEFAULT_PLACE.residual_factor == 20.0
     name, reason = place(drift(1, 1, 1), quiet_stage(), [0.021, 0.03, 0.001], SCATTER)  # median ratio 21
     assert name == "structure_or_measurement" and "(sensor misfit 0.021, 21 x the scatter)" in reason
     assert place(drift(1, 1, 1), quiet_stage(), [0.02, 0.03, 0.001], SCATTER)[0] == "tangential_contact"  # 20: not > 20
@@ -155,14 +155,14 @@ def test_an_opening_contact_is_normal_contact():
 
 
 def test_normal_force_left_beyond_normal_limit_is_normal_contact():
-    assert V.NORMAL_LIMIT == 0.25
+    assert V.DEFAULT_PLACE.normal_limit == 0.25
     name, reason = place(drift(1, 1, 1), quiet_stage(contact_force_N=0.3), ID_RES, SCATTER)
     assert name == "normal_contact" and "no elastic normal law fits the identified N(eta): 30% of N is left" in reason
     assert place(drift(1, 1, 1), quiet_stage(contact_force_N=0.25), ID_RES, SCATTER)[0] == "tangential_contact"
 
 
 def test_open_limit_is_the_share_of_the_preload_below_which_the_contact_is_open():
-    assert V.OPEN_LIMIT == 0.02
+    assert V.DEFAULT_PLACE.open_limit == 0.02
     N0 = 70.0
     n = N0 * (1 + np.cos(np.linspace(0, 2 * np.pi, 100, endpoint=False)))  # dips to 0 at mid-cycle
     assert V.open_fraction(n, N0) == pytest.approx(np.mean(n <= 1.4))
@@ -179,11 +179,22 @@ def test_the_checks_come_in_order_drift_structure_opening_normal():
     assert place(drift(1, 1, 1), loud, ID_RES, SCATTER)[1].startswith("the identified normal force falls to zero")
 
 
-def test_diagnosis_keeps_its_place_function_and_thresholds():
-    from contactid.gap import diagnosis
+def test_the_place_thresholds_are_settings():
+    """gap.place sets each threshold: the same records placed otherwise under other thresholds."""
+    from contactid.gap.diagnosis import GapSettings
 
-    assert (diagnosis.DRIFT_FACTOR, diagnosis.RESIDUAL_FACTOR, diagnosis.NORMAL_LIMIT, diagnosis.OPEN_LIMIT) == \
-        (V.DRIFT_FACTOR, V.RESIDUAL_FACTOR, V.NORMAL_LIMIT, V.OPEN_LIMIT)
+    settings = GapSettings.from_config({"place": {"drift_z": 10.0, "residual_factor": 30.0, "normal_limit": 0.4,
+                                                  "open_limit": 0.1}}, 1, 25)
+    t = settings.place
+    assert t == V.PlaceThresholds(10.0, 30.0, 0.4, 0.1)
+    assert GapSettings.from_config({}, 1, 25).place == V.DEFAULT_PLACE
+    assert place(drift(1.0, 9.0, 12.0), quiet_stage(), ID_RES, SCATTER, thresholds=t)[0] == "tangential_contact"
+    assert place(drift(1, 1, 1), quiet_stage(), [0.021, 0.03, 0.001], SCATTER, thresholds=t)[0] == \
+        "tangential_contact"
+    assert place(drift(1, 1, 1), quiet_stage(contact_force_N=0.3), ID_RES, SCATTER, thresholds=t)[0] == \
+        "tangential_contact"
+    n = 70.0 * (1 + np.cos(np.linspace(0, 2 * np.pi, 100, endpoint=False)))
+    assert V.open_fraction(n, 70.0, t.open_limit) == pytest.approx(np.mean(n <= 7.0))
 
 
 def test_an_unobservable_eta_leaves_the_contact_direction_open():

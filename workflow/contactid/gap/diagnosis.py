@@ -30,8 +30,7 @@ from .model import NONE, Augmentation, IdentifiedModel, fe_model
 from .records import RecordHarmonics
 from .refit import (baseline, calibrate, contact_grids, evaluate, gap_residual, gap_value,
                     identified_forces, law_friction_force)
-from .verdict import DRIFT_FACTOR, NORMAL_LIMIT, OPEN_LIMIT, RESIDUAL_FACTOR  # noqa: F401 (thresholds of the place)
-from .verdict import UPDATING_Z
+from .verdict import DEFAULT_PLACE, UPDATING_Z, PlaceThresholds
 from .verdict import (acts_where, at_floor, explains_materially, gap_shares, open_fraction, place as _place_of,
                       retried, updating_effect)
 from .verdict import verdict as _verdict
@@ -74,6 +73,7 @@ class GapSettings:
     joint_refit: bool = True  # the explanation's later steps refit the earlier steps' parameters with theirs
     pair_lookahead: float = 3.0  # where no candidate shrinks a gap above this many min_gap materially, try a pair
     retry_unmoved: bool = False  # later passes also try the candidates whose refit alone left them off
+    place: PlaceThresholds = DEFAULT_PLACE  # the localisation's thresholds (gap.place)
 
     @classmethod
     def from_config(cls, gap_cfg: Mapping | None, seed: int, n_harmonics_id: int) -> "GapSettings":
@@ -95,6 +95,7 @@ class GapSettings:
                 joint_refit=bool(g.get("joint_refit", d.joint_refit)),
                 pair_lookahead=float(g.get("pair_lookahead", d.pair_lookahead)),
                 retry_unmoved=bool(g.get("retry_unmoved", d.retry_unmoved)),
+                place=PlaceThresholds.from_config(g.get("place")),
                 **_updating_settings(g.get("model_updating"), d))
         if not 0.0 < s.min_reduction < 1.0:
             raise ValueError(f"gap.min_reduction = {s.min_reduction}: give a fraction in (0, 1)")
@@ -163,7 +164,8 @@ def cycle_parts(g: dict, k_t: float) -> dict:
 
 
 def localise(model: IdentifiedModel, records: dict, sims: dict, n_harmonics: int, linear: dict | None = None,
-             aug: Augmentation = NONE, eta_limit: float = 0.1, structures=()) -> tuple[dict, dict]:
+             aug: Augmentation = NONE, eta_limit: float = 0.1, structures=(),
+             thresholds: PlaceThresholds = DEFAULT_PLACE) -> tuple[dict, dict]:
     """The gap by stage, sensor, harmonic, part of the cycle and load level (the identified model
     as the chain left it, or with the effects ``aug`` added). Returns (summary for diagnosis.json, arrays for
     gap.nc)."""
@@ -208,7 +210,7 @@ def localise(model: IdentifiedModel, records: dict, sims: dict, n_harmonics: int
         N_law = A_el @ np.linalg.lstsq(A_el, N_id, rcond=None)[0]
         s_res.append(_rel(S_law, g["S"]))
         n_res.append(_rel(N_law, N_id))
-        open_frac.append(open_fraction(g["N"], model.preload))
+        open_frac.append(open_fraction(g["N"], model.preload, thresholds.open_limit))
         # energy per cycle (J): identified from the record vs the simulation
         T = 1.0 / rec.f0
         et_id = float(np.mean(g["S"] * g["xi_dot"]) * T)
@@ -244,7 +246,8 @@ def localise(model: IdentifiedModel, records: dict, sims: dict, n_harmonics: int
     sensors = records[cases[0]].sensors
     amps = [float(np.abs(records[c].acceleration[0, 0])) for c in cases]
     slope = float(np.polyfit(np.log(amps), np.log(np.maximum(acc_gap, 1e-12)), 1)[0]) if len(cases) > 1 else float("nan")
-    direction = "normal" if stage["contact_force_N"] > NORMAL_LIMIT or stage["open_fraction"] > 0 else "tangential"
+    direction = "normal" if stage["contact_force_N"] > thresholds.normal_limit or stage["open_fraction"] > 0 \
+        else "tangential"
     summary = {
         "stage": stage,
         "largest_stage": max(("accelerations", "generalized_coordinates", "contact_force_S", "contact_force_N",
@@ -270,7 +273,8 @@ def localise(model: IdentifiedModel, records: dict, sims: dict, n_harmonics: int
     summary["eta_observability"] = {"model_spread": spread, "limit": eta_limit,
                                     "observable": bool(not finite or worst <= eta_limit)}
     summary["place"], summary["place_reason"] = _place_of(summary["drift"], stage, np.array(id_res), np.array(scatter),
-                                                          summary["eta_observability"]["observable"], worst)
+                                                          summary["eta_observability"]["observable"], worst,
+                                                          thresholds)
     if not summary["eta_observability"]["observable"]:
         summary["direction"] = "unresolved"  # the normal direction's numbers rest on an unobservable eta
     return summary, arrays
@@ -317,8 +321,8 @@ def eta_model_spread(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmo
     return out
 
 
-# the place's thresholds (DRIFT_FACTOR, RESIDUAL_FACTOR, NORMAL_LIMIT, OPEN_LIMIT) and its logic live in
-# verdict.py (pure functions, unit-tested in tests/test_verdict.py); they stay importable from here
+# the place's thresholds (PlaceThresholds, config gap.place) and its logic live in verdict.py (pure functions,
+# unit-tested in tests/test_verdict.py)
 
 
 def linear_stage(model: IdentifiedModel, frf: xr.Dataset, modal: xr.Dataset) -> dict:
@@ -606,7 +610,7 @@ def diagnose(model: IdentifiedModel, records: Mapping[str, RecordHarmonics], cal
                                     max_evaluations=settings.max_evaluations)
     structures = tuple(updating.posterior_structures()) if updating is not None else ()
     where, arrays = localise(model, dict(records), base_sims, H, linear, eta_limit=settings.eta_observability_limit,
-                             structures=structures)
+                             structures=structures, thresholds=settings.place)
     results = candidate_results()
     # bootstrap over record blocks: the sims are fixed, the records resampled
     rng = generator(settings.seed, "gap/bootstrap")
@@ -713,7 +717,8 @@ def diagnose(model: IdentifiedModel, records: Mapping[str, RecordHarmonics], cal
         all_sims = {c: (cal.simulation if c == calibration_case else sims[c]) for c in cases}
         if all(s is not None for s in all_sims.values()):
             where_left, _ = localise(cal.model, dict(records), all_sims, H, linear, aug=cal.augmentation,
-                                     eta_limit=settings.eta_observability_limit, structures=structures)
+                                     eta_limit=settings.eta_observability_limit, structures=structures,
+                                     thresholds=settings.place)
             remaining["place"] = where_left["place"]
             remaining["place_reason"] = where_left["place_reason"]
     diag = Diagnosis(verdict, reason, rows, where, calibration_case, held, arrays,

@@ -7,23 +7,37 @@ misfits, ranked candidates with their held-out gaps and bootstrap intervals) and
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Mapping, Sequence
 
 import numpy as np
 
-# thresholds of the place (measured on rig data with each effect; see docs/gap.md): the records drift when
-# their trend exceeds DRIFT_FACTOR standard errors; the structure and sensor model disagrees with the
-# records when the inverse identification's sensor misfit exceeds RESIDUAL_FACTOR standard errors; the
-# normal contact is not elastic when the best elastic normal law leaves more than NORMAL_LIMIT of N
-DRIFT_FACTOR = 8.0
-RESIDUAL_FACTOR = 20.0
-NORMAL_LIMIT = 0.25
-OPEN_LIMIT = 0.02  # the contact is taken as open where the identified N is below this fraction of N0
+@dataclass(frozen=True)
+class PlaceThresholds:
+    """The place's thresholds (config ``gap.place``; measured on rig data with each effect, docs/gap.md; the
+    schema holds the same defaults, which tests/test_config.py checks): the records drift when their trend exceeds
+    ``drift_z`` standard errors; the structure and sensor model disagrees with the records when the inverse
+    identification's sensor misfit exceeds ``residual_factor`` times its scatter; the normal contact is not
+    elastic when the best elastic normal law leaves more than ``normal_limit`` of N; the contact is open where
+    the identified N is at or below ``open_limit`` times the preload N0."""
+
+    drift_z: float = 8.0
+    residual_factor: float = 20.0
+    normal_limit: float = 0.25
+    open_limit: float = 0.02
+
+    @classmethod
+    def from_config(cls, block: Mapping | None) -> "PlaceThresholds":
+        """From the ``gap.place`` block (keys left out: the defaults)."""
+        return cls(**{k: float(v) for k, v in (block or {}).items()})
 
 
-def open_fraction(normal_force, preload: float) -> float:
-    """Share of the cycle's samples where the contact is open: N at or below OPEN_LIMIT x the preload N0."""
-    return float(np.mean(np.asarray(normal_force) <= OPEN_LIMIT * preload))
+DEFAULT_PLACE = PlaceThresholds()
+
+
+def open_fraction(normal_force, preload: float, open_limit: float = DEFAULT_PLACE.open_limit) -> float:
+    """Share of the cycle's samples where the contact is open: N at or below ``open_limit`` x the preload N0."""
+    return float(np.mean(np.asarray(normal_force) <= open_limit * preload))
 
 
 def acts_where(acts_on: str, place: str) -> bool:
@@ -33,26 +47,27 @@ def acts_where(acts_on: str, place: str) -> bool:
 
 
 def place(drift: Mapping[str, Mapping], stage: Mapping[str, float], id_res, scatter,
-          eta_observable: bool = True, eta_spread: float = 0.0) -> tuple[str, str]:
+          eta_observable: bool = True, eta_spread: float = 0.0,
+          thresholds: PlaceThresholds = DEFAULT_PLACE) -> tuple[str, str]:
     """Where the gap lies, with the reason: (place, reason).
 
     drift: per load case {"change": relative change over the record, "z": its size in standard errors};
     stage: at least "open_fraction", "contact_force_N" and "contact_force_S" (relative gaps);
     id_res, scatter: per load case, the inverse identification's sensor misfit and its standard error.
-    The first that holds of: the records drift (median z > DRIFT_FACTOR) -> "non_stationary"; the
-    structure and sensor model misfits the records (median id_res / scatter > RESIDUAL_FACTOR) ->
+    The first that holds of: the records drift (median z > thresholds.drift_z) -> "non_stationary"; the
+    structure and sensor model misfits the records (median id_res / scatter > thresholds.residual_factor) ->
     "structure_or_measurement"; the contact opens (the identified N, observable, reaches zero) ->
     "normal_contact"; the normal motion eta is not observable (``eta_observable`` False: the identified eta
     moves by ``eta_spread`` over the structures the data allow), so the normal law cannot be tested and the
     directions cannot be told apart -> "contact"; no elastic normal law fits N(eta) (contact_force_N >
-    NORMAL_LIMIT) -> "normal_contact"; otherwise "tangential_contact"."""
+    thresholds.normal_limit) -> "normal_contact"; otherwise "tangential_contact"."""
     id_res, scatter = np.asarray(id_res, float), np.asarray(scatter, float)
     z = np.array([v["z"] for v in drift.values()])
-    if np.median(z) > DRIFT_FACTOR:
+    if np.median(z) > thresholds.drift_z:
         change = np.median([v["change"] for v in drift.values()])
         return "non_stationary", (f"the records' harmonics drift by {change:.2g} over a record "
                                   f"({np.median(z):.0f} standard errors)")
-    if np.median(id_res / scatter) > RESIDUAL_FACTOR:
+    if np.median(id_res / scatter) > thresholds.residual_factor:
         return "structure_or_measurement", (f"the linear structure and sensor model cannot fit the records at w "
                                             f"and 3w (sensor misfit {np.median(id_res):.2g}, "
                                             f"{np.median(id_res / scatter):.0f} x the scatter)")
@@ -63,7 +78,7 @@ def place(drift: Mapping[str, Mapping], stage: Mapping[str, float], id_res, scat
         return "contact", (f"the identified normal motion eta is not observable (it moves by {eta_spread:.0%} over "
                            "the structures the random test allows), so no normal law can be tested against it and the "
                            "normal and the tangential contact cannot be told apart")
-    if stage["contact_force_N"] > NORMAL_LIMIT:
+    if stage["contact_force_N"] > thresholds.normal_limit:
         return "normal_contact", (f"no elastic normal law fits the identified N(eta): {stage['contact_force_N']:.0%} "
                                   "of N is left (dissipation or opening in the normal direction)")
     return "tangential_contact", (f"structure, sensors and normal contact are consistent with the records; the "
