@@ -30,7 +30,7 @@ _EXPONENT_NUMBER = re.compile(r"^[-+]?(\d+|\d+\.\d*|\.\d+)[eE][-+]?\d+$")
 def _load_schema(schema) -> dict:
     if isinstance(schema, Mapping):
         return dict(schema)
-    return copy.deepcopy(_schema_file(str(schema)))
+    return copy.deepcopy(_schema_file(str(Path(schema).resolve())))
 
 
 @functools.lru_cache(maxsize=4)
@@ -68,6 +68,18 @@ def numbers_written_as_text(cfg: dict, schema) -> list:
     number: ``channel_time_skew: 4e-05`` is the text '4e-05' to PyYAML (it wants 4.0e-05), which the schema would
     refuse as "not of type 'number'". Returns [(dotted key, number)] of the values changed. Only values of that form where a number
     is wanted: a name or a path that looks like one elsewhere stays text."""
+    def texts(node):
+        if isinstance(node, str):
+            yield node
+        elif isinstance(node, Mapping):
+            for v in node.values():
+                yield from texts(v)
+        elif isinstance(node, list):
+            for v in node:
+                yield from texts(v)
+
+    if not any(_EXPONENT_NUMBER.match(t.strip()) for t in texts(cfg)):
+        return []  # nothing to look at (the usual case): no schema pass
     import jsonschema
 
     schema = _load_schema(schema)
