@@ -18,8 +18,9 @@ def timed_clean_run(*targets) -> float:
         for folder in ("workflow", "config", "paper"):
             shutil.copytree(ROOT / folder, tmp / folder, ignore=shutil.ignore_patterns("__pycache__", "*.egg-info"))
         t0 = time.perf_counter()
-        res = subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", *targets], cwd=tmp,
-                             capture_output=True, text=True)
+        res = subprocess.run(
+            [sys.executable, "-m", "snakemake", "--cores", "2", *targets], cwd=tmp, capture_output=True, text=True
+        )
         wall = time.perf_counter() - t0
     if res.returncode:
         print(res.stderr[-2000:])

@@ -40,9 +40,11 @@ def main():
     t0 = time.perf_counter()
     valanis_friction_force_reference(xi, n, pop[:8])
     ref = (time.perf_counter() - t0) / 8 * pop.shape[0]
-    print(f"fast kernel: {fast / steps * 1e9:.1f} ns per sample step per parameter set (goal <= 40), "
-          f"{fast / (m * pop.shape[0]) * 1e9:.0f} ns per sample per set per call ({periods.mean():.1f} periods to "
-          f"steady state); plain per-sample Python loop: {ref / steps * 1e9:.0f} ns; speed-up {ref / fast:.0f}x")
+    print(
+        f"fast kernel: {fast / steps * 1e9:.1f} ns per sample step per parameter set (goal <= 40), "
+        f"{fast / (m * pop.shape[0]) * 1e9:.0f} ns per sample per set per call ({periods.mean():.1f} periods to "
+        f"steady state); plain per-sample Python loop: {ref / steps * 1e9:.0f} ns; speed-up {ref / fast:.0f}x"
+    )
 
     m2 = 2048
     t2 = np.arange(m2) / m2
@@ -55,8 +57,10 @@ def main():
 
     t0 = time.perf_counter()
     res = fit_friction_law(coef(xi2), coef(n2 - 70), coef(S), 54.375, 70.0, FitSettings(), 1, 25)
-    print(f"whole fit (GA {FitSettings().population} x {FitSettings().generations}, polish, grid up to "
-          f"{res.grid_points}, intervals): {time.perf_counter() - t0:.2f} s (goal < 10 s)")
+    print(
+        f"whole fit (GA {FitSettings().population} x {FitSettings().generations}, polish, grid up to "
+        f"{res.grid_points}, intervals): {time.perf_counter() - t0:.2f} s (goal < 10 s)"
+    )
 
 
 if __name__ == "__main__":

@@ -50,13 +50,16 @@ def reference_package():
     """The package as it was at REFERENCE, importable as contactid_ref (its imports are relative)."""
     dest = CACHE / f"reference-{REFERENCE}"
     if not (dest / "contactid_ref").exists():
-        tar = subprocess.run(["git", "archive", REFERENCE, "workflow/contactid"], cwd=ROOT, capture_output=True,
-                             check=True).stdout
+        tar = subprocess.run(
+            ["git", "archive", REFERENCE, "workflow/contactid"], cwd=ROOT, capture_output=True, check=True
+        ).stdout
         with tarfile.open(fileobj=io.BytesIO(tar)) as t:
             t.extractall(dest, filter="data")
         (dest / "workflow" / "contactid").rename(dest / "contactid_ref")
     sys.path.insert(0, str(dest))
     return importlib.import_module("contactid_ref")
+
+
 EFFECTS = {"normal_contact_damping": 300.0, "viscous_friction": 300.0, "transducer_mass_error": 0.3}
 
 
@@ -84,8 +87,9 @@ def effect_data(cfg, effect, magnitude):
             recs[n].to_netcdf(folder / f"{n}.nc", engine="netcdf4")
     recs = {n: load_dataset(folder / f"{n}.nc") for n in names}
     model, modes, modal, frf = identify(cfg, recs["random_test"], recs[cfg["nonlinear"]["calibration_case"]])
-    fit = xr.Dataset({"parameter_value": ("parameter", np.asarray(model.friction))},
-                     attrs={"regularization": model.regularization})
+    fit = xr.Dataset(
+        {"parameter_value": ("parameter", np.asarray(model.friction))}, attrs={"regularization": model.regularization}
+    )
     return {"linear_modes": modes, "modal": modal, "frf": frf, "friction_fit": fit}, {c: recs[c] for c in cases}
 
 
@@ -97,8 +101,11 @@ def run(pkg, method, memo, ds, raw, cfg, warm_up=False, workers=1):
     K = cfg["nonlinear"]["n_harmonics"]
     records = {c: importlib.import_module(f"{pkg}.gap.records").record_harmonics(r, c, K) for c, r in raw.items()}
     lin = gd.linear_stage(model, ds["frf"], ds["modal"])
-    gap = {**cfg["gap"], "candidates": ["multi_asperity_friction", "preload_drift"], "max_evaluations": 3} if warm_up \
+    gap = (
+        {**cfg["gap"], "candidates": ["multi_asperity_friction", "preload_drift"], "max_evaluations": 3}
+        if warm_up
         else cfg["gap"]
+    )
     settings = gd.GapSettings.from_config(gap, cfg["seed"], K)
     fit_settings = importlib.import_module(f"{pkg}.friction_fit").settings_from_config(cfg["friction"])
     token = STEADY_STATE.set(method) if pkg == "contactid" else None
@@ -126,21 +133,32 @@ def compare(label, ds, raw, cfg) -> dict:
     after = {r["effect"]: r["heldout_gap_after"] for r in old.ranking}
     diffs = [abs(r["heldout_gap_after"] - after[r["effect"]]) for r in new.ranking]
     rel = [abs(r["heldout_gap_after"] / after[r["effect"]] - 1) for r in new.ranking]
-    row = {"data": label, "seconds_reference": t_old, "seconds_harmonic_balance": t_new,
-           "seconds_time_marching_unmemoised": t_plain, "seconds_two_workers": t_two,
-           "same_with_two_workers": [r["effect"] for r in two.ranking] == [r["effect"] for r in new.ranking],
-           "ratio": t_old / t_new, "verdict": [old.verdict, new.verdict],
-           "same_verdict": old.verdict == new.verdict, "same_ranking": order_old == order_new,
-           "ranking": [order_old, order_new], "heldout_gap_before": list(before),
-           "heldout_gap_after": [[after[e] for e in order_old], [r["heldout_gap_after"] for r in new.ranking]],
-           "max_abs_gap_difference": max([abs(before[1] - before[0]), *diffs]),
-           "max_rel_gap_difference": max([abs(before[1] / before[0] - 1), *rel])}
-    print(f"{label}: before harmonic balance ({REFERENCE}) {t_old:.1f} s, now {t_new:.1f} s (x{row['ratio']:.1f}; now "
-          f"forced to time marching without memos {t_plain:.1f} s; with two worker processes {t_two:.1f} s, "
-          f"{'same' if row['same_with_two_workers'] else 'OTHER'} ranking); verdict {old.verdict} / {new.verdict}; ranking "
-          f"{'same' if row['same_ranking'] else 'DIFFERENT'}; held-out gap before {before[0]:.4%} / {before[1]:.4%}; "
-          f"largest held-out gap difference {row['max_abs_gap_difference']:.2e} (absolute), "
-          f"{row['max_rel_gap_difference']:.1%} (relative)", flush=True)
+    row = {
+        "data": label,
+        "seconds_reference": t_old,
+        "seconds_harmonic_balance": t_new,
+        "seconds_time_marching_unmemoised": t_plain,
+        "seconds_two_workers": t_two,
+        "same_with_two_workers": [r["effect"] for r in two.ranking] == [r["effect"] for r in new.ranking],
+        "ratio": t_old / t_new,
+        "verdict": [old.verdict, new.verdict],
+        "same_verdict": old.verdict == new.verdict,
+        "same_ranking": order_old == order_new,
+        "ranking": [order_old, order_new],
+        "heldout_gap_before": list(before),
+        "heldout_gap_after": [[after[e] for e in order_old], [r["heldout_gap_after"] for r in new.ranking]],
+        "max_abs_gap_difference": max([abs(before[1] - before[0]), *diffs]),
+        "max_rel_gap_difference": max([abs(before[1] / before[0] - 1), *rel]),
+    }
+    print(
+        f"{label}: before harmonic balance ({REFERENCE}) {t_old:.1f} s, now {t_new:.1f} s (x{row['ratio']:.1f}; now "
+        f"forced to time marching without memos {t_plain:.1f} s; with two worker processes {t_two:.1f} s, "
+        f"{'same' if row['same_with_two_workers'] else 'OTHER'} ranking); verdict {old.verdict} / {new.verdict}; ranking "
+        f"{'same' if row['same_ranking'] else 'DIFFERENT'}; held-out gap before {before[0]:.4%} / {before[1]:.4%}; "
+        f"largest held-out gap difference {row['max_abs_gap_difference']:.2e} (absolute), "
+        f"{row['max_rel_gap_difference']:.1%} (relative)",
+        flush=True,
+    )
     if not row["same_ranking"]:
         print("  before:", order_old, "\n  now:   ", order_new)
     return row
@@ -160,8 +178,10 @@ def main():
         if only in (None, effect):
             rows.append(compare(f"{effect} {magnitude:g}", *effect_data(cfg, effect, magnitude), cfg))
     worst = max(r["seconds_harmonic_balance"] for r in rows)
-    print(f"slowest diagnosis {worst:.1f} s (goal 15 s: {'met' if worst <= 15 else 'NOT met'}); smallest ratio "
-          f"x{min(r['ratio'] for r in rows):.1f} (goal 5: {'met' if min(r['ratio'] for r in rows) >= 5 else 'NOT met'})")
+    print(
+        f"slowest diagnosis {worst:.1f} s (goal 15 s: {'met' if worst <= 15 else 'NOT met'}); smallest ratio "
+        f"x{min(r['ratio'] for r in rows):.1f} (goal 5: {'met' if min(r['ratio'] for r in rows) >= 5 else 'NOT met'})"
+    )
     CACHE.mkdir(parents=True, exist_ok=True)
     (CACHE / "gap_diagnosis.json").write_text(json.dumps(rows, indent=2, default=str))
 

@@ -28,8 +28,12 @@ from common import timed_clean_run  # noqa: E402
 
 
 def main():
-    wall = timed_clean_run("results/linear/linear_modes.nc", "results/figures/fig03_frf.png",
-                           "results/tables/table1.csv", "results/tables/paper_consistency.csv")
+    wall = timed_clean_run(
+        "results/linear/linear_modes.nc",
+        "results/figures/fig03_frf.png",
+        "results/tables/table1.csv",
+        "results/tables/paper_consistency.csv",
+    )
     cfg = with_defaults(yaml.safe_load((ROOT / "config" / "config.yaml").read_text()))
     m = assemble(structure_from_config(cfg["structure"], 3.95e6, 2.37e7))  # k_t, k_n: Table 3
     t0 = time.perf_counter()

@@ -35,7 +35,7 @@ def solve_ivp_baseline(sim, F1, F3, w, t_end):
     n = r.omega.size
 
     def rhs(t, y):
-        z, v, S = y[:n], y[n:2 * n], y[2 * n]
+        z, v, S = y[:n], y[n : 2 * n], y[2 * n]
         gz = r.shortening @ z
         xi_lin = r.xi @ z
         xi = xi_lin - 0.5 * z @ gz
@@ -45,8 +45,15 @@ def solve_ivp_baseline(sim, F1, F3, w, t_end):
         N = c.preload * max((c.static_approach - eta) / c.static_approach, 0.0) ** c.exponent
         dS = valanis_slope(S, xi, 1.0 if dxi >= 0 else -1.0, N, e_f, k_c, e_t, kappa, mu) * dxi if N > 0 else 0.0
         f = F1 * np.sin(w * t) + F3 * np.sin(3 * w * t)
-        a = (r.force * f - dxi_dq * S + r.eta * (N - c.preload) + r.k_t * r.xi * xi_lin + r.k_n * r.eta * eta
-             - cdamp * v - r.omega**2 * z)
+        a = (
+            r.force * f
+            - dxi_dq * S
+            + r.eta * (N - c.preload)
+            + r.k_t * r.xi * xi_lin
+            + r.k_n * r.eta * eta
+            - cdamp * v
+            - r.omega**2 * z
+        )
         return np.concatenate([v, a, [dS]])
 
     y0 = np.concatenate([sim.z, sim.v, [sim.state[0]]])
@@ -63,8 +70,10 @@ def main():
     t0 = time.perf_counter()
     raw, truth = dual_sine_test(st, rig, lc1, fs, 0.005, 1, "lc1", st["sensors"]["names"])
     warm = time.perf_counter() - t0
-    print(f"one load case (lc1), response control included: {warm:.2f} s warm, {cold:.2f} s with JIT compilation "
-          f"(goal < 10 s); control iterations {truth.sizes['iteration']}")
+    print(
+        f"one load case (lc1), response control included: {warm:.2f} s warm, {cold:.2f} s with JIT compilation "
+        f"(goal < 10 s); control iterations {truth.sizes['iteration']}"
+    )
 
     s = dual_sine_settings(rig, lc1, fs)
     sim = build_simulator(st, rig, s)
@@ -82,8 +91,10 @@ def main():
     t0 = time.perf_counter()
     sol = solve_ivp_baseline(sim, F1, F3, w, t_end)
     t_ivp = time.perf_counter() - t0
-    print(f"8 periods of lc1: numba central differences {t_numba * 1e3:.1f} ms, solve_ivp RK45 {t_ivp:.2f} s "
-          f"({sol.t.size} steps); speed-up {t_ivp / t_numba:.0f}x")
+    print(
+        f"8 periods of lc1: numba central differences {t_numba * 1e3:.1f} ms, solve_ivp RK45 {t_ivp:.2f} s "
+        f"({sol.t.size} steps); speed-up {t_ivp / t_numba:.0f}x"
+    )
 
     wall = timed_clean_run("rig")
     print(f"whole default rig data set (snakemake rig, from clean, 2 cores): {wall:.1f} s (goal < 40 s)")

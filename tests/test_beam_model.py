@@ -10,9 +10,22 @@ from structures import configured_structure
 
 def bare_beam(**kw):
     """The beam alone: no transducers, no pin, the block decoupled (k_s = 0, g = 0, J_s = 0)."""
-    base = dict(pin_mass=0.0, pin_inertia=0.0, force_transducer_mass=0.0, sensor_masses=(0.0, 0.0, 0.0),
-                block_inertia=0.0, string_stiffness=0.0, gravity=0.0, k_t=0.0, k_n=0.0, normal_lever_arm=0.0,
-                tangential_lever_arm=0.0, hanger_lever_arm=0.0, axial_inertia=True, n_elements=60)
+    base = dict(
+        pin_mass=0.0,
+        pin_inertia=0.0,
+        force_transducer_mass=0.0,
+        sensor_masses=(0.0, 0.0, 0.0),
+        block_inertia=0.0,
+        string_stiffness=0.0,
+        gravity=0.0,
+        k_t=0.0,
+        k_n=0.0,
+        normal_lever_arm=0.0,
+        tangential_lever_arm=0.0,
+        hanger_lever_arm=0.0,
+        axial_inertia=True,
+        n_elements=60,
+    )
     base.update(kw)
     return configured_structure(**base)
 

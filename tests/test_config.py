@@ -66,7 +66,9 @@ def test_exponent_notation_without_a_point_is_read_as_a_number(default_config):
     changed = numbers_written_as_text(cfg, SCHEMA)
     assert sorted(changed) == [("gap.n_bootstrap", 200), ("rig.effects.channel_time_skew", 4e-05)]
     assert isinstance(cfg["gap"]["n_bootstrap"], int) and cfg["structure"]["sensors"]["names"][0] == "1e3"
-    cfg["structure"]["sensors"]["names"] = default_config["structure"]["sensors"]["names"]  # (names start with a letter)
+    cfg["structure"]["sensors"]["names"] = default_config["structure"]["sensors"][
+        "names"
+    ]  # (names start with a letter)
     validate(cfg, SCHEMA)
     assert numbers_written_as_text(cfg, SCHEMA) == []
 

@@ -4,7 +4,9 @@ from contactid.consistency import paper_consistency_table
 
 
 def test_paper_tables_disagree_and_lever_arm_reconciles(default_config):
-    df = paper_consistency_table(default_config["structure"], default_config["rig"]["truth"]["friction"]).set_index("scenario")
+    df = paper_consistency_table(default_config["structure"], default_config["rig"]["truth"]["friction"]).set_index(
+        "scenario"
+    )
     # Table 3 as printed, a = r: frequencies some 2-5 % below Table 1
     assert df.loc["A", "err1_pct"] == pytest.approx(-4.9, abs=0.3)
     # k_t fitted to Table 1 with a = r comes out near 1e7 N/m

@@ -4,8 +4,7 @@ import pytest
 from contactid.contact_laws import NormalLaw, stiction_shear_stiffness
 from scipy.integrate import solve_ivp
 
-from contactid.friction import (SINGULAR_GUARD, slip_limit_flag, valanis_friction_force, valanis_slope,
-                                valanis_step)
+from contactid.friction import SINGULAR_GUARD, slip_limit_flag, valanis_friction_force, valanis_slope, valanis_step
 
 P = (3.857e7, 2.547e5, 1.0e4, 0.284, 0.397)  # e_f, k_c, e_t, kappa, mu (Table 4, e_t small)
 
@@ -72,11 +71,13 @@ def test_regularization_names_are_checked():
 def printed_law_fine(xi_of, dxi_of, n_of, periods=6):
     """Eq. 21 as printed, integrated in time by an adaptive Runge-Kutta method (independent of the kernel):
     dS/dt = dS/dxi (S, xi, sgn xi', N) xi'(t), over several periods; S over the last one at t in [0, 1)."""
+
     def rhs(t, y):
         v = dxi_of(t)
         if v == 0.0:
             return [0.0]
         return [valanis_slope.py_func(y[0], xi_of(t), np.sign(v), n_of(t), *P) * v]
+
     t_eval = periods - 1 + np.arange(4096) / 4096
     sol = solve_ivp(rhs, (0.0, periods), [0.0], method="RK45", rtol=1e-9, atol=1e-9, t_eval=t_eval, max_step=1e-3)
     return sol.y[0]

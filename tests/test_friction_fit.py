@@ -60,7 +60,7 @@ def test_guards_give_clear_errors(xi_n_params, message):
 
 def coefficients(x, k=25):
     m = x.size
-    return (2j * np.fft.fft(x)[1:k + 1] / m)[None]
+    return (2j * np.fft.fft(x)[1 : k + 1] / m)[None]
 
 
 @pytest.fixture(scope="module")

@@ -20,8 +20,15 @@ def _synthetic_record(coef_force, coef_acc, f0=50.0, fs=5120.0, n=8192, phase_sh
     t = np.arange(n) / fs
     w = 2 * np.pi * f0
     sig = lambda c: sum(np.imag(ch * np.exp(1j * (h + 1) * w * (t + phase_shift / w))) for h, ch in enumerate(c))  # noqa: E731
-    raw = raw_dataset(t, sig(coef_force), np.array([sig(c) for c in coef_acc]), ["a1", "a2"], [0.5, 0.3], fs,
-                      attrs={"excitation_frequency_hz": f0})
+    raw = raw_dataset(
+        t,
+        sig(coef_force),
+        np.array([sig(c) for c in coef_acc]),
+        ["a1", "a2"],
+        [0.5, 0.3],
+        fs,
+        attrs={"excitation_frequency_hz": f0},
+    )
     return raw
 
 
@@ -52,7 +59,9 @@ def test_register_refuses_taken_names_and_bad_ranges():
     with pytest.raises(ValueError, match="low must be below high"):
         register(Candidate("my_effect", "bad", (Parameter("x", "1", 1, 0),), lambda th: Augmentation()))
     with pytest.raises(ValueError, match="acts_on"):
-        register(Candidate("my_effect", "bad", (Parameter("x", "1", 0, 1),), lambda th: Augmentation(), acts_on="rotor"))
+        register(
+            Candidate("my_effect", "bad", (Parameter("x", "1", 0, 1),), lambda th: Augmentation(), acts_on="rotor")
+        )
     assert "my_effect" not in LIBRARY
 
 
@@ -152,29 +161,75 @@ def test_effect_missing_from_library_gives_none_and_points_at_the_normal_directi
 def test_report_section_is_plain_latex_with_and_without_the_benchmark():
     from contactid.gap.report import gap_section
 
-    stage = {k: 0.01 for k in ("accelerations", "generalized_coordinates", "identification_residual", "contact_force_S",
-                               "contact_force_N", "energy_tangential", "frf_peak_amplitude")}
-    diag = {"calibration_case": "lc1", "verdict": "none", "reason": "no candidate shrinks it by 30%", "ranking": [],
-            "where": {"stage": stage, "heldout_gap_before": 0.02, "heldout_gap_before_interval": [0.019, 0.021],
-                      "record_scatter": 1e-4, "by_harmonic": {1: 0.01, 2: 0.0}, "worst_sensor": "a1", "worst_harmonic": 3,
-                      "even_share": 0.1, "worst_cycle_part": "slip", "place": "tangential_contact",
-                      "place_reason": "the friction law leaves 1% of S"}}
-    bench = {"n_blind": 48, "top1_accuracy": 0.9375, "false_alarms": 0, "n_effect_free": 2,
-             "shrink_of_correct": {"min": 0.83, "median": 0.94}, "leave_out": {"n": 8, "verdict_none": 7, "place_right": 8},
-             "diagnosis_seconds": {"median": 53.0}, "per_effect_accuracy": {"viscous_friction": 1.0},
-             "compound": {"n": 40, "n_by_effect_count": {"0": 14, "1": 13, "2": 13},
-                          "perturbation_only_no_contact_effect": 0.9, "one_effect_named": 0.8,
-                          "one_effect_no_absent_contact_effect": 0.9, "two_effects_both_named": 0.5,
-                          "two_effects_one_named": 0.9, "remaining_gap_median": 0.005,
-                          "perturbation_only_median_abs_error": {"mu": 0.05, "kappa": 0.2, "e0": 0.1},
-                          "perturbation_only_interval_coverage": {"mu": 1.0, "kappa": 0.9286, "e0": 1.0},
-                          "perturbation_only_median_abs_bound_error": {"mu_a": 0.004, "e0_a2": 0.012},
-                          "perturbation_only_median_interval_halfwidth": {"mu": 0.16, "kappa": 0.6, "e0": 0.37}}}
+    stage = {
+        k: 0.01
+        for k in (
+            "accelerations",
+            "generalized_coordinates",
+            "identification_residual",
+            "contact_force_S",
+            "contact_force_N",
+            "energy_tangential",
+            "frf_peak_amplitude",
+        )
+    }
+    diag = {
+        "calibration_case": "lc1",
+        "verdict": "none",
+        "reason": "no candidate shrinks it by 30%",
+        "ranking": [],
+        "where": {
+            "stage": stage,
+            "heldout_gap_before": 0.02,
+            "heldout_gap_before_interval": [0.019, 0.021],
+            "record_scatter": 1e-4,
+            "by_harmonic": {1: 0.01, 2: 0.0},
+            "worst_sensor": "a1",
+            "worst_harmonic": 3,
+            "even_share": 0.1,
+            "worst_cycle_part": "slip",
+            "place": "tangential_contact",
+            "place_reason": "the friction law leaves 1% of S",
+        },
+    }
+    bench = {
+        "n_blind": 48,
+        "top1_accuracy": 0.9375,
+        "false_alarms": 0,
+        "n_effect_free": 2,
+        "shrink_of_correct": {"min": 0.83, "median": 0.94},
+        "leave_out": {"n": 8, "verdict_none": 7, "place_right": 8},
+        "diagnosis_seconds": {"median": 53.0},
+        "per_effect_accuracy": {"viscous_friction": 1.0},
+        "compound": {
+            "n": 40,
+            "n_by_effect_count": {"0": 14, "1": 13, "2": 13},
+            "perturbation_only_no_contact_effect": 0.9,
+            "one_effect_named": 0.8,
+            "one_effect_no_absent_contact_effect": 0.9,
+            "two_effects_both_named": 0.5,
+            "two_effects_one_named": 0.9,
+            "remaining_gap_median": 0.005,
+            "perturbation_only_median_abs_error": {"mu": 0.05, "kappa": 0.2, "e0": 0.1},
+            "perturbation_only_interval_coverage": {"mu": 1.0, "kappa": 0.9286, "e0": 1.0},
+            "perturbation_only_median_abs_bound_error": {"mu_a": 0.004, "e0_a2": 0.012},
+            "perturbation_only_median_interval_halfwidth": {"mu": 0.16, "kappa": 0.6, "e0": 0.37},
+        },
+    }
     assert "Compound benchmark" in gap_section(diag, bench) and "14 with 0" in gap_section(diag, bench)
     assert "$\\kappa$ $92.9$\\,\\%" in gap_section(diag, bench)  # interval coverage, three digits
     assert "$e_0 a^2$ $1.20$\\,\\%" in gap_section(diag, bench)
-    par = {n: {"value": 0.4, "profile_interval": [0.39, 0.41], "sd_cases": 0.01, "sd_structure": 0.08,
-               "interval": [0.33, 0.48], "scale": "log"} for n in ("e_f", "k_c", "e_t", "kappa", "mu", "e0")}
+    par = {
+        n: {
+            "value": 0.4,
+            "profile_interval": [0.39, 0.41],
+            "sd_cases": 0.01,
+            "sd_structure": 0.08,
+            "interval": [0.33, 0.48],
+            "scale": "log",
+        }
+        for n in ("e_f", "k_c", "e_t", "kappa", "mu", "e0")
+    }
     intervals = {"model": "updated", "n_structures": 12, "parameters": {**par, "confidence": 0.95}}
     text = gap_section(diag, None, intervals)
     assert "model-form uncertainty" in text and "e\\_0 at N\\_0" in text and "$0.48" in text
@@ -186,31 +241,99 @@ def test_report_section_is_plain_latex_with_and_without_the_benchmark():
 
 
 def _synthetic_diagnosis(steps, verdict="none", after=None):
-    stage = {k: 0.01 for k in ("accelerations", "generalized_coordinates", "identification_residual", "contact_force_S",
-                               "contact_force_N", "energy_tangential", "frf_peak_amplitude")}
-    rows = [{"effect": "transducer_mass_error", "n_parameters": 1, "heldout_gap_before": 0.04, "heldout_gap_after": after,
-             "heldout_gap_after_interval": [after, after], "reduction": None if after is None else 1 - after / 0.04,
-             "score": None, "parameters": {"mass_error": -0.3}},
-            {"effect": "viscous_friction", "n_parameters": 1, "heldout_gap_before": 0.04, "heldout_gap_after": 0.03,
-             "heldout_gap_after_interval": [0.029, 0.031], "reduction": 0.25, "score": -3.0, "parameters": {"sigma_2": 0.0}}]
+    stage = {
+        k: 0.01
+        for k in (
+            "accelerations",
+            "generalized_coordinates",
+            "identification_residual",
+            "contact_force_S",
+            "contact_force_N",
+            "energy_tangential",
+            "frf_peak_amplitude",
+        )
+    }
+    rows = [
+        {
+            "effect": "transducer_mass_error",
+            "n_parameters": 1,
+            "heldout_gap_before": 0.04,
+            "heldout_gap_after": after,
+            "heldout_gap_after_interval": [after, after],
+            "reduction": None if after is None else 1 - after / 0.04,
+            "score": None,
+            "parameters": {"mass_error": -0.3},
+        },
+        {
+            "effect": "viscous_friction",
+            "n_parameters": 1,
+            "heldout_gap_before": 0.04,
+            "heldout_gap_after": 0.03,
+            "heldout_gap_after_interval": [0.029, 0.031],
+            "reduction": 0.25,
+            "score": -3.0,
+            "parameters": {"sigma_2": 0.0},
+        },
+    ]
     left = steps[-1]["heldout_gap_after"] if steps else 0.04
-    return {"calibration_case": "lc1", "verdict": verdict, "reason": "a reason with 50% and a_b", "ranking": rows,
-            "where": {"stage": stage, "heldout_gap_before": 0.04, "heldout_gap_before_interval": [0.039, 0.041],
-                      "record_scatter": 1e-4, "by_harmonic": {1: 0.01}, "worst_sensor": "a1", "worst_harmonic": 3,
-                      "even_share": 0.1, "worst_cycle_part": "slip", "place": "normal_contact", "place_reason": "N left"},
-            "explanation": steps,
-            "remaining_gap": {"heldout_gap": left, "share": left**2 / 0.04**2, "at_floor": left < 0.006, "floor": 0.006,
-                              "min_reduction": 0.5, "place": "structure_or_measurement", "place_reason": "sensor misfit"},
-            "shrink": {}}
+    return {
+        "calibration_case": "lc1",
+        "verdict": verdict,
+        "reason": "a reason with 50% and a_b",
+        "ranking": rows,
+        "where": {
+            "stage": stage,
+            "heldout_gap_before": 0.04,
+            "heldout_gap_before_interval": [0.039, 0.041],
+            "record_scatter": 1e-4,
+            "by_harmonic": {1: 0.01},
+            "worst_sensor": "a1",
+            "worst_harmonic": 3,
+            "even_share": 0.1,
+            "worst_cycle_part": "slip",
+            "place": "normal_contact",
+            "place_reason": "N left",
+        },
+        "explanation": steps,
+        "remaining_gap": {
+            "heldout_gap": left,
+            "share": left**2 / 0.04**2,
+            "at_floor": left < 0.006,
+            "floor": 0.006,
+            "min_reduction": 0.5,
+            "place": "structure_or_measurement",
+            "place_reason": "sensor misfit",
+        },
+        "shrink": {},
+    }
 
 
-@pytest.mark.parametrize("steps, verdict, after", [
-    ([], "none", None),  # no verdict, a candidate whose prediction diverged (null in diagnosis.json)
-    ([{"effect": "transducer_mass_error", "parameters": {"mass_error": -0.3}, "heldout_gap_before": 0.04,
-       "heldout_gap_after": 0.01, "share": 0.9375},
-      {"effect": "normal_contact_damping", "parameters": {"alpha": 240.0}, "heldout_gap_before": 0.01,
-       "heldout_gap_after": 0.004, "share": 0.0525}], "transducer_mass_error", 0.01),
-])
+@pytest.mark.parametrize(
+    "steps, verdict, after",
+    [
+        ([], "none", None),  # no verdict, a candidate whose prediction diverged (null in diagnosis.json)
+        (
+            [
+                {
+                    "effect": "transducer_mass_error",
+                    "parameters": {"mass_error": -0.3},
+                    "heldout_gap_before": 0.04,
+                    "heldout_gap_after": 0.01,
+                    "share": 0.9375,
+                },
+                {
+                    "effect": "normal_contact_damping",
+                    "parameters": {"alpha": 240.0},
+                    "heldout_gap_before": 0.01,
+                    "heldout_gap_after": 0.004,
+                    "share": 0.0525,
+                },
+            ],
+            "transducer_mass_error",
+            0.01,
+        ),
+    ],
+)
 def test_every_figure_and_the_report_section_for_any_diagnosis(tmp_path, steps, verdict, after):
     """No step fails after its result exists: a negative parameter, a null gap, no verdict, two steps."""
     from contactid.gap import figures
@@ -224,7 +347,11 @@ def test_every_figure_and_the_report_section_for_any_diagnosis(tmp_path, steps, 
     text = gap_section(diag, None)
     assert "Step by step" in text and "gap_explanation.png" in text
     if steps:
-        assert "normal\\_contact\\_damping" in text and "mass\\_error $= -0.300$" in text and "at the identification" in text
+        assert (
+            "normal\\_contact\\_damping" in text
+            and "mass\\_error $= -0.300$" in text
+            and "at the identification" in text
+        )
     else:
         assert "nothing is added" in text and "structure\\_or\\_measurement" in text
 

@@ -29,8 +29,13 @@ EFFECTS = {
 def model(default_config):
     # the default rig's identified model (linear chain and friction fit on the default data)
     params = structure_from_config(default_config["structure"], 1.4308e7, 2.37e7)
-    return IdentifiedModel(params, (0.005, 0.005, 0.005), (3.857e7, 2.547e5, 1.0e4, 0.284, 0.397),
-                           float(default_config["structure"]["preload_n"]), frequencies=(54.75, 165.4, 333.8))
+    return IdentifiedModel(
+        params,
+        (0.005, 0.005, 0.005),
+        (3.857e7, 2.547e5, 1.0e4, 0.284, 0.397),
+        float(default_config["structure"]["preload_n"]),
+        frequencies=(54.75, 165.4, 333.8),
+    )
 
 
 def record(case: str) -> RecordHarmonics:
@@ -38,8 +43,20 @@ def record(case: str) -> RecordHarmonics:
     force = np.zeros(25, dtype=complex)
     force[:3] = FORCES[case]
     zeros = np.zeros((3, 25), dtype=complex)
-    return RecordHarmonics(case, F0, FS, 174, force, zeros, force[None], zeros[None], zeros, zeros,
-                           ("a1", "a2", "a3"), np.array([0.55, 0.3, 0.05]))
+    return RecordHarmonics(
+        case,
+        F0,
+        FS,
+        174,
+        force,
+        zeros,
+        force[None],
+        zeros[None],
+        zeros,
+        zeros,
+        ("a1", "a2", "a3"),
+        np.array([0.55, 0.3, 0.05]),
+    )
 
 
 @pytest.mark.parametrize("effect", list(EFFECTS))
@@ -127,8 +144,9 @@ def test_newton_matrix_by_woodbury_is_the_dense_jacobian(model):
 
     sim = simulator(model, Augmentation(hunt_crossley=300.0, iwan_share=0.3, viscous=100.0), FS, F0)
     n_per = int(round(1 / (F0 * sim.dt)))
-    hb = HarmonicBalance(sim.red, dataclasses.replace(sim.contact, preload_drift=0.0), sim.zeta, 2 * np.pi * F0, 9,
-                         n_per)
+    hb = HarmonicBalance(
+        sim.red, dataclasses.replace(sim.contact, preload_drift=0.0), sim.zeta, 2 * np.pi * F0, 9, n_per
+    )
     sol = hb.solve(np.array(FORCES["lc3"], dtype=complex))
     p = hb.path(hb.to_real(sol.Z))
     J = hb.jacobian(p) + np.kron(sim.red.shortening, hb.project(p["S"][:, None] * hb.E))

@@ -80,9 +80,13 @@ def test_paper_chain_refuses_more_modes_than_sensors():
 
 def test_real_nnms_and_phase_spread():
     """Terms in phase (or anti-phase) give a real NNM with zero spread; a 30 degree lag is flagged."""
-    c = np.array([[2.0 * np.exp(1j * 0.4), 0, 1.0 * np.exp(1j * 0.4)],
-                  [-0.5 * np.exp(1j * 0.4), 0, 3.0 * np.exp(1j * (0.4 + np.pi / 6))],
-                  [0.0 + 1e-9, 0, 0.1 * np.exp(1j * 0.4)]])
+    c = np.array(
+        [
+            [2.0 * np.exp(1j * 0.4), 0, 1.0 * np.exp(1j * 0.4)],
+            [-0.5 * np.exp(1j * 0.4), 0, 3.0 * np.exp(1j * (0.4 + np.pi / 6))],
+            [0.0 + 1e-9, 0, 0.1 * np.exp(1j * 0.4)],
+        ]
+    )
     coef, spread = nonlinear_mode_coefficients(c)
     assert spread[0] == pytest.approx(0.0, abs=1e-9)
     assert coef[0] == pytest.approx(np.array([2.0, -0.5, 0.0]) / np.sqrt(4.25), abs=1e-9)

@@ -27,8 +27,12 @@ def dual_sine(seed=0, noise=0.005, f0=F0, n=N, fs=FS):
     t = np.arange(n) / fs
     w = 2 * np.pi * f0
     force = 2.0 * np.sin(w * t) + 0.4 * np.sin(3 * w * t + 0.2)
-    acc = np.array([a * np.sin(w * t + p) + 2.5 * a * np.sin(3 * w * t + 2 * p) + 0.1 * a * np.sin(5 * w * t)
-                    for a, p in ((14.0, 0.1), (6.0, 0.4), (1.0, 0.7))])
+    acc = np.array(
+        [
+            a * np.sin(w * t + p) + 2.5 * a * np.sin(3 * w * t + 2 * p) + 0.1 * a * np.sin(5 * w * t)
+            for a, p in ((14.0, 0.1), (6.0, 0.4), (1.0, 0.7))
+        ]
+    )
     force += noise * np.std(force) * rng.standard_normal(n)
     acc += noise * np.std(acc, axis=1, keepdims=True) * rng.standard_normal(acc.shape)
     return raw_dataset(t, force, acc, ["a1", "a2", "a3"], [0.55, 0.3, 0.05], fs, {"excitation_frequency_hz": f0})
@@ -61,7 +65,9 @@ def test_round_trip_recovers_the_record_in_SI(tmp_path, fmt, storage):
 def test_unit_conversion_is_the_stated_one(tmp_path):
     # 1 g = 9.80665 m/s^2; 2.25 mV/N: 4.5 mV is 2 N
     raw = dual_sine(noise=0.0)
-    block = export_record(raw, tmp_path / "r.tdms", "tdms", {"force": ("mV", 2.25, "mV/N"), "acceleration": ("g", None, None)})
+    block = export_record(
+        raw, tmp_path / "r.tdms", "tdms", {"force": ("mV", 2.25, "mV/N"), "acceleration": ("g", None, None)}
+    )
     from nptdms import TdmsFile
 
     f = TdmsFile.read(tmp_path / "r.tdms")
@@ -74,21 +80,38 @@ def _block(tmp_path, fmt="tdms", storage=None):
     return export_record(dual_sine(), tmp_path / f"r.{fmt}", fmt, storage)
 
 
-@pytest.mark.parametrize("edit, message", [
-    (lambda b: b["channels"]["force"].pop("units"), "force.units is missing"),
-    (lambda b: b["channels"]["force"].update(units="furlong"), "is not a force unit"),
-    (lambda b: b["channels"]["sensors"][0].update(units="mV"), "give sensitivity and sensitivity_units"),
-    (lambda b: b["channels"]["sensors"][0].update(units="mV", sensitivity=-1, sensitivity_units="mV/g"), "positive"),
-    (lambda b: b["channels"]["sensors"][0].update(units="mV", sensitivity=10, sensitivity_units="mV/N"),
-     "sensitivity_units = 'mV/N'"),
-    (lambda b: b["channels"]["sensors"][1].update(channel="dual_sine/a1"), "mapped twice"),
-    (lambda b: b["channels"]["sensors"][2].pop("position_m"), "position_m is missing"),
-    (lambda b: b["channels"]["sensors"][0].update(units="g"), "labelled 'm/s^2' in the file but the channel map says units: g"),
-    (lambda b: b["channels"]["force"].update(channel="dual_sine/F"), "channel 'dual_sine/F' not found; the file has"),
-    (lambda b: b.update(sampling_rate_hz=5000.0), "sampled at 5120 Hz but load_cases.lc1 says sampling_rate_hz = 5000"),
-    (lambda b: b.pop("excitation_frequency_hz"), "excitation_frequency_hz is missing"),
-    (lambda b: b.update(file="nowhere.tdms"), "not found; correct 'file:'"),
-])
+@pytest.mark.parametrize(
+    "edit, message",
+    [
+        (lambda b: b["channels"]["force"].pop("units"), "force.units is missing"),
+        (lambda b: b["channels"]["force"].update(units="furlong"), "is not a force unit"),
+        (lambda b: b["channels"]["sensors"][0].update(units="mV"), "give sensitivity and sensitivity_units"),
+        (
+            lambda b: b["channels"]["sensors"][0].update(units="mV", sensitivity=-1, sensitivity_units="mV/g"),
+            "positive",
+        ),
+        (
+            lambda b: b["channels"]["sensors"][0].update(units="mV", sensitivity=10, sensitivity_units="mV/N"),
+            "sensitivity_units = 'mV/N'",
+        ),
+        (lambda b: b["channels"]["sensors"][1].update(channel="dual_sine/a1"), "mapped twice"),
+        (lambda b: b["channels"]["sensors"][2].pop("position_m"), "position_m is missing"),
+        (
+            lambda b: b["channels"]["sensors"][0].update(units="g"),
+            "labelled 'm/s^2' in the file but the channel map says units: g",
+        ),
+        (
+            lambda b: b["channels"]["force"].update(channel="dual_sine/F"),
+            "channel 'dual_sine/F' not found; the file has",
+        ),
+        (
+            lambda b: b.update(sampling_rate_hz=5000.0),
+            "sampled at 5120 Hz but load_cases.lc1 says sampling_rate_hz = 5000",
+        ),
+        (lambda b: b.pop("excitation_frequency_hz"), "excitation_frequency_hz is missing"),
+        (lambda b: b.update(file="nowhere.tdms"), "not found; correct 'file:'"),
+    ],
+)
 def test_bad_channel_maps_name_the_field_and_the_fix(tmp_path, edit, message):
     block = _block(tmp_path)
     edit(block)
@@ -144,6 +167,7 @@ def test_config_check_refuses_an_incomplete_import_before_any_rule(default_confi
 # ------------------------------------------------------------------------------------------
 # validation of raw records
 # ------------------------------------------------------------------------------------------
+
 
 def test_validation_passes_a_clean_record_and_recovers_its_frequency():
     raw = dual_sine()
@@ -236,8 +260,12 @@ def test_any_defective_record_gives_a_clear_error(tmp_path, mutation, i, k):
 
 
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
-@given(fmt=st.sampled_from(["uff58", "tdms", "csv"]), cut=st.floats(0.0, 0.999), junk=st.binary(max_size=64),
-       where=st.sampled_from(["truncate", "junk_head", "junk_tail", "zero"]))
+@given(
+    fmt=st.sampled_from(["uff58", "tdms", "csv"]),
+    cut=st.floats(0.0, 0.999),
+    junk=st.binary(max_size=64),
+    where=st.sampled_from(["truncate", "junk_head", "junk_tail", "zero"]),
+)
 def test_damaged_files_give_a_clear_error_or_a_valid_record(tmp_path_factory, fmt, cut, junk, where):
     tmp = tmp_path_factory.mktemp(fmt)
     small = dual_sine(n=2048)
@@ -247,7 +275,7 @@ def test_damaged_files_give_a_clear_error_or_a_valid_record(tmp_path_factory, fm
     if where == "truncate":
         data = data[: int(cut * len(data))]
     elif where == "junk_head":
-        data = junk + data[len(junk):]
+        data = junk + data[len(junk) :]
     elif where == "junk_tail":
         data = data[: int(cut * len(data))] + junk
     else:

@@ -17,8 +17,10 @@ from contactid.io import package_digest
 PACKAGE = Path(contactid.__file__).resolve().parent
 
 CALLEE = "from numba import njit\n\n\n@njit(cache=True)\ndef value():\n    return {value}\n"
-CALLER = ("from numba import njit\n\nfrom .probe_callee import value\n\n\n"
-          "@njit(cache=True)\ndef call():\n    return value()\n")
+CALLER = (
+    "from numba import njit\n\nfrom .probe_callee import value\n\n\n"
+    "@njit(cache=True)\ndef call():\n    return value()\n"
+)
 RUN = """
 import json, os, {pkg}.probe_caller as m
 result = m.call()
@@ -28,10 +30,20 @@ print(json.dumps({{"result": result, "cache_dir": os.environ.get("NUMBA_CACHE_DI
 
 
 def run(pkg: str, pythonpath: Path, cache_dir: Path) -> dict:
-    env = {**os.environ, "PYTHONPATH": str(pythonpath), "NUMBA_CACHE_DIR": str(cache_dir),
-           "PYTHONDONTWRITEBYTECODE": "1"}
-    out = subprocess.run([sys.executable, "-c", RUN.format(pkg=pkg)], env=env, capture_output=True, text=True,
-                         timeout=120, cwd=pythonpath)
+    env = {
+        **os.environ,
+        "PYTHONPATH": str(pythonpath),
+        "NUMBA_CACHE_DIR": str(cache_dir),
+        "PYTHONDONTWRITEBYTECODE": "1",
+    }
+    out = subprocess.run(
+        [sys.executable, "-c", RUN.format(pkg=pkg)],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        cwd=pythonpath,
+    )
     assert out.returncode == 0, out.stderr
     return json.loads(out.stdout.strip().splitlines()[-1])
 

@@ -17,7 +17,7 @@ NUMPY_REPR = re.compile(r"array\(|np\.\w+\(|\[\s*\d[\d.e+-]*\s+\d")  # array(...
 
 
 def coefficients(x, k=25):
-    return (2j * np.fft.fft(x)[1:k + 1] / x.size)[None]
+    return (2j * np.fft.fft(x)[1 : k + 1] / x.size)[None]
 
 
 def test_ga_logs_its_generations_with_plain_numbers(caplog):
@@ -27,8 +27,18 @@ def test_ga_logs_its_generations_with_plain_numbers(caplog):
     S = valanis_friction_force(xi, n, TRUE[None])[0]
     settings = FitSettings(population=12, generations=16, grid_points=128, max_grid_points=256)
     with caplog.at_level(logging.INFO, logger="contactid"):
-        fit_friction_law(coefficients(xi), coefficients(n - 70.0), coefficients(S), 54.375, 70.0, settings, seed=3,
-                         n_harmonics_data=25, intervals=False, label="synthetic fit")
+        fit_friction_law(
+            coefficients(xi),
+            coefficients(n - 70.0),
+            coefficients(S),
+            54.375,
+            70.0,
+            settings,
+            seed=3,
+            n_harmonics_data=25,
+            intervals=False,
+            label="synthetic fit",
+        )
     messages = [r.getMessage() for r in caplog.records if r.name.startswith("contactid")]
     generations = [m for m in messages if "GA generation" in m]
     # every few generations (about eight lines per run), the last one always

@@ -16,8 +16,16 @@ FS = 5120.0
 @pytest.fixture(scope="module")
 def lc1(default_config):
     c = default_config
-    return dual_sine_test(c["structure"], c["rig"], c["load_cases"]["lc1"], FS, c["rig"]["noise_fraction"], 1, "lc1",
-                          c["structure"]["sensors"]["names"])
+    return dual_sine_test(
+        c["structure"],
+        c["rig"],
+        c["load_cases"]["lc1"],
+        FS,
+        c["rig"]["noise_fraction"],
+        1,
+        "lc1",
+        c["structure"]["sensors"]["names"],
+    )
 
 
 def test_response_control_hits_table2(lc1):
@@ -83,8 +91,16 @@ def test_effects_off_are_bit_identical_and_on_change_the_response(default_config
     c = default_config
     rc = copy.deepcopy(c["rig"])
     rc["effects"] = {name: 0.0 for name in EFFECTS}
-    raw_off, _ = dual_sine_test(c["structure"], rc, c["load_cases"]["lc1"], FS, c["rig"]["noise_fraction"], 1, "lc1",
-                                c["structure"]["sensors"]["names"])
+    raw_off, _ = dual_sine_test(
+        c["structure"],
+        rc,
+        c["load_cases"]["lc1"],
+        FS,
+        c["rig"]["noise_fraction"],
+        1,
+        "lc1",
+        c["structure"]["sensors"]["names"],
+    )
     raw0, _ = lc1
     assert np.array_equal(raw_off["acceleration"].values, raw0["acceleration"].values)
     assert np.array_equal(raw_off["force"].values, raw0["force"].values)

@@ -16,10 +16,12 @@ from contactid.rig.random_test import random_test_datasets
 from contactid.rig.structure import rig_structure
 
 FS = 5120.0
-PERTURBED = {"beam": {"youngs_modulus_pa": 2.164e11 * 1.03},
-             "sensors": {"masses_kg": [0.0058 * 1.4] * 3},
-             "contact_geometry": {"tangential_lever_arm_m": 0.00458 * 1.08},
-             "clamp_rotational_stiffness_nm_per_rad": 2.0e5}
+PERTURBED = {
+    "beam": {"youngs_modulus_pa": 2.164e11 * 1.03},
+    "sensors": {"masses_kg": [0.0058 * 1.4] * 3},
+    "contact_geometry": {"tangential_lever_arm_m": 0.00458 * 1.08},
+    "clamp_rotational_stiffness_nm_per_rad": 2.0e5,
+}
 
 
 def test_true_structure_changes_the_rig_only(default_config):
@@ -37,13 +39,16 @@ def test_true_structure_changes_the_rig_only(default_config):
     assert structure_from_config(c["structure"], 1.0, 1.0).youngs_modulus == c["structure"]["beam"]["youngs_modulus_pa"]
 
 
-@pytest.mark.parametrize("changes, message", [
-    ({"beam": {"youngs_modulus": 2e11}}, r"rig.true_structure.beam.youngs_modulus is not a key of structure"),
-    ({"sensors": {"masses_kg": [0.01, 0.01]}}, r"must be a list of 3 entries"),
-    ({"preload_n": "75"}, r"must be a number"),
-    ({"beam": {"youngs_modulus_pa": "2e11"}}, r"write 2.0e\+11"),
-    ({"preload_n": -5.0}, r"must be positive"),
-])
+@pytest.mark.parametrize(
+    "changes, message",
+    [
+        ({"beam": {"youngs_modulus": 2e11}}, r"rig.true_structure.beam.youngs_modulus is not a key of structure"),
+        ({"sensors": {"masses_kg": [0.01, 0.01]}}, r"must be a list of 3 entries"),
+        ({"preload_n": "75"}, r"must be a number"),
+        ({"beam": {"youngs_modulus_pa": "2e11"}}, r"write 2.0e\+11"),
+        ({"preload_n": -5.0}, r"must be positive"),
+    ],
+)
 def test_bad_true_structure_is_named_with_its_fix(default_config, changes, message):
     cfg = copy.deepcopy(default_config)
     cfg["rig"]["true_structure"] = changes
@@ -66,8 +71,14 @@ def test_polynomial_hardening_normal_law_and_its_tangents():
     N, dN, dNd = (np.empty(eta.size) for _ in range(3))
     _normal_path(eta, deta, n0, d0, 1.0, k3, 30.0, True, N, dN, dNd)
     h = 1e-12
-    fd = [(_normal_force(e + h, 1e-4, n0, d0, 1.0, 30.0, True, k3) - _normal_force(e - h, 1e-4, n0, d0, 1.0, 30.0,
-                                                                                    True, k3)) / (2 * h) for e in eta]
+    fd = [
+        (
+            _normal_force(e + h, 1e-4, n0, d0, 1.0, 30.0, True, k3)
+            - _normal_force(e - h, 1e-4, n0, d0, 1.0, 30.0, True, k3)
+        )
+        / (2 * h)
+        for e in eta
+    ]
     assert dN == pytest.approx(fd, rel=1e-5)
 
 
@@ -97,11 +108,13 @@ def test_perturbed_rig_with_two_effects_runs_and_its_raw_records_carry_nothing_o
     change = truth_rt["natural_frequency"].values[:3] / truth_nominal["natural_frequency"].values[:3] - 1
     assert np.all(np.abs(change) > 1e-3) and np.all(np.abs(change) < 0.1)
     zeta = truth_rt["damping_ratio"].values
-    assert zeta[1] / zeta[0] == pytest.approx(truth_rt["natural_frequency"].values[1] /
-                                              truth_rt["natural_frequency"].values[0], rel=1e-9)
+    assert zeta[1] / zeta[0] == pytest.approx(
+        truth_rt["natural_frequency"].values[1] / truth_rt["natural_frequency"].values[0], rel=1e-9
+    )
 
-    raw, truth = dual_sine_test(c["structure"], rig, c["load_cases"]["lc1"], FS, 0.005, 1, "lc1",
-                                c["structure"]["sensors"]["names"])
+    raw, truth = dual_sine_test(
+        c["structure"], rig, c["load_cases"]["lc1"], FS, 0.005, 1, "lc1", c["structure"]["sensors"]["names"]
+    )
     assert truth.attrs["control_converged"] == 1
     assert truth.attrs["normal_cubic_n_per_m3"] == 4.0e19
     for ds in (raw, raw_rt):  # a raw record holds what a real test records, nothing of the rig's truth

@@ -23,9 +23,16 @@ def _start(proj: Path, *args) -> subprocess.Popen:
     env = {**os.environ, "PYTHONPATH": str(proj / "workflow"), "NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
     # as from a terminal: a run started in the background (CI, nohup ... &) inherits SIGINT ignored, and
     # Python then never turns Ctrl-C into KeyboardInterrupt; restore the default disposition
-    return subprocess.Popen([sys.executable, "-m", "snakemake", "--cores", "1", *args], cwd=proj, env=env,
-                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, start_new_session=True,
-                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    return subprocess.Popen(
+        [sys.executable, "-m", "snakemake", "--cores", "1", *args],
+        cwd=proj,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        start_new_session=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
 
 
 def _finish(p: subprocess.Popen, timeout=900) -> str:
@@ -70,8 +77,15 @@ def test_killed_runs_resume_to_bit_identical_results(small_run, tmp_path):
     # a copy of the shared small run without the rig's lc1 record and what the fit makes of it: the run makes
     # them again (the rig, the lc1 chain, the friction fit); the rest of the workflow stays as the copy has it
     run = copy_project(small_run, tmp_path / "run")
-    for rel in ("data/raw/lc1.nc", "data/truth/lc1.nc", TARGET, *[f"results/lc1/{f}.nc" for f in (
-            "raw_check", "generalized_coordinates", "nonlinear_modes", "reduced_model", "contact_forces")]):
+    for rel in (
+        "data/raw/lc1.nc",
+        "data/truth/lc1.nc",
+        TARGET,
+        *[
+            f"results/lc1/{f}.nc"
+            for f in ("raw_check", "generalized_coordinates", "nonlinear_modes", "reduced_model", "contact_forces")
+        ],
+    ):
         (run / rel).unlink()
     # 1. SIGKILL in the middle of the rig (no chance to clean up: the lock and the incomplete marker stay)
     first = _start(run, TARGET)

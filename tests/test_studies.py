@@ -33,8 +33,10 @@ def test_sweep_runs_one_job_per_point_and_errors_grow_with_noise(noise_sweep_run
     # (workflow_projects.prepare_noise_sweep_run; the points' random test is the small config's 51.2 s record)
     proj = noise_sweep_run
     points = sorted((proj / "results/studies/noise").glob("*.json"))
-    assert [p.name for p in points] == ["noise_fraction~0.001_record_samples~8192_seed~1.json",
-                                        "noise_fraction~0.05_record_samples~8192_seed~1.json"]
+    assert [p.name for p in points] == [
+        "noise_fraction~0.001_record_samples~8192_seed~1.json",
+        "noise_fraction~0.05_record_samples~8192_seed~1.json",
+    ]
     ds = xr.load_dataset(proj / "results/studies/noise_study.nc", engine="netcdf4")
     assert dict(ds.sizes) == {"noise_fraction": 2, "record_samples": 1, "seed": 1}
     low, high = (json.loads(p.read_text()) for p in points)

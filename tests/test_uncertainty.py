@@ -77,8 +77,9 @@ def test_the_data_bind_mu_times_the_lever_arm_not_mu(default_config):
     for lam in (1.0, 1.05, 0.95):
         p = model.structure
         p2 = p.replace(tangential_lever_arm=lam * p.tangential_lever_arm).with_contact(p.k_t / lam**2, p.k_n)
-        out[lam] = with_e0(_refit(dataclasses.replace(model, structure=p2), rec, fit_settings, 1, "lever").params,
-                           model.preload)
+        out[lam] = with_e0(
+            _refit(dataclasses.replace(model, structure=p2), rec, fit_settings, 1, "lever").params, model.preload
+        )
     mu, e0 = NAMES.index("mu"), NAMES.index("e0")
     for lam in (1.05, 0.95):
         assert abs(out[lam][mu] / out[1.0][mu] - 1) > 0.04  # mu itself moves with the lever arm ...

@@ -49,8 +49,9 @@ def test_data_of_the_nominal_structure_are_not_updated(nominal):
 
 
 def test_updating_settings_and_their_errors():
-    s = GapSettings.from_config({"model_updating": {"parameters": ["transducer_mass_scale"], "residue_accuracy": 0.05}},
-                                1, 25)
+    s = GapSettings.from_config(
+        {"model_updating": {"parameters": ["transducer_mass_scale"], "residue_accuracy": 0.05}}, 1, 25
+    )
     assert s.model_updating and s.updating_parameters == ("transducer_mass_scale",) and s.residue_accuracy == 0.05
     assert not GapSettings.from_config({"model_updating": {"enabled": False}}, 1, 25).model_updating
     assert GapSettings.from_config({}, 1, 25).updating_parameters == tuple(FACTORS)

@@ -15,13 +15,20 @@ PLACE = "tangential_contact"
 def row(effect, after, before=0.02, consistent=True, acts_on=PLACE, low=None):
     """A ranked candidate as diagnose() builds it: held-out gap ``after`` against ``before``."""
     red = 1 - after / before
-    return {"effect": effect, "acts_on": acts_on, "consistent": consistent, "heldout_gap_after": after,
-            "reduction": red, "reduction_interval": [red - 0.05 if low is None else low, red + 0.05]}
+    return {
+        "effect": effect,
+        "acts_on": acts_on,
+        "consistent": consistent,
+        "heldout_gap_after": after,
+        "reduction": red,
+        "reduction_interval": [red - 0.05 if low is None else low, red + 0.05],
+    }
 
 
 # ----------------------------------------------------------------------------------------------
 # verdict
 # ----------------------------------------------------------------------------------------------
+
 
 def test_no_candidates_give_none_without_reason():
     assert verdict([], 0.05, 1e-4, PLACE, SETTINGS) == ("none", "")
@@ -32,8 +39,10 @@ def test_clean_winner_is_named_with_its_bootstrap_p_better():
     boots = {"viscous_friction": np.array([1.0, 2.0, 3.0, 4.0]), "structural_damping": np.array([2.0, 3.0, 4.0, 1.0])}
     name, reason = verdict(rows, 0.02, 1e-4, PLACE, SETTINGS, boots)
     assert name == "viscous_friction"
-    assert reason == ("viscous_friction shrinks the held-out gap from 0.02 to 0.002 (90.0%); runner-up "
-                      "structural_damping 0.012; bootstrap P(better) 0.75")
+    assert reason == (
+        "viscous_friction shrinks the held-out gap from 0.02 to 0.002 (90.0%); runner-up "
+        "structural_damping 0.012; bootstrap P(better) 0.75"
+    )
 
 
 def test_a_sole_candidate_wins_without_runner_up():
@@ -48,7 +57,9 @@ def test_gap_below_min_gap_gives_none():
     assert name == "none"
     assert reason.startswith("the held-out gap 0.0059 is below gap.min_gap = 0.006")
     # at the threshold itself the gap counts (strict inequality): the clean winner is named
-    assert verdict([row("viscous_friction", 0.0005, before=0.006)], 0.006, 1e-5, PLACE, SETTINGS)[0] == "viscous_friction"
+    assert (
+        verdict([row("viscous_friction", 0.0005, before=0.006)], 0.006, 1e-5, PLACE, SETTINGS)[0] == "viscous_friction"
+    )
 
 
 def test_gap_within_the_records_scatter_gives_none():
@@ -80,19 +91,25 @@ def test_runner_up_too_close_gives_none():
     rows = [row("viscous_friction", 0.004), row("normal_contact_damping", 0.0059)]  # 0.0059 < 1.5 x 0.004
     name, reason = verdict(rows, 0.02, 1e-4, PLACE, SETTINGS)
     assert name == "none"
-    assert reason == ("viscous_friction and normal_contact_damping explain the gap about equally (held-out gaps "
-                      "0.004, 0.0059; separation 1.5)")
+    assert reason == (
+        "viscous_friction and normal_contact_damping explain the gap about equally (held-out gaps "
+        "0.004, 0.0059; separation 1.5)"
+    )
     rows = [row("viscous_friction", 0.004), row("normal_contact_damping", 0.006)]  # exactly 1.5 x: separated
     assert verdict(rows, 0.02, 1e-4, PLACE, SETTINGS)[0] == "viscous_friction"
 
 
 def test_no_candidate_acting_where_the_gap_lies_gives_none():
-    rows = [row("normal_contact_damping", 0.001, consistent=False, acts_on="normal_contact"),
-            row("contact_separation", 0.003, consistent=False, acts_on="normal_contact")]
+    rows = [
+        row("normal_contact_damping", 0.001, consistent=False, acts_on="normal_contact"),
+        row("contact_separation", 0.003, consistent=False, acts_on="normal_contact"),
+    ]
     name, reason = verdict(rows, 0.02, 1e-4, PLACE, SETTINGS)
     assert name == "none"
-    assert reason == ("the gap lies in tangential_contact and no candidate of the library acts there and explains it "
-                      "(best by score: normal_contact_damping, acting on normal_contact, 95.0%)")
+    assert reason == (
+        "the gap lies in tangential_contact and no candidate of the library acts there and explains it "
+        "(best by score: normal_contact_damping, acting on normal_contact, 95.0%)"
+    )
     # this reason comes first, whatever the size of the gap
     assert verdict(rows, 0.001, 1e-4, PLACE, SETTINGS)[1].startswith("the gap lies in tangential_contact")
 
@@ -102,7 +119,9 @@ def test_the_winner_is_the_best_consistent_candidate_and_the_runner_up_any_other
     # the best-scored candidate acts elsewhere: the best consistent one is judged, against the best other one
     rows = [inconsistent, row("viscous_friction", 0.002)]
     name, reason = verdict(rows, 0.02, 1e-4, PLACE, SETTINGS)
-    assert name == "none" and reason.startswith("viscous_friction and normal_contact_damping explain the gap about equally")
+    assert name == "none" and reason.startswith(
+        "viscous_friction and normal_contact_damping explain the gap about equally"
+    )
     rows = [row("viscous_friction", 0.002), {**inconsistent, "heldout_gap_after": 0.004}]
     assert verdict(rows, 0.02, 1e-4, PLACE, SETTINGS)[0] == "viscous_friction"
 
@@ -118,6 +137,7 @@ def test_verdict_reads_gap_settings_like_a_mapping():
 # ----------------------------------------------------------------------------------------------
 # place
 # ----------------------------------------------------------------------------------------------
+
 
 def quiet_stage(**kw):
     return {"open_fraction": 0.0, "contact_force_N": 0.05, "contact_force_S": 0.012, **kw}
@@ -138,7 +158,9 @@ def test_consistent_records_put_the_gap_in_the_tangential_contact():
 def test_drift_beyond_drift_factor_is_non_stationary():
     assert V.DEFAULT_PLACE.drift_z == 8.0
     name, reason = place(drift(1.0, 9.0, 12.0, change=0.05), quiet_stage(), ID_RES, SCATTER)  # median 9 > 8
-    assert name == "non_stationary" and reason == "the records' harmonics drift by 0.05 over a record (9 standard errors)"
+    assert (
+        name == "non_stationary" and reason == "the records' harmonics drift by 0.05 over a record (9 standard errors)"
+    )
     assert place(drift(1.0, 8.0, 12.0), quiet_stage(), ID_RES, SCATTER)[0] == "tangential_contact"  # median 8: not > 8
 
 
@@ -183,16 +205,18 @@ def test_the_place_thresholds_are_settings():
     """gap.place sets each threshold: the same records placed otherwise under other thresholds."""
     from contactid.gap.diagnosis import GapSettings
 
-    settings = GapSettings.from_config({"place": {"drift_z": 10.0, "residual_factor": 30.0, "normal_limit": 0.4,
-                                                  "open_limit": 0.1}}, 1, 25)
+    settings = GapSettings.from_config(
+        {"place": {"drift_z": 10.0, "residual_factor": 30.0, "normal_limit": 0.4, "open_limit": 0.1}}, 1, 25
+    )
     t = settings.place
     assert t == V.PlaceThresholds(10.0, 30.0, 0.4, 0.1)
     assert GapSettings.from_config({}, 1, 25).place == V.DEFAULT_PLACE
     assert place(drift(1.0, 9.0, 12.0), quiet_stage(), ID_RES, SCATTER, thresholds=t)[0] == "tangential_contact"
-    assert place(drift(1, 1, 1), quiet_stage(), [0.021, 0.03, 0.001], SCATTER, thresholds=t)[0] == \
-        "tangential_contact"
-    assert place(drift(1, 1, 1), quiet_stage(contact_force_N=0.3), ID_RES, SCATTER, thresholds=t)[0] == \
-        "tangential_contact"
+    assert place(drift(1, 1, 1), quiet_stage(), [0.021, 0.03, 0.001], SCATTER, thresholds=t)[0] == "tangential_contact"
+    assert (
+        place(drift(1, 1, 1), quiet_stage(contact_force_N=0.3), ID_RES, SCATTER, thresholds=t)[0]
+        == "tangential_contact"
+    )
     n = 70.0 * (1 + np.cos(np.linspace(0, 2 * np.pi, 100, endpoint=False)))
     assert V.open_fraction(n, 70.0, t.open_limit) == pytest.approx(np.mean(n <= 7.0))
 
@@ -215,6 +239,7 @@ def test_an_unobservable_eta_leaves_the_contact_direction_open():
 # the additive explanation (diagnosis.explain) on hand-made candidate results
 # ----------------------------------------------------------------------------------------------
 
+
 class _Cal:
     def __init__(self, name, theta, earlier=()):
         self.candidate, self.theta = name, np.atleast_1d(theta)
@@ -236,8 +261,9 @@ def _explain(first, passes, before=0.04, scatter=1e-4, settings=None, later=None
         tried.append((cal.candidate, tuple(remaining)))
         return wrap(passes[len(tried) - 1])
 
-    steps, left, last = explain(wrap(first), list(first), before, scatter, s, lambda sims: sims["gap"], next_pass,
-                                later)
+    steps, left, last = explain(
+        wrap(first), list(first), before, scatter, s, lambda sims: sims["gap"], next_pass, later
+    )
     return steps, left, tried
 
 
@@ -248,11 +274,12 @@ def test_explanation_adds_effects_until_none_shrinks_what_is_left():
     third = {"structural_damping": 0.0075}
     steps, left, tried = _explain(first, [second, third])
     assert [s["effect"] for s in steps] == ["viscous_friction", "normal_contact_damping"]
-    assert tried == [("viscous_friction", ("normal_contact_damping", "structural_damping")),
-                     ("normal_contact_damping", ("structural_damping",))]
+    assert tried == [
+        ("viscous_friction", ("normal_contact_damping", "structural_damping")),
+        ("normal_contact_damping", ("structural_damping",)),
+    ]
     assert left == 0.008
-    assert [s["share"] for s in steps] == pytest.approx([(0.04**2 - 0.02**2) / 0.04**2,
-                                                         (0.02**2 - 0.008**2) / 0.04**2])
+    assert [s["share"] for s in steps] == pytest.approx([(0.04**2 - 0.02**2) / 0.04**2, (0.02**2 - 0.008**2) / 0.04**2])
     assert sum(s["share"] for s in steps) + V.gap_shares(0.04, [0.02, 0.008])[1] == pytest.approx(1.0)
     assert steps[0]["heldout_gap_before"] == 0.04 and steps[1]["heldout_gap_before"] == 0.02
 
@@ -278,15 +305,21 @@ def test_later_passes_try_only_the_candidates_that_moved_alone():
 
     from contactid.gap.candidates import LIBRARY
 
-    first = {"viscous_friction": [350.0], "structural_damping": [0.0], "channel_time_skew": [0.0, 2e-6, 0.0],
-             "normal_contact_damping": [0.0], "transducer_mass_error": [-1e-13]}
+    first = {
+        "viscous_friction": [350.0],
+        "structural_damping": [0.0],
+        "channel_time_skew": [0.0, 2e-6, 0.0],
+        "normal_contact_damping": [0.0],
+        "transducer_mass_error": [-1e-13],
+    }
     moved = V.retried(first, LIBRARY, SimpleNamespace(retry_unmoved=False))
     assert moved == ["viscous_friction", "channel_time_skew"]  # one channel's delay moved: the candidate did
     assert V.retried(first, LIBRARY, SimpleNamespace(retry_unmoved=True)) == list(first)
     # the explanation tries on top only those (and the pair lookahead draws its second from them too)
     gaps = {"viscous_friction": 0.02, "normal_contact_damping": 0.03, "structural_damping": 0.039}
-    steps, left, tried = _explain(gaps, [{"normal_contact_damping": 0.008}],
-                                  later=["viscous_friction", "normal_contact_damping"])
+    steps, left, tried = _explain(
+        gaps, [{"normal_contact_damping": 0.008}], later=["viscous_friction", "normal_contact_damping"]
+    )
     assert tried == [("viscous_friction", ("normal_contact_damping",))]
     assert [s["effect"] for s in steps] == ["viscous_friction", "normal_contact_damping"] and left == 0.008
     steps, left, tried = _explain(gaps, [], later=["viscous_friction"])
@@ -304,6 +337,7 @@ def test_material_and_floor_rules():
 # ----------------------------------------------------------------------------------------------
 # the compound benchmark's items and scores (gap.benchmark), on hand-made rows
 # ----------------------------------------------------------------------------------------------
+
 
 def test_compound_items_are_seeded_and_balanced():
     from contactid.gap.benchmark import COMPOUND_EFFECTS, RANGES, compound_items
@@ -326,13 +360,22 @@ def test_compound_score_counts_named_effects_against_the_truth():
     from contactid.gap.benchmark import compound_score
 
     def row(effects, named, mu=0.01):
-        return {"effects": {e: 1.0 for e in effects}, "updating_accepted": True,
-                "explanation": [{"effect": "model_updating"}] + [{"effect": e} for e in named],
-                "remaining_gap": {"heldout_gap": 0.005}, "friction_errors": {"mu": mu, "kappa": 0.1, "e0": -0.02}}
+        return {
+            "effects": {e: 1.0 for e in effects},
+            "updating_accepted": True,
+            "explanation": [{"effect": "model_updating"}] + [{"effect": e} for e in named],
+            "remaining_gap": {"heldout_gap": 0.005},
+            "friction_errors": {"mu": mu, "kappa": 0.1, "e0": -0.02},
+        }
 
-    rows = [row([], []), row([], ["viscous_friction"]), row([], ["contact_separation"]),  # model form: not a contact effect
-            row(["viscous_friction"], ["viscous_friction"]), row(["viscous_friction"], ["normal_contact_damping"]),
-            row(["viscous_friction", "structural_damping"], ["viscous_friction"])]
+    rows = [
+        row([], []),
+        row([], ["viscous_friction"]),
+        row([], ["contact_separation"]),  # model form: not a contact effect
+        row(["viscous_friction"], ["viscous_friction"]),
+        row(["viscous_friction"], ["normal_contact_damping"]),
+        row(["viscous_friction", "structural_damping"], ["viscous_friction"]),
+    ]
     s = compound_score(rows)
     assert s["perturbation_only_no_contact_effect"] == pytest.approx(2 / 3)
     assert s["one_effect_named"] == 0.5 and s["one_effect_no_absent_contact_effect"] == 0.5
@@ -350,23 +393,28 @@ def test_bound_errors_take_the_lever_arm_out_of_mu_and_e0():
     truth = {"e_f_n_per_m": 3.857e7, "k_c_per_m": 2.547e5, "e_t_n_per_m": 0.0, "kappa": 0.284, "mu": 0.397}
     # the model's lever arm is 8 % short of the rig's: S, hence mu, comes out 8 % high, e_0 (1.08)^2 high
     e0 = stiction_shear_stiffness(70.0, truth["e_f_n_per_m"], truth["k_c_per_m"]) * 1.08**2
-    model = SimpleNamespace(structure=SimpleNamespace(tangential_lever_arm=0.006),
-                            friction=(1e12, e0 / 70.0, 0.0, 0.284, 0.397 * 1.08))  # e_f large: e_0 = k_c N0
+    model = SimpleNamespace(
+        structure=SimpleNamespace(tangential_lever_arm=0.006), friction=(1e12, e0 / 70.0, 0.0, 0.284, 0.397 * 1.08)
+    )  # e_f large: e_0 = k_c N0
     b = bound_errors(model, truth, 70.0, 0.006 * 1.08)
     assert b["mu_a"] == pytest.approx(0.0, abs=1e-9) and b["e0_a2"] == pytest.approx(0.0, abs=1e-4)
 
 
 def test_an_update_that_moves_only_the_transducer_masses_is_the_transducer_mass_error():
     ident = {f: {"posterior_sd": 0.05} for f in ("stiffness_scale", "mass_scale", "transducer_mass_scale")}
-    assert V.updating_effect({"stiffness_scale": 1.01, "mass_scale": 0.99, "transducer_mass_scale": 1.3},
-                             ident) == "transducer_mass_error"
+    assert (
+        V.updating_effect({"stiffness_scale": 1.01, "mass_scale": 0.99, "transducer_mass_scale": 1.3}, ident)
+        == "transducer_mass_error"
+    )
     # two factors moved: no single library effect; nothing moved: none
     assert V.updating_effect({"stiffness_scale": 1.2, "mass_scale": 1.0, "transducer_mass_scale": 1.3}, ident) is None
     assert V.updating_effect({"stiffness_scale": 1.0, "mass_scale": 1.0, "transducer_mass_scale": 1.1}, ident) is None
     # masses +20 % found at 1.2 with a posterior sd of 0.078 (2.3 sd; the blind benchmark's items): the effect
     wide = {**ident, "transducer_mass_scale": {"posterior_sd": 0.078}}
-    assert V.updating_effect({"stiffness_scale": 1.0, "mass_scale": 1.0, "transducer_mass_scale": 1.2},
-                             wide) == "transducer_mass_error"
+    assert (
+        V.updating_effect({"stiffness_scale": 1.0, "mass_scale": 1.0, "transducer_mass_scale": 1.2}, wide)
+        == "transducer_mass_error"
+    )
     # the stiffness alone moved: model form without an effect of its own
     assert V.updating_effect({"stiffness_scale": 1.2, "mass_scale": 1.0, "transducer_mass_scale": 1.0}, ident) is None
 
@@ -376,13 +424,27 @@ def test_a_joint_refit_step_reports_the_earlier_steps_refitted_parameters():
 
     from contactid.gap.diagnosis import explain
 
-    first = {"viscous_friction": (_Cal("viscous_friction", 1222.0), {"gap": 0.02}, None),
-             "normal_contact_damping": (_Cal("normal_contact_damping", 300.0), {"gap": 0.03}, None)}
+    first = {
+        "viscous_friction": (_Cal("viscous_friction", 1222.0), {"gap": 0.02}, None),
+        "normal_contact_damping": (_Cal("normal_contact_damping", 300.0), {"gap": 0.03}, None),
+    }
     # on top of viscous friction, the joint refit gives sigma_2 back (1222 -> 569) as alpha takes its share
-    second = {"normal_contact_damping": (_Cal("normal_contact_damping", 255.0, [("viscous_friction", np.array([569.0]))]),
-                                         {"gap": 0.007}, None)}
-    steps, left, _ = explain(first, list(first), 0.04, 1e-4, SimpleNamespace(**SETTINGS), lambda sims: sims["gap"],
-                             lambda remaining, cal: second)
+    second = {
+        "normal_contact_damping": (
+            _Cal("normal_contact_damping", 255.0, [("viscous_friction", np.array([569.0]))]),
+            {"gap": 0.007},
+            None,
+        )
+    }
+    steps, left, _ = explain(
+        first,
+        list(first),
+        0.04,
+        1e-4,
+        SimpleNamespace(**SETTINGS),
+        lambda sims: sims["gap"],
+        lambda remaining, cal: second,
+    )
     assert [s["effect"] for s in steps] == ["viscous_friction", "normal_contact_damping"] and left == 0.007
     assert "earlier_refitted" not in steps[0]
     assert steps[1]["parameters"] == {"alpha": 255.0}
@@ -392,9 +454,14 @@ def test_a_joint_refit_step_reports_the_earlier_steps_refitted_parameters():
 def test_joint_candidate_starts_at_the_earlier_steps_values_and_splits_its_theta():
     from contactid.gap.candidates import LIBRARY, joint_candidate
 
-    joint, split = joint_candidate(LIBRARY["normal_contact_damping"],
-                                   [(LIBRARY["viscous_friction"], np.array([1222.0])),
-                                    (LIBRARY["channel_time_skew"], np.array([1e-5, 2e-5, 3e-5]))], 3)
+    joint, split = joint_candidate(
+        LIBRARY["normal_contact_damping"],
+        [
+            (LIBRARY["viscous_friction"], np.array([1222.0])),
+            (LIBRARY["channel_time_skew"], np.array([1e-5, 2e-5, 3e-5])),
+        ],
+        3,
+    )
     assert joint.name == "normal_contact_damping" and joint.acts_on == "normal_contact" and not joint.per_channel
     assert [p.name for p in joint.parameters] == ["alpha", "sigma_2", "delay", "delay", "delay"]
     assert joint.parameters[0].start == 0.0 and joint.parameters[1].start == 1222.0
@@ -409,6 +476,7 @@ def test_joint_candidate_starts_at_the_earlier_steps_values_and_splits_its_theta
 # ----------------------------------------------------------------------------------------------
 # the detection ladder (gap.benchmark), on hand-made rows
 # ----------------------------------------------------------------------------------------------
+
 
 def test_ladder_items_put_every_effect_at_fractions_of_its_typical_magnitude():
     from contactid.gap.benchmark import ladder_items
@@ -427,8 +495,9 @@ def test_refitted_magnitude_maps_candidate_parameters_to_the_rigs_units():
 
     assert refitted_magnitude("normal_contact_damping", {"alpha": 310.0}) == 310.0
     # the rig delays channel k of 3 by m (k + 1) / 3: delays (1, 2, 3) e-5 are m = 3e-5
-    assert refitted_magnitude("channel_time_skew", {"delay_2": 3e-5, "delay_0": 1e-5, "delay_1": 2e-5}) == \
-        pytest.approx(3e-5)
+    assert refitted_magnitude(
+        "channel_time_skew", {"delay_2": 3e-5, "delay_0": 1e-5, "delay_1": 2e-5}
+    ) == pytest.approx(3e-5)
     assert refitted_magnitude("contact_separation", {"exponent": 1.5, "stiffness_factor": 1.0}) is None
     assert refitted_magnitude("viscous_friction", None) is None
 
@@ -437,14 +506,24 @@ def test_ladder_scores_only_where_the_gap_exceeds_twice_the_floor():
     from contactid.gap.benchmark import ladder_score
 
     def row(effect, m, gap, verdict, refit):
-        return {"effect": effect, "magnitude": m, "seed": 1, "heldout_gap_before": gap, "verdict": verdict,
-                "refitted_magnitude": refit, "fraction": 1.0, "item": f"{effect}-{m}"}
+        return {
+            "effect": effect,
+            "magnitude": m,
+            "seed": 1,
+            "heldout_gap_before": gap,
+            "verdict": verdict,
+            "refitted_magnitude": refit,
+            "fraction": 1.0,
+            "item": f"{effect}-{m}",
+        }
 
-    rows = [row("viscous_friction", 300.0, 0.05, "viscous_friction", 320.0),   # detectable, named, +7 %
-            row("viscous_friction", 30.0, 0.008, "none", None),                 # below twice the floor: not scored
-            row("structural_damping", 0.005, 0.03, "structural_damping", 0.007),  # named, +40 %: out
-            row("contact_separation", 5.2, 0.3, "contact_separation", None),    # named, magnitude not comparable
-            row("preload_drift", 0.1, 0.02, "none", 0.1)]                       # detectable, not named
+    rows = [
+        row("viscous_friction", 300.0, 0.05, "viscous_friction", 320.0),  # detectable, named, +7 %
+        row("viscous_friction", 30.0, 0.008, "none", None),  # below twice the floor: not scored
+        row("structural_damping", 0.005, 0.03, "structural_damping", 0.007),  # named, +40 %: out
+        row("contact_separation", 5.2, 0.3, "contact_separation", None),  # named, magnitude not comparable
+        row("preload_drift", 0.1, 0.02, "none", 0.1),
+    ]  # detectable, not named
     s = ladder_score(rows, 0.006)
     assert s["n"] == 5 and s["n_detectable"] == 4
     assert s["named_where_detectable"] == 0.75

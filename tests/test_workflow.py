@@ -11,8 +11,13 @@ import numpy as np
 import pytest
 import yaml
 
-from workflow_projects import (ROOT, copy_project, make_project, project_config, small_project,  # noqa: F401
-                               snakemake)
+from workflow_projects import (
+    copy_project,
+    make_project,
+    project_config,
+    small_project,  # noqa: F401
+    snakemake,
+)
 
 pytestmark = pytest.mark.workflow
 
@@ -203,8 +208,11 @@ def test_new_load_case_runs_only_its_jobs(default_run, tmp_path):
     res = snakemake(default_run, "--configfile", str(alt), "-n", "--quiet", "rules")
     assert res.returncode == 0, res.stderr[-3000:]
     out = res.stdout + res.stderr
-    jobs = {line.split()[0]: int(line.split()[1]) for line in out.splitlines()
-            if len(line.split()) == 2 and line.split()[1].isdigit()}
+    jobs = {
+        line.split()[0]: int(line.split()[1])
+        for line in out.splitlines()
+        if len(line.split()) == 2 and line.split()[1].isdigit()
+    }
     assert jobs.get("rig_dual_sine") == 1 and jobs.get("raw_check") == 1
     assert "rig_random_test" not in jobs and "frf" not in jobs and "stiction_stiffness" not in jobs
     assert "friction_fit" not in jobs  # the calibration fit stays; lc4 is validated with it
@@ -275,9 +283,16 @@ def test_gap_diagnosis_of_default_data_names_no_effect(default_run):
     d = json.loads((default_run / "results" / "gap" / "diagnosis.json").read_text())
     assert d["verdict"] == "none", d["reason"]  # effect-free rig data: no false alarm
     assert {"verdict", "ranking", "where"} <= set(d)
-    assert {r["effect"] for r in d["ranking"]} == {"structural_damping", "normal_contact_damping", "viscous_friction",
-                                                   "multi_asperity_friction", "transducer_mass_error",
-                                                   "channel_time_skew", "contact_separation", "preload_drift"}
+    assert {r["effect"] for r in d["ranking"]} == {
+        "structural_damping",
+        "normal_contact_damping",
+        "viscous_friction",
+        "multi_asperity_friction",
+        "transducer_mass_error",
+        "channel_time_skew",
+        "contact_separation",
+        "preload_drift",
+    }
     for r in d["ranking"]:
         assert {"effect", "heldout_gap_before", "heldout_gap_after", "score"} <= set(r)
         assert r["heldout_gap_after"] > 0.5 * r["heldout_gap_before"]  # nothing explains what is not there

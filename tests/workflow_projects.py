@@ -70,8 +70,13 @@ def _kernel_dir(proj: Path, digest: str, package_dir: Path) -> Path:
     NUMBA_CACHE_DIR, .snakemake/numba-cache/<digest>, and numba's subdirectory for that source directory)."""
     from numba.core.caching import _CacheLocator  # the subdirectory numba's NUMBA_CACHE_DIR locator uses
 
-    return (proj / ".snakemake" / "numba-cache" / digest
-            / _CacheLocator.get_suitable_cache_subpath(str(package_dir / "_.py")))
+    return (
+        proj
+        / ".snakemake"
+        / "numba-cache"
+        / digest
+        / _CacheLocator.get_suitable_cache_subpath(str(package_dir / "_.py"))
+    )
 
 
 def seed_kernels(proj: Path, donor: Path | None = None) -> int:
@@ -122,8 +127,12 @@ def make_project(tmp: Path, overrides: dict | None = None, config: Path = DEFAUL
 # what the tests on the small config read from the shared small run: every record, the chain up to every
 # case's contact forces, the friction fit and the gap diagnosis (not the outputs for people: figures, tables,
 # report; the acceptance run makes those, and the tests of them use it)
-SMALL_RUN_TARGETS = ("rig", "results/friction/friction_fit.nc", "results/gap/diagnosis.json",
-                     *[f"results/{c}/contact_forces.nc" for c in ("lc1", "lc2", "lc3")])
+SMALL_RUN_TARGETS = (
+    "rig",
+    "results/friction/friction_fit.nc",
+    "results/gap/diagnosis.json",
+    *[f"results/{c}/contact_forces.nc" for c in ("lc1", "lc2", "lc3")],
+)
 
 
 def small_project(tmp: Path, overrides: dict | None = None) -> Path:
@@ -149,8 +158,14 @@ def snakemake_env(cwd: Path) -> dict:
 
 
 def snakemake(cwd: Path, *args, timeout: float = 600) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", *args], cwd=cwd, env=snakemake_env(cwd),
-                          capture_output=True, text=True, timeout=timeout)
+    return subprocess.run(
+        [sys.executable, "-m", "snakemake", "--cores", "2", *args],
+        cwd=cwd,
+        env=snakemake_env(cwd),
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+    )
 
 
 class BackgroundRun:
@@ -196,10 +211,15 @@ class BackgroundRun:
                     return
                 nice = self.nice
                 with open(self.log, "w") as out:
-                    self.proc = subprocess.Popen([sys.executable, "-m", "snakemake", "--cores", "2", *self.targets],
-                                                 cwd=self.proj, env=snakemake_env(self.proj), stdout=out,
-                                                 stderr=subprocess.STDOUT, process_group=0,
-                                                 preexec_fn=(lambda: os.nice(nice)) if nice else None)
+                    self.proc = subprocess.Popen(
+                        [sys.executable, "-m", "snakemake", "--cores", "2", *self.targets],
+                        cwd=self.proj,
+                        env=snakemake_env(self.proj),
+                        stdout=out,
+                        stderr=subprocess.STDOUT,
+                        process_group=0,
+                        preexec_fn=(lambda: os.nice(nice)) if nice else None,
+                    )
         except BaseException as exc:  # reported by wait(), in the test that needs the run
             self._error = exc
 
@@ -241,6 +261,7 @@ class BackgroundRun:
 # prepare(directory) -> (project, targets); those on the small config run after the small run
 # ------------------------------------------------------------------------------------------------
 
+
 def prepare_small_run(d: Path):
     return small_project(d), SMALL_RUN_TARGETS
 
@@ -249,8 +270,9 @@ def prepare_default_run(d: Path):
     return make_project(d), ()  # the default target: the whole workflow
 
 
-TWO_CASES = {"load_cases": {"lc1": {"A1_m_per_s2": 14.0, "A2_m_per_s2": 34.0},
-                            "lc3": {"A1_m_per_s2": 20.0, "A2_m_per_s2": 50.0}}}
+TWO_CASES = {
+    "load_cases": {"lc1": {"A1_m_per_s2": 14.0, "A2_m_per_s2": 34.0}, "lc3": {"A1_m_per_s2": 20.0, "A2_m_per_s2": 50.0}}
+}
 
 
 def prepare_rig_run(d: Path):
@@ -288,9 +310,11 @@ def prepare_noise_sweep_run(d: Path):
     return small_project(d, SWEEP), ("noise_study",)
 
 
-MEASURED_FORMATS = {"lc1": ("uff58", {"acceleration": ("g", None, None)}),
-                    "lc2": ("tdms", {"force": ("mV", 2.25, "mV/N"), "acceleration": ("mV", 10.2, "mV/g")}),
-                    "lc3": ("csv", None)}
+MEASURED_FORMATS = {
+    "lc1": ("uff58", {"acceleration": ("g", None, None)}),
+    "lc2": ("tdms", {"force": ("mV", 2.25, "mV/N"), "acceleration": ("mV", 10.2, "mV/g")}),
+    "lc3": ("csv", None),
+}
 
 
 def prepare_measured_run(d: Path, small_run: Path):

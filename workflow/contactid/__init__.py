@@ -57,7 +57,9 @@ def _use_numba_cache_keyed_by_code() -> str:
     try:
         target.mkdir(parents=True, exist_ok=True)
     except OSError:
-        target = Path(tempfile.gettempdir()) / f"contactid-numba-cache-{getattr(os, 'getuid', lambda: 0)()}" / target.name
+        target = (
+            Path(tempfile.gettempdir()) / f"contactid-numba-cache-{getattr(os, 'getuid', lambda: 0)()}" / target.name
+        )
     os.environ["NUMBA_CACHE_DIR"] = str(target)
     if "numba" in sys.modules:  # numba read its settings when it was imported: read them again
         sys.modules["numba"].core.config.reload_config()

@@ -24,6 +24,8 @@ def clamped_pinned_eigenvalues(n: int) -> np.ndarray:
     return _roots(lambda x: np.sin(x) - np.cos(x) * np.tanh(x), n, 1)
 
 
-def beam_frequencies_hz(beta_l: np.ndarray, bending_stiffness: float, mass_per_length: float, length: float) -> np.ndarray:
+def beam_frequencies_hz(
+    beta_l: np.ndarray, bending_stiffness: float, mass_per_length: float, length: float
+) -> np.ndarray:
     """f_i = (beta_i L)^2 / (2 pi L^2) sqrt(EI / rho A) (Hz)."""
     return np.asarray(beta_l) ** 2 / (2 * np.pi * length**2) * np.sqrt(bending_stiffness / mass_per_length)

@@ -55,15 +55,22 @@ def audit_dataset(path: Path, root: Path | None = None) -> dict:
         values = np.asarray(var.values)
         if values.dtype.kind in "fc" and not np.isfinite(values).all() and "nonfinite_meaning" not in var.attrs:
             problems.append(f"{name}: {int((~np.isfinite(values)).sum())} non-finite values")
-    return {"dataset": str(path), "producer": producer, "inputs": "; ".join(inputs),
-            "status": "ok" if not problems else "flagged", "problems": "; ".join(problems)}
+    return {
+        "dataset": str(path),
+        "producer": producer,
+        "inputs": "; ".join(inputs),
+        "status": "ok" if not problems else "flagged",
+        "problems": "; ".join(problems),
+    }
 
 
 def audit(paths, root: str | os.PathLike | None = None) -> pd.DataFrame:
     """Audit every netCDF file under ``paths``; relative input paths resolve against ``root``."""
     files = sorted({p for top in paths for p in (Path(top).rglob("*.nc") if Path(top).is_dir() else [Path(top)])})
-    return pd.DataFrame([audit_dataset(p, None if root is None else Path(root)) for p in files],
-                        columns=["dataset", "producer", "inputs", "status", "problems"])
+    return pd.DataFrame(
+        [audit_dataset(p, None if root is None else Path(root)) for p in files],
+        columns=["dataset", "producer", "inputs", "status", "problems"],
+    )
 
 
 def main(argv=None) -> int:

@@ -95,22 +95,47 @@ def mesh_nodes(length: float, key_points, n_elements: int) -> np.ndarray:
 
 
 def _element_matrices(EI: float, rhoA: float, le: float):
-    k = EI / le**3 * np.array(
-        [[12, 6 * le, -12, 6 * le], [6 * le, 4 * le**2, -6 * le, 2 * le**2],
-         [-12, -6 * le, 12, -6 * le], [6 * le, 2 * le**2, -6 * le, 4 * le**2]]
+    k = (
+        EI
+        / le**3
+        * np.array(
+            [
+                [12, 6 * le, -12, 6 * le],
+                [6 * le, 4 * le**2, -6 * le, 2 * le**2],
+                [-12, -6 * le, 12, -6 * le],
+                [6 * le, 2 * le**2, -6 * le, 4 * le**2],
+            ]
+        )
     )
-    m = rhoA * le / 420.0 * np.array(
-        [[156, 22 * le, 54, -13 * le], [22 * le, 4 * le**2, 13 * le, -3 * le**2],
-         [54, 13 * le, 156, -22 * le], [-13 * le, -3 * le**2, -22 * le, 4 * le**2]]
+    m = (
+        rhoA
+        * le
+        / 420.0
+        * np.array(
+            [
+                [156, 22 * le, 54, -13 * le],
+                [22 * le, 4 * le**2, 13 * le, -3 * le**2],
+                [54, 13 * le, 156, -22 * le],
+                [-13 * le, -3 * le**2, -22 * le, 4 * le**2],
+            ]
+        )
     )
     return k, m
 
 
 def _element_shortening(le: float):
     """int N'^T N' dx of a Hermite element (the geometric stiffness of a unit axial tension), 1/m."""
-    return 1.0 / (30.0 * le) * np.array(
-        [[36, 3 * le, -36, 3 * le], [3 * le, 4 * le**2, -3 * le, -(le**2)],
-         [-36, -3 * le, 36, -3 * le], [3 * le, -(le**2), -3 * le, 4 * le**2]]
+    return (
+        1.0
+        / (30.0 * le)
+        * np.array(
+            [
+                [36, 3 * le, -36, 3 * le],
+                [3 * le, 4 * le**2, -3 * le, -(le**2)],
+                [-36, -3 * le, 36, -3 * le],
+                [3 * le, -(le**2), -3 * le, 4 * le**2],
+            ]
+        )
     )
 
 
@@ -333,8 +358,10 @@ class ContactFrequencyMap:
             K = self._k0 + k_t * self._xx + k_n * self._ee
             lam, vec = scipy.linalg.eigh(K, m.mass, subset_by_index=[0, n_check - 1])
         p = m.params
-        frac = (p.block_mass * ((m.block_lateral_vector @ vec) ** 2 + (m.block_axial_vector @ vec) ** 2)
-                + p.block_inertia * vec[m.thetas_dof] ** 2)
+        frac = (
+            p.block_mass * ((m.block_lateral_vector @ vec) ** 2 + (m.block_axial_vector @ vec) ** 2)
+            + p.block_inertia * vec[m.thetas_dof] ** 2
+        )
         keep = np.flatnonzero(frac < self.max_block_fraction)[: self.n_modes]
         if len(keep) < self.n_modes:
             raise ValueError(f"fewer than {self.n_modes} structural modes among the lowest {n_check}")

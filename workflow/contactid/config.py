@@ -68,6 +68,7 @@ def numbers_written_as_text(cfg: dict, schema) -> list:
     number: ``channel_time_skew: 4e-05`` is the text '4e-05' to PyYAML (it wants 4.0e-05), which the schema would
     refuse as "not of type 'number'". Returns [(dotted key, number)] of the values changed. Only values of that form where a number
     is wanted: a name or a path that looks like one elsewhere stays text."""
+
     def texts(node):
         if isinstance(node, str):
             yield node
@@ -86,8 +87,12 @@ def numbers_written_as_text(cfg: dict, schema) -> list:
     changed = []
     for err in jsonschema.Draft202012Validator(schema).iter_errors(cfg):
         wanted = err.validator_value if isinstance(err.validator_value, list) else [err.validator_value]
-        if err.validator != "type" or not isinstance(err.instance, str) or not (
-                {"number", "integer"} & set(wanted)) or not _EXPONENT_NUMBER.match(err.instance.strip()):
+        if (
+            err.validator != "type"
+            or not isinstance(err.instance, str)
+            or not ({"number", "integer"} & set(wanted))
+            or not _EXPONENT_NUMBER.match(err.instance.strip())
+        ):
             continue
         value = float(err.instance)
         if "number" not in wanted:  # an integer
@@ -110,8 +115,10 @@ def _true_structure_errors(structure: Mapping, changes: Mapping, path: str = "ri
     for key, value in changes.items():
         where = f"{path}.{key}"
         if key not in structure:
-            errors.append(f"{where} is not a key of structure (one of: {', '.join(sorted(structure))}); "
-                          "rig.true_structure takes any subset of the structure keys")
+            errors.append(
+                f"{where} is not a key of structure (one of: {', '.join(sorted(structure))}); "
+                "rig.true_structure takes any subset of the structure keys"
+            )
             continue
         nominal = structure[key]
         if isinstance(nominal, Mapping):
@@ -152,30 +159,42 @@ def check_config(cfg: Mapping, source: str = "config/config.yaml") -> None:
     n_sens = len(sens["positions_m"])
     for key in ("names", "masses_kg"):
         if len(sens[key]) != n_sens:
-            errors.append(f"structure.sensors.{key} has {len(sens[key])} entries but positions_m has {n_sens}; "
-                          "give one per sensor")
+            errors.append(
+                f"structure.sensors.{key} has {len(sens[key])} entries but positions_m has {n_sens}; "
+                "give one per sensor"
+            )
     for i, x in enumerate(sens["positions_m"]):
         if not 0 < x <= L:
-            errors.append(f"structure.sensors.positions_m[{i}] = {x} m lies outside the beam; allowed range (0, {L}] m "
-                          "(structure.beam.length_m)")
+            errors.append(
+                f"structure.sensors.positions_m[{i}] = {x} m lies outside the beam; allowed range (0, {L}] m "
+                "(structure.beam.length_m)"
+            )
     if not 0 < st["excitation_position_m"] <= L:
-        errors.append(f"structure.excitation_position_m = {st['excitation_position_m']} m lies outside the beam; "
-                      f"allowed range (0, {L}] m")
+        errors.append(
+            f"structure.excitation_position_m = {st['excitation_position_m']} m lies outside the beam; "
+            f"allowed range (0, {L}] m"
+        )
     for block in ("modal", "linear_modes"):
         n_modes = cfg[block]["n_modes"]
         if n_modes > n_sens:
-            errors.append(f"{block}.n_modes = {n_modes} exceeds the number of sensors ({n_sens}); "
-                          f"Eq. 15 needs at least as many sensors as modes: lower {block}.n_modes or add sensors")
+            errors.append(
+                f"{block}.n_modes = {n_modes} exceeds the number of sensors ({n_sens}); "
+                f"Eq. 15 needs at least as many sensors as modes: lower {block}.n_modes or add sensors"
+            )
     rt = cfg["random_test"]
     if rt["source"] == "measured" and not rt.get("file"):
-        errors.append("random_test.source is 'measured' but random_test.file is not set; give the path of the raw record")
+        errors.append(
+            "random_test.source is 'measured' but random_test.file is not set; give the path of the raw record"
+        )
     fs = rt["sampling_rate_hz"]
     lo, hi = rt["band_hz"]
     if not lo < hi:
         errors.append(f"random_test.band_hz = [{lo}, {hi}]: the lower edge must be below the upper")
     if hi >= 0.4 * fs:
-        errors.append(f"random_test.band_hz upper edge {hi} Hz must stay below 0.4 x sampling_rate_hz = {0.4 * fs} Hz "
-                      "(anti-alias filter transition)")
+        errors.append(
+            f"random_test.band_hz upper edge {hi} Hz must stay below 0.4 x sampling_rate_hz = {0.4 * fs} Hz "
+            "(anti-alias filter transition)"
+        )
     mlo, mhi = cfg["modal"]["band_hz"]
     if not mlo < mhi:
         errors.append(f"modal.band_hz = [{mlo}, {mhi}]: the lower edge must be below the upper")
@@ -185,9 +204,11 @@ def check_config(cfg: Mapping, source: str = "config/config.yaml") -> None:
     blocks = cfg["modal"]["uncertainty_blocks"]
     n = rt["duration_s"] * fs
     if rt["source"] == "rig" and n / blocks < 2 * seg:
-        errors.append(f"random_test.duration_s = {rt['duration_s']} s gives {int(n)} samples, fewer than "
-                      f"2 x frf.segment_length x modal.uncertainty_blocks = {2 * seg * blocks}; lengthen the record "
-                      "or shorten the segment")
+        errors.append(
+            f"random_test.duration_s = {rt['duration_s']} s gives {int(n)} samples, fewer than "
+            f"2 x frf.segment_length x modal.uncertainty_blocks = {2 * seg * blocks}; lengthen the record "
+            "or shorten the segment"
+        )
     for name in ("k_t_bounds_n_per_m", "k_n_bounds_n_per_m"):
         b = cfg["stiction"].get(name)
         if b is not None and not b[0] < b[1]:
@@ -199,9 +220,13 @@ def check_config(cfg: Mapping, source: str = "config/config.yaml") -> None:
         else:
             for key in ("A1_m_per_s2", "A2_m_per_s2"):
                 if key not in lc:
-                    errors.append(f"load_cases.{case}.{key} is missing: a rig load case needs its target "
-                                  "driving-point harmonic amplitudes (Table 2)")
-    for where, block in [("random_test", rt)] + [(f"load_cases.{c}", lc) for c, lc in (cfg.get("load_cases") or {}).items()]:
+                    errors.append(
+                        f"load_cases.{case}.{key} is missing: a rig load case needs its target "
+                        "driving-point harmonic amplitudes (Table 2)"
+                    )
+    for where, block in [("random_test", rt)] + [
+        (f"load_cases.{c}", lc) for c, lc in (cfg.get("load_cases") or {}).items()
+    ]:
         if block.get("source", "rig") == "measured" and block.get("format", "netcdf") != "netcdf" and block.get("file"):
             from .importers import record_spec
             from .io import RawDataError

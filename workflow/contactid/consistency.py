@@ -50,8 +50,14 @@ def fit_scenario(base: StructureParameters, scenario: Scenario, target_hz=TABLE1
 
     x0 = [np.log10(getattr(p0, n)) if n in LOG_FIELDS else getattr(p0, n) for n in names]
     lower = [-np.inf if n in LOG_FIELDS else 0.0 for n in names]  # masses, lengths stay non-negative
-    r = least_squares(lambda x: natural_frequencies(build(x)[0], len(target_hz)) / target_hz - 1.0, x0,
-                      bounds=(lower, np.inf), x_scale="jac", xtol=1e-12, ftol=1e-12)
+    r = least_squares(
+        lambda x: natural_frequencies(build(x)[0], len(target_hz)) / target_hz - 1.0,
+        x0,
+        bounds=(lower, np.inf),
+        x_scale="jac",
+        xtol=1e-12,
+        ftol=1e-12,
+    )
     p, ch = build(r.x)
     return ch, natural_frequencies(p, len(target_hz))
 
@@ -76,8 +82,12 @@ def paper_consistency_table(structure_cfg: Mapping, friction_truth: Mapping | No
         Scenario("D", "Table 3; E fitted", t3, ("youngs_modulus",)),
         Scenario("E", "Table 3; thickness fitted", t3, ("thickness",)),
         Scenario("F", "Table 3; transducer masses scaled (force transducer fitted)", t3, ("force_transducer_mass",)),
-        Scenario("G", "Table 3; clamp rotational compliance fitted", {**t3, "clamp_rotational_stiffness": 1e6},
-                 ("clamp_rotational_stiffness",)),
+        Scenario(
+            "G",
+            "Table 3; clamp rotational compliance fitted",
+            {**t3, "clamp_rotational_stiffness": 1e6},
+            ("clamp_rotational_stiffness",),
+        ),
         Scenario("H", "Table 3; tangential lever arm a fitted", t3, ("tangential_lever_arm",)),
         Scenario("I", "Table 3; a = r + h/2", {**t3, "tangential_lever_arm": r + h / 2}, ()),
         Scenario("J", "Table 3; a and E fitted", t3, ("tangential_lever_arm", "youngs_modulus")),
@@ -94,19 +104,37 @@ def paper_consistency_table(structure_cfg: Mapping, friction_truth: Mapping | No
     if friction_truth:
         fr = ValanisParameters.from_config(friction_truth)
         p = cfg_params.with_contact(float(stiction_shear_stiffness(n0, fr.e_f, fr.k_c)), TABLE3["k_n"])
-        rows.append(_row("config", "configured structure with the rig's k_t = e_0(N0) (the rig's default truth)",
-                         {}, p, natural_frequencies(p, 3)))
+        rows.append(
+            _row(
+                "config",
+                "configured structure with the rig's k_t = e_0(N0) (the rig's default truth)",
+                {},
+                p,
+                natural_frequencies(p, 3),
+            )
+        )
     return pd.DataFrame(rows)
 
 
 def _row(name: str, description: str, fitted: Mapping, p: StructureParameters, f: np.ndarray) -> dict:
     err = 100.0 * (f / TABLE1_HZ - 1.0)
     return {
-        "scenario": name, "assumption": description,
+        "scenario": name,
+        "assumption": description,
         "fitted": "; ".join(f"{k}={v:.4g}" for k, v in fitted.items()) or "-",
-        "k_t_n_per_m": p.k_t, "k_n_n_per_m": p.k_n, "tangential_lever_arm_m": p.tangential_lever_arm,
+        "k_t_n_per_m": p.k_t,
+        "k_n_n_per_m": p.k_n,
+        "tangential_lever_arm_m": p.tangential_lever_arm,
         "youngs_modulus_pa": p.youngs_modulus,
-        "rotational_restraint_nm_per_rad": p.tangential_lever_arm**2 * p.k_t * p.axial_stiffness / (p.k_t + p.axial_stiffness),
-        "f1_hz": f[0], "f2_hz": f[1], "f3_hz": f[2],
-        "err1_pct": err[0], "err2_pct": err[1], "err3_pct": err[2], "max_abs_err_pct": float(np.max(np.abs(err))),
+        "rotational_restraint_nm_per_rad": p.tangential_lever_arm**2
+        * p.k_t
+        * p.axial_stiffness
+        / (p.k_t + p.axial_stiffness),
+        "f1_hz": f[0],
+        "f2_hz": f[1],
+        "f3_hz": f[2],
+        "err1_pct": err[0],
+        "err2_pct": err[1],
+        "err3_pct": err[2],
+        "max_abs_err_pct": float(np.max(np.abs(err))),
     }

@@ -24,8 +24,9 @@ class ValanisParameters:
 
     @classmethod
     def from_config(cls, c) -> "ValanisParameters":
-        return cls(float(c["e_f_n_per_m"]), float(c["k_c_per_m"]), float(c["e_t_n_per_m"]),
-                   float(c["kappa"]), float(c["mu"]))
+        return cls(
+            float(c["e_f_n_per_m"]), float(c["k_c_per_m"]), float(c["e_t_n_per_m"]), float(c["kappa"]), float(c["mu"])
+        )
 
 
 def stiction_shear_stiffness(normal_force, e_f: float, k_c: float):
@@ -36,7 +37,11 @@ def stiction_shear_stiffness(normal_force, e_f: float, k_c: float):
     from .friction import initial_stiffness  # the one implementation of Eq. 22 (compiled; the kernels call it)
 
     n = np.asarray(normal_force, dtype=float)
-    return initial_stiffness(float(n), float(e_f), float(k_c)) if n.ndim == 0 else initial_stiffness(n, float(e_f), float(k_c))
+    return (
+        initial_stiffness(float(n), float(e_f), float(k_c))
+        if n.ndim == 0
+        else initial_stiffness(n, float(e_f), float(k_c))
+    )
 
 
 @dataclass(frozen=True)

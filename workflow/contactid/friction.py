@@ -38,8 +38,10 @@ MAX_SUBSTEPS = 256
 def slip_limit_flag(regularization: str) -> bool:
     """True for ``slip_limit``, False for ``none`` (Eq. 21 as printed); ValueError for anything else."""
     if regularization not in REGULARIZATIONS:
-        raise ValueError(f"friction regularization {regularization!r} is not one of {REGULARIZATIONS}: "
-                         "write friction.regularization: none (Eq. 21 as printed) or slip_limit")
+        raise ValueError(
+            f"friction regularization {regularization!r} is not one of {REGULARIZATIONS}: "
+            "write friction.regularization: none (Eq. 21 as printed) or slip_limit"
+        )
     return regularization == "slip_limit"
 
 
@@ -166,8 +168,18 @@ def valanis_step(S, xi0, xi1, n0, n1, e_f, k_c, e_t, kappa, mu, n_min, slip_limi
         return 0.0
     e0a = initial_stiffness(n0, e_f, k_c)
     e0b = initial_stiffness(n1, e_f, k_c)
-    return _step_terms(S, xi0, xi1, e0a, slip_width(n0, e0a, e_t, kappa, mu), e0b,
-                       slip_width(n1, e0b, e_t, kappa, mu), e_t, kappa, slip_limit)
+    return _step_terms(
+        S,
+        xi0,
+        xi1,
+        e0a,
+        slip_width(n0, e0a, e_t, kappa, mu),
+        e0b,
+        slip_width(n1, e0b, e_t, kappa, mu),
+        e_t,
+        kappa,
+        slip_limit,
+    )
 
 
 PARAMETER_NAMES = ("e_f", "k_c", "e_t", "kappa", "mu")
@@ -205,8 +217,10 @@ def _check_signals(xi, normal_force, n_min):
     if not (np.isfinite(xi).all() and np.isfinite(n).all()):
         raise ValueError("xi or normal_force holds NaN or infinite samples")
     if np.min(n) <= n_min:
-        raise ValueError(f"the normal force reaches {np.min(n):.3g} N <= {n_min:g} N: the contact opens, where the "
-                         "law carries no friction (S = 0); the periodic friction force is not defined by Eq. 21 there")
+        raise ValueError(
+            f"the normal force reaches {np.min(n):.3g} N <= {n_min:g} N: the contact opens, where the "
+            "law carries no friction (S = 0); the periodic friction force is not defined by Eq. 21 there"
+        )
     return xi, n
 
 
@@ -215,8 +229,15 @@ def _step_python(S, xi0, xi1, n0, n1, e_f, k_c, e_t, kappa, mu, n_min, slip_limi
     return valanis_step.py_func(S, xi0, xi1, n0, n1, e_f, k_c, e_t, kappa, mu, n_min, slip_limit)
 
 
-def valanis_friction_force_reference(xi, normal_force, params, tol: float = 1e-7, max_periods: int = 200,
-                                     n_min: float = 1e-6, regularization: str = "none") -> np.ndarray:
+def valanis_friction_force_reference(
+    xi,
+    normal_force,
+    params,
+    tol: float = 1e-7,
+    max_periods: int = 200,
+    n_min: float = 1e-6,
+    regularization: str = "none",
+) -> np.ndarray:
     """Plain reference implementation of :func:`valanis_friction_force` (a Python loop per
     sample and parameter set), used to test the fast kernel."""
     xi, n = _check_signals(xi, normal_force, n_min)
@@ -273,8 +294,16 @@ def _population_kernel(xi, n, p, tol, max_periods, n_min, slip_limit, out, perio
         periods_used[k] = used
 
 
-def valanis_friction_force(xi, normal_force, params, tol: float = 1e-7, max_periods: int = 200,
-                           n_min: float = 1e-6, return_periods: bool = False, regularization: str = "none"):
+def valanis_friction_force(
+    xi,
+    normal_force,
+    params,
+    tol: float = 1e-7,
+    max_periods: int = 200,
+    n_min: float = 1e-6,
+    return_periods: bool = False,
+    regularization: str = "none",
+):
     """Friction force S (N) of the modified Valanis law (Eqs. 21-22) at periodic steady state.
 
     xi: (n_samples,) tangential motion (m) over a whole number of periods (periodic: the last

@@ -105,7 +105,9 @@ def _ga(problem: _Problem, settings: FitSettings, seed: int, label: str = "frict
         creator.create("ValanisFitness", base.Fitness, weights=(-1.0,))
         creator.create("ValanisIndividual", list, fitness=creator.ValanisFitness)
     if settings.population < 2:
-        raise ValueError(f"friction.population = {settings.population}: the genetic algorithm needs at least 2 individuals")
+        raise ValueError(
+            f"friction.population = {settings.population}: the genetic algorithm needs at least 2 individuals"
+        )
     py_rng = random.Random(int(generator(seed, "friction/ga").integers(2**31)))
     state = random.getstate()
     random.seed(py_rng.random())  # DEAP's operators draw from the module-level generator
@@ -126,8 +128,14 @@ def _ga(problem: _Problem, settings: FitSettings, seed: int, label: str = "frict
         hof.update(pop)
         logbook = []
         every = max(1, settings.generations // 8)  # about eight progress lines per run
-        log.info("%s: GA, %d individuals, %d generations, %d points per period; best misfit at start %.4g",
-                 label, settings.population, settings.generations, problem.S.size, hof[0].fitness.values[0])
+        log.info(
+            "%s: GA, %d individuals, %d generations, %d points per period; best misfit at start %.4g",
+            label,
+            settings.population,
+            settings.generations,
+            problem.S.size,
+            hof[0].fitness.values[0],
+        )
         for gen in range(settings.generations):
             offspring = [creator.ValanisIndividual(list(ind)) for ind in tb.select(pop, len(pop))]
             for a, b in zip(offspring[::2], offspring[1::2]):
@@ -149,8 +157,14 @@ def _ga(problem: _Problem, settings: FitSettings, seed: int, label: str = "frict
             vals = np.array([ind.fitness.values[0] for ind in pop])
             logbook.append((gen, float(vals.min()), float(vals.mean())))
             if (gen + 1) % every == 0 or gen + 1 == settings.generations:
-                log.info("%s: GA generation %d/%d: best misfit %.4g, mean %.4g", label, gen + 1,
-                         settings.generations, vals.min(), vals.mean())
+                log.info(
+                    "%s: GA generation %d/%d: best misfit %.4g, mean %.4g",
+                    label,
+                    gen + 1,
+                    settings.generations,
+                    vals.min(),
+                    vals.mean(),
+                )
         return np.array(hof[0]), logbook
     finally:
         random.setstate(state)
@@ -186,16 +200,27 @@ def _polish(problem: _Problem, u0, fixed: dict | None = None):
     threads = numba.get_num_threads()
     numba.set_num_threads(1)  # a handful of sets per call: parallel threads cost more than they give
     try:
-        r = least_squares(fun, np.clip(u0[free], 0, 1), jac=jac, bounds=(0.0, 1.0), x_scale=0.05, xtol=1e-10,
-                          ftol=1e-12)
+        r = least_squares(
+            fun, np.clip(u0[free], 0, 1), jac=jac, bounds=(0.0, 1.0), x_scale=0.05, xtol=1e-10, ftol=1e-12
+        )
     finally:
         numba.set_num_threads(threads)
     return full(r.x), float(np.sum(r.fun**2)), r
 
 
-def fit_friction_law(coef_xi, coef_n, coef_s, f0: float, preload: float, settings: FitSettings, seed: int,
-                     n_harmonics_data: int | None = None, intervals: bool = True,
-                     label: str = "friction fit", start=None) -> FitResult:
+def fit_friction_law(
+    coef_xi,
+    coef_n,
+    coef_s,
+    f0: float,
+    preload: float,
+    settings: FitSettings,
+    seed: int,
+    n_harmonics_data: int | None = None,
+    intervals: bool = True,
+    label: str = "friction fit",
+    start=None,
+) -> FitResult:
     """GA + polish on the calibration case's xi, N (total = preload + dynamic) and S harmonics,
     with the grid refined until the parameters move by less than ``refine_tolerance``; then the
     profile-likelihood intervals (skipped with ``intervals`` False: NaN intervals). ``label`` starts
@@ -220,9 +245,17 @@ def fit_friction_law(coef_xi, coef_n, coef_s, f0: float, preload: float, setting
         u_best, ssr, res = _polish(problem, u_best)
         p = problem.physical(u_best)[0]
         history.append((m, *p, float(np.sqrt(ssr / m))))
-        log.info("%s: polished on %d points: misfit %.4g, %s", label, m, np.sqrt(ssr / m),
-                 ", ".join(f"{name} = {v:.4g}" for name, v in zip(PARAMETER_NAMES, p)))
-        if prev is not None and np.max(np.abs(p / np.where(prev == 0, 1, prev) - 1)[[0, 1, 3, 4]]) < settings.refine_tolerance:
+        log.info(
+            "%s: polished on %d points: misfit %.4g, %s",
+            label,
+            m,
+            np.sqrt(ssr / m),
+            ", ".join(f"{name} = {v:.4g}" for name, v in zip(PARAMETER_NAMES, p)),
+        )
+        if (
+            prev is not None
+            and np.max(np.abs(p / np.where(prev == 0, 1, prev) - 1)[[0, 1, 3, 4]]) < settings.refine_tolerance
+        ):
             break
         if 2 * m > settings.max_grid_points:
             log.warning("friction fit: the grid reached %d points without the parameters settling", m)
@@ -254,8 +287,11 @@ def fit_friction_law(coef_xi, coef_n, coef_s, f0: float, preload: float, setting
         return u, s_j
 
     if want_intervals:
-        log.info("%s: profile-likelihood intervals of the 5 parameters (%.0f %% confidence)", label,
-                 100 * settings.confidence)
+        log.info(
+            "%s: profile-likelihood intervals of the 5 parameters (%.0f %% confidence)",
+            label,
+            100 * settings.confidence,
+        )
     for i in range(5 if want_intervals else 0):
         for side, direction in ((0, -1.0), (1, +1.0)):
             edge = 0.0 if direction < 0 else 1.0
@@ -288,9 +324,18 @@ def fit_friction_law(coef_xi, coef_n, coef_s, f0: float, preload: float, setting
             unit = u_best.copy()
             unit[i] = crossing
             intervals[i, side] = problem.physical(unit)[0][i]
-        log.info("%s: %s in [%.4g, %.4g]%s", label, PARAMETER_NAMES[i], intervals[i, 0], intervals[i, 1],
-                 "" if bounded[i].all() else " (" + " and ".join(
-                     f"not bounded {end} by the data" for end, b in zip(("below", "above"), bounded[i]) if not b) + ")")
+        log.info(
+            "%s: %s in [%.4g, %.4g]%s",
+            label,
+            PARAMETER_NAMES[i],
+            intervals[i, 0],
+            intervals[i, 1],
+            ""
+            if bounded[i].all()
+            else " ("
+            + " and ".join(f"not bounded {end} by the data" for end, b in zip(("below", "above"), bounded[i]) if not b)
+            + ")",
+        )
     profiles = {k: np.array(sorted(v)) for k, v in profiles.items()}
     # correlation from the Jacobian at the optimum (unit-cube coordinates), for sensitive parameters
     J = res.jac
@@ -307,16 +352,29 @@ def fit_friction_law(coef_xi, coef_n, coef_s, f0: float, preload: float, setting
     for i, name in enumerate(PARAMETER_NAMES):
         for edge, label in ((0.0, "lower"), (1.0, "upper")):
             if abs(u_best[i] - edge) < 1e-3 and not (name == "e_t" and edge == 0.0 and settings.bounds[2][0] == 0.0):
-                warnings.append(f"{name} = {p[i]:.4g} sits at its {label} search bound {settings.bounds[i][int(edge)]:.4g}: "
-                                f"the bounds may exclude the best value; widen friction.bounds.{name}")
+                warnings.append(
+                    f"{name} = {p[i]:.4g} sits at its {label} search bound {settings.bounds[i][int(edge)]:.4g}: "
+                    f"the bounds may exclude the best value; widen friction.bounds.{name}"
+                )
     for w in warnings:
         log.warning("friction fit: %s", w)
-    return FitResult(p, float(np.sqrt(ssr_min / problem.S.size)), e0, logbook, history, intervals, bounded,
-                     (min(e0_vals), max(e0_vals)), corr, m, profiles, warnings)
+    return FitResult(
+        p,
+        float(np.sqrt(ssr_min / problem.S.size)),
+        e0,
+        logbook,
+        history,
+        intervals,
+        bounded,
+        (min(e0_vals), max(e0_vals)),
+        corr,
+        m,
+        profiles,
+        warnings,
+    )
 
 
-def friction_fit_dataset(forces, preload: float, settings: FitSettings, seed: int, n_harmonics: int,
-                         paper_forces=None):
+def friction_fit_dataset(forces, preload: float, settings: FitSettings, seed: int, n_harmonics: int, paper_forces=None):
     """Dataset of the fit on the calibration case's identified forces (working method), with the
     paper's chain's forces fitted beside it when given (reproduction)."""
     import xarray as xr
@@ -332,44 +390,117 @@ def friction_fit_dataset(forces, preload: float, settings: FitSettings, seed: in
 
     res = run(forces["S"].values, forces["xi"].values, forces["N_dyn"].values, "friction fit")
     data = {
-        "parameter_value": ("parameter", res.params, {"units": "mixed (N/m, 1/m, N/m, 1, 1)", "long_name": "fitted e_f, k_c, e_t, kappa, mu"}),
-        "interval_low": ("parameter", res.intervals[:, 0], {"units": "mixed", "long_name": "profile-likelihood interval, lower end"}),
-        "interval_high": ("parameter", res.intervals[:, 1], {"units": "mixed", "long_name": "profile-likelihood interval, upper end"}),
-        "bounded_below": ("parameter", res.bounded[:, 0].astype(int), {"units": "1", "long_name": "1 if the data bound it from below inside the search range"}),
-        "bounded_above": ("parameter", res.bounded[:, 1].astype(int), {"units": "1", "long_name": "1 if the data bound it from above inside the search range"}),
-        "correlation": (("parameter", "parameter_"), res.correlation, {"units": "1", "long_name": "correlation at the optimum", "nonfinite_meaning": "NaN: the parameter is insensitive at the optimum"}),
-        "ga_best": ("generation", [b for _, b, _ in res.logbook], {"units": "1", "long_name": "best misfit (NRMSE of S) per generation"}),
-        "ga_mean": ("generation", [m for _, _, m in res.logbook], {"units": "1", "long_name": "mean misfit per generation"}),
-        "grid_history": (("refinement", "grid_field"), np.array(res.grid_history),
-                         {"units": "mixed", "long_name": "grid points, e_f, k_c, e_t, kappa, mu, misfit per refinement"}),
+        "parameter_value": (
+            "parameter",
+            res.params,
+            {"units": "mixed (N/m, 1/m, N/m, 1, 1)", "long_name": "fitted e_f, k_c, e_t, kappa, mu"},
+        ),
+        "interval_low": (
+            "parameter",
+            res.intervals[:, 0],
+            {"units": "mixed", "long_name": "profile-likelihood interval, lower end"},
+        ),
+        "interval_high": (
+            "parameter",
+            res.intervals[:, 1],
+            {"units": "mixed", "long_name": "profile-likelihood interval, upper end"},
+        ),
+        "bounded_below": (
+            "parameter",
+            res.bounded[:, 0].astype(int),
+            {"units": "1", "long_name": "1 if the data bound it from below inside the search range"},
+        ),
+        "bounded_above": (
+            "parameter",
+            res.bounded[:, 1].astype(int),
+            {"units": "1", "long_name": "1 if the data bound it from above inside the search range"},
+        ),
+        "correlation": (
+            ("parameter", "parameter_"),
+            res.correlation,
+            {
+                "units": "1",
+                "long_name": "correlation at the optimum",
+                "nonfinite_meaning": "NaN: the parameter is insensitive at the optimum",
+            },
+        ),
+        "ga_best": (
+            "generation",
+            [b for _, b, _ in res.logbook],
+            {"units": "1", "long_name": "best misfit (NRMSE of S) per generation"},
+        ),
+        "ga_mean": (
+            "generation",
+            [m for _, _, m in res.logbook],
+            {"units": "1", "long_name": "mean misfit per generation"},
+        ),
+        "grid_history": (
+            ("refinement", "grid_field"),
+            np.array(res.grid_history),
+            {"units": "mixed", "long_name": "grid points, e_f, k_c, e_t, kappa, mu, misfit per refinement"},
+        ),
     }
-    attrs = {"e0_at_preload_n_per_m": res.e0_at_preload, "e0_interval_low": res.e0_interval[0],
-             "e0_interval_high": res.e0_interval[1], "misfit_nrmse": res.misfit, "grid_points": res.grid_points,
-             "preload_n": preload, "excitation_frequency_hz": f0, "n_harmonics": n_harmonics, "seed": seed,
-             "population": settings.population, "generations": settings.generations,
-             "regularization": settings.regularization,
-             "warnings": "; ".join(res.warnings) or "none"}
+    attrs = {
+        "e0_at_preload_n_per_m": res.e0_at_preload,
+        "e0_interval_low": res.e0_interval[0],
+        "e0_interval_high": res.e0_interval[1],
+        "misfit_nrmse": res.misfit,
+        "grid_points": res.grid_points,
+        "preload_n": preload,
+        "excitation_frequency_hz": f0,
+        "n_harmonics": n_harmonics,
+        "seed": seed,
+        "population": settings.population,
+        "generations": settings.generations,
+        "regularization": settings.regularization,
+        "warnings": "; ".join(res.warnings) or "none",
+    }
     n_total = preload + forces["N_dyn"].values
     attrs["open_fraction"] = float(np.mean(n_total <= N_OPEN))  # share of the record with the contact open
     if paper_forces is not None:
         try:
             n_paper = preload + paper_forces["N_dyn_paper"].values
             if np.min(n_paper) <= 0:  # not a separation the working method sees: the paper's N is wrong
-                raise ValueError(f"the normal force reaches {np.min(n_paper):.3g} N <= 0 N, where the working "
-                                 "method's contact stays closed: the paper's N is not a physical normal force")
-            rp = run(paper_forces["S_paper"].values, paper_forces["xi_paper"].values, paper_forces["N_dyn_paper"].values,
-                     "friction fit (paper's chain)")
-            data["paper_parameter_value"] = ("parameter", rp.params, {"units": "mixed", "long_name": "fitted to the paper's chain's forces"})
-            data["paper_interval_low"] = ("parameter", rp.intervals[:, 0], {"units": "mixed", "long_name": "paper's chain: interval, lower end"})
-            data["paper_interval_high"] = ("parameter", rp.intervals[:, 1], {"units": "mixed", "long_name": "paper's chain: interval, upper end"})
+                raise ValueError(
+                    f"the normal force reaches {np.min(n_paper):.3g} N <= 0 N, where the working "
+                    "method's contact stays closed: the paper's N is not a physical normal force"
+                )
+            rp = run(
+                paper_forces["S_paper"].values,
+                paper_forces["xi_paper"].values,
+                paper_forces["N_dyn_paper"].values,
+                "friction fit (paper's chain)",
+            )
+            data["paper_parameter_value"] = (
+                "parameter",
+                rp.params,
+                {"units": "mixed", "long_name": "fitted to the paper's chain's forces"},
+            )
+            data["paper_interval_low"] = (
+                "parameter",
+                rp.intervals[:, 0],
+                {"units": "mixed", "long_name": "paper's chain: interval, lower end"},
+            )
+            data["paper_interval_high"] = (
+                "parameter",
+                rp.intervals[:, 1],
+                {"units": "mixed", "long_name": "paper's chain: interval, upper end"},
+            )
             attrs["paper_e0_at_preload_n_per_m"] = rp.e0_at_preload
             attrs["paper_misfit_nrmse"] = rp.misfit
         except ValueError as exc:  # e.g. the paper's N reaches zero: the law is not defined there
             log.warning("the paper's chain's forces cannot be fitted: %s", exc)
             attrs["paper_fit_error"] = str(exc)
-    return xr.Dataset(data, coords={"parameter": list(PARAMETER_NAMES), "parameter_": list(PARAMETER_NAMES),
-                                    "generation": np.arange(len(res.logbook)),
-                                    "grid_field": ["grid_points", *PARAMETER_NAMES, "misfit"]}, attrs=attrs)
+    return xr.Dataset(
+        data,
+        coords={
+            "parameter": list(PARAMETER_NAMES),
+            "parameter_": list(PARAMETER_NAMES),
+            "generation": np.arange(len(res.logbook)),
+            "grid_field": ["grid_points", *PARAMETER_NAMES, "misfit"],
+        },
+        attrs=attrs,
+    )
 
 
 def validation_dataset(forces, fit, preload: float, n_harmonics: int, truth=None):
@@ -393,8 +524,13 @@ def validation_dataset(forces, fit, preload: float, n_harmonics: int, truth=None
     other = next(r for r in REGULARIZATIONS if r != reading)
     S_other = valanis_friction_force(xi, N, fit["parameter_value"].values[None, :], regularization=other)[0]
     S_pred, S_other = S_pred - S_pred.mean(), S_other - S_other.mean()
-    attrs = {"nrmse_vs_identified": nrmse(S_pred, S_id), "excitation_frequency_hz": f0, "regularization": reading,
-             "other_regularization": other, "nrmse_other_regularization": nrmse(S_other, S_pred)}
+    attrs = {
+        "nrmse_vs_identified": nrmse(S_pred, S_id),
+        "excitation_frequency_hz": f0,
+        "regularization": reading,
+        "other_regularization": other,
+        "nrmse_other_regularization": nrmse(S_other, S_pred),
+    }
     data = {
         "xi": ("phase", xi, {"units": "m", "long_name": "identified xi over one period"}),
         "xi_dot": ("phase", xi_dot, {"units": "m/s", "long_name": "identified d xi/dt over one period"}),
@@ -406,8 +542,11 @@ def validation_dataset(forces, fit, preload: float, n_harmonics: int, truth=None
         ts = periodic_grid(fourier_series(truth["S"].values, fs, f0, max(n_harmonics, 60))[0], f0, m)[0]
         attrs["nrmse_vs_truth"] = nrmse(S_pred, ts)
         data["S_truth"] = ("phase", ts - ts.mean(), {"units": "N", "long_name": "true S, mean removed"})
-    return xr.Dataset(data, coords={"phase": ("phase", np.arange(m) / m, {"units": "1", "long_name": "fraction of the period"})},
-                      attrs=attrs)
+    return xr.Dataset(
+        data,
+        coords={"phase": ("phase", np.arange(m) / m, {"units": "1", "long_name": "fraction of the period"})},
+        attrs=attrs,
+    )
 
 
 def settings_from_config(cfg) -> FitSettings:
@@ -421,10 +560,13 @@ def settings_from_config(cfg) -> FitSettings:
         if not lo < hi:
             raise ValueError(f"friction.bounds.{key} = [{lo}, {hi}]: the lower bound must be below the upper")
         bounds.append((float(lo), float(hi)))
-    return FitSettings(bounds=tuple(bounds), population=int(cfg.get("population", d.population)),
-                       generations=int(cfg.get("generations", d.generations)),
-                       grid_points=int(cfg.get("grid_points", d.grid_points)),
-                       max_grid_points=int(cfg.get("max_grid_points", d.max_grid_points)),
-                       confidence=float(cfg.get("confidence", d.confidence)),
-                       misfit_floor=float(cfg.get("misfit_floor", d.misfit_floor)),
-                       regularization=str(cfg.get("regularization", d.regularization)))
+    return FitSettings(
+        bounds=tuple(bounds),
+        population=int(cfg.get("population", d.population)),
+        generations=int(cfg.get("generations", d.generations)),
+        grid_points=int(cfg.get("grid_points", d.grid_points)),
+        max_grid_points=int(cfg.get("max_grid_points", d.max_grid_points)),
+        confidence=float(cfg.get("confidence", d.confidence)),
+        misfit_floor=float(cfg.get("misfit_floor", d.misfit_floor)),
+        regularization=str(cfg.get("regularization", d.regularization)),
+    )

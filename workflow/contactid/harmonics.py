@@ -40,7 +40,7 @@ def periodic_harmonics(x: np.ndarray, t_first: float, w: float, n_per: int, H: i
     x = np.atleast_2d(x)
     periods = x.shape[1] // n_per
     mean_period = x[:, : periods * n_per].reshape(x.shape[0], periods, n_per).mean(axis=1)
-    X = np.fft.fft(mean_period, axis=1)[:, 1:H + 1]
+    X = np.fft.fft(mean_period, axis=1)[:, 1 : H + 1]
     h = np.arange(1, H + 1)
     return 2j * X / n_per * np.exp(-1j * h * w * t_first)
 

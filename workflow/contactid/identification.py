@@ -53,16 +53,19 @@ def nrmse(estimate: np.ndarray, truth: np.ndarray) -> float:
 # ----------------------------------------------------------------------------------------------
 
 
-def generalized_coordinates(phi_sensor: np.ndarray, acceleration: np.ndarray, fs: float, f0: float,
-                            n_harmonics: int) -> tuple[np.ndarray, np.ndarray]:
+def generalized_coordinates(
+    phi_sensor: np.ndarray, acceleration: np.ndarray, fs: float, f0: float, n_harmonics: int
+) -> tuple[np.ndarray, np.ndarray]:
     """Generalized accelerations p''(t) = Phi^+ w''(t) (Eq. 15) and their K harmonics (Eq. 16).
 
     phi_sensor: (j, m) linear mode shapes at the j sensors; acceleration: (j, n_t) m/s^2.
     Returns (p'' raw (m, n_t), coefficients (m, K)). Refuses m > j."""
     j, m = phi_sensor.shape
     if m > j:
-        raise IdentificationError(f"m = {m} linear modes need at least as many sensors (Eq. 15: j >= m); "
-                                  f"the record has j = {j}: lower nonlinear.n_modes or add sensors")
+        raise IdentificationError(
+            f"m = {m} linear modes need at least as many sensors (Eq. 15: j >= m); "
+            f"the record has j = {j}: lower nonlinear.n_modes or add sensors"
+        )
     pdd = np.linalg.pinv(phi_sensor) @ acceleration
     return pdd, fourier_series(pdd, fs, f0, n_harmonics)
 
@@ -121,8 +124,7 @@ def galerkin_contact_forces(model: FEModel, nnm: np.ndarray, q: np.ndarray, qdd:
         S[k], N[k] = np.linalg.lstsq(A, lhs[:, k], rcond=None)[0][:2]
     xi = xi_r @ q - 0.5 * _column_forms(q, G, q)
     eta = eta_r @ q
-    return {"S": S, "N_dyn": N, "xi": xi, "eta": eta, "reduced_mass": Mr, "reduced_stiffness": Kr,
-            "reduced_force": Fr}
+    return {"S": S, "N_dyn": N, "xi": xi, "eta": eta, "reduced_mass": Mr, "reduced_stiffness": Kr, "reduced_force": Fr}
 
 
 # ----------------------------------------------------------------------------------------------
@@ -168,7 +170,7 @@ def period_coefficients(x_grid: np.ndarray, n_harmonics: int) -> np.ndarray:
     """Harmonics c_h (h = 1..K) of periodic rows sampled at M points over one period,
     x ~ mean + sum Im(c_h e^{i h w t}) (exact for M > 2K)."""
     M = x_grid.shape[-1]
-    X = np.fft.fft(x_grid, axis=-1)[..., 1:n_harmonics + 1]
+    X = np.fft.fft(x_grid, axis=-1)[..., 1 : n_harmonics + 1]
     return 2j * X / M
 
 
@@ -190,8 +192,9 @@ class InverseHarmonics:
     residual: np.ndarray
 
 
-def inverse_harmonics(model: FEModel, zeta: np.ndarray, F_coef: np.ndarray, A_coef: np.ndarray, f0: float,
-                      n_iterations: int = 8) -> InverseHarmonics:
+def inverse_harmonics(
+    model: FEModel, zeta: np.ndarray, F_coef: np.ndarray, A_coef: np.ndarray, f0: float, n_iterations: int = 8
+) -> InverseHarmonics:
     """Per-harmonic inverse identification from the force harmonics F_coef (K,) and the sensor
     acceleration harmonics A_coef (j, K) (convention of Eq. 16). The axial-force term of Eq. 1
     (G q S) mixes harmonics; it is moved to the known side and updated by fixed-point iteration."""
@@ -239,12 +242,29 @@ def inverse_harmonics(model: FEModel, zeta: np.ndarray, F_coef: np.ndarray, A_co
     xi_dot = period_coefficients(model.xi_vector @ qdg - _column_forms(qg, G, qdg), K)
     eta = model.eta_vector @ q_coef
     h = np.arange(1, K + 1)
-    return InverseHarmonics(S=r_coef[0] + p.k_t * xi_lin, N_dyn=r_coef[1] - p.k_n * eta, xi=xi, eta=eta,
-                            xi_dot=xi_dot, eta_dot=1j * h * w0 * eta, q=q_coef, r=r_coef, residual=residual)
+    return InverseHarmonics(
+        S=r_coef[0] + p.k_t * xi_lin,
+        N_dyn=r_coef[1] - p.k_n * eta,
+        xi=xi,
+        eta=eta,
+        xi_dot=xi_dot,
+        eta_dot=1j * h * w0 * eta,
+        q=q_coef,
+        r=r_coef,
+        residual=residual,
+    )
 
 
-def inverse_identification(model: FEModel, zeta: np.ndarray, force: np.ndarray, acceleration: np.ndarray,
-                           fs: float, f0: float, n_harmonics: int, n_iterations: int = 8) -> InverseResult:
+def inverse_identification(
+    model: FEModel,
+    zeta: np.ndarray,
+    force: np.ndarray,
+    acceleration: np.ndarray,
+    fs: float,
+    f0: float,
+    n_harmonics: int,
+    n_iterations: int = 8,
+) -> InverseResult:
     """Contact forces as unknown inputs, harmonic by harmonic, with the stuck linear model
     (:func:`inverse_harmonics` on the record's K harmonics, then the time signals)."""
     p = model.params
@@ -265,5 +285,16 @@ def inverse_identification(model: FEModel, zeta: np.ndarray, force: np.ndarray, 
     N_dyn = r[1] - p.k_n * eta
     xi_dot = model.xi_vector @ qd - _column_forms(q, G, qd)
     eta_dot = model.eta_vector @ qd
-    return InverseResult(S - S.mean(), N_dyn - N_dyn.mean(), xi - xi.mean(), eta - eta.mean(), xi_dot, eta_dot,
-                         res.S, res.N_dyn, model.xi_vector @ q_coef, res.eta, res.residual)
+    return InverseResult(
+        S - S.mean(),
+        N_dyn - N_dyn.mean(),
+        xi - xi.mean(),
+        eta - eta.mean(),
+        xi_dot,
+        eta_dot,
+        res.S,
+        res.N_dyn,
+        model.xi_vector @ q_coef,
+        res.eta,
+        res.residual,
+    )

@@ -54,8 +54,9 @@ def package_digest() -> str:
 
 def git_revision() -> str:
     try:
-        out = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True, timeout=5,
-                             cwd=Path(__file__).resolve().parent)
+        out = subprocess.run(
+            ["git", "rev-parse", "HEAD"], capture_output=True, text=True, timeout=5, cwd=Path(__file__).resolve().parent
+        )
         return out.stdout.strip() or "unknown"
     except (OSError, subprocess.SubprocessError):
         return "unknown"
@@ -135,19 +136,27 @@ def load_dataset(path: str | os.PathLike) -> xr.Dataset:
     return xr.load_dataset(path, engine=ENGINE)
 
 
-def raw_dataset(time, force, acceleration, sensor_names, positions, sampling_rate_hz: float,
-                attrs: Mapping | None = None) -> xr.Dataset:
+def raw_dataset(
+    time, force, acceleration, sensor_names, positions, sampling_rate_hz: float, attrs: Mapping | None = None
+) -> xr.Dataset:
     """Build a raw record in the documented format."""
     ds = xr.Dataset(
         {
             "force": ("time", np.asarray(force, dtype=float), {"units": "N", "long_name": "excitation force at d_p"}),
-            "acceleration": (("sensor", "time"), np.asarray(acceleration, dtype=float),
-                             {"units": "m/s^2", "long_name": "lateral acceleration"}),
+            "acceleration": (
+                ("sensor", "time"),
+                np.asarray(acceleration, dtype=float),
+                {"units": "m/s^2", "long_name": "lateral acceleration"},
+            ),
         },
         coords={
             "time": ("time", np.asarray(time, dtype=float), {"units": "s", "long_name": "time"}),
             "sensor": ("sensor", list(sensor_names)),
-            "position": ("sensor", np.asarray(positions, dtype=float), {"units": "m", "long_name": "distance from the clamp"}),
+            "position": (
+                "sensor",
+                np.asarray(positions, dtype=float),
+                {"units": "m", "long_name": "distance from the clamp"},
+            ),
         },
         attrs={"sampling_rate_hz": float(sampling_rate_hz), **dict(attrs or {})},
     )
@@ -158,8 +167,9 @@ _ACC_UNITS = {"m/s^2", "m/s2", "m s-2", "m/s**2"}
 _FORCE_UNITS = {"N", "newton"}
 
 
-def read_raw(path: str | os.PathLike, dual_sine: bool = False, min_samples: int = 16, min_periods: int = 8,
-             max_harmonic: int = 1) -> xr.Dataset:
+def read_raw(
+    path: str | os.PathLike, dual_sine: bool = False, min_samples: int = 16, min_periods: int = 8, max_harmonic: int = 1
+) -> xr.Dataset:
     """Load and check a raw record; raise :class:`RawDataError` naming the file,
     the field and the fix when it does not follow the documented format.
 
@@ -171,7 +181,9 @@ def read_raw(path: str | os.PathLike, dual_sine: bool = False, min_samples: int 
     try:
         ds = load_dataset(path)
     except Exception as exc:  # noqa: BLE001 - any reader failure is a format problem for the user
-        raise RawDataError(f"{path}: cannot be read as netCDF ({exc}); write it in the raw format of config/README.md") from exc
+        raise RawDataError(
+            f"{path}: cannot be read as netCDF ({exc}); write it in the raw format of config/README.md"
+        ) from exc
 
     def fail(msg):
         raise RawDataError(f"{path}: {msg} (raw format: see config/README.md)")
@@ -225,9 +237,13 @@ def read_raw(path: str | os.PathLike, dual_sine: bool = False, min_samples: int 
             fail(f"excitation_frequency_hz = {f0}; must be positive")
         periods = ds.sizes["time"] / fs * f0
         if periods < min_periods:
-            fail(f"the record holds {periods:.1f} periods of {f0:g} Hz, too short for the Fourier fit; "
-                 f"record at least {min_periods} periods")
+            fail(
+                f"the record holds {periods:.1f} periods of {f0:g} Hz, too short for the Fourier fit; "
+                f"record at least {min_periods} periods"
+            )
         if max_harmonic * f0 >= fs / 2:
-            fail(f"sampling_rate_hz = {fs:g} cannot resolve harmonic {max_harmonic} of {f0:g} Hz; "
-                 f"sample faster than {2 * max_harmonic * f0:g} Hz")
+            fail(
+                f"sampling_rate_hz = {fs:g} cannot resolve harmonic {max_harmonic} of {f0:g} Hz; "
+                f"sample faster than {2 * max_harmonic * f0:g} Hz"
+            )
     return ds

@@ -33,8 +33,18 @@ def _fmt(v, digits: int = 4) -> str:
 
 def _name(key: str) -> str:
     """A LaTeX macro name from a key: letters only (digits spelled)."""
-    words = {"0": "zero", "1": "one", "2": "two", "3": "three", "4": "four", "5": "five", "6": "six", "7": "seven",
-             "8": "eight", "9": "nine"}
+    words = {
+        "0": "zero",
+        "1": "one",
+        "2": "two",
+        "3": "three",
+        "4": "four",
+        "5": "five",
+        "6": "six",
+        "7": "seven",
+        "8": "eight",
+        "9": "nine",
+    }
     key = "".join(words.get(ch, ch) for ch in key)
     return re.sub(r"[^A-Za-z]", "", key)
 
@@ -105,17 +115,44 @@ def tabular(df: pd.DataFrame, columns: Mapping[str, str], caption: str, label: s
         cells = []
         for col in columns:
             x = r[col]
-            cells.append(f"${_fmt(x)}$" if isinstance(x, (int, float, np.number)) and not isinstance(x, bool) else
-                         str(x).replace("_", r"\_"))
+            cells.append(
+                f"${_fmt(x)}$"
+                if isinstance(x, (int, float, np.number)) and not isinstance(x, bool)
+                else str(x).replace("_", r"\_")
+            )
         rows.append(" & ".join(cells) + r" \\")
     spec = "l" + "r" * (len(columns) - 1)
-    return "\n".join([r"\begin{table}[htbp]", r"\centering\small", f"\\caption{{{caption}}}\\label{{{label}}}",
-                      f"\\begin{{tabular}}{{{spec}}}", r"\toprule", head, r"\midrule", *rows, r"\bottomrule",
-                      r"\end{tabular}", r"\end{table}"]) + "\n"
+    return (
+        "\n".join(
+            [
+                r"\begin{table}[htbp]",
+                r"\centering\small",
+                f"\\caption{{{caption}}}\\label{{{label}}}",
+                f"\\begin{{tabular}}{{{spec}}}",
+                r"\toprule",
+                head,
+                r"\midrule",
+                *rows,
+                r"\bottomrule",
+                r"\end{tabular}",
+                r"\end{table}",
+            ]
+        )
+        + "\n"
+    )
 
 
-PAPER_GIVEN = {"length_m", "width_m", "thickness_m", "radius_m", "normal_lever_arm_m", "excitation_position_m",
-               "positions_m", "preload_n", "block.mass_kg"}
+PAPER_GIVEN = {
+    "length_m",
+    "width_m",
+    "thickness_m",
+    "radius_m",
+    "normal_lever_arm_m",
+    "excitation_position_m",
+    "positions_m",
+    "preload_n",
+    "block.mass_kg",
+}
 
 
 def setup_table(structure_cfg: Mapping) -> str:
@@ -129,12 +166,26 @@ def setup_table(structure_cfg: Mapping) -> str:
                 walk(v, key + ".")
             else:
                 given = k in PAPER_GIVEN or key in PAPER_GIVEN
-                rows.append({"quantity": key, "value": ", ".join(_fmt(x) for x in v) if isinstance(v, list) else
-                             ("rigid" if v is None else v), "source": "paper" if given else "ours"})
+                rows.append(
+                    {
+                        "quantity": key,
+                        "value": ", ".join(_fmt(x) for x in v)
+                        if isinstance(v, list)
+                        else ("rigid" if v is None else v),
+                        "source": "paper" if given else "ours",
+                    }
+                )
+
     walk(structure_cfg)
-    lines = [r"\begin{table}[htbp]", r"\centering\footnotesize",
-             r"\caption{The structure model. Values marked \emph{ours} are not given by the paper; config/README.md gives the reasoning for each.}\label{tab:setup}",
-             r"\begin{tabular}{llc}", r"\toprule", r"quantity (config key) & value & source \\", r"\midrule"]
+    lines = [
+        r"\begin{table}[htbp]",
+        r"\centering\footnotesize",
+        r"\caption{The structure model. Values marked \emph{ours} are not given by the paper; config/README.md gives the reasoning for each.}\label{tab:setup}",
+        r"\begin{tabular}{llc}",
+        r"\toprule",
+        r"quantity (config key) & value & source \\",
+        r"\midrule",
+    ]
     for r in rows:
         val = r["value"]
         val = f"${_fmt(val)}$" if isinstance(val, (int, float)) else f"${val}$" if "times" in str(val) else str(val)
@@ -146,10 +197,12 @@ def setup_table(structure_cfg: Mapping) -> str:
 def data_checks_text(summary: Mapping) -> str:
     """The report's paragraph on the raw records' validation: the checks, and each warning by record."""
     warnings = summary.get("data_warnings") or {}
-    lines = [r"\paragraph{Data checks.} Every raw record passed the validation before identification (format, "
-             r"finite samples, length and sampling rate for the harmonics and the FRF resolution, clipping, the "
-             r"excitation frequency recovered from the force, stationarity of first against last third, the random "
-             r"test's coherence in the modal band; thresholds in \texttt{raw\_checks})."]
+    lines = [
+        r"\paragraph{Data checks.} Every raw record passed the validation before identification (format, "
+        r"finite samples, length and sampling rate for the harmonics and the FRF resolution, clipping, the "
+        r"excitation frequency recovered from the force, stationarity of first against last third, the random "
+        r"test's coherence in the modal band; thresholds in \texttt{raw\_checks})."
+    ]
     items = [(rec, w) for rec, ws in sorted(warnings.items()) for w in ws]
     if not items:
         lines.append("No check came within a factor of two of its limit.")
@@ -162,6 +215,16 @@ def data_checks_text(summary: Mapping) -> str:
 
 def plain_text(text: str) -> str:
     """Plain text (messages, names) safe in LaTeX: its special characters escaped."""
-    repl = {"\\": r"\textbackslash{}", "_": r"\_", "%": r"\%", "&": r"\&", "#": r"\#", "$": r"\$",
-            "{": r"\{", "}": r"\}", "^": r"\^{}", "~": r"\~{}"}
+    repl = {
+        "\\": r"\textbackslash{}",
+        "_": r"\_",
+        "%": r"\%",
+        "&": r"\&",
+        "#": r"\#",
+        "$": r"\$",
+        "{": r"\{",
+        "}": r"\}",
+        "^": r"\^{}",
+        "~": r"\~{}",
+    }
     return "".join(repl.get(ch, ch) for ch in str(text))

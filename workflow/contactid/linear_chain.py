@@ -29,7 +29,8 @@ def check_sensor_layout(raw: xr.Dataset, structure_cfg: Mapping, path: str, tol_
     if pos.shape != want.shape or np.max(np.abs(pos - want)) > tol_m:
         raise RawDataError(
             f"{path}: sensor positions {pos.tolist()} m differ from structure.sensors.positions_m "
-            f"{want.tolist()} m; make the model's sensor layout (config) match the test")
+            f"{want.tolist()} m; make the model's sensor layout (config) match the test"
+        )
 
 
 def frf_dataset(raw: xr.Dataset, segment_length: int, overlap: float, window: str, blocks: int) -> xr.Dataset:
@@ -41,8 +42,10 @@ def frf_dataset(raw: xr.Dataset, segment_length: int, overlap: float, window: st
     acc = raw["acceleration"].values
     n = force.size
     if n < 2 * segment_length:
-        raise RawDataError(f"record of {n} samples is shorter than two FRF segments of {segment_length}; "
-                           "lengthen the record or lower frf.segment_length")
+        raise RawDataError(
+            f"record of {n} samples is shorter than two FRF segments of {segment_length}; "
+            "lengthen the record or lower frf.segment_length"
+        )
     full = h1_frf(force, acc, fs, segment_length, overlap, window)
     nb = n // blocks
     block_h1 = []
@@ -50,18 +53,39 @@ def frf_dataset(raw: xr.Dataset, segment_length: int, overlap: float, window: st
     for b in range(blocks):
         sl = slice(b * nb, (b + 1) * nb)
         est = h1_frf(force[sl], acc[:, sl], fs, seg_b, overlap, window)
-        block_h1.append(np.stack([np.interp(full.frequency_hz, est.frequency_hz, h.real)
-                                  + 1j * np.interp(full.frequency_hz, est.frequency_hz, h.imag) for h in est.h1]))
+        block_h1.append(
+            np.stack(
+                [
+                    np.interp(full.frequency_hz, est.frequency_hz, h.real)
+                    + 1j * np.interp(full.frequency_hz, est.frequency_hz, h.imag)
+                    for h in est.h1
+                ]
+            )
+        )
     block_h1 = np.array(block_h1)
     ds = xr.Dataset(
         {
-            "h1_real": (("sensor", "frequency"), full.h1.real, {"units": "m/s^2/N", "long_name": "H1 accelerance, real part"}),
-            "h1_imag": (("sensor", "frequency"), full.h1.imag, {"units": "m/s^2/N", "long_name": "H1 accelerance, imaginary part"}),
+            "h1_real": (
+                ("sensor", "frequency"),
+                full.h1.real,
+                {"units": "m/s^2/N", "long_name": "H1 accelerance, real part"},
+            ),
+            "h1_imag": (
+                ("sensor", "frequency"),
+                full.h1.imag,
+                {"units": "m/s^2/N", "long_name": "H1 accelerance, imaginary part"},
+            ),
             "coherence": (("sensor", "frequency"), full.coherence, {"units": "1", "long_name": "ordinary coherence"}),
-            "block_h1_real": (("block", "sensor", "frequency"), block_h1.real,
-                              {"units": "m/s^2/N", "long_name": "H1 of consecutive sub-records, real part"}),
-            "block_h1_imag": (("block", "sensor", "frequency"), block_h1.imag,
-                              {"units": "m/s^2/N", "long_name": "H1 of consecutive sub-records, imaginary part"}),
+            "block_h1_real": (
+                ("block", "sensor", "frequency"),
+                block_h1.real,
+                {"units": "m/s^2/N", "long_name": "H1 of consecutive sub-records, real part"},
+            ),
+            "block_h1_imag": (
+                ("block", "sensor", "frequency"),
+                block_h1.imag,
+                {"units": "m/s^2/N", "long_name": "H1 of consecutive sub-records, imaginary part"},
+            ),
         },
         coords={
             "frequency": ("frequency", full.frequency_hz, {"units": "Hz", "long_name": "frequency"}),
@@ -69,8 +93,14 @@ def frf_dataset(raw: xr.Dataset, segment_length: int, overlap: float, window: st
             "position": ("sensor", raw["position"].values, {"units": "m", "long_name": "distance from the clamp"}),
             "block": np.arange(blocks),
         },
-        attrs={"n_averages": full.n_averages, "segment_length": segment_length, "overlap": overlap, "window": window,
-               "sampling_rate_hz": fs, "driving_point_sensor": str(raw["sensor"].values[0])},
+        attrs={
+            "n_averages": full.n_averages,
+            "segment_length": segment_length,
+            "overlap": overlap,
+            "window": window,
+            "sampling_rate_hz": fs,
+            "driving_point_sensor": str(raw["sensor"].values[0]),
+        },
     )
     return ds
 
@@ -105,23 +135,64 @@ def modal_dataset(frf: xr.Dataset, n_modes: int, band_hz, order: int) -> xr.Data
     spread = []
     for o in (order - 2, order + 2):
         try:
-            spread.append(np.abs(fit_modes(f, complex_frf(frf), n_modes, tuple(band_hz), o).natural_frequency_hz
-                                 - est.natural_frequency_hz))
+            spread.append(
+                np.abs(
+                    fit_modes(f, complex_frf(frf), n_modes, tuple(band_hz), o).natural_frequency_hz
+                    - est.natural_frequency_hz
+                )
+            )
         except ValueError:
             pass
     order_spread = np.max(spread, axis=0) if spread else np.full(n_modes, np.nan)
     return xr.Dataset(
         {
-            "natural_frequency": ("mode", est.natural_frequency_hz, {"units": "Hz", "long_name": "undamped natural frequency |s_r|/2pi"}),
-            "natural_frequency_std": ("mode", sf, {"units": "Hz", "long_name": "standard uncertainty of the natural frequency (sub-records)", "nonfinite_meaning": "NaN: fewer than two sub-records could be fitted"}),
-            "order_spread": ("mode", order_spread, {"units": "Hz", "long_name": "change of the frequency at model order +-2", "nonfinite_meaning": "NaN: no neighbouring order could be fitted"}),
+            "natural_frequency": (
+                "mode",
+                est.natural_frequency_hz,
+                {"units": "Hz", "long_name": "undamped natural frequency |s_r|/2pi"},
+            ),
+            "natural_frequency_std": (
+                "mode",
+                sf,
+                {
+                    "units": "Hz",
+                    "long_name": "standard uncertainty of the natural frequency (sub-records)",
+                    "nonfinite_meaning": "NaN: fewer than two sub-records could be fitted",
+                },
+            ),
+            "order_spread": (
+                "mode",
+                order_spread,
+                {
+                    "units": "Hz",
+                    "long_name": "change of the frequency at model order +-2",
+                    "nonfinite_meaning": "NaN: no neighbouring order could be fitted",
+                },
+            ),
             "damping_ratio": ("mode", est.damping_ratio, {"units": "1", "long_name": "modal damping ratio"}),
-            "damping_ratio_std": ("mode", sz, {"units": "1", "long_name": "standard uncertainty of the damping ratio", "nonfinite_meaning": "NaN: fewer than two sub-records could be fitted"}),
-            "residue_abs": (("sensor", "mode"), np.abs(est.residues), {"units": "m/s^2/N rad/s", "long_name": "|accelerance residue|"}),
+            "damping_ratio_std": (
+                "mode",
+                sz,
+                {
+                    "units": "1",
+                    "long_name": "standard uncertainty of the damping ratio",
+                    "nonfinite_meaning": "NaN: fewer than two sub-records could be fitted",
+                },
+            ),
+            "residue_abs": (
+                ("sensor", "mode"),
+                np.abs(est.residues),
+                {"units": "m/s^2/N rad/s", "long_name": "|accelerance residue|"},
+            ),
         },
         coords={"mode": np.arange(1, n_modes + 1), "sensor": frf["sensor"].values},
-        attrs={"method": "LSCF poles + LSFD residues", "order": order, "band_low_hz": band_hz[0], "band_high_hz": band_hz[1],
-               "n_blocks_used": len(blocks_f)},
+        attrs={
+            "method": "LSCF poles + LSFD residues",
+            "order": order,
+            "band_low_hz": band_hz[0],
+            "band_high_hz": band_hz[1],
+            "n_blocks_used": len(blocks_f),
+        },
     )
 
 
@@ -132,29 +203,67 @@ def stiction_dataset(modal: xr.Dataset, structure_cfg: Mapping, stiction_cfg: Ma
     stat = np.nan_to_num(modal["natural_frequency_std"].values, nan=0.0)
     sigma = frequency_sigma(f_id, stat, float(stiction_cfg["frequency_uncertainty_floor"]))
     params = structure_from_config(structure_cfg, 1e7, 1e8)
-    fit = stiction_stiffness(params, f_id, sigma, tuple(stiction_cfg.get("k_t_bounds_n_per_m", (1e5, 1e9))),
-                             tuple(stiction_cfg.get("k_n_bounds_n_per_m", (1e5, 1e11))),
-                             float(stiction_cfg["confidence"]))
+    fit = stiction_stiffness(
+        params,
+        f_id,
+        sigma,
+        tuple(stiction_cfg.get("k_t_bounds_n_per_m", (1e5, 1e9))),
+        tuple(stiction_cfg.get("k_n_bounds_n_per_m", (1e5, 1e11))),
+        float(stiction_cfg["confidence"]),
+    )
     gt, pt = fit.profiles["k_t"]
     gn, pn = fit.profiles["k_n"]
     return xr.Dataset(
         {
             "k_t": ((), fit.k_t, {"units": "N/m", "long_name": "tangential contact stiffness at stiction (best fit)"}),
-            "k_n": ((), fit.k_n, {"units": "N/m", "long_name": "normal contact stiffness (best fit; see k_n_bounded_above)"}),
-            "k_t_interval": ("bound", np.asarray(fit.k_t_interval), {"units": "N/m", "long_name": "confidence interval of k_t", "nonfinite_meaning": "inf: the data do not bound k_t from above"}),
-            "k_n_interval": ("bound", np.asarray(fit.k_n_interval), {"units": "N/m", "long_name": "confidence interval of k_n", "nonfinite_meaning": "inf: the data do not bound k_n from above"}),
-            "model_frequency": ("mode", fit.model_frequencies_hz, {"units": "Hz", "long_name": "model natural frequency at the best fit"}),
+            "k_n": (
+                (),
+                fit.k_n,
+                {"units": "N/m", "long_name": "normal contact stiffness (best fit; see k_n_bounded_above)"},
+            ),
+            "k_t_interval": (
+                "bound",
+                np.asarray(fit.k_t_interval),
+                {
+                    "units": "N/m",
+                    "long_name": "confidence interval of k_t",
+                    "nonfinite_meaning": "inf: the data do not bound k_t from above",
+                },
+            ),
+            "k_n_interval": (
+                "bound",
+                np.asarray(fit.k_n_interval),
+                {
+                    "units": "N/m",
+                    "long_name": "confidence interval of k_n",
+                    "nonfinite_meaning": "inf: the data do not bound k_n from above",
+                },
+            ),
+            "model_frequency": (
+                "mode",
+                fit.model_frequencies_hz,
+                {"units": "Hz", "long_name": "model natural frequency at the best fit"},
+            ),
             "identified_frequency": ("mode", f_id, {"units": "Hz", "long_name": "identified natural frequency"}),
             "frequency_sigma": ("mode", sigma, {"units": "Hz", "long_name": "frequency uncertainty used as weight"}),
             "profile_k_t_chi2": ("k_t_grid", pt, {"units": "1", "long_name": "profile misfit over k_t"}),
             "profile_k_n_chi2": ("k_n_grid", pn, {"units": "1", "long_name": "profile misfit over k_n"}),
         },
-        coords={"bound": ["lower", "upper"], "mode": modal["mode"].values,
-                "k_t_grid": ("k_t_grid", gt, {"units": "N/m"}), "k_n_grid": ("k_n_grid", gn, {"units": "N/m"})},
-        attrs={"chi2_min": fit.chi2_min, "confidence": fit.confidence,
-               "k_t_bounded": int(fit.k_t_bounded), "k_n_bounded_above": int(fit.k_n_bounded_above),
-               "k_n_bounded_below": int(fit.k_n_bounded_below),
-               "k_t_interval_note": "; ".join(fit.notes["k_t"]), "k_n_interval_note": "; ".join(fit.notes["k_n"])},
+        coords={
+            "bound": ["lower", "upper"],
+            "mode": modal["mode"].values,
+            "k_t_grid": ("k_t_grid", gt, {"units": "N/m"}),
+            "k_n_grid": ("k_n_grid", gn, {"units": "N/m"}),
+        },
+        attrs={
+            "chi2_min": fit.chi2_min,
+            "confidence": fit.confidence,
+            "k_t_bounded": int(fit.k_t_bounded),
+            "k_n_bounded_above": int(fit.k_n_bounded_above),
+            "k_n_bounded_below": int(fit.k_n_bounded_below),
+            "k_t_interval_note": "; ".join(fit.notes["k_t"]),
+            "k_n_interval_note": "; ".join(fit.notes["k_n"]),
+        },
     )
 
 
@@ -169,8 +278,9 @@ def contact_stiffness_for_modes(stiction: xr.Dataset, k_n_prior: float) -> tuple
     return k_t, max(float(k_n_prior), lower), "prior (data bound k_n from one side only)"
 
 
-def linear_modes_dataset(stiction: xr.Dataset, structure_cfg: Mapping, n_modes: int, grid_points: int,
-                         k_n_prior: float) -> xr.Dataset:
+def linear_modes_dataset(
+    stiction: xr.Dataset, structure_cfg: Mapping, n_modes: int, grid_points: int, k_n_prior: float
+) -> xr.Dataset:
     """Mass-normalised linear modes (Eq. 14): phi_i(x) on a grid, its slope,
     u_i, y_si, theta_si, the contact coordinates xi_i, eta_i and the values at
     the sensors and the driving point."""
@@ -183,20 +293,47 @@ def linear_modes_dataset(stiction: xr.Dataset, structure_cfg: Mapping, n_modes: 
     V = modes.shapes
     return xr.Dataset(
         {
-            "natural_frequency": ("mode", modes.frequencies_hz, {"units": "Hz", "long_name": "natural frequency of the linear model"}),
-            "phi": (("x", "mode"), phi, {"units": "kg^-1/2", "long_name": "mass-normalised lateral mode shape phi_i(x)"}),
+            "natural_frequency": (
+                "mode",
+                modes.frequencies_hz,
+                {"units": "Hz", "long_name": "natural frequency of the linear model"},
+            ),
+            "phi": (
+                ("x", "mode"),
+                phi,
+                {"units": "kg^-1/2", "long_name": "mass-normalised lateral mode shape phi_i(x)"},
+            ),
             "dphi_dx": (("x", "mode"), dphi, {"units": "kg^-1/2/m", "long_name": "slope of the mode shape"}),
             "u": ("mode", V[model.u_dof], {"units": "kg^-1/2", "long_name": "axial tip motion u_i"}),
             "y_s": ("mode", V[model.ys_dof], {"units": "kg^-1/2", "long_name": "string stretch y_si"}),
             "theta_s": ("mode", V[model.thetas_dof], {"units": "rad kg^-1/2", "long_name": "pendulum angle theta_si"}),
-            "xi": ("mode", model.xi_vector @ V, {"units": "kg^-1/2", "long_name": "tangential contact motion xi_i (Eq. 9, linear part)"}),
-            "eta": ("mode", model.eta_vector @ V, {"units": "kg^-1/2", "long_name": "normal contact motion eta_i (Eq. 8)"}),
-            "phi_sensor": (("sensor", "mode"), model.sensor_vectors @ V, {"units": "kg^-1/2", "long_name": "mode shape at the sensors"}),
-            "phi_drive": ("mode", model.force_vector @ V, {"units": "kg^-1/2", "long_name": "mode shape at the driving point d_p"}),
+            "xi": (
+                "mode",
+                model.xi_vector @ V,
+                {"units": "kg^-1/2", "long_name": "tangential contact motion xi_i (Eq. 9, linear part)"},
+            ),
+            "eta": (
+                "mode",
+                model.eta_vector @ V,
+                {"units": "kg^-1/2", "long_name": "normal contact motion eta_i (Eq. 8)"},
+            ),
+            "phi_sensor": (
+                ("sensor", "mode"),
+                model.sensor_vectors @ V,
+                {"units": "kg^-1/2", "long_name": "mode shape at the sensors"},
+            ),
+            "phi_drive": (
+                "mode",
+                model.force_vector @ V,
+                {"units": "kg^-1/2", "long_name": "mode shape at the driving point d_p"},
+            ),
             "k_t": ((), k_t, {"units": "N/m", "long_name": "tangential contact stiffness used"}),
             "k_n": ((), k_n, {"units": "N/m", "long_name": "normal contact stiffness used"}),
         },
-        coords={"x": ("x", x, {"units": "m", "long_name": "distance from the clamp"}), "mode": np.arange(1, n_modes + 1),
-                "sensor": list(structure_cfg["sensors"]["names"])},
+        coords={
+            "x": ("x", x, {"units": "m", "long_name": "distance from the clamp"}),
+            "mode": np.arange(1, n_modes + 1),
+            "sensor": list(structure_cfg["sensors"]["names"]),
+        },
         attrs={"k_n_choice": how, "normalisation": "phi^T M phi = 1"},
     )

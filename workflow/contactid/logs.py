@@ -23,8 +23,10 @@ def fmt(value, digits: int = 4) -> str:
     if isinstance(value, (float, np.floating)):
         return f"{float(value):.{digits}g}"
     if isinstance(value, Mapping):
-        return ", ".join(f"{fmt(k)} = " + (f"({fmt(v, digits)})" if isinstance(v, Mapping) else fmt(v, digits))
-                         for k, v in value.items())
+        return ", ".join(
+            f"{fmt(k)} = " + (f"({fmt(v, digits)})" if isinstance(v, Mapping) else fmt(v, digits))
+            for k, v in value.items()
+        )
     if isinstance(value, (list, tuple, np.ndarray)):
         return "[" + ", ".join(fmt(v, digits) for v in np.asarray(value, dtype=object).ravel()) + "]"
     return str(value)

@@ -80,13 +80,20 @@ def lsfd_residues(frequency_hz: np.ndarray, frf: np.ndarray, poles: np.ndarray) 
     for o in range(H.shape[0]):
         b = np.concatenate([H[o].real, H[o].imag])
         c = np.linalg.lstsq(Areal, b, rcond=None)[0]
-        res[o] = c[0:2 * len(poles):2] + 1j * c[1:2 * len(poles):2]
+        res[o] = c[0 : 2 * len(poles) : 2] + 1j * c[1 : 2 * len(poles) : 2]
         fit[o] = A @ c
     return res, fit
 
 
-def fit_modes(frequency_hz: np.ndarray, frf: np.ndarray, n_modes: int, band_hz: tuple[float, float],
-              order: int = 24, max_damping: float = 0.2, weights: np.ndarray | None = None) -> ModalEstimate:
+def fit_modes(
+    frequency_hz: np.ndarray,
+    frf: np.ndarray,
+    n_modes: int,
+    band_hz: tuple[float, float],
+    order: int = 24,
+    max_damping: float = 0.2,
+    weights: np.ndarray | None = None,
+) -> ModalEstimate:
     """Identify the ``n_modes`` dominant physical modes in ``band_hz``.
 
     Poles from LSCF at ``order`` are kept if stable, inside the band and with
@@ -99,7 +106,8 @@ def fit_modes(frequency_hz: np.ndarray, frf: np.ndarray, n_modes: int, band_hz: 
     if sel.sum() < 2 * order:
         raise ValueError(
             f"only {int(sel.sum())} frequency lines in the band {band_hz} Hz for an LSCF order of {order}; "
-            "use a longer FRF segment or a wider band")
+            "use a longer FRF segment or a wider band"
+        )
     fb, Hb = f[sel], np.atleast_2d(frf)[:, sel]
     Wb = None if weights is None else np.atleast_2d(weights)[:, sel]
     s = lscf_poles(fb, Hb, order, Wb)

@@ -31,8 +31,12 @@ def linear_model(structure_cfg: Mapping, linear_modes: xr.Dataset) -> FEModel:
 
 
 def _record(raw: xr.Dataset):
-    return (raw["force"].values, raw["acceleration"].values, float(raw.attrs["sampling_rate_hz"]),
-            float(raw.attrs["excitation_frequency_hz"]))
+    return (
+        raw["force"].values,
+        raw["acceleration"].values,
+        float(raw.attrs["sampling_rate_hz"]),
+        float(raw.attrs["excitation_frequency_hz"]),
+    )
 
 
 def generalized_coordinates_dataset(raw: xr.Dataset, linear_modes: xr.Dataset, n_harmonics: int) -> xr.Dataset:
@@ -43,20 +47,45 @@ def generalized_coordinates_dataset(raw: xr.Dataset, linear_modes: xr.Dataset, n
     t = raw["time"].values
     return xr.Dataset(
         {
-            "p_ddot_measured": (("mode", "time"), pdd, {"units": "kg^1/2 m/s^2", "long_name": "p''(t) = Phi^+ w''(t) (Eq. 15)"}),
-            "p_ddot": (("mode", "time"), synthesize(coef, f0, t, 0), {"units": "kg^1/2 m/s^2", "long_name": "Fourier series of p'' (Eq. 16)"}),
-            "p": (("mode", "time"), synthesize(coef, f0, t, -2), {"units": "kg^1/2 m", "long_name": "p(t) by analytic integration (Eq. 17)"}),
+            "p_ddot_measured": (
+                ("mode", "time"),
+                pdd,
+                {"units": "kg^1/2 m/s^2", "long_name": "p''(t) = Phi^+ w''(t) (Eq. 15)"},
+            ),
+            "p_ddot": (
+                ("mode", "time"),
+                synthesize(coef, f0, t, 0),
+                {"units": "kg^1/2 m/s^2", "long_name": "Fourier series of p'' (Eq. 16)"},
+            ),
+            "p": (
+                ("mode", "time"),
+                synthesize(coef, f0, t, -2),
+                {"units": "kg^1/2 m", "long_name": "p(t) by analytic integration (Eq. 17)"},
+            ),
             "amplitude": (("mode", "harmonic"), np.abs(coef), {"units": "kg^1/2 m/s^2", "long_name": "A_ki of Eq. 16"}),
-            "phase": (("mode", "harmonic"), np.angle(coef), {"units": "rad", "long_name": "psi_ki of Eq. 16 (sine reference)"}),
+            "phase": (
+                ("mode", "harmonic"),
+                np.angle(coef),
+                {"units": "rad", "long_name": "psi_ki of Eq. 16 (sine reference)"},
+            ),
         },
-        coords={"mode": linear_modes["mode"].values, "time": ("time", t, {"units": "s"}),
-                "harmonic": np.arange(1, n_harmonics + 1)},
+        coords={
+            "mode": linear_modes["mode"].values,
+            "time": ("time", t, {"units": "s"}),
+            "harmonic": np.arange(1, n_harmonics + 1),
+        },
         attrs={"excitation_frequency_hz": f0, "n_harmonics": n_harmonics},
     )
 
 
-def nonlinear_modes_dataset(gc: xr.Dataset, linear_modes: xr.Dataset, raw: xr.Dataset, structure_cfg: Mapping,
-                            n_harmonics: int, phase_limit_deg: float) -> xr.Dataset:
+def nonlinear_modes_dataset(
+    gc: xr.Dataset,
+    linear_modes: xr.Dataset,
+    raw: xr.Dataset,
+    structure_cfg: Mapping,
+    n_harmonics: int,
+    phase_limit_deg: float,
+) -> xr.Dataset:
     """Eq. 20's two real NNMs, the phase check, the NNM coordinates and the reconstruction of the
     driving-point acceleration (Fig. 5)."""
     force, acc, fs, f0 = _record(raw)
@@ -71,25 +100,46 @@ def nonlinear_modes_dataset(gc: xr.Dataset, linear_modes: xr.Dataset, raw: xr.Da
     return xr.Dataset(
         {
             "coefficient": (("nnm", "mode"), coef, {"units": "1", "long_name": "NNM on the linear modes (Eq. 20)"}),
-            "phase_spread": ("nnm", spread, {"units": "deg", "long_name": "largest phase deviation among terms of one frequency"}),
+            "phase_spread": (
+                "nnm",
+                spread,
+                {"units": "deg", "long_name": "largest phase deviation among terms of one frequency"},
+            ),
             "shape": (("x", "nnm"), lm["phi"].values @ coef.T, {"units": "kg^-1/2", "long_name": "NNM lateral shape"}),
             "u": ("nnm", coef @ lm["u"].values, {"units": "kg^-1/2", "long_name": "NNM axial tip motion"}),
             "y_s": ("nnm", coef @ lm["y_s"].values, {"units": "kg^-1/2", "long_name": "NNM string stretch"}),
-            "theta_s": ("nnm", coef @ lm["theta_s"].values, {"units": "rad kg^-1/2", "long_name": "NNM pendulum angle"}),
+            "theta_s": (
+                "nnm",
+                coef @ lm["theta_s"].values,
+                {"units": "rad kg^-1/2", "long_name": "NNM pendulum angle"},
+            ),
             "q": (("nnm", "time"), q, {"units": "kg^1/2 m", "long_name": "NNM coordinates (Eq. 19)"}),
             "q_ddot": (("nnm", "time"), qdd, {"units": "kg^1/2 m/s^2", "long_name": "NNM accelerations"}),
-            "drive_measured": ("time", measured, {"units": "m/s^2", "long_name": "measured driving-point acceleration"}),
-            "drive_reconstructed": ("time", recon, {"units": "m/s^2", "long_name": "driving-point acceleration from the NNMs (Fig. 5)"}),
+            "drive_measured": (
+                "time",
+                measured,
+                {"units": "m/s^2", "long_name": "measured driving-point acceleration"},
+            ),
+            "drive_reconstructed": (
+                "time",
+                recon,
+                {"units": "m/s^2", "long_name": "driving-point acceleration from the NNMs (Fig. 5)"},
+            ),
         },
         coords={"nnm": ["w", "3w"], "mode": lm["mode"].values, "x": lm["x"], "time": raw["time"]},
-        attrs={"reconstruction_nrmse": nrmse(recon, measured), "phase_limit_deg": phase_limit_deg,
-               "excitation_frequency_hz": f0,
-               "complex_modes": int(np.any(spread > phase_limit_deg)), "n_harmonics": n_harmonics},
+        attrs={
+            "reconstruction_nrmse": nrmse(recon, measured),
+            "phase_limit_deg": phase_limit_deg,
+            "excitation_frequency_hz": f0,
+            "complex_modes": int(np.any(spread > phase_limit_deg)),
+            "n_harmonics": n_harmonics,
+        },
     )
 
 
-def reduced_model_dataset(nnm: xr.Dataset, linear_modes: xr.Dataset, raw: xr.Dataset, structure_cfg: Mapping,
-                          n_harmonics: int) -> xr.Dataset:
+def reduced_model_dataset(
+    nnm: xr.Dataset, linear_modes: xr.Dataset, raw: xr.Dataset, structure_cfg: Mapping, n_harmonics: int
+) -> xr.Dataset:
     """The Galerkin reduced model on the NNMs (Eqs. 10-12) and the paper's S(t), N(t) by force-state mapping."""
     force, acc, fs, f0 = _record(raw)
     model = linear_model(structure_cfg, linear_modes)
@@ -101,11 +151,31 @@ def reduced_model_dataset(nnm: xr.Dataset, linear_modes: xr.Dataset, raw: xr.Dat
     centre = lambda x: x - x.mean()  # noqa: E731
     return xr.Dataset(
         {
-            "reduced_mass": (("nnm", "nnm_"), g["reduced_mass"], {"units": "1", "long_name": "generalized mass (Eq. 12)"}),
-            "reduced_stiffness": (("nnm", "nnm_"), g["reduced_stiffness"], {"units": "1/s^2", "long_name": "generalized stiffness without contact springs"}),
-            "reduced_force": ("nnm", g["reduced_force"], {"units": "kg^-1/2", "long_name": "generalized force of a unit force at d_p"}),
-            "S": ("time", centre(g["S"]), {"units": "N", "long_name": "friction force S(t), paper's chain, mean removed"}),
-            "N_dyn": ("time", centre(g["N_dyn"]), {"units": "N", "long_name": "dynamic normal force, paper's chain, mean removed"}),
+            "reduced_mass": (
+                ("nnm", "nnm_"),
+                g["reduced_mass"],
+                {"units": "1", "long_name": "generalized mass (Eq. 12)"},
+            ),
+            "reduced_stiffness": (
+                ("nnm", "nnm_"),
+                g["reduced_stiffness"],
+                {"units": "1/s^2", "long_name": "generalized stiffness without contact springs"},
+            ),
+            "reduced_force": (
+                "nnm",
+                g["reduced_force"],
+                {"units": "kg^-1/2", "long_name": "generalized force of a unit force at d_p"},
+            ),
+            "S": (
+                "time",
+                centre(g["S"]),
+                {"units": "N", "long_name": "friction force S(t), paper's chain, mean removed"},
+            ),
+            "N_dyn": (
+                "time",
+                centre(g["N_dyn"]),
+                {"units": "N", "long_name": "dynamic normal force, paper's chain, mean removed"},
+            ),
             "xi": ("time", centre(g["xi"]), {"units": "m", "long_name": "xi(t) from the NNMs, mean removed"}),
             "eta": ("time", centre(g["eta"]), {"units": "m", "long_name": "eta(t) from the NNMs, mean removed"}),
         },
@@ -114,9 +184,18 @@ def reduced_model_dataset(nnm: xr.Dataset, linear_modes: xr.Dataset, raw: xr.Dat
     )
 
 
-def contact_forces_dataset(raw: xr.Dataset, paper: xr.Dataset, linear_modes: xr.Dataset, modal: xr.Dataset,
-                           stiction: xr.Dataset, structure_cfg: Mapping, n_harmonics: int,
-                           truth: xr.Dataset | None, observability_limit: float = 0.1, structures=()) -> xr.Dataset:
+def contact_forces_dataset(
+    raw: xr.Dataset,
+    paper: xr.Dataset,
+    linear_modes: xr.Dataset,
+    modal: xr.Dataset,
+    stiction: xr.Dataset,
+    structure_cfg: Mapping,
+    n_harmonics: int,
+    truth: xr.Dataset | None,
+    observability_limit: float = 0.1,
+    structures=(),
+) -> xr.Dataset:
     """Both methods side by side: the working method (per-harmonic inverse identification) and the
     paper's chain; the paper's error decomposed into k_t dxi and k_n deta; the working method's
     sensitivity to the linear chain's stiffness intervals and to ``structures`` (the structures the random test
@@ -137,8 +216,11 @@ def contact_forces_dataset(raw: xr.Dataset, paper: xr.Dataset, linear_modes: xr.
         for val in (a, b):
             ch = {"k_t": val, "k_n": k_n} if name == "k_t" else {"k_t": k_t, "k_n": val}
             m2 = assemble(model.params.with_contact(**ch))
-            res.append(inverse_identification(m2, modal_damping_vector(m2, modal["damping_ratio"].values), force, acc,
-                                              fs, f0, n_harmonics))
+            res.append(
+                inverse_identification(
+                    m2, modal_damping_vector(m2, modal["damping_ratio"].values), force, acc, fs, f0, n_harmonics
+                )
+            )
         spreads[name] = {q: nrmse(getattr(res[0], q), getattr(res[1], q)) for q in ("S", "N_dyn", "xi", "eta")}
     eta_spread = max(spreads["k_n"]["eta"], spreads["k_t"]["eta"])
     structure_spread = {}
@@ -167,9 +249,13 @@ def contact_forces_dataset(raw: xr.Dataset, paper: xr.Dataset, linear_modes: xr.
     k1, k2 = np.linalg.lstsq(A, inv.N_dyn, rcond=None)[0]
     attrs = {
         "method": "inverse: per-harmonic unknown-input identification with the identified linear model",
-        "n_harmonics": n_harmonics, "excitation_frequency_hz": f0, "eta_observable": int(eta_observable), "eta_spread_over_stiffness_intervals": eta_spread,
+        "n_harmonics": n_harmonics,
+        "excitation_frequency_hz": f0,
+        "eta_observable": int(eta_observable),
+        "eta_spread_over_stiffness_intervals": eta_spread,
         "eta_spread_over_structures": structure_spread.get("eta", float("nan")),
-        "normal_stiffness_from_n_eta_n_per_m": float(k1), "normal_hardening_n_per_m2": float(k2),
+        "normal_stiffness_from_n_eta_n_per_m": float(k1),
+        "normal_hardening_n_per_m2": float(k2),
         "paper_S_decomposition_nrmse": nrmse(paper["S"].values, S_expl),
         "paper_N_decomposition_nrmse": nrmse(paper["N_dyn"].values, N_expl),
         "paper_xi_unrepresented_fraction": nrmse(paper["xi"].values, inv.xi),
@@ -177,7 +263,11 @@ def contact_forces_dataset(raw: xr.Dataset, paper: xr.Dataset, linear_modes: xr.
     }
     data = {
         "S": ("time", inv.S, {"units": "N", "long_name": "friction force S(t), working method, mean removed"}),
-        "N_dyn": ("time", inv.N_dyn, {"units": "N", "long_name": "dynamic normal force N(t) - N0, working method, mean removed"}),
+        "N_dyn": (
+            "time",
+            inv.N_dyn,
+            {"units": "N", "long_name": "dynamic normal force N(t) - N0, working method, mean removed"},
+        ),
         "xi": ("time", inv.xi, {"units": "m", "long_name": "xi(t), working method, mean removed"}),
         "eta": ("time", inv.eta, {"units": "m", "long_name": "eta(t), working method, mean removed"}),
         "xi_dot": ("time", inv.xi_dot, {"units": "m/s", "long_name": "d xi/dt, working method"}),
@@ -192,11 +282,18 @@ def contact_forces_dataset(raw: xr.Dataset, paper: xr.Dataset, linear_modes: xr.
     }
     if truth is not None:
         tS, tN, txi, teta = (truth[k].values for k in ("S", "N", "xi", "eta"))
-        for method, (S, N, xi, eta) in {"": (inv.S, inv.N_dyn, inv.xi, inv.eta),
-                                        "paper_": (paper["S"].values, paper["N_dyn"].values, paper["xi"].values,
-                                                   paper["eta"].values)}.items():
-            attrs.update({f"{method}S_nrmse": nrmse(S, tS), f"{method}N_nrmse": nrmse(N, tN),
-                          f"{method}xi_nrmse": nrmse(xi, txi), f"{method}eta_nrmse": nrmse(eta, teta)})
+        for method, (S, N, xi, eta) in {
+            "": (inv.S, inv.N_dyn, inv.xi, inv.eta),
+            "paper_": (paper["S"].values, paper["N_dyn"].values, paper["xi"].values, paper["eta"].values),
+        }.items():
+            attrs.update(
+                {
+                    f"{method}S_nrmse": nrmse(S, tS),
+                    f"{method}N_nrmse": nrmse(N, tN),
+                    f"{method}xi_nrmse": nrmse(xi, txi),
+                    f"{method}eta_nrmse": nrmse(eta, teta),
+                }
+            )
         data["S_truth"] = ("time", tS - tS.mean(), {"units": "N", "long_name": "true S, mean removed"})
         data["N_dyn_truth"] = ("time", tN - tN.mean(), {"units": "N", "long_name": "true N - N0, mean removed"})
         data["xi_truth"] = ("time", txi - txi.mean(), {"units": "m", "long_name": "true xi, mean removed"})
@@ -204,8 +301,9 @@ def contact_forces_dataset(raw: xr.Dataset, paper: xr.Dataset, linear_modes: xr.
     return xr.Dataset(data, coords={"time": raw["time"], "harmonic": np.arange(1, n_harmonics + 1)}, attrs=attrs)
 
 
-def harmonic_study(raw: xr.Dataset, truth: xr.Dataset, linear_modes: xr.Dataset, modal: xr.Dataset,
-                   structure_cfg: Mapping, counts) -> "pandas.DataFrame":  # noqa: F821
+def harmonic_study(
+    raw: xr.Dataset, truth: xr.Dataset, linear_modes: xr.Dataset, modal: xr.Dataset, structure_cfg: Mapping, counts
+) -> "pandas.DataFrame":  # noqa: F821
     """Errors of the working method against the truth for several harmonic counts K, beside the
     truth's own truncation floor (its S kept to K harmonics)."""
     import pandas as pd
@@ -218,7 +316,14 @@ def harmonic_study(raw: xr.Dataset, truth: xr.Dataset, linear_modes: xr.Dataset,
     for K in counts:
         inv = inverse_identification(model, zeta, force, acc, fs, f0, int(K))
         S_trunc = synthesize(fourier_series(truth["S"].values, fs, f0, int(K)), f0, t, 0)[0]
-        rows.append({"K": int(K), "S_nrmse": nrmse(inv.S, truth["S"].values), "N_nrmse": nrmse(inv.N_dyn, truth["N"].values),
-                     "xi_nrmse": nrmse(inv.xi, truth["xi"].values), "eta_nrmse": nrmse(inv.eta, truth["eta"].values),
-                     "S_truncation_floor": nrmse(S_trunc, truth["S"].values)})
+        rows.append(
+            {
+                "K": int(K),
+                "S_nrmse": nrmse(inv.S, truth["S"].values),
+                "N_nrmse": nrmse(inv.N_dyn, truth["N"].values),
+                "xi_nrmse": nrmse(inv.xi, truth["xi"].values),
+                "eta_nrmse": nrmse(inv.eta, truth["eta"].values),
+                "S_truncation_floor": nrmse(S_trunc, truth["S"].values),
+            }
+        )
     return pd.DataFrame(rows)

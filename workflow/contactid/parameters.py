@@ -9,7 +9,7 @@ the configuration, where each default is documented with its reasoning
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from typing import Mapping
 
 STANDARD_GRAVITY = 9.80665  # m/s^2

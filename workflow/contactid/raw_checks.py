@@ -17,8 +17,10 @@ def driving_point_index(raw: xr.Dataset, excitation_position_m: float, path: str
     pos = np.asarray(raw["position"].values, dtype=float)
     i = int(np.argmin(np.abs(pos - excitation_position_m)))
     if abs(pos[i] - excitation_position_m) > tol_m:
-        raise RawDataError(f"{path}: no accelerometer at the driving point d_p = {excitation_position_m} m "
-                           f"(positions {pos.tolist()} m); the response control and Table 2 refer to it")
+        raise RawDataError(
+            f"{path}: no accelerometer at the driving point d_p = {excitation_position_m} m "
+            f"(positions {pos.tolist()} m); the response control and Table 2 refer to it"
+        )
     return i
 
 
@@ -38,16 +40,32 @@ def dual_sine_check_dataset(raw: xr.Dataset, structure_cfg: Mapping, path: str, 
     last = np.abs(harmonic_content(acc[i, -n:], fs, f0, (1, 3)))
     return xr.Dataset(
         {
-            "acceleration_amplitude": (("sensor", "harmonic"), np.abs(c_acc), {"units": "m/s^2", "long_name": "harmonic amplitude"}),
-            "acceleration_phase": (("sensor", "harmonic"), np.angle(c_acc), {"units": "rad", "long_name": "harmonic phase (sine reference)"}),
+            "acceleration_amplitude": (
+                ("sensor", "harmonic"),
+                np.abs(c_acc),
+                {"units": "m/s^2", "long_name": "harmonic amplitude"},
+            ),
+            "acceleration_phase": (
+                ("sensor", "harmonic"),
+                np.angle(c_acc),
+                {"units": "rad", "long_name": "harmonic phase (sine reference)"},
+            ),
             "force_amplitude": ("harmonic", np.abs(c_force), {"units": "N", "long_name": "force harmonic amplitude"}),
             "force_phase": ("harmonic", np.angle(c_force), {"units": "rad", "long_name": "force harmonic phase"}),
-            "stationarity_change": ("excitation_harmonic", np.abs(last / first - 1),
-                                    {"units": "1", "long_name": "driving-point harmonic change, last vs first third"}),
+            "stationarity_change": (
+                "excitation_harmonic",
+                np.abs(last / first - 1),
+                {"units": "1", "long_name": "driving-point harmonic change, last vs first third"},
+            ),
         },
         coords={"sensor": raw["sensor"].values, "harmonic": h, "excitation_harmonic": [1, 3]},
-        attrs={"A1_m_per_s2": float(np.abs(c_acc[i, 0])), "A2_m_per_s2": float(np.abs(c_acc[i, 2])) if max_harmonic >= 3 else np.nan,
-               "excitation_frequency_hz": f0, "periods": float(acc.shape[1] / fs * f0), "driving_point_sensor": str(raw["sensor"].values[i])},
+        attrs={
+            "A1_m_per_s2": float(np.abs(c_acc[i, 0])),
+            "A2_m_per_s2": float(np.abs(c_acc[i, 2])) if max_harmonic >= 3 else np.nan,
+            "excitation_frequency_hz": f0,
+            "periods": float(acc.shape[1] / fs * f0),
+            "driving_point_sensor": str(raw["sensor"].values[i]),
+        },
     )
 
 
@@ -57,8 +75,14 @@ def dual_sine_check_dataset(raw: xr.Dataset, structure_cfg: Mapping, path: str, 
 # beyond half its limit is a warning stored in the check dataset and shown in the report
 # ------------------------------------------------------------------------------------------
 
-CHECK_DEFAULTS = {"clip_samples": 8, "frequency_tolerance_cycles": 0.02, "stationarity_tolerance": 0.05,
-                  "min_coherence": 0.5, "coherence_fraction": 0.5, "max_frf_resolution_hz": 0.5}
+CHECK_DEFAULTS = {
+    "clip_samples": 8,
+    "frequency_tolerance_cycles": 0.02,
+    "stationarity_tolerance": 0.05,
+    "min_coherence": 0.5,
+    "coherence_fraction": 0.5,
+    "max_frf_resolution_hz": 0.5,
+}
 
 
 def check_settings(checks: Mapping | None) -> dict:
@@ -77,8 +101,10 @@ def _channels(raw: xr.Dataset, path: str = "record"):
     for name, x in chans:
         big = float(np.max(np.abs(x))) if x.size else 0.0
         if big > PHYSICAL_LIMIT:
-            raise RawDataError(f"{path}: channel {name}: magnitude check failed: |value| reaches {big:.3g} (N or m/s^2), "
-                               f"beyond any vibration test ({PHYSICAL_LIMIT:g}); check the channel's units and sensitivity")
+            raise RawDataError(
+                f"{path}: channel {name}: magnitude check failed: |value| reaches {big:.3g} (N or m/s^2), "
+                f"beyond any vibration test ({PHYSICAL_LIMIT:g}); check the channel's units and sensitivity"
+            )
     yield from chans
 
 
@@ -98,9 +124,11 @@ def clipping_warnings(channels, path: str, clip_samples: int, drive: str) -> lis
     for name, x in channels:
         at = samples_at_limit(x)
         if at >= clip_samples:
-            raise RawDataError(f"{path}: channel {name}: clipping check failed: {at} samples sit at the range limit "
-                               f"({x.max():.6g} / {x.min():.6g}); raw_checks.clip_samples = {clip_samples}. "
-                               f"Lower the input range's gain or the {drive} and record again")
+            raise RawDataError(
+                f"{path}: channel {name}: clipping check failed: {at} samples sit at the range limit "
+                f"({x.max():.6g} / {x.min():.6g}); raw_checks.clip_samples = {clip_samples}. "
+                f"Lower the input range's gain or the {drive} and record again"
+            )
         if at >= max(2, clip_samples // 2):
             warnings.append(f"{name}: {at} samples at the range limit (clipping check: {clip_samples})")
     return warnings
@@ -124,8 +152,12 @@ def recovered_frequency(x: np.ndarray, fs: float, declared_hz: float) -> tuple[f
     def neg_mag(f):
         return -abs(np.dot(y, np.exp(-2j * np.pi * f * t)))
 
-    res = minimize_scalar(neg_mag, bounds=(max((k - 1) * df, 0.0), (k + 1) * df), method="bounded",
-                          options={"xatol": 1e-7 * max(k, 1) * df})
+    res = minimize_scalar(
+        neg_mag,
+        bounds=(max((k - 1) * df, 0.0), (k + 1) * df),
+        method="bounded",
+        options={"xatol": 1e-7 * max(k, 1) * df},
+    )
     h = max(1, int(round(res.x / declared_hz)))
     return float(res.x / h), h
 
@@ -143,13 +175,17 @@ def validate_dual_sine(raw: xr.Dataset, path: str, checks: Mapping) -> list[str]
     f_rec, h = recovered_frequency(np.asarray(raw["force"].values, float), fs, f0)
     drift_cycles = abs(f_rec - f0) * duration
     if h not in (1, 2, 3) or drift_cycles > c["frequency_tolerance_cycles"]:
-        raise RawDataError(f"{path}: channel force: excitation frequency check failed: the record's excitation is at "
-                           f"{f_rec:.6g} Hz (strongest line at harmonic {h}), the file declares {f0:.6g} Hz, "
-                           f"{drift_cycles:.3g} cycles apart over the record (raw_checks.frequency_tolerance_cycles = "
-                           f"{c['frequency_tolerance_cycles']}); correct excitation_frequency_hz")
+        raise RawDataError(
+            f"{path}: channel force: excitation frequency check failed: the record's excitation is at "
+            f"{f_rec:.6g} Hz (strongest line at harmonic {h}), the file declares {f0:.6g} Hz, "
+            f"{drift_cycles:.3g} cycles apart over the record (raw_checks.frequency_tolerance_cycles = "
+            f"{c['frequency_tolerance_cycles']}); correct excitation_frequency_hz"
+        )
     if drift_cycles > 0.5 * c["frequency_tolerance_cycles"]:
-        warnings.append(f"force: excitation at {f_rec:.6g} Hz against {f0:.6g} Hz declared ({drift_cycles:.3g} cycles "
-                        "over the record)")
+        warnings.append(
+            f"force: excitation at {f_rec:.6g} Hz against {f0:.6g} Hz declared ({drift_cycles:.3g} cycles "
+            "over the record)"
+        )
     third = n // 3
     for name, x in channels:
         whole = np.abs(harmonic_content(x, fs, f0, (1, 3)))
@@ -158,11 +194,13 @@ def validate_dual_sine(raw: xr.Dataset, path: str, checks: Mapping) -> list[str]
         change = np.abs(last - first) / np.maximum(whole, 0.05 * whole.max())
         worst = int(np.argmax(change))
         if change[worst] > c["stationarity_tolerance"]:
-            raise RawDataError(f"{path}: channel {name}: stationarity check failed: the amplitude at {(1, 3)[worst]} w "
-                               f"changes by {change[worst]:.3g} between the record's first and last thirds "
-                               f"(raw_checks.stationarity_tolerance = {c['stationarity_tolerance']}); record after the "
-                               "transient has died out, or raise the tolerance to accept a drifting test (the gap "
-                               "diagnosis can model a drifting preload)")
+            raise RawDataError(
+                f"{path}: channel {name}: stationarity check failed: the amplitude at {(1, 3)[worst]} w "
+                f"changes by {change[worst]:.3g} between the record's first and last thirds "
+                f"(raw_checks.stationarity_tolerance = {c['stationarity_tolerance']}); record after the "
+                "transient has died out, or raise the tolerance to accept a drifting test (the gap "
+                "diagnosis can model a drifting preload)"
+            )
         if change[worst] > 0.5 * c["stationarity_tolerance"]:
             warnings.append(f"{name}: amplitude at {(1, 3)[worst]} w changes by {change[worst]:.3g} over the record")
     return warnings
@@ -176,14 +214,18 @@ def validate_random_test(raw: xr.Dataset, path: str, checks: Mapping, segment_le
     warnings = clipping_warnings(list(_channels(raw, path)), path, c["clip_samples"], "force level")
     need = 2 * segment_length * blocks
     if n < need:
-        raise RawDataError(f"{path}: record length check failed: {n} samples, fewer than 2 x frf.segment_length x "
-                           f"modal.uncertainty_blocks = {need}; record {need / fs:.1f} s or more, or lower "
-                           "frf.segment_length")
+        raise RawDataError(
+            f"{path}: record length check failed: {n} samples, fewer than 2 x frf.segment_length x "
+            f"modal.uncertainty_blocks = {need}; record {need / fs:.1f} s or more, or lower "
+            "frf.segment_length"
+        )
     df = fs / segment_length
     if df > c["max_frf_resolution_hz"]:
-        raise RawDataError(f"{path}: FRF resolution check failed: {fs:g} Hz / frf.segment_length {segment_length} = "
-                           f"{df:.3g} Hz between lines, coarser than raw_checks.max_frf_resolution_hz = "
-                           f"{c['max_frf_resolution_hz']}; raise frf.segment_length (and the record length)")
+        raise RawDataError(
+            f"{path}: FRF resolution check failed: {fs:g} Hz / frf.segment_length {segment_length} = "
+            f"{df:.3g} Hz between lines, coarser than raw_checks.max_frf_resolution_hz = "
+            f"{c['max_frf_resolution_hz']}; raise frf.segment_length (and the record length)"
+        )
     return warnings
 
 
@@ -198,10 +240,12 @@ def validate_coherence(frf: xr.Dataset, band_hz, path: str, checks: Mapping) -> 
         share = float(np.mean(coh[band] >= c["min_coherence"]))
         shares[str(s)] = share
         if share < c["coherence_fraction"]:
-            raise RawDataError(f"{path}: channel {s}: coherence check failed: only {share:.1%} of the lines in "
-                               f"{band_hz[0]:g}-{band_hz[1]:g} Hz reach coherence {c['min_coherence']} "
-                               f"(raw_checks.coherence_fraction = {c['coherence_fraction']}); raise the force level, "
-                               "average longer, or check the sensor and its cable")
+            raise RawDataError(
+                f"{path}: channel {s}: coherence check failed: only {share:.1%} of the lines in "
+                f"{band_hz[0]:g}-{band_hz[1]:g} Hz reach coherence {c['min_coherence']} "
+                f"(raw_checks.coherence_fraction = {c['coherence_fraction']}); raise the force level, "
+                "average longer, or check the sensor and its cable"
+            )
         if share < 0.5 * (1.0 + c["coherence_fraction"]):
             warnings.append(f"{s}: {share:.1%} of the band's lines reach coherence {c['min_coherence']}")
     return shares, warnings

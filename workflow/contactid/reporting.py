@@ -24,9 +24,18 @@ def table1(modal: xr.Dataset, truth: xr.Dataset | None) -> pd.DataFrame:
     for i, f in enumerate(modal["natural_frequency"].values):
         paper = TABLE1_HZ[i] if i < len(TABLE1_HZ) else np.nan
         tr = float(truth["natural_frequency"].values[i]) if truth is not None else np.nan
-        rows.append({"mode": i + 1, "identified_hz": f, "std_hz": float(modal["natural_frequency_std"].values[i]),
-                     "damping_ratio": float(modal["damping_ratio"].values[i]), "paper_hz": paper, "truth_hz": tr,
-                     "diff_vs_paper_pct": _pct(f, paper), "diff_vs_truth_pct": _pct(f, tr)})
+        rows.append(
+            {
+                "mode": i + 1,
+                "identified_hz": f,
+                "std_hz": float(modal["natural_frequency_std"].values[i]),
+                "damping_ratio": float(modal["damping_ratio"].values[i]),
+                "paper_hz": paper,
+                "truth_hz": tr,
+                "diff_vs_paper_pct": _pct(f, paper),
+                "diff_vs_truth_pct": _pct(f, tr),
+            }
+        )
     return pd.DataFrame(rows)
 
 
@@ -38,19 +47,26 @@ def table3(stiction: xr.Dataset, truth: xr.Dataset | None) -> pd.DataFrame:
         bounded = not math.isinf(hi)
         value = float(stiction[name]) if bounded else np.nan
         tr = float(truth[name]) if truth is not None else np.nan
-        rows.append({"parameter": name, "identified_n_per_m": value, "interval_low_n_per_m": lo,
-                     "interval_high_n_per_m": hi, "reported_as": "value" if bounded else "lower bound",
-                     "paper_n_per_m": TABLE3[name], "truth_n_per_m": tr,
-                     "diff_vs_paper_pct": _pct(value if bounded else lo, TABLE3[name]),
-                     "diff_vs_truth_pct": _pct(value if bounded else lo, tr),
-                     "truth_inside_interval": bool(lo <= tr <= hi) if np.isfinite(tr) else None})
+        rows.append(
+            {
+                "parameter": name,
+                "identified_n_per_m": value,
+                "interval_low_n_per_m": lo,
+                "interval_high_n_per_m": hi,
+                "reported_as": "value" if bounded else "lower bound",
+                "paper_n_per_m": TABLE3[name],
+                "truth_n_per_m": tr,
+                "diff_vs_paper_pct": _pct(value if bounded else lo, TABLE3[name]),
+                "diff_vs_truth_pct": _pct(value if bounded else lo, tr),
+                "truth_inside_interval": bool(lo <= tr <= hi) if np.isfinite(tr) else None,
+            }
+        )
     return pd.DataFrame(rows)
 
 
 def stiction_summary(stiction: xr.Dataset) -> dict:
     """The ``stiction`` block of summary.json: k_t and k_n, or k_n_lower_bound."""
-    out = {"k_t": float(stiction["k_t"]),
-           "k_t_interval": [float(v) for v in stiction["k_t_interval"].values]}
+    out = {"k_t": float(stiction["k_t"]), "k_t_interval": [float(v) for v in stiction["k_t_interval"].values]}
     lo, hi = (float(v) for v in stiction["k_n_interval"].values)
     if math.isinf(hi):
         out["k_n_lower_bound"] = lo
@@ -61,13 +77,17 @@ def stiction_summary(stiction: xr.Dataset) -> dict:
 
 
 def linear_summary(modal: xr.Dataset, stiction: xr.Dataset, truth: xr.Dataset | None) -> dict:
-    out = {"natural_frequencies_hz": [float(f) for f in modal["natural_frequency"].values],
-           "damping_ratios": [float(z) for z in modal["damping_ratio"].values],
-           "stiction": stiction_summary(stiction)}
+    out = {
+        "natural_frequencies_hz": [float(f) for f in modal["natural_frequency"].values],
+        "damping_ratios": [float(z) for z in modal["damping_ratio"].values],
+        "stiction": stiction_summary(stiction),
+    }
     if truth is not None:
         n = modal.sizes["mode"]
-        out["truth"] = {"natural_frequencies_hz": [float(f) for f in truth["natural_frequency"].values[:n]],
-                        "stiction": {"k_t": float(truth["k_t"]), "k_n": float(truth["k_n"])}}
+        out["truth"] = {
+            "natural_frequencies_hz": [float(f) for f in truth["natural_frequency"].values[:n]],
+            "stiction": {"k_t": float(truth["k_t"]), "k_n": float(truth["k_n"])},
+        }
     return out
 
 
@@ -76,8 +96,11 @@ def load_case_summary(checks: Mapping[str, xr.Dataset], truths: Mapping[str, xr.
     warnings (``data_warnings``), and (rig cases) the truth's force amplitudes and contact extremes."""
     out = {"load_cases": {}, "data_warnings": {}}
     for case, ds in checks.items():
-        out["load_cases"][case] = {"A1_m_per_s2": ds.attrs["A1_m_per_s2"], "A2_m_per_s2": ds.attrs["A2_m_per_s2"],
-                                   "excitation_frequency_hz": ds.attrs["excitation_frequency_hz"]}
+        out["load_cases"][case] = {
+            "A1_m_per_s2": ds.attrs["A1_m_per_s2"],
+            "A2_m_per_s2": ds.attrs["A2_m_per_s2"],
+            "excitation_frequency_hz": ds.attrs["excitation_frequency_hz"],
+        }
         out["data_warnings"][case] = json.loads(ds.attrs.get("warnings", "[]"))
     if truths:
         out["truth_load_cases"] = {}
@@ -86,9 +109,15 @@ def load_case_summary(checks: Mapping[str, xr.Dataset], truths: Mapping[str, xr.
             n = tr["N"].values
             slip = np.abs(tr["S"].values) / np.where(n > 0, mu * n, np.inf)
             out["truth_load_cases"][case] = {
-                "F1_n": tr.attrs["F1_n"], "F3_n": tr.attrs["F3_n"], "N_min_n": float(n.min()), "N_max_n": float(n.max()),
-                "max_S_over_mu_N": float(slip.max()), "energy_residual": tr.attrs.get("energy_energy_residual"),
-                "target_A1_m_per_s2": tr.attrs["target_A1_m_per_s2"], "target_A2_m_per_s2": tr.attrs["target_A2_m_per_s2"]}
+                "F1_n": tr.attrs["F1_n"],
+                "F3_n": tr.attrs["F3_n"],
+                "N_min_n": float(n.min()),
+                "N_max_n": float(n.max()),
+                "max_S_over_mu_N": float(slip.max()),
+                "energy_residual": tr.attrs.get("energy_energy_residual"),
+                "target_A1_m_per_s2": tr.attrs["target_A1_m_per_s2"],
+                "target_A2_m_per_s2": tr.attrs["target_A2_m_per_s2"],
+            }
     return out
 
 
@@ -165,8 +194,15 @@ def plot_fig05(nnm: xr.Dataset, case: str, png: str, pdf: str) -> None:
     sel = slice(0, int(np.searchsorted(t, 3.0 / nnm.attrs["excitation_frequency_hz"])))
     fig, ax = plt.subplots(figsize=(6.5, 3.8))
     ax.plot(1e3 * t[sel], nnm["drive_measured"].values[sel], "-", lw=1.2, color="C0", label="measured")
-    ax.plot(1e3 * t[sel], nnm["drive_reconstructed"].values[sel], "o", ms=3, mfc="none", color="C3",
-            label=f"reconstructed from the NNMs (NRMSE {100 * nnm.attrs['reconstruction_nrmse']:.1f} %)")
+    ax.plot(
+        1e3 * t[sel],
+        nnm["drive_reconstructed"].values[sel],
+        "o",
+        ms=3,
+        mfc="none",
+        color="C3",
+        label=f"reconstructed from the NNMs (NRMSE {100 * nnm.attrs['reconstruction_nrmse']:.1f} %)",
+    )
     ax.set_xlabel("time (ms)")
     ax.set_ylabel("acceleration at d$_p$ (m s$^{-2}$)")
     ax.set_title(f"Driving-point acceleration, {case}")
@@ -188,10 +224,21 @@ def plot_fig06(forces: Mapping[str, xr.Dataset], png: str, pdf: str) -> None:
     fig, axes = plt.subplots(2, len(cases), figsize=(3.3 * len(cases), 6.2), squeeze=False)
     for j, case in enumerate(cases):
         ds = forces[case]
-        for row, (F, X, Fp, Xp, Ft, Xt, xl, yl) in enumerate((
+        for row, (F, X, Fp, Xp, Ft, Xt, xl, yl) in enumerate(
+            (
                 ("S", "xi", "S_paper", "xi_paper", "S_truth", "xi_truth", r"$\xi$ ($\mu$m)", "S (N)"),
-                ("N_dyn", "eta", "N_dyn_paper", "eta_paper", "N_dyn_truth", "eta_truth", r"$\eta$ ($\mu$m)",
-                 "N - N$_0$ (N)"))):
+                (
+                    "N_dyn",
+                    "eta",
+                    "N_dyn_paper",
+                    "eta_paper",
+                    "N_dyn_truth",
+                    "eta_truth",
+                    r"$\eta$ ($\mu$m)",
+                    "N - N$_0$ (N)",
+                ),
+            )
+        ):
             ax = axes[row, j]
             if Ft in ds:
                 ax.plot(1e6 * ds[Xt].values, ds[Ft].values, "-", color="0.6", lw=3, label="rig truth")
@@ -217,14 +264,20 @@ def contact_force_summary(forces: Mapping[str, xr.Dataset], nnms: Mapping[str, x
     work, paper = {}, {}
     for case, ds in forces.items():
         a = ds.attrs
-        w = {"eta_observable": bool(a["eta_observable"]), "eta_spread_over_structures": a.get("eta_spread_over_structures"),
-             "normal_stiffness_from_n_eta_n_per_m": a["normal_stiffness_from_n_eta_n_per_m"],
-             "normal_hardening_n_per_m2": a["normal_hardening_n_per_m2"], "n_harmonics": a["n_harmonics"]}
-        p = {"nnm_phase_spread_deg": [float(v) for v in nnms[case]["phase_spread"].values],
-             "complex_modes": bool(nnms[case].attrs["complex_modes"]),
-             "reconstruction_nrmse": nnms[case].attrs["reconstruction_nrmse"],
-             "S_decomposition_nrmse": a["paper_S_decomposition_nrmse"],
-             "N_decomposition_nrmse": a["paper_N_decomposition_nrmse"]}
+        w = {
+            "eta_observable": bool(a["eta_observable"]),
+            "eta_spread_over_structures": a.get("eta_spread_over_structures"),
+            "normal_stiffness_from_n_eta_n_per_m": a["normal_stiffness_from_n_eta_n_per_m"],
+            "normal_hardening_n_per_m2": a["normal_hardening_n_per_m2"],
+            "n_harmonics": a["n_harmonics"],
+        }
+        p = {
+            "nnm_phase_spread_deg": [float(v) for v in nnms[case]["phase_spread"].values],
+            "complex_modes": bool(nnms[case].attrs["complex_modes"]),
+            "reconstruction_nrmse": nnms[case].attrs["reconstruction_nrmse"],
+            "S_decomposition_nrmse": a["paper_S_decomposition_nrmse"],
+            "N_decomposition_nrmse": a["paper_N_decomposition_nrmse"],
+        }
         for q in ("S", "N", "xi", "eta"):
             if f"{q}_nrmse" in a:
                 w[f"{q}_nrmse"] = a[f"{q}_nrmse"]
@@ -242,25 +295,58 @@ def table4(fit: xr.Dataset, truth_friction: Mapping | None) -> pd.DataFrame:
         tr = float(truth_friction[keys[name]]) if truth_friction else np.nan
         v = float(fit["parameter_value"].values[i])
         lo, hi = float(fit["interval_low"].values[i]), float(fit["interval_high"].values[i])
-        kind = ("value" if fit["bounded_below"].values[i] and fit["bounded_above"].values[i] else
-                "upper bound" if fit["bounded_above"].values[i] else
-                "lower bound" if fit["bounded_below"].values[i] else "not determined")
-        rows.append({"parameter": name, "identified": v, "interval_low": lo, "interval_high": hi, "reported_as": kind,
-                     "paper_chain_fit": float(fit["paper_parameter_value"].values[i]) if "paper_parameter_value" in fit else np.nan,
-                     "paper_value": TABLE4[name], "truth": tr,
-                     "diff_vs_truth_pct": _pct(v, tr) if name != "e_t" else np.nan,
-                     "truth_inside_interval": bool(lo <= tr <= hi) if np.isfinite(tr) else None})
+        kind = (
+            "value"
+            if fit["bounded_below"].values[i] and fit["bounded_above"].values[i]
+            else "upper bound"
+            if fit["bounded_above"].values[i]
+            else "lower bound"
+            if fit["bounded_below"].values[i]
+            else "not determined"
+        )
+        rows.append(
+            {
+                "parameter": name,
+                "identified": v,
+                "interval_low": lo,
+                "interval_high": hi,
+                "reported_as": kind,
+                "paper_chain_fit": float(fit["paper_parameter_value"].values[i])
+                if "paper_parameter_value" in fit
+                else np.nan,
+                "paper_value": TABLE4[name],
+                "truth": tr,
+                "diff_vs_truth_pct": _pct(v, tr) if name != "e_t" else np.nan,
+                "truth_inside_interval": bool(lo <= tr <= hi) if np.isfinite(tr) else None,
+            }
+        )
     e0 = fit.attrs["e0_at_preload_n_per_m"]
     e0_paper = float(stiction_shear_stiffness_paper(fit.attrs["preload_n"]))
-    e0_truth = (float(stiction_shear_stiffness(fit.attrs["preload_n"], float(truth_friction["e_f_n_per_m"]),
-                                               float(truth_friction["k_c_per_m"])))
-                if truth_friction else np.nan)
-    rows.append({"parameter": "e0_at_preload", "identified": e0, "interval_low": fit.attrs["e0_interval_low"],
-                 "interval_high": fit.attrs["e0_interval_high"], "reported_as": "value",
-                 "paper_chain_fit": fit.attrs.get("paper_e0_at_preload_n_per_m", np.nan), "paper_value": e0_paper,
-                 "truth": e0_truth, "diff_vs_truth_pct": _pct(e0, e0_truth),
-                 "truth_inside_interval": bool(fit.attrs["e0_interval_low"] <= e0_truth <= fit.attrs["e0_interval_high"])
-                 if np.isfinite(e0_truth) else None})
+    e0_truth = (
+        float(
+            stiction_shear_stiffness(
+                fit.attrs["preload_n"], float(truth_friction["e_f_n_per_m"]), float(truth_friction["k_c_per_m"])
+            )
+        )
+        if truth_friction
+        else np.nan
+    )
+    rows.append(
+        {
+            "parameter": "e0_at_preload",
+            "identified": e0,
+            "interval_low": fit.attrs["e0_interval_low"],
+            "interval_high": fit.attrs["e0_interval_high"],
+            "reported_as": "value",
+            "paper_chain_fit": fit.attrs.get("paper_e0_at_preload_n_per_m", np.nan),
+            "paper_value": e0_paper,
+            "truth": e0_truth,
+            "diff_vs_truth_pct": _pct(e0, e0_truth),
+            "truth_inside_interval": bool(fit.attrs["e0_interval_low"] <= e0_truth <= fit.attrs["e0_interval_high"])
+            if np.isfinite(e0_truth)
+            else None,
+        }
+    )
     return pd.DataFrame(rows)
 
 
@@ -272,22 +358,33 @@ def stiction_shear_stiffness_paper(preload: float) -> float:
 def friction_summary(fit: xr.Dataset, validations: Mapping[str, xr.Dataset]) -> dict:
     """`friction` and `validation_nrmse` blocks of summary.json."""
     p = dict(zip(fit["parameter"].values, (float(v) for v in fit["parameter_value"].values)))
-    intervals = {n: [float(lo), float(hi)] for n, lo, hi in
-                 zip(fit["parameter"].values, fit["interval_low"].values, fit["interval_high"].values)}
-    bounded_only = [n for n, b, a in zip(fit["parameter"].values, fit["bounded_below"].values, fit["bounded_above"].values)
-                    if not (b and a)]
-    out = {"friction": {**p, "e0_at_preload": fit.attrs["e0_at_preload_n_per_m"],
-                        "intervals": {**intervals, "e0_at_preload": [fit.attrs["e0_interval_low"], fit.attrs["e0_interval_high"]]},
-                        "only_bounded": bounded_only, "misfit_nrmse": fit.attrs["misfit_nrmse"],
-                        "correlation_e_f_k_c": float(fit["correlation"].values[0, 1]),
-                        "regularization": fit.attrs["regularization"],
-                        # S of the fitted parameters read the other way (slip_limit vs as printed), NRMSE per case
-                        "S_change_other_regularization": {c: v.attrs["nrmse_other_regularization"]
-                                                          for c, v in validations.items()}},
-           "validation_nrmse": {c: v.attrs["nrmse_vs_identified"] for c, v in validations.items()}}
+    intervals = {
+        n: [float(lo), float(hi)]
+        for n, lo, hi in zip(fit["parameter"].values, fit["interval_low"].values, fit["interval_high"].values)
+    }
+    bounded_only = [
+        n
+        for n, b, a in zip(fit["parameter"].values, fit["bounded_below"].values, fit["bounded_above"].values)
+        if not (b and a)
+    ]
+    out = {
+        "friction": {
+            **p,
+            "e0_at_preload": fit.attrs["e0_at_preload_n_per_m"],
+            "intervals": {**intervals, "e0_at_preload": [fit.attrs["e0_interval_low"], fit.attrs["e0_interval_high"]]},
+            "only_bounded": bounded_only,
+            "misfit_nrmse": fit.attrs["misfit_nrmse"],
+            "correlation_e_f_k_c": float(fit["correlation"].values[0, 1]),
+            "regularization": fit.attrs["regularization"],
+            # S of the fitted parameters read the other way (slip_limit vs as printed), NRMSE per case
+            "S_change_other_regularization": {c: v.attrs["nrmse_other_regularization"] for c, v in validations.items()},
+        },
+        "validation_nrmse": {c: v.attrs["nrmse_vs_identified"] for c, v in validations.items()},
+    }
     if any("nrmse_vs_truth" in v.attrs for v in validations.values()):
-        out["validation_nrmse_vs_truth"] = {c: v.attrs["nrmse_vs_truth"] for c, v in validations.items()
-                                            if "nrmse_vs_truth" in v.attrs}
+        out["validation_nrmse_vs_truth"] = {
+            c: v.attrs["nrmse_vs_truth"] for c, v in validations.items() if "nrmse_vs_truth" in v.attrs
+        }
     return out
 
 
@@ -296,12 +393,16 @@ def model_form_summary(intervals: Mapping) -> dict:
     for (``chain`` or ``updated``), the confidence and per parameter its value and interval with the model-form
     term (``e0`` is e_0 at the preload)."""
     par = intervals["parameters"]
-    return {"model": intervals["model"], "confidence": par["confidence"],
-            **{n: {"value": v["value"], "interval": v["interval"]} for n, v in par.items() if n != "confidence"}}
+    return {
+        "model": intervals["model"],
+        "confidence": par["confidence"],
+        **{n: {"value": v["value"], "interval": v["interval"]} for n, v in par.items() if n != "confidence"},
+    }
 
 
-def plot_friction_figures(fit: xr.Dataset, validations: Mapping[str, xr.Dataset], truth_friction: Mapping | None,
-                          paths: Mapping[str, str]) -> None:
+def plot_friction_figures(
+    fit: xr.Dataset, validations: Mapping[str, xr.Dataset], truth_friction: Mapping | None, paths: Mapping[str, str]
+) -> None:
     """Fig. 7 (e_0 vs N), Fig. 8 (S vs xi), Fig. 9 (S vs xi'), and the GA convergence."""
     plt = _mpl()
     n0 = fit.attrs["preload_n"]
@@ -309,7 +410,9 @@ def plot_friction_figures(fit: xr.Dataset, validations: Mapping[str, xr.Dataset]
     p = dict(zip(fit["parameter"].values, fit["parameter_value"].values))
     fig, ax = plt.subplots(figsize=(6.0, 4.0))
     ax.plot(N, 1e-6 * stiction_shear_stiffness(N, p["e_f"], p["k_c"]), "-", color="C0", label="identified")
-    ax.plot(N, 1e-6 * stiction_shear_stiffness(N, TABLE4["e_f"], TABLE4["k_c"]), "--", color="C1", label="paper, Table 4")
+    ax.plot(
+        N, 1e-6 * stiction_shear_stiffness(N, TABLE4["e_f"], TABLE4["k_c"]), "--", color="C1", label="paper, Table 4"
+    )
     if truth_friction:
         ef, kc = float(truth_friction["e_f_n_per_m"]), float(truth_friction["k_c_per_m"])
         ax.plot(N, 1e-6 * stiction_shear_stiffness(N, ef, kc), ":", color="0.3", lw=2, label="rig truth")
@@ -324,14 +427,24 @@ def plot_friction_figures(fit: xr.Dataset, validations: Mapping[str, xr.Dataset]
     fig.savefig(paths["fig07_png"], dpi=150)
     fig.savefig(paths["fig07_pdf"])
     plt.close(fig)
-    for key, xvar, xlabel, scale in (("fig08", "xi", r"$\xi$ ($\mu$m)", 1e6), ("fig09", "xi_dot", r"d$\xi$/dt (mm/s)", 1e3)):
+    for key, xvar, xlabel, scale in (
+        ("fig08", "xi", r"$\xi$ ($\mu$m)", 1e6),
+        ("fig09", "xi_dot", r"d$\xi$/dt (mm/s)", 1e3),
+    ):
         cases = list(validations)
         fig, axes = plt.subplots(1, len(cases), figsize=(3.3 * len(cases), 3.4), squeeze=False)
         for j, case in enumerate(cases):
             v = validations[case]
             ax = axes[0, j]
-            ax.plot(scale * v[xvar].values[::4], v["S_identified"].values[::4], "o", ms=3, mfc="none", color="C0",
-                    label="identified")
+            ax.plot(
+                scale * v[xvar].values[::4],
+                v["S_identified"].values[::4],
+                "o",
+                ms=3,
+                mfc="none",
+                color="C0",
+                label="identified",
+            )
             ax.plot(scale * v[xvar].values, v["S_predicted"].values, "-", color="C3", lw=1.2, label="predicted")
             ax.set_title(f"{case} (NRMSE {100 * v.attrs['nrmse_vs_identified']:.1f} %)", fontsize=9)
             ax.set_xlabel(xlabel)

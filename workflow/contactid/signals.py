@@ -22,8 +22,14 @@ class FRFEstimate:
     n_averages: int
 
 
-def h1_frf(force: np.ndarray, responses: np.ndarray, sampling_rate_hz: float,
-           segment_length: int, overlap: float = 0.5, window: str = "hann") -> FRFEstimate:
+def h1_frf(
+    force: np.ndarray,
+    responses: np.ndarray,
+    sampling_rate_hz: float,
+    segment_length: int,
+    overlap: float = 0.5,
+    window: str = "hann",
+) -> FRFEstimate:
     """H1 = G_fx / G_ff and coherence |G_fx|^2 / (G_ff G_xx), Welch-averaged.
 
     force: (n,) in N; responses: (n_out, n) in any unit; returns H1 in

@@ -58,18 +58,26 @@ def _residuals(fmap: ContactFrequencyMap, f_id, sigma, log_kt, log_kn):
 
 def _fit_one(params, f_id, sigma, fixed_name, fixed_log, start, bounds):
     """Fit the free log-stiffness with the other fixed; returns (x, chi2)."""
+
     def res(x):
         if fixed_name == "k_n":
             return _residuals(params, f_id, sigma, x[0], fixed_log)
         return _residuals(params, f_id, sigma, fixed_log, x[0])
+
     r = least_squares(res, [start], bounds=([bounds[0]], [bounds[1]]), x_scale=[0.1], xtol=1e-10, ftol=1e-12)
     return r.x[0], float(2 * r.cost)
 
 
 def _joint_fit(params, f_id, sigma, x0, lt, ln):
     """Least-squares fit of (log10 k_t, log10 k_n) from x0; returns (x, chi2)."""
-    r = least_squares(lambda x: _residuals(params, f_id, sigma, x[0], x[1]), x0,
-                      bounds=([lt[0], ln[0]], [lt[1], ln[1]]), x_scale=[0.1, 1.0], xtol=1e-12, ftol=1e-14)
+    r = least_squares(
+        lambda x: _residuals(params, f_id, sigma, x[0], x[1]),
+        x0,
+        bounds=([lt[0], ln[0]], [lt[1], ln[1]]),
+        x_scale=[0.1, 1.0],
+        xtol=1e-12,
+        ftol=1e-14,
+    )
     return r.x, float(2 * r.cost)
 
 
@@ -99,16 +107,25 @@ def interval_edge(profile, grid, chi2_prof, i_min, direction, chi2_min, threshol
     a, b = sorted((grid[j], grid[j + direction]))
     fa, fb = profile(a) - chi2_min - threshold, profile(b) - chi2_min - threshold
     if not (np.isfinite(fa) and np.isfinite(fb)) or fa * fb > 0:
-        return None, (f"the profile misfit does not cross the threshold between 10^{a:.3f} and 10^{b:.3f} "
-                      f"({fa + threshold:.3g} and {fb + threshold:.3g} above the minimum, threshold {threshold:.3g}): "
-                      "the data do not bound this side")
+        return None, (
+            f"the profile misfit does not cross the threshold between 10^{a:.3f} and 10^{b:.3f} "
+            f"({fa + threshold:.3g} and {fb + threshold:.3g} above the minimum, threshold {threshold:.3g}): "
+            "the data do not bound this side"
+        )
     if fa == 0.0 or fb == 0.0:
         return (a if fa == 0.0 else b), ""
     return brentq(lambda x: profile(x) - chi2_min - threshold, a, b, xtol=1e-6), ""
 
 
-def stiction_stiffness(params: StructureParameters, f_id_hz, sigma_hz, k_t_bounds=(1e5, 1e9),
-                       k_n_bounds=(1e5, 1e11), confidence: float = 0.95, n_profile: int = 25) -> StiffnessFit:
+def stiction_stiffness(
+    params: StructureParameters,
+    f_id_hz,
+    sigma_hz,
+    k_t_bounds=(1e5, 1e9),
+    k_n_bounds=(1e5, 1e11),
+    confidence: float = 0.95,
+    n_profile: int = 25,
+) -> StiffnessFit:
     """Fit k_t and k_n (N/m) of Eq. (13) to the identified natural frequencies.
 
     Misfit chi2 = sum_i ((f_i(k_t, k_n) - f_id,i) / sigma_i)^2 over the first
@@ -144,6 +161,7 @@ def stiction_stiffness(params: StructureParameters, f_id_hz, sigma_hz, k_t_bound
 
     profiles, lo_hi, flags, notes = {}, {}, {}, {}
     for name, rng, idx, other_rng in (("k_n", ln, 1, lt), ("k_t", lt, 0, ln)):
+
         def profile(x, name=name, other_rng=other_rng, idx=idx):
             return _fit_one(params, f_id, sigma, name, x, best[1 - idx], other_rng)[1]
 
@@ -152,13 +170,22 @@ def stiction_stiffness(params: StructureParameters, f_id_hz, sigma_hz, k_t_bound
         i_min = int(np.argmin(chi2_p))
         (lo, why_lo), (hi, why_hi) = (interval_edge(profile, grid, chi2_p, i_min, d, chi2_min, thr) for d in (-1, +1))
         flags[name] = (lo is not None, hi is not None)
-        notes[name] = tuple(w for w in (f"lower: {why_lo}" if lo is None else "",
-                                        f"upper: {why_hi}" if hi is None else "") if w)
-        lo_hi[name] = (10.0 ** (lo if lo is not None else rng[0]), 10.0 ** hi if hi is not None else np.inf)
+        notes[name] = tuple(
+            w for w in (f"lower: {why_lo}" if lo is None else "", f"upper: {why_hi}" if hi is None else "") if w
+        )
+        lo_hi[name] = (10.0 ** (lo if lo is not None else rng[0]), 10.0**hi if hi is not None else np.inf)
     f_best = params(10.0 ** best[0], 10.0 ** best[1])
     return StiffnessFit(
-        k_t=float(10.0 ** best[0]), k_n=float(10.0 ** best[1]),
-        k_t_interval=lo_hi["k_t"], k_n_interval=lo_hi["k_n"],
-        k_t_bounded=all(flags["k_t"]), k_n_bounded_above=flags["k_n"][1], k_n_bounded_below=flags["k_n"][0],
-        model_frequencies_hz=f_best, chi2_min=chi2_min, confidence=confidence, profiles=profiles, notes=notes,
+        k_t=float(10.0 ** best[0]),
+        k_n=float(10.0 ** best[1]),
+        k_t_interval=lo_hi["k_t"],
+        k_n_interval=lo_hi["k_n"],
+        k_t_bounded=all(flags["k_t"]),
+        k_n_bounded_above=flags["k_n"][1],
+        k_n_bounded_below=flags["k_n"][0],
+        model_frequencies_hz=f_best,
+        chi2_min=chi2_min,
+        confidence=confidence,
+        profiles=profiles,
+        notes=notes,
     )

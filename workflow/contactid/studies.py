@@ -33,8 +33,10 @@ def noise_study_table(study_cfg: Mapping | None) -> pd.DataFrame:
         raise ValueError(f"noise_study.noise_fractions = {c['noise_fractions']}: noise fractions are >= 0")
     if min(c["record_samples"]) < 1024:
         raise ValueError(f"noise_study.record_samples = {c['record_samples']}: give at least 1024 samples per record")
-    rows = [{"noise_fraction": float(n), "record_samples": int(r), "seed": int(s)}
-            for n, r, s in itertools.product(c["noise_fractions"], c["record_samples"], c["seeds"])]
+    rows = [
+        {"noise_fraction": float(n), "record_samples": int(r), "seed": int(s)}
+        for n, r, s in itertools.product(c["noise_fractions"], c["record_samples"], c["seeds"])
+    ]
     return pd.DataFrame(rows, columns=["noise_fraction", "record_samples", "seed"])
 
 
@@ -62,8 +64,16 @@ def run_point(cfg: Mapping, noise_fraction: float, record_samples: int, seed: in
     cal = cfg["nonlinear"]["calibration_case"]
     raw_rt, truth_rt = random_test_datasets(cfg["structure"], random_test_rig_config(rig), cfg["random_test"], rig_seed)
     fs = float(cfg["random_test"]["sampling_rate_hz"])
-    raw_cal, truth_cal = dual_sine_test(cfg["structure"], rig, cfg["load_cases"][cal], fs, float(noise_fraction), rig_seed,
-                                        cal, cfg["structure"]["sensors"]["names"])
+    raw_cal, truth_cal = dual_sine_test(
+        cfg["structure"],
+        rig,
+        cfg["load_cases"][cal],
+        fs,
+        float(noise_fraction),
+        rig_seed,
+        cal,
+        cfg["structure"]["sensors"]["names"],
+    )
     t_rig = time.perf_counter() - t0
     model, modes, _, _ = identify(cfg, raw_rt, raw_cal)
     tf = rig["truth"]["friction"]
@@ -71,21 +81,36 @@ def run_point(cfg: Mapping, noise_fraction: float, record_samples: int, seed: in
     e_f, k_c, _, _, mu = (float(x) for x in model.friction)
     e0, e0_true = e0_at(e_f, k_c, N0), e0_at(tf["e_f_n_per_m"], tf["k_c_per_m"], N0)
     k_t, k_t_true = float(modes["k_t"]), float(truth_rt["k_t"])
-    return {"noise_fraction": float(noise_fraction), "record_samples": int(record_samples), "seed": int(seed),
-            "mu": mu, "mu_true": float(tf["mu"]), "e0": e0, "e0_true": e0_true, "k_t": k_t, "k_t_true": k_t_true,
-            "error_mu": mu / float(tf["mu"]) - 1.0, "error_e0": e0 / e0_true - 1.0, "error_k_t": k_t / k_t_true - 1.0,
-            "seconds": {"rig": t_rig, "identification": time.perf_counter() - t0 - t_rig}}
+    return {
+        "noise_fraction": float(noise_fraction),
+        "record_samples": int(record_samples),
+        "seed": int(seed),
+        "mu": mu,
+        "mu_true": float(tf["mu"]),
+        "e0": e0,
+        "e0_true": e0_true,
+        "k_t": k_t,
+        "k_t_true": k_t_true,
+        "error_mu": mu / float(tf["mu"]) - 1.0,
+        "error_e0": e0 / e0_true - 1.0,
+        "error_k_t": k_t / k_t_true - 1.0,
+        "seconds": {"rig": t_rig, "identification": time.perf_counter() - t0 - t_rig},
+    }
 
 
 def gather(rows: list) -> xr.Dataset:
     """The points stacked on (noise_fraction, record_samples, seed): identified values, truths and
     relative errors of mu, e_0 and k_t."""
-    df = pd.DataFrame([{**{k: v for k, v in r.items() if k != "seconds"}, "seconds": sum(r["seconds"].values())}
-                       for r in rows])
+    df = pd.DataFrame(
+        [{**{k: v for k, v in r.items() if k != "seconds"}, "seconds": sum(r["seconds"].values())} for r in rows]
+    )
     df = df.set_index(["noise_fraction", "record_samples", "seed"]).sort_index()
     ds = xr.Dataset.from_dataframe(df)
-    meaning = {"mu": ("1", "friction coefficient mu"), "e0": ("N/m", "tangential stiffness e_0 at the preload (Eq. 22)"),
-               "k_t": ("N/m", "contact stiffness at stiction k_t")}
+    meaning = {
+        "mu": ("1", "friction coefficient mu"),
+        "e0": ("N/m", "tangential stiffness e_0 at the preload (Eq. 22)"),
+        "k_t": ("N/m", "contact stiffness at stiction k_t"),
+    }
     for q, (unit, name) in meaning.items():
         ds[q].attrs.update(units=unit, long_name=f"identified {name}")
         ds[f"{q}_true"].attrs.update(units=unit, long_name=f"rig truth: {name}")
@@ -112,7 +137,7 @@ def plot_noise_study(ds: xr.Dataset, default_noise: float, png: str, pdf: str | 
     for ax, q in zip(axes, QUANTITIES):
         err = 100 * np.abs(ds[f"error_{q}"].values)  # (noise, length, seed)
         for j, n in enumerate(ds["record_samples"].values):
-            line, = ax.plot(noise, np.median(err[:, j, :], axis=1), "-o", ms=3, label=f"{int(n)} samples")
+            (line,) = ax.plot(noise, np.median(err[:, j, :], axis=1), "-o", ms=3, label=f"{int(n)} samples")
             for s in range(err.shape[2]):
                 ax.plot(noise, err[:, j, s], ".", color=line.get_color(), alpha=0.4)
         ax.axvline(default_noise, color="k", ls="--", lw=0.8)
@@ -125,8 +150,9 @@ def plot_noise_study(ds: xr.Dataset, default_noise: float, png: str, pdf: str | 
         ax.set_xlabel("sensor noise (rms fraction)")
         ax.set_title(f"|error| of {labels[q]} (%)")
     axes[0].legend(fontsize=8)
-    axes[-1].text(0.02, 0.02, "from the random test: the same for every record length", transform=axes[-1].transAxes,
-                  fontsize=7)
+    axes[-1].text(
+        0.02, 0.02, "from the random test: the same for every record length", transform=axes[-1].transAxes, fontsize=7
+    )
     fig.tight_layout()
     fig.savefig(png, dpi=130)
     if pdf:
@@ -139,8 +165,10 @@ def report_section(ds: xr.Dataset | None) -> str:
     the figure; without the study (noise_study.in_report: false) a sentence saying how to run it."""
     head = "\\section{Identification accuracy against sensor noise and record length}\n"
     if ds is None:
-        return head + ("The Monte Carlo study is not part of this report (\\texttt{noise\\_study.in\\_report: false}); "
-                       "\\texttt{snakemake noise\\_study} runs it.\n")
+        return head + (
+            "The Monte Carlo study is not part of this report (\\texttt{noise\\_study.in\\_report: false}); "
+            "\\texttt{snakemake noise\\_study} runs it.\n"
+        )
     noise = ds["noise_fraction"].values
     longest = int(ds["record_samples"].values.max())
     default = float(ds.attrs.get("default_noise_fraction", noise[len(noise) // 2]))
@@ -150,16 +178,20 @@ def report_section(ds: xr.Dataset | None) -> str:
         return 100 * float(np.median(np.abs(ds[f"error_{q}"].sel(record_samples=longest).values[i])))
 
     n_points = ds.sizes["noise_fraction"] * ds.sizes["record_samples"] * ds.sizes["seed"]
-    text = (f"Each of the {n_points} points of the parameter table (noise fractions "
-            f"{', '.join(f'{x:g}' for x in noise)}; records of {', '.join(str(int(r)) for r in ds['record_samples'].values)} "
-            f"samples; {ds.sizes['seed']} seeds) is one Snakemake job: the rig records a random test and the calibration "
-            f"case, the chain identifies $k_t$ and the friction law, and the errors against the rig's truth are gathered "
-            f"(Fig.~\\ref{{fig:noise}}). With {longest}-sample records the median error of $\\mu$ is "
-            f"{med('mu', i_def):.2g}\\,\\% at the default noise ({noise[i_def]:g}) and {med('mu', -1):.2g}\\,\\% at "
-            f"{noise[-1]:g}; of $e_0$ {med('e0', i_def):.2g}\\,\\% and {med('e0', -1):.2g}\\,\\%; of $k_t$ "
-            f"{med('k_t', i_def):.2g}\\,\\% and {med('k_t', -1):.2g}\\,\\%.\n")
-    fig = ("\\begin{figure}[H]\\centering\\includegraphics[width=\\textwidth]{noise_study.pdf}\n"
-           "\\caption{Relative error of $\\mu$, $e_0$ at the preload and $k_t$ against the sensor noise: dots are seeds, "
-           "lines the medians per dual-sine record length ($k_t$ comes from the random test, the same for both); the "
-           "dashed line marks the default noise.}\\label{fig:noise}\\end{figure}\n")
+    text = (
+        f"Each of the {n_points} points of the parameter table (noise fractions "
+        f"{', '.join(f'{x:g}' for x in noise)}; records of {', '.join(str(int(r)) for r in ds['record_samples'].values)} "
+        f"samples; {ds.sizes['seed']} seeds) is one Snakemake job: the rig records a random test and the calibration "
+        f"case, the chain identifies $k_t$ and the friction law, and the errors against the rig's truth are gathered "
+        f"(Fig.~\\ref{{fig:noise}}). With {longest}-sample records the median error of $\\mu$ is "
+        f"{med('mu', i_def):.2g}\\,\\% at the default noise ({noise[i_def]:g}) and {med('mu', -1):.2g}\\,\\% at "
+        f"{noise[-1]:g}; of $e_0$ {med('e0', i_def):.2g}\\,\\% and {med('e0', -1):.2g}\\,\\%; of $k_t$ "
+        f"{med('k_t', i_def):.2g}\\,\\% and {med('k_t', -1):.2g}\\,\\%.\n"
+    )
+    fig = (
+        "\\begin{figure}[H]\\centering\\includegraphics[width=\\textwidth]{noise_study.pdf}\n"
+        "\\caption{Relative error of $\\mu$, $e_0$ at the preload and $k_t$ against the sensor noise: dots are seeds, "
+        "lines the medians per dual-sine record length ($k_t$ comes from the random test, the same for both); the "
+        "dashed line marks the default noise.}\\label{fig:noise}\\end{figure}\n"
+    )
     return head + text + fig

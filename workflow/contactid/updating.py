@@ -45,7 +45,9 @@ class StructuralFactor:
 
 
 def _scale_masses(p: StructureParameters, m: float) -> StructureParameters:
-    return p.replace(sensor_masses=tuple(m * x for x in p.sensor_masses), force_transducer_mass=m * p.force_transducer_mass)
+    return p.replace(
+        sensor_masses=tuple(m * x for x in p.sensor_masses), force_transducer_mass=m * p.force_transducer_mass
+    )
 
 
 def _clamp(p: StructureParameters, m: float) -> StructureParameters:
@@ -55,15 +57,27 @@ def _clamp(p: StructureParameters, m: float) -> StructureParameters:
 
 CLAMP_REFERENCE = 1.0e5  # N m/rad: a clamp about 700 x stiffer than the beam's EI / L
 
-FACTORS = {f.name: f for f in (
-    StructuralFactor("stiffness_scale", "Young's modulus E (the beam's bending and axial stiffness)", 0.05,
-                     lambda p, m: p.replace(youngs_modulus=m * p.youngs_modulus)),
-    StructuralFactor("mass_scale", "the beam's density", 0.03, lambda p, m: p.replace(density=m * p.density)),
-    StructuralFactor("transducer_mass_scale", "every transducer mass (accelerometers and force transducer)", 0.5,
-                     _scale_masses),
-    StructuralFactor("tangential_lever_arm_scale", "the tangential lever arm (height of the contact line)", 0.1,
-                     lambda p, m: p.replace(tangential_lever_arm=m * p.tangential_lever_arm)),
-)}
+FACTORS = {
+    f.name: f
+    for f in (
+        StructuralFactor(
+            "stiffness_scale",
+            "Young's modulus E (the beam's bending and axial stiffness)",
+            0.05,
+            lambda p, m: p.replace(youngs_modulus=m * p.youngs_modulus),
+        ),
+        StructuralFactor("mass_scale", "the beam's density", 0.03, lambda p, m: p.replace(density=m * p.density)),
+        StructuralFactor(
+            "transducer_mass_scale", "every transducer mass (accelerometers and force transducer)", 0.5, _scale_masses
+        ),
+        StructuralFactor(
+            "tangential_lever_arm_scale",
+            "the tangential lever arm (height of the contact line)",
+            0.1,
+            lambda p, m: p.replace(tangential_lever_arm=m * p.tangential_lever_arm),
+        ),
+    )
+}
 DEFAULT_FACTORS = tuple(FACTORS)
 
 
@@ -92,9 +106,20 @@ class UpdatingResult:
         """The result written by ``summary`` (model_updating.json), with the structure rebuilt from ``params``
         (the configured structure) by the same factors, k_t and k_n."""
         p = apply_factors(params.with_contact(float(summary["k_t"]), float(summary["k_n"])), summary["factors"])
-        return cls(dict(summary["factors"]), float(summary["k_t"]), float(summary["k_n"]), p,
-                   float(summary["chi2_nominal"]), float(summary["chi2_updated"]), bool(summary["accepted"]),
-                   dict(summary["identifiability"]), None, int(summary["n_data"]), summary["covariance"], params)
+        return cls(
+            dict(summary["factors"]),
+            float(summary["k_t"]),
+            float(summary["k_n"]),
+            p,
+            float(summary["chi2_nominal"]),
+            float(summary["chi2_updated"]),
+            bool(summary["accepted"]),
+            dict(summary["identifiability"]),
+            None,
+            int(summary["n_data"]),
+            summary["covariance"],
+            params,
+        )
 
     def posterior_structures(self) -> list:
         """The structures the random test allows: the update moved by +-1 standard deviation along each principal
@@ -111,14 +136,26 @@ class UpdatingResult:
         for lam_i, v in zip(lam, vec.T):
             for sign in (-1.0, 1.0):
                 y = x + sign * np.sqrt(max(lam_i, 0.0)) * v
-                out.append(apply_factors(self.nominal.with_contact(float(np.exp(y[0])), float(np.exp(y[1]))),
-                                         {f: float(np.exp(val)) for f, val in zip(names, y[2:])}))
+                out.append(
+                    apply_factors(
+                        self.nominal.with_contact(float(np.exp(y[0])), float(np.exp(y[1]))),
+                        {f: float(np.exp(val)) for f, val in zip(names, y[2:])},
+                    )
+                )
         return out
 
     def summary(self) -> dict:
-        return {"accepted": self.accepted, "factors": dict(self.factors), "k_t": self.k_t, "k_n": self.k_n,
-                "chi2_nominal": self.chi2_nominal, "chi2_updated": self.chi2_updated, "n_data": self.n_data,
-                "identifiability": self.identifiability, "covariance": self.covariance}
+        return {
+            "accepted": self.accepted,
+            "factors": dict(self.factors),
+            "k_t": self.k_t,
+            "k_n": self.k_n,
+            "chi2_nominal": self.chi2_nominal,
+            "chi2_updated": self.chi2_updated,
+            "n_data": self.n_data,
+            "identifiability": self.identifiability,
+            "covariance": self.covariance,
+        }
 
 
 def apply_factors(params: StructureParameters, factors: dict) -> StructureParameters:
@@ -139,9 +176,17 @@ def modal_predictions(params: StructureParameters, n_modes: int) -> tuple[np.nda
     return modes.frequencies_hz, np.abs(phi_s * phi_d[None, :]) / (2 * w[None, :])
 
 
-def update_structure(params: StructureParameters, f_id_hz, f_sigma_hz, residues, residue_accuracy: float = 0.01,
-                     factors=DEFAULT_FACTORS, contact_prior_sd: float = 3.0, confidence: float = 0.95,
-                     prior_sd=None) -> UpdatingResult:
+def update_structure(
+    params: StructureParameters,
+    f_id_hz,
+    f_sigma_hz,
+    residues,
+    residue_accuracy: float = 0.01,
+    factors=DEFAULT_FACTORS,
+    contact_prior_sd: float = 3.0,
+    confidence: float = 0.95,
+    prior_sd=None,
+) -> UpdatingResult:
     """Update the structure ``params`` (with its k_t, k_n as the start) to the random test's modal data.
 
     f_id_hz, f_sigma_hz: (n,) identified natural frequencies and their standard errors (Hz); residues:
@@ -163,8 +208,10 @@ def update_structure(params: StructureParameters, f_id_hz, f_sigma_hz, residues,
     x_nom = np.array([np.log(params.k_t), np.log(params.k_n)] + [0.0] * len(names))
 
     def structure(x):
-        return apply_factors(params.with_contact(float(np.exp(x[0])), float(np.exp(x[1]))),
-                             {f: float(np.exp(v)) for f, v in zip(names, x[2:])})
+        return apply_factors(
+            params.with_contact(float(np.exp(x[0])), float(np.exp(x[1]))),
+            {f: float(np.exp(v)) for f, v in zip(names, x[2:])},
+        )
 
     def data_residuals(x):
         try:
@@ -216,12 +263,27 @@ def update_structure(params: StructureParameters, f_id_hz, f_sigma_hz, residues,
         others = [j for j in range(len(labels)) if j != i]
         j = max(others, key=lambda j: abs(corr[i, j])) if others else None
         ratio = float(post_sd[i] / sd[i])
-        ident[name] = {"posterior_sd": float(post_sd[i]), "prior_sd": float(sd[i]), "posterior_over_prior": ratio,
-                       "bound_by_data": bool(ratio < IDENTIFIED),
-                       "most_correlated_with": labels[j] if j is not None else None,
-                       "correlation": float(corr[i, j]) if j is not None else None}
+        ident[name] = {
+            "posterior_sd": float(post_sd[i]),
+            "prior_sd": float(sd[i]),
+            "posterior_over_prior": ratio,
+            "bound_by_data": bool(ratio < IDENTIFIED),
+            "most_correlated_with": labels[j] if j is not None else None,
+            "correlation": float(corr[i, j]) if j is not None else None,
+        }
     x = x1 if accepted else x0
     f_best, _ = modal_predictions(structure(x), n)
-    return UpdatingResult({f: float(np.exp(v)) for f, v in zip(names, x[2:])}, float(np.exp(x[0])),
-                          float(np.exp(x[1])), structure(x), chi2_nominal, chi2_updated, accepted, ident, f_best,
-                          int(n + (0 if R_id is None else R_id.size)), cov.tolist(), params)
+    return UpdatingResult(
+        {f: float(np.exp(v)) for f, v in zip(names, x[2:])},
+        float(np.exp(x[0])),
+        float(np.exp(x[1])),
+        structure(x),
+        chi2_nominal,
+        chi2_updated,
+        accepted,
+        ident,
+        f_best,
+        int(n + (0 if R_id is None else R_id.size)),
+        cov.tolist(),
+        params,
+    )

@@ -20,15 +20,30 @@ if "updating" in inp.keys():  # the structures the random test allows (model upd
     if upd["enabled"]:
         nominal = structure_from_config(snakemake.params.structure, float(modes["k_t"]), float(modes["k_n"]))
         structures = UpdatingResult.from_summary(upd, nominal).posterior_structures()
-ds = contact_forces_dataset(read_raw(inp.raw, dual_sine=True), load_dataset(inp.reduced), modes,
-                            load_dataset(inp.modal), load_dataset(inp.stiction), snakemake.params.structure, K, truth,
-                            float(nl["observability_limit"]), structures)
+ds = contact_forces_dataset(
+    read_raw(inp.raw, dual_sine=True),
+    load_dataset(inp.reduced),
+    modes,
+    load_dataset(inp.modal),
+    load_dataset(inp.stiction),
+    snakemake.params.structure,
+    K,
+    truth,
+    float(nl["observability_limit"]),
+    structures,
+)
 if not ds.attrs["eta_observable"]:
-    log.warning("eta moves by %.0f %% across the linear chain's stiffness intervals and by %.0f %% across the "
-                "structures the random test allows: it is not observable from these sensors; N(t) is (spread %.2g)",
-                100 * ds.attrs["eta_spread_over_stiffness_intervals"], 100 * ds.attrs["eta_spread_over_structures"],
-                ds.attrs["spread_k_n_N_dyn"])
-ds.attrs.update(provenance("contact_forces", {"structure": snakemake.params.structure, "nonlinear": nl},
-                           {k: v for k, v in inp.items()}))
+    log.warning(
+        "eta moves by %.0f %% across the linear chain's stiffness intervals and by %.0f %% across the "
+        "structures the random test allows: it is not observable from these sensors; N(t) is (spread %.2g)",
+        100 * ds.attrs["eta_spread_over_stiffness_intervals"],
+        100 * ds.attrs["eta_spread_over_structures"],
+        ds.attrs["spread_k_n_N_dyn"],
+    )
+ds.attrs.update(
+    provenance(
+        "contact_forces", {"structure": snakemake.params.structure, "nonlinear": nl}, {k: v for k, v in inp.items()}
+    )
+)
 write_dataset(ds, snakemake.output.forces)
 log.info("NRMSE %s", fmt({k.removesuffix("_nrmse"): v for k, v in ds.attrs.items() if "nrmse" in k}))

@@ -8,5 +8,6 @@ from contactid.reporting import plot_fig03
 
 setup_logging(snakemake.log[0])
 Path(snakemake.output.png).parent.mkdir(parents=True, exist_ok=True)
-plot_fig03(load_dataset(snakemake.input.frf), load_dataset(snakemake.input.modal), snakemake.output.png,
-           snakemake.output.pdf)
+plot_fig03(
+    load_dataset(snakemake.input.frf), load_dataset(snakemake.input.modal), snakemake.output.png, snakemake.output.pdf
+)

@@ -23,10 +23,15 @@ shares, coherence_warnings = validate_coherence(ds, p.band_hz, path, checks)
 warnings += coherence_warnings
 ds.attrs["warnings"] = json.dumps(warnings)
 ds.attrs["coherence_share"] = json.dumps(shares)
-ds.attrs.update(provenance("frf", {"frf": p.frf, "blocks": p.blocks, "checks": checks, "band_hz": p.band_hz},
-                           {"raw": path}))
+ds.attrs.update(
+    provenance("frf", {"frf": p.frf, "blocks": p.blocks, "checks": checks, "band_hz": p.band_hz}, {"raw": path})
+)
 write_dataset(ds, snakemake.output.frf)
 for w in warnings:
     log.warning("%s: %s", path, w)
-log.info("FRF with %d averages; share of lines with coherence >= %g: %s", ds.attrs["n_averages"],
-         checks["min_coherence"], fmt(shares, 3))
+log.info(
+    "FRF with %d averages; share of lines with coherence >= %g: %s",
+    ds.attrs["n_averages"],
+    checks["min_coherence"],
+    fmt(shares, 3),
+)

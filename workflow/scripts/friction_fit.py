@@ -7,10 +7,20 @@ from contactid.logs import fmt, setup_logging
 log = setup_logging(snakemake.log[0])
 p = snakemake.params
 forces = load_dataset(snakemake.input.forces)
-ds = friction_fit_dataset(forces, float(p.preload), settings_from_config(p.friction), int(p.seed), int(p.n_harmonics),
-                          paper_forces=forces)
-ds.attrs.update(provenance("friction_fit", {"friction": p.friction, "seed": p.seed, "preload": p.preload,
-                                            "n_harmonics": p.n_harmonics}, {"forces": snakemake.input.forces}))
+ds = friction_fit_dataset(
+    forces, float(p.preload), settings_from_config(p.friction), int(p.seed), int(p.n_harmonics), paper_forces=forces
+)
+ds.attrs.update(
+    provenance(
+        "friction_fit",
+        {"friction": p.friction, "seed": p.seed, "preload": p.preload, "n_harmonics": p.n_harmonics},
+        {"forces": snakemake.input.forces},
+    )
+)
 write_dataset(ds, snakemake.output.fit)
-log.info("fitted %s; e0(N0) = %.4g N/m, misfit %.4g", fmt(dict(zip(ds["parameter"].values, ds["parameter_value"].values))),
-         ds.attrs["e0_at_preload_n_per_m"], ds.attrs["misfit_nrmse"])
+log.info(
+    "fitted %s; e0(N0) = %.4g N/m, misfit %.4g",
+    fmt(dict(zip(ds["parameter"].values, ds["parameter_value"].values))),
+    ds.attrs["e0_at_preload_n_per_m"],
+    ds.attrs["misfit_nrmse"],
+)

@@ -20,13 +20,30 @@ records = {c: record_harmonics(read_raw(path, dual_sine=True), c, K) for c, path
 fit_settings = settings_from_config(p.friction)
 with open(inp.updating) as fh:
     upd_summary = json.load(fh)
-_, model, upd = diagnosed_model(p.structure, load_dataset(inp.modes), modal, load_dataset(inp.fit),
-                                records[p.calibration_case], upd_summary, fit_settings, settings, int(p.seed))
-unc = friction_uncertainty(model, records, p.calibration_case, fit_settings, int(p.seed),
-                           upd.posterior_structures() if upd is not None else ())
+_, model, upd = diagnosed_model(
+    p.structure,
+    load_dataset(inp.modes),
+    modal,
+    load_dataset(inp.fit),
+    records[p.calibration_case],
+    upd_summary,
+    fit_settings,
+    settings,
+    int(p.seed),
+)
+unc = friction_uncertainty(
+    model, records, p.calibration_case, fit_settings, int(p.seed), upd.posterior_structures() if upd is not None else ()
+)
 par = unc.summary()
-out = {"model": "updated" if upd is not None and upd.accepted else "chain", "calibration_case": p.calibration_case,
-       "load_cases": list(p.cases), "n_structures": len(unc.structure_fits), "parameters": par}
+out = {
+    "model": "updated" if upd is not None and upd.accepted else "chain",
+    "calibration_case": p.calibration_case,
+    "load_cases": list(p.cases),
+    "n_structures": len(unc.structure_fits),
+    "parameters": par,
+}
 write_text(snakemake.output[0], json.dumps(out, indent=2, default=float))
-log.info("friction intervals with model form: %s", ", ".join(
-    f"{n} [{v['interval'][0]:.4g}, {v['interval'][1]:.4g}]" for n, v in par.items() if n != "confidence"))
+log.info(
+    "friction intervals with model form: %s",
+    ", ".join(f"{n} [{v['interval'][0]:.4g}, {v['interval'][1]:.4g}]" for n, v in par.items() if n != "confidence"),
+)

@@ -11,11 +11,28 @@ log = setup_logging(snakemake.log[0])
 rows = [json.load(open(path)) for path in snakemake.input.rows]
 result = score(rows)
 # one line per item: the single-effect items' shrink, the compound items' effects and explanation, a failure's reason
-KEYS = {"blind": ("shrink_true",), "effect_free": ("shrink_true",), "leave_out": ("shrink_true",),
-        "compound": ("effects", "named", "updating_accepted", "friction_errors")}
-result["items"] = [{k: r[k] for k in ("item", "effect", "magnitude", "seed", "kind", "verdict", "seconds",
-                                      *(("failed",) if r.get("failed") else ("heldout_gap_before", *KEYS[r["kind"]])))}
-                   for r in rows]
+KEYS = {
+    "blind": ("shrink_true",),
+    "effect_free": ("shrink_true",),
+    "leave_out": ("shrink_true",),
+    "compound": ("effects", "named", "updating_accepted", "friction_errors"),
+}
+result["items"] = [
+    {
+        k: r[k]
+        for k in (
+            "item",
+            "effect",
+            "magnitude",
+            "seed",
+            "kind",
+            "verdict",
+            "seconds",
+            *(("failed",) if r.get("failed") else ("heldout_gap_before", *KEYS[r["kind"]])),
+        )
+    }
+    for r in rows
+]
 write_text(snakemake.output.summary, json.dumps(_clean(result), indent=2))
 labels = list(result["confusion"])
 cols = sorted({c for row in result["confusion"].values() for c in row}, key=lambda c: (c == "none", c))
@@ -23,5 +40,10 @@ lines = ["true," + ",".join(cols)]
 lines += [t + "," + ",".join(str(result["confusion"][t].get(c, 0)) for c in cols) for t in labels]
 write_text(snakemake.output.confusion, "\n".join(lines) + "\n")
 confusion_figure(result, snakemake.output.figure)
-log.info("top-1 accuracy %.3f over %d, false alarms %d of %d", result["top1_accuracy"], result["n_blind"],
-         result["false_alarms"], result["n_effect_free"])
+log.info(
+    "top-1 accuracy %.3f over %d, false alarms %d of %d",
+    result["top1_accuracy"],
+    result["n_blind"],
+    result["false_alarms"],
+    result["n_effect_free"],
+)

@@ -26,16 +26,41 @@ records = {c: record_harmonics(read_raw(path, dual_sine=True), c, K) for c, path
 fit_settings = settings_from_config(p.friction)
 with open(inp.updating) as fh:
     upd_summary = json.load(fh)
-chain_model, model, updating = diagnosed_model(p.structure, load_dataset(inp.modes), modal, load_dataset(inp.fit),
-                                               records[p.calibration_case], upd_summary, fit_settings, settings,
-                                               int(p.seed))
+chain_model, model, updating = diagnosed_model(
+    p.structure,
+    load_dataset(inp.modes),
+    modal,
+    load_dataset(inp.fit),
+    records[p.calibration_case],
+    upd_summary,
+    fit_settings,
+    settings,
+    int(p.seed),
+)
 linear = linear_stage(model, load_dataset(inp.frf), modal)
-diag = diagnose(model, records, p.calibration_case, settings, fit_settings, linear, workers=workers,
-                identified=chain_model, updating=updating)
+diag = diagnose(
+    model,
+    records,
+    p.calibration_case,
+    settings,
+    fit_settings,
+    linear,
+    workers=workers,
+    identified=chain_model,
+    updating=updating,
+)
 seconds = time.perf_counter() - t0
-prov = provenance("gap_diagnosis", {"gap": p.gap, "structure": p.structure, "friction": p.friction, "seed": p.seed},
-                  {"modes": inp.modes, "modal": inp.modal, "frf": inp.frf, "fit": inp.fit,
-                   **{f"raw_{c}": path for c, path in zip(p.cases, inp.raw)}})
+prov = provenance(
+    "gap_diagnosis",
+    {"gap": p.gap, "structure": p.structure, "friction": p.friction, "seed": p.seed},
+    {
+        "modes": inp.modes,
+        "modal": inp.modal,
+        "frf": inp.frf,
+        "fit": inp.fit,
+        **{f"raw_{c}": path for c, path in zip(p.cases, inp.raw)},
+    },
+)
 ds = gap_dataset(diag, records, settings.n_harmonics)
 ds.attrs.update(prov)
 write_dataset(ds, snakemake.output.dataset)

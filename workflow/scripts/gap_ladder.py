@@ -11,9 +11,20 @@ log = setup_logging(snakemake.log[0])
 rows = [json.load(open(path)) for path in snakemake.input.rows]
 result = ladder_score(rows, float(snakemake.params.floor))
 write_text(snakemake.output[0], json.dumps(_clean(result), indent=2))
-log.info("detection ladder: %d items, %d detectable (held-out gap above twice the floor); named in %s, refitted "
-         "magnitude within 25 %% in %s of them", result["n"], result["n_detectable"],
-         result["named_where_detectable"], result["magnitude_within_where_detectable"])
+log.info(
+    "detection ladder: %d items, %d detectable (held-out gap above twice the floor); named in %s, refitted "
+    "magnitude within 25 %% in %s of them",
+    result["n"],
+    result["n_detectable"],
+    result["named_where_detectable"],
+    result["magnitude_within_where_detectable"],
+)
 for i in result["items"]:
-    log.info("%s: gap %.3g%s -> %s, refitted %s", i["item"], i.get("heldout_gap_before", float("nan")),
-             " (detectable)" if i.get("detectable") else "", i.get("verdict"), i.get("refitted_magnitude"))
+    log.info(
+        "%s: gap %.3g%s -> %s, refitted %s",
+        i["item"],
+        i.get("heldout_gap_before", float("nan")),
+        " (detectable)" if i.get("detectable") else "",
+        i.get("verdict"),
+        i.get("refitted_magnitude"),
+    )

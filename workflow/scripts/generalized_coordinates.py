@@ -8,6 +8,9 @@ log = setup_logging(snakemake.log[0])
 K = int(snakemake.params.nonlinear["n_harmonics"])
 raw = read_raw(snakemake.input.raw, dual_sine=True)
 ds = generalized_coordinates_dataset(raw, load_dataset(snakemake.input.modes), K)
-ds.attrs.update(provenance("generalized_coordinates", {"n_harmonics": K},
-                           {"raw": snakemake.input.raw, "modes": snakemake.input.modes}))
+ds.attrs.update(
+    provenance(
+        "generalized_coordinates", {"n_harmonics": K}, {"raw": snakemake.input.raw, "modes": snakemake.input.modes}
+    )
+)
 write_dataset(ds, snakemake.output.gc)

@@ -8,8 +8,14 @@ from contactid.nonlinear_chain import harmonic_study
 
 log = setup_logging(snakemake.log[0])
 inp = snakemake.input
-df = harmonic_study(read_raw(inp.raw, dual_sine=True), load_dataset(inp.truth), load_dataset(inp.modes),
-                    load_dataset(inp.modal), snakemake.params.structure, snakemake.params.counts)
+df = harmonic_study(
+    read_raw(inp.raw, dual_sine=True),
+    load_dataset(inp.truth),
+    load_dataset(inp.modes),
+    load_dataset(inp.modal),
+    snakemake.params.structure,
+    snakemake.params.counts,
+)
 Path(snakemake.output.table).parent.mkdir(parents=True, exist_ok=True)
 df.to_csv(snakemake.output.table, index=False, float_format="%.6g")
 log.info("\n%s", df.to_string())

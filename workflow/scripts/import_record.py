@@ -11,5 +11,11 @@ raw = import_record(p.block, p.where, dual_sine=record != "random_test")
 raw.attrs.update(provenance(snakemake.rule, dict(p.block), {k: v for k, v in snakemake.input.items()}))
 raw.attrs["source_sha256"] = file_digest(snakemake.input.file)
 write_dataset(raw, snakemake.output.raw)
-log.info("%s: %d samples at %g Hz from %s (%s)", record, raw.sizes["time"], raw.attrs["sampling_rate_hz"],
-         snakemake.input.file, raw.attrs["conversion"])
+log.info(
+    "%s: %d samples at %g Hz from %s (%s)",
+    record,
+    raw.sizes["time"],
+    raw.attrs["sampling_rate_hz"],
+    snakemake.input.file,
+    raw.attrs["conversion"],
+)

@@ -15,8 +15,9 @@ p = snakemake.params
 path = snakemake.input.raw
 checks = check_settings(p.checks)
 max_h = int(checks["max_harmonic"])
-raw = read_raw(path, dual_sine=True, min_periods=int(checks["min_periods"]),
-               max_harmonic=max(max_h, int(p.n_harmonics)))
+raw = read_raw(
+    path, dual_sine=True, min_periods=int(checks["min_periods"]), max_harmonic=max(max_h, int(p.n_harmonics))
+)
 check_sensor_layout(raw, p.structure, path)
 warnings = validate_dual_sine(raw, path, checks)
 ds = dual_sine_check_dataset(raw, p.structure, path, max_h)
@@ -25,5 +26,10 @@ ds.attrs.update(provenance("raw_check", {"checks": checks, "n_harmonics": p.n_ha
 write_dataset(ds, snakemake.output.check)
 for w in warnings:
     log.warning("%s: %s", path, w)
-log.info("%s: A1 = %.4g, A2 = %.4g m/s^2 at %.4g Hz", path, ds.attrs["A1_m_per_s2"], ds.attrs["A2_m_per_s2"],
-         ds.attrs["excitation_frequency_hz"])
+log.info(
+    "%s: A1 = %.4g, A2 = %.4g m/s^2 at %.4g Hz",
+    path,
+    ds.attrs["A1_m_per_s2"],
+    ds.attrs["A2_m_per_s2"],
+    ds.attrs["excitation_frequency_hz"],
+)

@@ -7,8 +7,14 @@ from contactid.nonlinear_chain import reduced_model_dataset
 log = setup_logging(snakemake.log[0])
 K = int(snakemake.params.nonlinear["n_harmonics"])
 raw = read_raw(snakemake.input.raw, dual_sine=True)
-ds = reduced_model_dataset(load_dataset(snakemake.input.nnm), load_dataset(snakemake.input.modes), raw,
-                           snakemake.params.structure, K)
-ds.attrs.update(provenance("reduced_model", {"structure": snakemake.params.structure, "n_harmonics": K},
-                           {"raw": snakemake.input.raw, "nnm": snakemake.input.nnm, "modes": snakemake.input.modes}))
+ds = reduced_model_dataset(
+    load_dataset(snakemake.input.nnm), load_dataset(snakemake.input.modes), raw, snakemake.params.structure, K
+)
+ds.attrs.update(
+    provenance(
+        "reduced_model",
+        {"structure": snakemake.params.structure, "n_harmonics": K},
+        {"raw": snakemake.input.raw, "nnm": snakemake.input.nnm, "modes": snakemake.input.modes},
+    )
+)
 write_dataset(ds, snakemake.output.reduced)

@@ -15,29 +15,94 @@ cons = pd.read_csv(inp.consistency)
 Path(out.numbers).write_text(macros(report_values(summary, cons)))
 Path(out.setup).write_text(setup_table(snakemake.params.structure))
 Path(out.datachecks).write_text(data_checks_text(summary))
-Path(out.table1).write_text(tabular(pd.read_csv(inp.table1), {
-    "mode": "mode", "identified_hz": "identified (Hz)", "paper_hz": "paper (Hz)", "truth_hz": "rig truth (Hz)",
-    "diff_vs_paper_pct": "vs paper (\\%)", "diff_vs_truth_pct": "vs truth (\\%)", "damping_ratio": "damping"},
-    "Natural frequencies at low-level random excitation (paper, Table 1).", "tab:t1"))
-Path(out.table3).write_text(tabular(pd.read_csv(inp.table3), {
-    "parameter": "", "identified_n_per_m": "identified (N/m)", "interval_low_n_per_m": "interval low",
-    "interval_high_n_per_m": "interval high", "reported_as": "reported as", "paper_n_per_m": "paper",
-    "truth_n_per_m": "rig truth"}, "Contact stiffness at stiction (paper, Table 3).", "tab:t3"))
-Path(out.table4).write_text(tabular(pd.read_csv(inp.table4), {
-    "parameter": "", "identified": "identified", "interval_low": "interval low", "interval_high": "interval high",
-    "reported_as": "reported as", "paper_value": "paper", "truth": "rig truth"},
-    "Friction-law parameters (paper, Table 4): working method with profile-likelihood intervals.", "tab:t4"))
-Path(out.consistency).write_text(tabular(cons, {
-    "scenario": "", "assumption": "assumption", "k_t_n_per_m": "$k_t$ (N/m)", "tangential_lever_arm_m": "$a$ (m)",
-    "youngs_modulus_pa": "$E$ (Pa)", "max_abs_err_pct": "max err (\\%)"},
-    "Table 1 against Tables 3 and 4 under candidate assumptions.", "tab:cons").replace("\\small", "\\scriptsize"))
+Path(out.table1).write_text(
+    tabular(
+        pd.read_csv(inp.table1),
+        {
+            "mode": "mode",
+            "identified_hz": "identified (Hz)",
+            "paper_hz": "paper (Hz)",
+            "truth_hz": "rig truth (Hz)",
+            "diff_vs_paper_pct": "vs paper (\\%)",
+            "diff_vs_truth_pct": "vs truth (\\%)",
+            "damping_ratio": "damping",
+        },
+        "Natural frequencies at low-level random excitation (paper, Table 1).",
+        "tab:t1",
+    )
+)
+Path(out.table3).write_text(
+    tabular(
+        pd.read_csv(inp.table3),
+        {
+            "parameter": "",
+            "identified_n_per_m": "identified (N/m)",
+            "interval_low_n_per_m": "interval low",
+            "interval_high_n_per_m": "interval high",
+            "reported_as": "reported as",
+            "paper_n_per_m": "paper",
+            "truth_n_per_m": "rig truth",
+        },
+        "Contact stiffness at stiction (paper, Table 3).",
+        "tab:t3",
+    )
+)
+Path(out.table4).write_text(
+    tabular(
+        pd.read_csv(inp.table4),
+        {
+            "parameter": "",
+            "identified": "identified",
+            "interval_low": "interval low",
+            "interval_high": "interval high",
+            "reported_as": "reported as",
+            "paper_value": "paper",
+            "truth": "rig truth",
+        },
+        "Friction-law parameters (paper, Table 4): working method with profile-likelihood intervals.",
+        "tab:t4",
+    )
+)
+Path(out.consistency).write_text(
+    tabular(
+        cons,
+        {
+            "scenario": "",
+            "assumption": "assumption",
+            "k_t_n_per_m": "$k_t$ (N/m)",
+            "tangential_lever_arm_m": "$a$ (m)",
+            "youngs_modulus_pa": "$E$ (Pa)",
+            "max_abs_err_pct": "max err (\\%)",
+        },
+        "Table 1 against Tables 3 and 4 under candidate assumptions.",
+        "tab:cons",
+    ).replace("\\small", "\\scriptsize")
+)
 rows = []
 for case, w in summary.get("contact_forces", {}).items():
     p = summary["contact_forces_paper"][case]
-    rows.append({"case": case, **{f"w_{q}": 100 * w.get(f"{q}_nrmse", float("nan")) for q in ("S", "N", "xi", "eta")},
-                 **{f"p_{q}": 100 * p.get(f"{q}_nrmse", float("nan")) for q in ("S", "N", "xi", "eta")}})
-Path(out.contact).write_text(tabular(pd.DataFrame(rows), {
-    "case": "case", "w_S": "$S$", "w_N": "$N$", "w_xi": "$\\xi$", "w_eta": "$\\eta$", "p_S": "$S$ (paper)",
-    "p_N": "$N$ (paper)", "p_xi": "$\\xi$ (paper)", "p_eta": "$\\eta$ (paper)"},
-    "NRMSE (\\%) of the identified contact forces and motions against the rig truth: working method and the paper's chain.",
-    "tab:contact"))
+    rows.append(
+        {
+            "case": case,
+            **{f"w_{q}": 100 * w.get(f"{q}_nrmse", float("nan")) for q in ("S", "N", "xi", "eta")},
+            **{f"p_{q}": 100 * p.get(f"{q}_nrmse", float("nan")) for q in ("S", "N", "xi", "eta")},
+        }
+    )
+Path(out.contact).write_text(
+    tabular(
+        pd.DataFrame(rows),
+        {
+            "case": "case",
+            "w_S": "$S$",
+            "w_N": "$N$",
+            "w_xi": "$\\xi$",
+            "w_eta": "$\\eta$",
+            "p_S": "$S$ (paper)",
+            "p_N": "$N$ (paper)",
+            "p_xi": "$\\xi$ (paper)",
+            "p_eta": "$\\eta$ (paper)",
+        },
+        "NRMSE (\\%) of the identified contact forces and motions against the rig truth: working method and the paper's chain.",
+        "tab:contact",
+    )
+)

@@ -12,4 +12,6 @@ raw.attrs.update(provenance("rig_random_test", cfg))
 truth.attrs.update(provenance("rig_random_test", cfg))
 write_dataset(truth, snakemake.output.truth)
 write_dataset(raw, snakemake.output.raw)
-log.info("random test: %d samples, true frequencies %s Hz", raw.sizes["time"], fmt(truth["natural_frequency"].values[:3], 5))
+log.info(
+    "random test: %d samples, true frequencies %s Hz", raw.sizes["time"], fmt(truth["natural_frequency"].values[:3], 5)
+)

@@ -7,8 +7,16 @@ from contactid.logs import fmt, setup_logging
 log = setup_logging(snakemake.log[0])
 p = snakemake.params
 ds = stiction_dataset(load_dataset(snakemake.input.modal), p.structure, p.stiction)
-ds.attrs.update(provenance("stiction_stiffness", {"structure": p.structure, "stiction": p.stiction},
-                           {"modal": snakemake.input.modal}))
+ds.attrs.update(
+    provenance(
+        "stiction_stiffness", {"structure": p.structure, "stiction": p.stiction}, {"modal": snakemake.input.modal}
+    )
+)
 write_dataset(ds, snakemake.output.stiction)
-log.info("k_t = %.4g N/m, interval %s; k_n = %.4g N/m, interval %s", float(ds["k_t"]), fmt(ds["k_t_interval"].values),
-         float(ds["k_n"]), fmt(ds["k_n_interval"].values))
+log.info(
+    "k_t = %.4g N/m, interval %s; k_n = %.4g N/m, interval %s",
+    float(ds["k_t"]),
+    fmt(ds["k_t_interval"].values),
+    float(ds["k_n"]),
+    fmt(ds["k_n_interval"].values),
+)

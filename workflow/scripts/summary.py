@@ -4,22 +4,27 @@ import json
 
 from contactid.io import load_dataset
 from contactid.logs import setup_logging
-from contactid.reporting import (contact_force_summary, friction_summary, linear_summary, load_case_summary,
-                                 model_form_summary)
+from contactid.reporting import (
+    contact_force_summary,
+    friction_summary,
+    linear_summary,
+    load_case_summary,
+    model_form_summary,
+)
 
 log = setup_logging(snakemake.log[0])
 inp = snakemake.input
 truth = load_dataset(inp.truth) if "truth" in inp.keys() else None
 summary = linear_summary(load_dataset(inp.modal), load_dataset(inp.stiction), truth)
-checks = {k[len("check_"):]: load_dataset(v) for k, v in inp.items() if k.startswith("check_")}
-truths = {k[len("truth_"):]: load_dataset(v) for k, v in inp.items() if k.startswith("truth_")}
+checks = {k[len("check_") :]: load_dataset(v) for k, v in inp.items() if k.startswith("check_")}
+truths = {k[len("truth_") :]: load_dataset(v) for k, v in inp.items() if k.startswith("truth_")}
 summary.update(load_case_summary(checks, truths))
 summary["data_warnings"]["random_test"] = json.loads(load_dataset(inp.frf).attrs.get("warnings", "[]"))
-forces = {k[len("forces_"):]: load_dataset(v) for k, v in inp.items() if k.startswith("forces_")}
-nnms = {k[len("nnm_"):]: load_dataset(v) for k, v in inp.items() if k.startswith("nnm_")}
+forces = {k[len("forces_") :]: load_dataset(v) for k, v in inp.items() if k.startswith("forces_")}
+nnms = {k[len("nnm_") :]: load_dataset(v) for k, v in inp.items() if k.startswith("nnm_")}
 summary.update(contact_force_summary(forces, nnms))
 if "fit" in inp.keys():
-    validations = {k[len("validation_"):]: load_dataset(v) for k, v in inp.items() if k.startswith("validation_")}
+    validations = {k[len("validation_") :]: load_dataset(v) for k, v in inp.items() if k.startswith("validation_")}
     summary.update(friction_summary(load_dataset(inp.fit), validations))
 if "friction_intervals" in inp.keys():
     with open(inp.friction_intervals) as fh:

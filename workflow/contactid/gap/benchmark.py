@@ -71,8 +71,13 @@ def benchmark_items(cfg: Mapping, seed: int) -> dict:
         for e in effects:
             lo, hi = ranges[e]
             lib = [x for x in EFFECTS if x != e]
-            items[f"lo_{e}-0-s{seeds[0]}"] = {"effect": e, "magnitude": 0.5 * (lo + hi), "seed": seeds[0],
-                                              "library": lib, "kind": "leave_out"}
+            items[f"lo_{e}-0-s{seeds[0]}"] = {
+                "effect": e,
+                "magnitude": 0.5 * (lo + hi),
+                "seed": seeds[0],
+                "library": lib,
+                "kind": "leave_out",
+            }
     items.update(compound_items(int(cfg.get("compound", 20)), seeds, seed, ranges))
     return items
 
@@ -97,8 +102,14 @@ def ladder_items(cfg: Mapping, seed: int) -> dict:
     for e in effects:
         for s in [int(x) for x in cfg.get("seeds", [1, 2])]:
             for k, f in enumerate(fractions):
-                items[f"ladder_{e}-{k}-s{s}"] = {"effect": e, "magnitude": f * ladder_typical(e, ranges), "seed": s,
-                                                 "library": None, "kind": "ladder", "fraction": f}
+                items[f"ladder_{e}-{k}-s{s}"] = {
+                    "effect": e,
+                    "magnitude": f * ladder_typical(e, ranges),
+                    "seed": s,
+                    "library": None,
+                    "kind": "ladder",
+                    "fraction": f,
+                }
     return items
 
 
@@ -108,9 +119,14 @@ def refitted_magnitude(effect: str, parameters: Mapping | None) -> float | None:
     rig delays channel k of n by m (k + 1) / n; m is the least-squares fit of the refitted per-channel delays."""
     if not parameters:
         return None
-    direct = {"structural_damping": "extra_damping_ratio", "normal_contact_damping": "alpha",
-              "viscous_friction": "sigma_2", "multi_asperity_friction": "iwan_share",
-              "transducer_mass_error": "mass_error", "preload_drift": "relative_drift"}
+    direct = {
+        "structural_damping": "extra_damping_ratio",
+        "normal_contact_damping": "alpha",
+        "viscous_friction": "sigma_2",
+        "multi_asperity_friction": "iwan_share",
+        "transducer_mass_error": "mass_error",
+        "preload_drift": "relative_drift",
+    }
     if effect in direct:
         return float(parameters[direct[effect]])
     if effect == "channel_time_skew":
@@ -149,17 +165,32 @@ def run_item(spec: Mapping, cfg: Mapping) -> dict:
     hidden = f"{spec['effect']} at {spec['magnitude']:.4g}" if spec["effect"] else "no effect"
     if compound:
         hidden = "perturbed rig with " + (", ".join(f"{e} at {m:.4g}" for e, m in effects.items()) or "no effect")
-    log.info("benchmark item (%s, seed %d): %s; making the rig records of %s", spec["kind"], int(spec["seed"]),
-             hidden, ", ".join(["random_test", *cases]))
+    log.info(
+        "benchmark item (%s, seed %d): %s; making the rig records of %s",
+        spec["kind"],
+        int(spec["seed"]),
+        hidden,
+        ", ".join(["random_test", *cases]),
+    )
     recs, converged = rig_records(cfg, effects, int(spec["seed"]), cases)
     t_rig = time.perf_counter() - t0
-    bad = [n for n, ds in recs.items() if not (np.isfinite(ds["acceleration"].values).all()
-                                               and np.isfinite(ds["force"].values).all())]
+    bad = [
+        n
+        for n, ds in recs.items()
+        if not (np.isfinite(ds["acceleration"].values).all() and np.isfinite(ds["force"].values).all())
+    ]
     if bad:  # the rig could not simulate this data set: say so, score it apart
-        log.warning("benchmark item (%s): the rig's records of %s are not finite; not diagnosed", spec["kind"],
-                    ", ".join(bad))
-        return {**dict(spec), "failed": f"rig records not finite: {', '.join(bad)}", "verdict": None,
-                "correct": False, "control_converged": converged, "seconds": {"rig": t_rig}}
+        log.warning(
+            "benchmark item (%s): the rig's records of %s are not finite; not diagnosed", spec["kind"], ", ".join(bad)
+        )
+        return {
+            **dict(spec),
+            "failed": f"rig records not finite: {', '.join(bad)}",
+            "verdict": None,
+            "correct": False,
+            "control_converged": converged,
+            "seconds": {"rig": t_rig},
+        }
     log.info("rig records made in %.1f s; identifying the model", t_rig)
     model, modes, modal, frf = identify(cfg, recs["random_test"], recs[cal])
     K = int(cfg.get("nonlinear", {}).get("n_harmonics", 25))
@@ -171,12 +202,23 @@ def run_item(spec: Mapping, cfg: Mapping) -> dict:
         gap_cfg["candidates"] = list(spec["library"])
     settings = GapSettings.from_config(gap_cfg, int(cfg["seed"]), K)
     t1 = time.perf_counter()
-    log.info("model identified in %.1f s; diagnosing%s", t_id,
-             "" if spec.get("library") is None else f" with a library that lacks {spec['effect']}")
+    log.info(
+        "model identified in %.1f s; diagnosing%s",
+        t_id,
+        "" if spec.get("library") is None else f" with a library that lacks {spec['effect']}",
+    )
     chain_model = model
     model, updating = updated_model(chain_model, modal, records[cal], fit_settings, settings, int(cfg["seed"]))
-    diag = diagnose(model, records, cal, settings, fit_settings, linear_stage(model, frf, modal),
-                    identified=chain_model, updating=updating)
+    diag = diagnose(
+        model,
+        records,
+        cal,
+        settings,
+        fit_settings,
+        linear_stage(model, frf, modal),
+        identified=chain_model,
+        updating=updating,
+    )
     t_diag = time.perf_counter() - t1
     by = {r["effect"]: r for r in diag.ranking}
     if compound:
@@ -185,42 +227,83 @@ def run_item(spec: Mapping, cfg: Mapping) -> dict:
         named = [s["effect"] for s in diag.explanation if s["effect"] != "model_updating"]
         preload = float(cfg["structure"]["preload_n"])
         t_unc = time.perf_counter()
-        unc = friction_uncertainty(model, records, cal, fit_settings, int(cfg["seed"]),
-                                   updating.posterior_structures() if updating is not None else ())
+        unc = friction_uncertainty(
+            model,
+            records,
+            cal,
+            fit_settings,
+            int(cfg["seed"]),
+            updating.posterior_structures() if updating is not None else (),
+        )
         t_unc = time.perf_counter() - t_unc
-        row = {**dict(spec), "verdict": diag.verdict, "reason": diag.reason, "explanation": diag.explanation,
-               "remaining_gap": diag.remaining_gap, "named": named, "correct": set(named) == set(effects),
-               "updating_accepted": bool(updating is not None and updating.accepted),
-               "heldout_gap_before": diag.where.get("heldout_gap_identified", diag.where["heldout_gap_before"]),
-               "friction_errors": friction_errors(model, cfg["rig"]["truth"]["friction"], preload),
-               "friction_errors_chain": friction_errors(chain_model, cfg["rig"]["truth"]["friction"], preload),
-               "bound_errors": bound_errors(model, cfg["rig"]["truth"]["friction"], preload,
-                                            cfg["rig"]["true_structure"]["contact_geometry"]["tangential_lever_arm_m"]),
-               "friction_intervals": {n: [float(v) for v in unc.interval[NAMES.index(n)]] for n in ("mu", "kappa", "e0")},
-               "friction_covered": unc.covers(friction_truth(cfg["rig"]["truth"]["friction"], preload)),
-               "friction_interval_halfwidth": unc.relative_halfwidth(("mu", "kappa", "e0")),
-               "where": diag.where, "control_converged": converged,
-               "seconds": {"rig": t_rig, "identification": t_id, "diagnosis": time.perf_counter() - t1 - t_unc,
-                           "intervals": t_unc}}
-        log.info("benchmark item (compound): %s -> explanation %s (remaining gap %.3g), mu error %.2g %%, %.1f s",
-                 hidden, ", ".join(["model_updating"] * row["updating_accepted"] + named) or "none",
-                 diag.remaining_gap["heldout_gap"], 100 * row["friction_errors"]["mu"], time.perf_counter() - t0)
+        row = {
+            **dict(spec),
+            "verdict": diag.verdict,
+            "reason": diag.reason,
+            "explanation": diag.explanation,
+            "remaining_gap": diag.remaining_gap,
+            "named": named,
+            "correct": set(named) == set(effects),
+            "updating_accepted": bool(updating is not None and updating.accepted),
+            "heldout_gap_before": diag.where.get("heldout_gap_identified", diag.where["heldout_gap_before"]),
+            "friction_errors": friction_errors(model, cfg["rig"]["truth"]["friction"], preload),
+            "friction_errors_chain": friction_errors(chain_model, cfg["rig"]["truth"]["friction"], preload),
+            "bound_errors": bound_errors(
+                model,
+                cfg["rig"]["truth"]["friction"],
+                preload,
+                cfg["rig"]["true_structure"]["contact_geometry"]["tangential_lever_arm_m"],
+            ),
+            "friction_intervals": {n: [float(v) for v in unc.interval[NAMES.index(n)]] for n in ("mu", "kappa", "e0")},
+            "friction_covered": unc.covers(friction_truth(cfg["rig"]["truth"]["friction"], preload)),
+            "friction_interval_halfwidth": unc.relative_halfwidth(("mu", "kappa", "e0")),
+            "where": diag.where,
+            "control_converged": converged,
+            "seconds": {
+                "rig": t_rig,
+                "identification": t_id,
+                "diagnosis": time.perf_counter() - t1 - t_unc,
+                "intervals": t_unc,
+            },
+        }
+        log.info(
+            "benchmark item (compound): %s -> explanation %s (remaining gap %.3g), mu error %.2g %%, %.1f s",
+            hidden,
+            ", ".join(["model_updating"] * row["updating_accepted"] + named) or "none",
+            diag.remaining_gap["heldout_gap"],
+            100 * row["friction_errors"]["mu"],
+            time.perf_counter() - t0,
+        )
         return row
     true = spec["effect"]
     expected = "none" if spec["kind"] == "leave_out" else (true or "none")
-    log.info("benchmark item (%s): %s -> verdict %s (expected %s: %s), %.1f s in all", spec["kind"], hidden,
-             diag.verdict, expected, "right" if diag.verdict == expected else "wrong", time.perf_counter() - t0)
-    return {**dict(spec), "verdict": diag.verdict, "reason": diag.reason, "correct": (diag.verdict == (true or "none"))
-            if spec["kind"] != "leave_out" else diag.verdict == "none",
-            "heldout_gap_before": diag.where["heldout_gap_before"],
-            "heldout_gap_identified": diag.where.get("heldout_gap_identified", diag.where["heldout_gap_before"]),
-            "heldout_gap_after_true": by[true]["heldout_gap_after"] if true in by else None,
-            "refitted_magnitude": _refitted(true, by, updating),
-            "shrink_true": by[true]["reduction"] if true in by else None,
-            "ranking": [{k: r[k] for k in ("effect", "heldout_gap_before", "heldout_gap_after", "score", "reduction")}
-                        for r in diag.ranking],
-            "where": diag.where, "control_converged": converged,
-            "seconds": {"rig": t_rig, "identification": t_id, "diagnosis": t_diag}}
+    log.info(
+        "benchmark item (%s): %s -> verdict %s (expected %s: %s), %.1f s in all",
+        spec["kind"],
+        hidden,
+        diag.verdict,
+        expected,
+        "right" if diag.verdict == expected else "wrong",
+        time.perf_counter() - t0,
+    )
+    return {
+        **dict(spec),
+        "verdict": diag.verdict,
+        "reason": diag.reason,
+        "correct": (diag.verdict == (true or "none")) if spec["kind"] != "leave_out" else diag.verdict == "none",
+        "heldout_gap_before": diag.where["heldout_gap_before"],
+        "heldout_gap_identified": diag.where.get("heldout_gap_identified", diag.where["heldout_gap_before"]),
+        "heldout_gap_after_true": by[true]["heldout_gap_after"] if true in by else None,
+        "refitted_magnitude": _refitted(true, by, updating),
+        "shrink_true": by[true]["reduction"] if true in by else None,
+        "ranking": [
+            {k: r[k] for k in ("effect", "heldout_gap_before", "heldout_gap_after", "score", "reduction")}
+            for r in diag.ranking
+        ],
+        "where": diag.where,
+        "control_converged": converged,
+        "seconds": {"rig": t_rig, "identification": t_id, "diagnosis": t_diag},
+    }
 
 
 def score(rows: list) -> dict:
@@ -244,22 +327,40 @@ def score(rows: list) -> dict:
     for r in lo:  # "contact" (eta not observable) is right for a normal or tangential effect, if less specific
         place_ok.append(acts_where(EXPECTED_PLACE[r["effect"]], r["where"].get("place")))
     return {
-        "n_blind": len(blind), "top1_accuracy": len(correct) / max(len(blind), 1),
-        "n_effect_free": len(free), "false_alarms": sum(r["verdict"] != "none" for r in free),
-        "shrink_of_correct": {"min": float(np.min(shrink)) if shrink else None,
-                              "median": float(np.median(shrink)) if shrink else None,
-                              "all_at_least_half": bool(shrink) and all(s >= 0.5 for s in shrink)},
-        "leave_out": {"n": len(lo), "verdict_none": sum(r["verdict"] == "none" for r in lo),
-                      "place_right": int(sum(place_ok)),
-                      "items": [{"effect": r["effect"], "verdict": r["verdict"], "place": r["where"].get("place"),
-                                 "expected_place": EXPECTED_PLACE[r["effect"]], "direction": r["where"].get("direction"),
-                                 "largest_stage": r["where"].get("largest_stage"),
-                                 "harmonic_class": r["where"].get("harmonic_class")} for r in lo]},
+        "n_blind": len(blind),
+        "top1_accuracy": len(correct) / max(len(blind), 1),
+        "n_effect_free": len(free),
+        "false_alarms": sum(r["verdict"] != "none" for r in free),
+        "shrink_of_correct": {
+            "min": float(np.min(shrink)) if shrink else None,
+            "median": float(np.median(shrink)) if shrink else None,
+            "all_at_least_half": bool(shrink) and all(s >= 0.5 for s in shrink),
+        },
+        "leave_out": {
+            "n": len(lo),
+            "verdict_none": sum(r["verdict"] == "none" for r in lo),
+            "place_right": int(sum(place_ok)),
+            "items": [
+                {
+                    "effect": r["effect"],
+                    "verdict": r["verdict"],
+                    "place": r["where"].get("place"),
+                    "expected_place": EXPECTED_PLACE[r["effect"]],
+                    "direction": r["where"].get("direction"),
+                    "largest_stage": r["where"].get("largest_stage"),
+                    "harmonic_class": r["where"].get("harmonic_class"),
+                }
+                for r in lo
+            ],
+        },
         "confusion": conf,
-        "per_effect_accuracy": {e: float(np.mean([r["verdict"] == e for r in blind if r["effect"] == e]))
-                                for e in labels if e != "none"},
-        "diagnosis_seconds": {"median": float(np.median([r["seconds"]["diagnosis"] for r in rows])) if rows else None,
-                              "max": float(np.max([r["seconds"]["diagnosis"] for r in rows])) if rows else None},
+        "per_effect_accuracy": {
+            e: float(np.mean([r["verdict"] == e for r in blind if r["effect"] == e])) for e in labels if e != "none"
+        },
+        "diagnosis_seconds": {
+            "median": float(np.median([r["seconds"]["diagnosis"] for r in rows])) if rows else None,
+            "max": float(np.max([r["seconds"]["diagnosis"] for r in rows])) if rows else None,
+        },
         **({"compound": compound_score(comp)} if comp else {}),
         "failed": [{k: r.get(k) for k in ("kind", "effect", "effects", "seed", "failed")} for r in failed],
     }
@@ -273,27 +374,47 @@ def ladder_score(rows: list, floor: float, tolerance: float = 0.25) -> dict:
     items = []
     for r in rows:
         if r.get("failed"):
-            items.append({"item": r.get("item"), "effect": r["effect"], "fraction": r.get("fraction"), "failed": r["failed"]})
+            items.append(
+                {"item": r.get("item"), "effect": r["effect"], "fraction": r.get("fraction"), "failed": r["failed"]}
+            )
             continue
         gap = r.get("heldout_gap_identified", r["heldout_gap_before"])
         detectable = bool(gap > 2.0 * floor)
         m = r.get("refitted_magnitude")
         err = None if m is None or not r["magnitude"] else float(m / r["magnitude"] - 1.0)
-        items.append({"item": r.get("item"), "effect": r["effect"], "fraction": r.get("fraction"), "seed": r["seed"],
-                      "magnitude": r["magnitude"], "heldout_gap_before": gap,
-                      "detectable": detectable, "verdict": r["verdict"], "named": r["verdict"] == r["effect"],
-                      "refitted_magnitude": m, "magnitude_error": err,
-                      "magnitude_within": None if err is None else bool(abs(err) <= tolerance)})
+        items.append(
+            {
+                "item": r.get("item"),
+                "effect": r["effect"],
+                "fraction": r.get("fraction"),
+                "seed": r["seed"],
+                "magnitude": r["magnitude"],
+                "heldout_gap_before": gap,
+                "detectable": detectable,
+                "verdict": r["verdict"],
+                "named": r["verdict"] == r["effect"],
+                "refitted_magnitude": m,
+                "magnitude_error": err,
+                "magnitude_within": None if err is None else bool(abs(err) <= tolerance),
+            }
+        )
     det = [i for i in items if i.get("detectable")]
     comparable = [i for i in det if i["magnitude_within"] is not None]
     share = lambda xs: float(np.mean(xs)) if xs else None  # noqa: E731
-    return {"n": len(items), "n_failed": sum("failed" in i for i in items), "floor": floor, "tolerance": tolerance,
-            "n_detectable": len(det), "named_where_detectable": share([i["named"] for i in det]),
-            "magnitude_within_where_detectable": share([i["magnitude_within"] for i in comparable]),
-            "all_named_and_within": bool(det) and all(i["named"] and i["magnitude_within"] is not False for i in det),
-            "false_names_below_detectable": sum(i["verdict"] not in ("none", i["effect"]) for i in items
-                                                if "failed" not in i and not i["detectable"]),
-            "items": items}
+    return {
+        "n": len(items),
+        "n_failed": sum("failed" in i for i in items),
+        "floor": floor,
+        "tolerance": tolerance,
+        "n_detectable": len(det),
+        "named_where_detectable": share([i["named"] for i in det]),
+        "magnitude_within_where_detectable": share([i["magnitude_within"] for i in comparable]),
+        "all_named_and_within": bool(det) and all(i["named"] and i["magnitude_within"] is not False for i in det),
+        "false_names_below_detectable": sum(
+            i["verdict"] not in ("none", i["effect"]) for i in items if "failed" not in i and not i["detectable"]
+        ),
+        "items": items,
+    }
 
 
 def confusion_figure(result: dict, path: str) -> None:
@@ -316,8 +437,10 @@ def confusion_figure(result: dict, path: str) -> None:
     ax.set_yticks(range(len(rows)), rows)
     ax.set_xlabel("verdict")
     ax.set_ylabel("effect on in the rig")
-    ax.set_title(f"Blind benchmark: top-1 {result['top1_accuracy']:.0%} of {result['n_blind']}, "
-                 f"false alarms {result['false_alarms']}/{result['n_effect_free']}")
+    ax.set_title(
+        f"Blind benchmark: top-1 {result['top1_accuracy']:.0%} of {result['n_blind']}, "
+        f"false alarms {result['false_alarms']}/{result['n_effect_free']}"
+    )
     fig.tight_layout()
     fig.savefig(path, dpi=130)
     plt.close(fig)
@@ -364,9 +487,17 @@ def compound_items(n_per_seed: int, seeds, seed: int, ranges: Mapping) -> dict:
                 e = options[int(rng.integers(len(options)))]
                 lo, hi = ranges[e]
                 effects[e] = float(rng.uniform(lo, hi))
-            items[f"compound-{k}-s{s}"] = {"kind": "compound", "seed": int(s), "effect": None, "magnitude": 0.0,
-                                           "library": None, "effects": effects, "perturbation": pert,
-                                           "normal_cubic_n_per_m3": cubic, "damping_form": form}
+            items[f"compound-{k}-s{s}"] = {
+                "kind": "compound",
+                "seed": int(s),
+                "effect": None,
+                "magnitude": 0.0,
+                "library": None,
+                "effects": effects,
+                "perturbation": pert,
+                "normal_cubic_n_per_m3": cubic,
+                "damping_form": form,
+            }
     return items
 
 
@@ -382,12 +513,16 @@ def compound_config(cfg: Mapping, spec: Mapping) -> dict:
         "beam": {"youngs_modulus_pa": st["beam"]["youngs_modulus_pa"] * (1 + p["youngs_modulus"])},
         "sensors": {"masses_kg": [m * (1 + p["transducer_masses"]) for m in st["sensors"]["masses_kg"]]},
         "force_transducer_mass_kg": st["force_transducer_mass_kg"] * (1 + p["transducer_masses"]),
-        "contact_geometry": {"tangential_lever_arm_m": st["contact_geometry"]["tangential_lever_arm_m"]
-                             * (1 + p["tangential_lever_arm"])},
+        "contact_geometry": {
+            "tangential_lever_arm_m": st["contact_geometry"]["tangential_lever_arm_m"] * (1 + p["tangential_lever_arm"])
+        },
     }
     if spec["normal_cubic_n_per_m3"]:
-        rig["truth"]["normal"] = {**rig["truth"]["normal"], "exponent": 1.0,
-                                  "cubic_n_per_m3": float(spec["normal_cubic_n_per_m3"])}
+        rig["truth"]["normal"] = {
+            **rig["truth"]["normal"],
+            "exponent": 1.0,
+            "cubic_n_per_m3": float(spec["normal_cubic_n_per_m3"]),
+        }
     rig["true_damping"] = {"form": spec["damping_form"], "reference_frequency_hz": 54.4}
     return out
 
@@ -397,8 +532,11 @@ def friction_truth(truth_friction: Mapping, preload: float) -> dict:
     from ..contact_laws import stiction_shear_stiffness
 
     t = truth_friction
-    return {"mu": float(t["mu"]), "kappa": float(t["kappa"]),
-            "e0": float(stiction_shear_stiffness(preload, t["e_f_n_per_m"], t["k_c_per_m"]))}
+    return {
+        "mu": float(t["mu"]),
+        "kappa": float(t["kappa"]),
+        "e0": float(stiction_shear_stiffness(preload, t["e_f_n_per_m"], t["k_c_per_m"])),
+    }
 
 
 def friction_errors(model, truth_friction: Mapping, preload: float) -> dict:
@@ -421,6 +559,7 @@ def bound_errors(model, truth_friction: Mapping, preload: float, true_lever_arm:
 
 def compound_score(rows: list) -> dict:
     """Scores of the compound items (see config/README.md, gap_benchmark.compound)."""
+
     def named(r):
         return {s["effect"] for s in r["explanation"] if s["effect"] != "model_updating"}
 
@@ -432,20 +571,30 @@ def compound_score(rows: list) -> dict:
         tp = sum(e in r["effects"] and e in named(r) for r in rows)
         fn = sum(e in r["effects"] and e not in named(r) for r in rows)
         fp = sum(e not in r["effects"] and e in named(r) for r in rows)
-        per_effect[e] = {"recall": tp / (tp + fn) if tp + fn else None, "precision": tp / (tp + fp) if tp + fp else None,
-                         "true": tp + fn, "named": tp + fp}
+        per_effect[e] = {
+            "recall": tp / (tp + fn) if tp + fn else None,
+            "precision": tp / (tp + fp) if tp + fp else None,
+            "true": tp + fn,
+            "named": tp + fp,
+        }
     errors = {k: [abs(r["friction_errors"][k]) for r in by_n[0]] for k in ("mu", "kappa", "e0")}
     bound = {k: [abs(r["bound_errors"][k]) for r in by_n[0] if r.get("bound_errors")] for k in ("mu_a", "e0_a2")}
-    covered = {k: [bool(r["friction_covered"][k]) for r in by_n[0] if k in (r.get("friction_covered") or {})]
-               for k in ("mu", "kappa", "e0")}
-    width = {k: [r["friction_interval_halfwidth"][k] for r in by_n[0] if r.get("friction_interval_halfwidth")]
-             for k in ("mu", "kappa", "e0")}
+    covered = {
+        k: [bool(r["friction_covered"][k]) for r in by_n[0] if k in (r.get("friction_covered") or {})]
+        for k in ("mu", "kappa", "e0")
+    }
+    width = {
+        k: [r["friction_interval_halfwidth"][k] for r in by_n[0] if r.get("friction_interval_halfwidth")]
+        for k in ("mu", "kappa", "e0")
+    }
     return {
-        "n": len(rows), "n_by_effect_count": {str(n): len(v) for n, v in by_n.items()},
+        "n": len(rows),
+        "n_by_effect_count": {str(n): len(v) for n, v in by_n.items()},
         "perturbation_only_no_contact_effect": share([not (named(r) & set(CONTACT_EFFECTS)) for r in by_n[0]]),
         "one_effect_named": share([set(r["effects"]) <= named(r) for r in by_n[1]]),
-        "one_effect_no_absent_contact_effect": share([not ((named(r) - set(r["effects"])) & set(CONTACT_EFFECTS))
-                                                      for r in by_n[1]]),
+        "one_effect_no_absent_contact_effect": share(
+            [not ((named(r) - set(r["effects"])) & set(CONTACT_EFFECTS)) for r in by_n[1]]
+        ),
         "two_effects_both_named": share([set(r["effects"]) <= named(r) for r in by_n[2]]),
         "two_effects_one_named": share([bool(set(r["effects"]) & named(r)) for r in by_n[2]]),
         "per_effect": per_effect,
@@ -454,5 +603,7 @@ def compound_score(rows: list) -> dict:
         "perturbation_only_median_abs_error": {k: float(np.median(v)) if v else None for k, v in errors.items()},
         "perturbation_only_median_abs_bound_error": {k: float(np.median(v)) if v else None for k, v in bound.items()},
         "perturbation_only_interval_coverage": {k: share(v) for k, v in covered.items()},
-        "perturbation_only_median_interval_halfwidth": {k: float(np.median(v)) if v else None for k, v in width.items()},
+        "perturbation_only_median_interval_halfwidth": {
+            k: float(np.median(v)) if v else None for k, v in width.items()
+        },
     }

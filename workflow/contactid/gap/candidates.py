@@ -72,8 +72,10 @@ def register(candidate: Candidate) -> Candidate:
     if not candidate.parameters:
         raise ValueError(f"gap candidate {candidate.name!r}: give at least one parameter")
     if candidate.acts_on not in (*PLACES, "any"):
-        raise ValueError(f"gap candidate {candidate.name!r}: acts_on = {candidate.acts_on!r}; give one of "
-                         f"{', '.join(PLACES)} or 'any'")
+        raise ValueError(
+            f"gap candidate {candidate.name!r}: acts_on = {candidate.acts_on!r}; give one of "
+            f"{', '.join(PLACES)} or 'any'"
+        )
     for p in candidate.parameters:
         if not p.low < p.high:
             raise ValueError(f"gap candidate {candidate.name!r}, parameter {p.name}: low must be below high")
@@ -81,36 +83,84 @@ def register(candidate: Candidate) -> Candidate:
     return candidate
 
 
-register(Candidate("structural_damping", "extra modal damping of the beam's modes at test level",
-                   (Parameter("extra_damping_ratio", "1", 0.0, 0.05),),
-                   lambda th: Augmentation(extra_damping=float(th[0])), acts_on="structure_or_measurement"))
-register(Candidate("normal_contact_damping", "Hunt-Crossley damping of the normal contact, N (1 - alpha deta/dt)",
-                   (Parameter("alpha", "s/m", 0.0, 3000.0),),
-                   lambda th: Augmentation(hunt_crossley=float(th[0])), acts_on="normal_contact"))
-register(Candidate("viscous_friction", "velocity-dependent friction, S + sigma_2 dxi/dt",
-                   (Parameter("sigma_2", "N s/m", 0.0, 3000.0),),
-                   lambda th: Augmentation(viscous=float(th[0])), acts_on="tangential_contact"))
-register(Candidate("multi_asperity_friction", "share of the tangential contact carried by a 16-slider Iwan element "
-                   "(internal hysteresis loops)",
-                   (Parameter("iwan_share", "1", 0.0, 1.0),),
-                   lambda th: Augmentation(iwan_share=float(th[0])), acts_on="tangential_contact"))
-register(Candidate("transducer_mass_error", "every transducer mass wrong by the same factor 1 + m",
-                   (Parameter("mass_error", "1", -0.9, 3.0),),
-                   lambda th: Augmentation(mass_error=float(th[0])), acts_on="structure_or_measurement"))
-register(Candidate("channel_time_skew", "each accelerometer channel late on the force by its own delay",
-                   (Parameter("delay", "s", -2.0e-4, 2.0e-4),),
-                   lambda th: Augmentation(delays=tuple(float(x) for x in th)), per_channel=True,
-                   acts_on="structure_or_measurement"))
-register(Candidate("contact_separation", "unilateral hardening normal contact N0 ((delta0 - eta)/delta0)^p that opens "
-                   "(instead of Eq. 13's linear spring), delta0 = p N0 / (c k_n)",
-                   (Parameter("exponent", "1", 1.0, 3.0),
-                    # c = 1 keeps the identified k_n as the law's tangent stiffness at the preload
-                    Parameter("stiffness_factor", "1", 0.3, 3.0, start=1.0)),
-                   lambda th: Augmentation(unilateral_exponent=float(th[0]), normal_stiffness_factor=float(th[1])),
-                   acts_on="normal_contact"))
-register(Candidate("preload_drift", "static normal preload drifting linearly over each record",
-                   (Parameter("relative_drift", "1", -0.5, 0.5),),
-                   lambda th: Augmentation(preload_drift=float(th[0])), acts_on="non_stationary"))
+register(
+    Candidate(
+        "structural_damping",
+        "extra modal damping of the beam's modes at test level",
+        (Parameter("extra_damping_ratio", "1", 0.0, 0.05),),
+        lambda th: Augmentation(extra_damping=float(th[0])),
+        acts_on="structure_or_measurement",
+    )
+)
+register(
+    Candidate(
+        "normal_contact_damping",
+        "Hunt-Crossley damping of the normal contact, N (1 - alpha deta/dt)",
+        (Parameter("alpha", "s/m", 0.0, 3000.0),),
+        lambda th: Augmentation(hunt_crossley=float(th[0])),
+        acts_on="normal_contact",
+    )
+)
+register(
+    Candidate(
+        "viscous_friction",
+        "velocity-dependent friction, S + sigma_2 dxi/dt",
+        (Parameter("sigma_2", "N s/m", 0.0, 3000.0),),
+        lambda th: Augmentation(viscous=float(th[0])),
+        acts_on="tangential_contact",
+    )
+)
+register(
+    Candidate(
+        "multi_asperity_friction",
+        "share of the tangential contact carried by a 16-slider Iwan element (internal hysteresis loops)",
+        (Parameter("iwan_share", "1", 0.0, 1.0),),
+        lambda th: Augmentation(iwan_share=float(th[0])),
+        acts_on="tangential_contact",
+    )
+)
+register(
+    Candidate(
+        "transducer_mass_error",
+        "every transducer mass wrong by the same factor 1 + m",
+        (Parameter("mass_error", "1", -0.9, 3.0),),
+        lambda th: Augmentation(mass_error=float(th[0])),
+        acts_on="structure_or_measurement",
+    )
+)
+register(
+    Candidate(
+        "channel_time_skew",
+        "each accelerometer channel late on the force by its own delay",
+        (Parameter("delay", "s", -2.0e-4, 2.0e-4),),
+        lambda th: Augmentation(delays=tuple(float(x) for x in th)),
+        per_channel=True,
+        acts_on="structure_or_measurement",
+    )
+)
+register(
+    Candidate(
+        "contact_separation",
+        "unilateral hardening normal contact N0 ((delta0 - eta)/delta0)^p that opens "
+        "(instead of Eq. 13's linear spring), delta0 = p N0 / (c k_n)",
+        (
+            Parameter("exponent", "1", 1.0, 3.0),
+            # c = 1 keeps the identified k_n as the law's tangent stiffness at the preload
+            Parameter("stiffness_factor", "1", 0.3, 3.0, start=1.0),
+        ),
+        lambda th: Augmentation(unilateral_exponent=float(th[0]), normal_stiffness_factor=float(th[1])),
+        acts_on="normal_contact",
+    )
+)
+register(
+    Candidate(
+        "preload_drift",
+        "static normal preload drifting linearly over each record",
+        (Parameter("relative_drift", "1", -0.5, 0.5),),
+        lambda th: Augmentation(preload_drift=float(th[0])),
+        acts_on="non_stationary",
+    )
+)
 
 BUILTIN = tuple(LIBRARY)
 
@@ -131,13 +181,17 @@ def joint_candidate(new: Candidate, earlier, n_channels: int) -> tuple[Candidate
     candidate, split), split(theta) -> [theta of new, theta of each earlier step]. Every parameter has a start
     (new's: off, zero or its range's low end, unless it gives one), so the search also starts from the earlier
     step's optimum itself (``refit.calibrate``)."""
+
     def expand(c: Candidate, theta=None):
         params = c.parameters * (n_channels if c.per_channel else 1)
         if theta is None:  # the new effect starts off, at its own start where it gives one
-            return tuple(Parameter(p.name, p.unit, p.low, p.high, start=p.off if p.start is None else p.start)
-                         for p in params)
-        return tuple(Parameter(p.name, p.unit, p.low, p.high, start=float(np.clip(t, p.low, p.high)))
-                     for p, t in zip(params, np.atleast_1d(theta)))
+            return tuple(
+                Parameter(p.name, p.unit, p.low, p.high, start=p.off if p.start is None else p.start) for p in params
+            )
+        return tuple(
+            Parameter(p.name, p.unit, p.low, p.high, start=float(np.clip(t, p.low, p.high)))
+            for p, t in zip(params, np.atleast_1d(theta))
+        )
 
     parts = [expand(new)] + [expand(c, th) for c, th in earlier]
     sizes = np.cumsum([len(x) for x in parts])[:-1]
@@ -161,5 +215,6 @@ def load_plugins(modules) -> None:
         try:
             importlib.import_module(name)
         except ImportError as exc:
-            raise ValueError(f"gap.plugins: cannot import {name!r} ({exc}); put the module on PYTHONPATH "
-                             "or under workflow/") from None
+            raise ValueError(
+                f"gap.plugins: cannot import {name!r} ({exc}); put the module on PYTHONPATH or under workflow/"
+            ) from None

@@ -28,11 +28,27 @@ from ..random_streams import generator
 from .candidates import LIBRARY, joint_candidate, merged_augmentation
 from .model import NONE, Augmentation, IdentifiedModel, fe_model
 from .records import RecordHarmonics
-from .refit import (baseline, calibrate, contact_grids, evaluate, gap_residual, gap_value,
-                    identified_forces, law_friction_force)
+from .refit import (
+    baseline,
+    calibrate,
+    contact_grids,
+    evaluate,
+    gap_residual,
+    gap_value,
+    identified_forces,
+    law_friction_force,
+)
 from .verdict import DEFAULT_PLACE, UPDATING_Z, PlaceThresholds
-from .verdict import (acts_where, at_floor, explains_materially, gap_shares, open_fraction, place as _place_of,
-                      retried, updating_effect)
+from .verdict import (
+    acts_where,
+    at_floor,
+    explains_materially,
+    gap_shares,
+    open_fraction,
+    place as _place_of,
+    retried,
+    updating_effect,
+)
 from .verdict import verdict as _verdict
 
 log = logging.getLogger(__name__)
@@ -65,7 +81,12 @@ class GapSettings:
     max_evaluations: int = 10
     model_updating: bool = True
     eta_observability_limit: float = 0.1
-    updating_parameters: tuple = ("stiffness_scale", "mass_scale", "transducer_mass_scale", "tangential_lever_arm_scale")
+    updating_parameters: tuple = (
+        "stiffness_scale",
+        "mass_scale",
+        "transducer_mass_scale",
+        "tangential_lever_arm_scale",
+    )
     residue_accuracy: float = 0.01
     frequency_floor: float = 0.001
     updating_confidence: float = 0.95
@@ -84,26 +105,32 @@ class GapSettings:
             unknown = [c for c in cands if c not in LIBRARY]
             if unknown:
                 raise ValueError(f"gap.candidates: unknown {unknown}; the library has {', '.join(LIBRARY)}")
-        s = cls(n_harmonics=int(g.get("n_harmonics", d.n_harmonics)), identification_harmonics=int(n_harmonics_id),
-                candidates=tuple(cands) if cands is not None else None,
-                min_gap=float(g.get("min_gap", d.min_gap)),
-                min_reduction=float(g.get("min_reduction", d.min_reduction)),
-                separation=float(g.get("separation", d.separation)), noise_factor=float(g.get("noise_factor", d.noise_factor)),
-                n_bootstrap=int(g.get("n_bootstrap", d.n_bootstrap)), seed=int(seed),
-                max_evaluations=int(g.get("max_evaluations", d.max_evaluations)),
-                eta_observability_limit=float(g.get("eta_observability_limit", d.eta_observability_limit)),
-                joint_refit=bool(g.get("joint_refit", d.joint_refit)),
-                pair_lookahead=float(g.get("pair_lookahead", d.pair_lookahead)),
-                retry_unmoved=bool(g.get("retry_unmoved", d.retry_unmoved)),
-                place=PlaceThresholds.from_config(g.get("place")),
-                **_updating_settings(g.get("model_updating"), d))
+        s = cls(
+            n_harmonics=int(g.get("n_harmonics", d.n_harmonics)),
+            identification_harmonics=int(n_harmonics_id),
+            candidates=tuple(cands) if cands is not None else None,
+            min_gap=float(g.get("min_gap", d.min_gap)),
+            min_reduction=float(g.get("min_reduction", d.min_reduction)),
+            separation=float(g.get("separation", d.separation)),
+            noise_factor=float(g.get("noise_factor", d.noise_factor)),
+            n_bootstrap=int(g.get("n_bootstrap", d.n_bootstrap)),
+            seed=int(seed),
+            max_evaluations=int(g.get("max_evaluations", d.max_evaluations)),
+            eta_observability_limit=float(g.get("eta_observability_limit", d.eta_observability_limit)),
+            joint_refit=bool(g.get("joint_refit", d.joint_refit)),
+            pair_lookahead=float(g.get("pair_lookahead", d.pair_lookahead)),
+            retry_unmoved=bool(g.get("retry_unmoved", d.retry_unmoved)),
+            place=PlaceThresholds.from_config(g.get("place")),
+            **_updating_settings(g.get("model_updating"), d),
+        )
         if not 0.0 < s.min_reduction < 1.0:
             raise ValueError(f"gap.min_reduction = {s.min_reduction}: give a fraction in (0, 1)")
         if s.separation < 1.0:
             raise ValueError(f"gap.separation = {s.separation}: give a factor >= 1")
         if s.n_harmonics < 3 or s.n_harmonics > s.identification_harmonics:
-            raise ValueError(f"gap.n_harmonics = {s.n_harmonics}: give 3 .. nonlinear.n_harmonics "
-                             f"({s.identification_harmonics})")
+            raise ValueError(
+                f"gap.n_harmonics = {s.n_harmonics}: give 3 .. nonlinear.n_harmonics ({s.identification_harmonics})"
+            )
         return s
 
 
@@ -116,11 +143,14 @@ def _updating_settings(block, d: "GapSettings") -> dict:
     unknown = [x for x in params if x not in FACTORS]
     if unknown:
         raise ValueError(f"gap.model_updating.parameters: unknown {unknown}; choose from {', '.join(FACTORS)}")
-    return {"model_updating": bool(b.get("enabled", True)), "updating_parameters": params,
-            "residue_accuracy": float(b.get("residue_accuracy", d.residue_accuracy)),
-            "updating_confidence": float(b.get("confidence", d.updating_confidence)),
-            "frequency_floor": float(b.get("frequency_floor", d.frequency_floor)),
-            "updating_prior_sd": _prior_sd(b.get("prior_sd"), FACTORS)}
+    return {
+        "model_updating": bool(b.get("enabled", True)),
+        "updating_parameters": params,
+        "residue_accuracy": float(b.get("residue_accuracy", d.residue_accuracy)),
+        "updating_confidence": float(b.get("confidence", d.updating_confidence)),
+        "frequency_floor": float(b.get("frequency_floor", d.frequency_floor)),
+        "updating_prior_sd": _prior_sd(b.get("prior_sd"), FACTORS),
+    }
 
 
 def _prior_sd(block, factors) -> tuple:
@@ -130,8 +160,10 @@ def _prior_sd(block, factors) -> tuple:
         if name not in factors:
             raise ValueError(f"gap.model_updating.prior_sd: unknown factor {name!r}; choose from {', '.join(factors)}")
         if not isinstance(v, (int, float)) or isinstance(v, bool) or not 0.0 < float(v) <= 2.0:
-            raise ValueError(f"gap.model_updating.prior_sd.{name} = {v!r}: give the relative spread of the factor "
-                             f"(sd of its ln) as a number in (0, 2], for example 0.02 for a value known to 2 %")
+            raise ValueError(
+                f"gap.model_updating.prior_sd.{name} = {v!r}: give the relative spread of the factor "
+                f"(sd of its ln) as a number in (0, 2], for example 0.02 for a value known to 2 %"
+            )
         out.append((str(name), float(v)))
     return tuple(sorted(out))
 
@@ -139,6 +171,7 @@ def _prior_sd(block, factors) -> tuple:
 # ------------------------------------------------------------------------------------------
 # localisation
 # ------------------------------------------------------------------------------------------
+
 
 def _rel(a, b) -> float:
     return float(np.linalg.norm(np.asarray(a) - np.asarray(b)) / max(np.linalg.norm(b), 1e-300))
@@ -163,9 +196,17 @@ def cycle_parts(g: dict, k_t: float) -> dict:
     return {"stick": stick, "slip": slip, "velocity_reversal": reversal, "peak_compression": peak}
 
 
-def localise(model: IdentifiedModel, records: dict, sims: dict, n_harmonics: int, linear: dict | None = None,
-             aug: Augmentation = NONE, eta_limit: float = 0.1, structures=(),
-             thresholds: PlaceThresholds = DEFAULT_PLACE) -> tuple[dict, dict]:
+def localise(
+    model: IdentifiedModel,
+    records: dict,
+    sims: dict,
+    n_harmonics: int,
+    linear: dict | None = None,
+    aug: Augmentation = NONE,
+    eta_limit: float = 0.1,
+    structures=(),
+    thresholds: PlaceThresholds = DEFAULT_PLACE,
+) -> tuple[dict, dict]:
     """The gap by stage, sensor, harmonic, part of the cycle and load level (the identified model
     as the chain left it, or with the effects ``aug`` added). Returns (summary for diagnosis.json, arrays for
     gap.nc)."""
@@ -200,8 +241,9 @@ def localise(model: IdentifiedModel, records: dict, sims: dict, n_harmonics: int
         id_res.append(float(np.sqrt(np.mean(forces.residual[[0, 2]] ** 2))))
         scatter.append(identification_noise(model, rec))
         g = contact_grids(forces, rec.f0, model.preload, 256)
-        S_law = law_friction_force(g["xi"], g["xi_dot"], g["N"], np.asarray(model.friction), aug,
-                                   model.regularization)[0]
+        S_law = law_friction_force(g["xi"], g["xi_dot"], g["N"], np.asarray(model.friction), aug, model.regularization)[
+            0
+        ]
         S_law -= S_law.mean()
         N_id = g["N"] - model.preload
         # the best elastic normal law at the identified motion (stiffness + hardening): what it leaves
@@ -221,8 +263,9 @@ def localise(model: IdentifiedModel, records: dict, sims: dict, n_harmonics: int
         r_t = periodic_grid(sims[c].acceleration[0, :H] - rec.acceleration[0, :H], rec.f0, 256)[0]
         a_rms = np.sqrt(np.mean(periodic_grid(rec.acceleration[0, :H], rec.f0, 256)[0] ** 2))
         parts = cycle_parts(g, model.structure.k_t)
-        parts_rms.append([float(np.sqrt(np.mean(r_t[parts[p]] ** 2)) / a_rms) if parts[p].any() else 0.0
-                          for p in part_names])
+        parts_rms.append(
+            [float(np.sqrt(np.mean(r_t[parts[p]] ** 2)) / a_rms) if parts[p].any() else 0.0 for p in part_names]
+        )
         maps.append(np.array([g["xi"], g["xi_dot"], g["S"] - S_law, g["eta"], g["eta_dot"], N_id - N_law]))
     stage["identification_residual"] = float(np.sqrt(np.mean(np.square(id_res))))
     stage["open_fraction"] = float(np.max(open_frac))
@@ -245,13 +288,25 @@ def localise(model: IdentifiedModel, records: dict, sims: dict, n_harmonics: int
     part_mean = np.mean(arrays["gap_by_cycle_part"], axis=0)
     sensors = records[cases[0]].sensors
     amps = [float(np.abs(records[c].acceleration[0, 0])) for c in cases]
-    slope = float(np.polyfit(np.log(amps), np.log(np.maximum(acc_gap, 1e-12)), 1)[0]) if len(cases) > 1 else float("nan")
-    direction = "normal" if stage["contact_force_N"] > thresholds.normal_limit or stage["open_fraction"] > 0 \
-        else "tangential"
+    slope = (
+        float(np.polyfit(np.log(amps), np.log(np.maximum(acc_gap, 1e-12)), 1)[0]) if len(cases) > 1 else float("nan")
+    )
+    direction = (
+        "normal" if stage["contact_force_N"] > thresholds.normal_limit or stage["open_fraction"] > 0 else "tangential"
+    )
     summary = {
         "stage": stage,
-        "largest_stage": max(("accelerations", "generalized_coordinates", "contact_force_S", "contact_force_N",
-                              "energy_tangential", "energy_normal"), key=lambda k: stage[k]),
+        "largest_stage": max(
+            (
+                "accelerations",
+                "generalized_coordinates",
+                "contact_force_S",
+                "contact_force_N",
+                "energy_tangential",
+                "energy_normal",
+            ),
+            key=lambda k: stage[k],
+        ),
         "direction": direction,
         "by_sensor": {s: float(v) for s, v in zip(sensors, np.sqrt(np.mean(arrays["gap_by_sensor"] ** 2, axis=0)))},
         "worst_sensor": sensors[int(np.argmax(np.mean(arrays["gap_by_sensor"] ** 2, axis=0)))],
@@ -270,11 +325,20 @@ def localise(model: IdentifiedModel, records: dict, sims: dict, n_harmonics: int
     spread = {c: eta_model_spread(model, aug, records[c], structures) for c in cases}
     finite = [v for v in spread.values() if np.isfinite(v)]
     worst = max(finite) if finite else float("nan")
-    summary["eta_observability"] = {"model_spread": spread, "limit": eta_limit,
-                                    "observable": bool(not finite or worst <= eta_limit)}
-    summary["place"], summary["place_reason"] = _place_of(summary["drift"], stage, np.array(id_res), np.array(scatter),
-                                                          summary["eta_observability"]["observable"], worst,
-                                                          thresholds)
+    summary["eta_observability"] = {
+        "model_spread": spread,
+        "limit": eta_limit,
+        "observable": bool(not finite or worst <= eta_limit),
+    }
+    summary["place"], summary["place_reason"] = _place_of(
+        summary["drift"],
+        stage,
+        np.array(id_res),
+        np.array(scatter),
+        summary["eta_observability"]["observable"],
+        worst,
+        thresholds,
+    )
     if not summary["eta_observability"]["observable"]:
         summary["direction"] = "unresolved"  # the normal direction's numbers rest on an unobservable eta
     return summary, arrays
@@ -344,13 +408,16 @@ def linear_stage(model: IdentifiedModel, frf: xr.Dataset, modal: xr.Dataset) -> 
         W = 2 * np.pi * freq[i]
         Hm = -(W**2) * np.sum(d * b / (wn**2 - W**2 + 2j * zeta * wn * W))
         peak_err.append(abs(Hm) / abs(H1[i]) - 1)
-    return {"frf_frequency": float(np.sqrt(np.mean((f_model / f_id - 1) ** 2))),
-            "frf_peak_amplitude": float(np.sqrt(np.mean(np.square(peak_err))))}
+    return {
+        "frf_frequency": float(np.sqrt(np.mean((f_model / f_id - 1) ** 2))),
+        "frf_peak_amplitude": float(np.sqrt(np.mean(np.square(peak_err)))),
+    }
 
 
 # ------------------------------------------------------------------------------------------
 # ranking and verdict
 # ------------------------------------------------------------------------------------------
+
 
 @dataclass
 class Diagnosis:
@@ -367,9 +434,17 @@ class Diagnosis:
     remaining_gap: dict = field(default_factory=dict)
 
     def summary(self) -> dict:
-        return {"verdict": self.verdict, "reason": self.reason, "ranking": self.ranking, "where": self.where,
-                "explanation": self.explanation, "remaining_gap": self.remaining_gap,
-                "shrink": self.shrink, "calibration_case": self.calibration_case, "heldout_cases": self.heldout_cases}
+        return {
+            "verdict": self.verdict,
+            "reason": self.reason,
+            "ranking": self.ranking,
+            "where": self.where,
+            "explanation": self.explanation,
+            "remaining_gap": self.remaining_gap,
+            "shrink": self.shrink,
+            "calibration_case": self.calibration_case,
+            "heldout_cases": self.heldout_cases,
+        }
 
 
 def shrink_views(records, cases, before_sims, after_sims, boot, H) -> dict:
@@ -410,9 +485,20 @@ def _bootstrap_records(rec: RecordHarmonics, rng, n: int, H: int) -> np.ndarray:
     return rec.block_acceleration[idx][:, :, :, :H].mean(axis=1)
 
 
-def _candidate(name: str, model: IdentifiedModel, records: Mapping[str, RecordHarmonics], calibration_case: str,
-               score_cases: list, base_sims: dict, fit_settings: FitSettings, H: int, max_evaluations: int,
-               base_steps: tuple = (), joint: bool = True, alone: dict | None = None):
+def _candidate(
+    name: str,
+    model: IdentifiedModel,
+    records: Mapping[str, RecordHarmonics],
+    calibration_case: str,
+    score_cases: list,
+    base_sims: dict,
+    fit_settings: FitSettings,
+    H: int,
+    max_evaluations: int,
+    base_steps: tuple = (),
+    joint: bool = True,
+    alone: dict | None = None,
+):
     """One candidate added to the explanation's earlier steps ``base_steps`` ((name, theta), ...): calibrated on
     the calibration case (with ``joint``, together with the earlier steps' parameters, ``joint_candidate``;
     otherwise with them held), predicted on the scored cases (each simulation warm-started from the baseline's).
@@ -426,8 +512,9 @@ def _candidate(name: str, model: IdentifiedModel, records: Mapping[str, RecordHa
     free = [n for n, _ in base_steps if not LIBRARY[n].per_channel]
     if free and joint and not LIBRARY[name].per_channel:
         base = merged_augmentation((LIBRARY[n], th) for n, th in base_steps if n not in free)
-        cand, split = joint_candidate(LIBRARY[name], [(LIBRARY[n], th) for n, th in base_steps if n in free],
-                                      rec.acceleration.shape[0])
+        cand, split = joint_candidate(
+            LIBRARY[name], [(LIBRARY[n], th) for n, th in base_steps if n in free], rec.acceleration.shape[0]
+        )
         mixes = ()
         if alone and name in alone:
             first = np.array([p.start for p in cand.parameters])  # the earlier optimum, this effect off
@@ -436,16 +523,27 @@ def _candidate(name: str, model: IdentifiedModel, records: Mapping[str, RecordHa
             own[:n_new] = np.atleast_1d(alone[name])
             own[n_new:] = [p.off for p in cand.parameters[n_new:]]
             mixes = tuple((1 - t) * first + t * own for t in (1 / 3, 2 / 3))
-        cal = calibrate(model, cand, rec, fit_settings, H, max_evaluations, start=base_sims[calibration_case],
-                        starts=mixes, base=base)
+        cal = calibrate(
+            model,
+            cand,
+            rec,
+            fit_settings,
+            H,
+            max_evaluations,
+            start=base_sims[calibration_case],
+            starts=mixes,
+            base=base,
+        )
         own_theta, *refitted = split(cal.theta)
         refitted = dict(zip(free, refitted))
-        cal = dataclasses.replace(cal, theta=own_theta, steps=tuple((n, refitted.get(n, th)) for n, th in base_steps)
-                                  + ((name, own_theta),))
+        cal = dataclasses.replace(
+            cal, theta=own_theta, steps=tuple((n, refitted.get(n, th)) for n, th in base_steps) + ((name, own_theta),)
+        )
     else:
         base = merged_augmentation((LIBRARY[n], th) for n, th in base_steps)
-        cal = calibrate(model, LIBRARY[name], rec, fit_settings, H, max_evaluations, start=base_sims[calibration_case],
-                        base=base)
+        cal = calibrate(
+            model, LIBRARY[name], rec, fit_settings, H, max_evaluations, start=base_sims[calibration_case], base=base
+        )
         cal = dataclasses.replace(cal, steps=tuple(base_steps) + ((name, cal.theta),))
     sims = {calibration_case: None}
     res = {}
@@ -453,9 +551,13 @@ def _candidate(name: str, model: IdentifiedModel, records: Mapping[str, RecordHa
         _, _, sim, _ = evaluate(cal.model, cal.augmentation, records[c], None, H, refit=False, start=base_sims[c])
         sims[c] = sim
         res[c] = gap_residual(sim, records[c], H)
-    log.info("candidate %s: theta [%s], calibration gap %.4g, held-out gap %s", name,
-             ", ".join(f"{t:.4g}" for t in np.ravel(cal.theta)), cal.gap,
-             ", ".join(f"{c} {gap_value(r):.4g}" for c, r in res.items()))
+    log.info(
+        "candidate %s: theta [%s], calibration gap %.4g, held-out gap %s",
+        name,
+        ", ".join(f"{t:.4g}" for t in np.ravel(cal.theta)),
+        cal.gap,
+        ", ".join(f"{c} {gap_value(r):.4g}" for c, r in res.items()),
+    )
     return cal, sims, res
 
 
@@ -506,8 +608,9 @@ def _candidates(names, workers: int, **common):
     workers = max(1, min(int(workers), len(names)))
     pool = _pool(workers) if workers > 1 else None
     if workers > 1 and pool is None:
-        log.info("gap candidates: numba's parallel threads already run in this process; one process instead of %d",
-                 workers)
+        log.info(
+            "gap candidates: numba's parallel threads already run in this process; one process instead of %d", workers
+        )
     if pool is None:
         return lambda: {name: _candidate(name, **common) for name in names}
     pending = pool.map_async(_candidate_task, [(name, common) for name in names], chunksize=1)
@@ -519,12 +622,22 @@ def _parameter_values(name: str, cal=None, theta=None) -> dict:
     channel)."""
     cand = LIBRARY[name]
     theta = np.atleast_1d(cal.theta if theta is None else theta)
-    return {p.name if not cand.per_channel else f"{p.name}_{i}": float(v)
-            for i, (p, v) in enumerate(zip(cand.parameters * len(theta), theta))}
+    return {
+        p.name if not cand.per_channel else f"{p.name}_{i}": float(v)
+        for i, (p, v) in enumerate(zip(cand.parameters * len(theta), theta))
+    }
 
 
-def explain(first: dict, names: list, before: float, scatter: float, settings: GapSettings, heldout_gap,
-            next_pass, later: list | None = None) -> tuple[list, float, tuple | None]:
+def explain(
+    first: dict,
+    names: list,
+    before: float,
+    scatter: float,
+    settings: GapSettings,
+    heldout_gap,
+    next_pass,
+    later: list | None = None,
+) -> tuple[list, float, tuple | None]:
     """The additive explanation of the held-out gap: add the candidate that leaves the smallest held-out gap
     (its refit included), then try the remaining candidates on top of it (``next_pass(remaining, calibration)``
     gives their results), and so on; stop when no candidate shrinks what is left materially
@@ -560,15 +673,28 @@ def explain(first: dict, names: list, before: float, scatter: float, settings: G
             results2 = next_pass(others, results[best][0])
             gaps2 = finite_gaps(results2, others)
             best2 = min(gaps2, key=gaps2.get) if gaps2 else None
-            if best2 is None or not (gaps2[best2] < gaps[best] - beyond_scatter
-                                     and explains_materially(gap, gaps2[best2], scatter, settings)):
+            if best2 is None or not (
+                gaps2[best2] < gaps[best] - beyond_scatter and explains_materially(gap, gaps2[best2], scatter, settings)
+            ):
                 break
-            log.info("explanation: %s alone leaves %.4g of %.4g, with %s %.4g: the pair is added", best, gaps[best],
-                     gap, best2, gaps2[best2])
+            log.info(
+                "explanation: %s alone leaves %.4g of %.4g, with %s %.4g: the pair is added",
+                best,
+                gaps[best],
+                gap,
+                best2,
+                gaps2[best2],
+            )
             chosen.append((best2, results2[best2], gaps2[best2]))
         for name, (cal, sims, _), after in chosen:
-            steps.append({"effect": name, "parameters": _parameter_values(name, cal), "heldout_gap_before": gap,
-                          "heldout_gap_after": after})
+            steps.append(
+                {
+                    "effect": name,
+                    "parameters": _parameter_values(name, cal),
+                    "heldout_gap_before": gap,
+                    "heldout_gap_after": after,
+                }
+            )
             if len(cal.steps) > 1:  # the earlier steps' parameters as refitted with this one (gap.joint_refit)
                 steps[-1]["earlier_refitted"] = {n: _parameter_values(n, theta=th) for n, th in cal.steps[:-1]}
             log.info("explanation step %d: %s leaves a held-out gap of %.4g (from %.4g)", len(steps), name, after, gap)
@@ -583,9 +709,17 @@ def explain(first: dict, names: list, before: float, scatter: float, settings: G
     return steps, gap, last
 
 
-def diagnose(model: IdentifiedModel, records: Mapping[str, RecordHarmonics], calibration_case: str,
-             settings: GapSettings, fit_settings: FitSettings, linear: dict | None = None,
-             workers: int = 1, identified: IdentifiedModel | None = None, updating=None) -> Diagnosis:
+def diagnose(
+    model: IdentifiedModel,
+    records: Mapping[str, RecordHarmonics],
+    calibration_case: str,
+    settings: GapSettings,
+    fit_settings: FitSettings,
+    linear: dict | None = None,
+    workers: int = 1,
+    identified: IdentifiedModel | None = None,
+    updating=None,
+) -> Diagnosis:
     """Run the whole diagnosis on the load cases' records (``calibration_case`` for the refits,
     the others held out); the candidates in ``workers`` processes (see ``_candidates``). ``identified``: the
     chain's own model when ``model`` is its update (``gap.pipeline.updated_model``; ``updating`` its
@@ -605,12 +739,29 @@ def diagnose(model: IdentifiedModel, records: Mapping[str, RecordHarmonics], cal
     # candidates: calibrate, predict the held-out cases (forked before the localisation runs numba's
     # parallel friction kernel in this process)
     names = list(settings.candidates or tuple(LIBRARY))
-    candidate_results = _candidates(names, workers, model=model, records=records, calibration_case=calibration_case,
-                                    score_cases=score_cases, base_sims=base_sims, fit_settings=fit_settings, H=H,
-                                    max_evaluations=settings.max_evaluations)
+    candidate_results = _candidates(
+        names,
+        workers,
+        model=model,
+        records=records,
+        calibration_case=calibration_case,
+        score_cases=score_cases,
+        base_sims=base_sims,
+        fit_settings=fit_settings,
+        H=H,
+        max_evaluations=settings.max_evaluations,
+    )
     structures = tuple(updating.posterior_structures()) if updating is not None else ()
-    where, arrays = localise(model, dict(records), base_sims, H, linear, eta_limit=settings.eta_observability_limit,
-                             structures=structures, thresholds=settings.place)
+    where, arrays = localise(
+        model,
+        dict(records),
+        base_sims,
+        H,
+        linear,
+        eta_limit=settings.eta_observability_limit,
+        structures=structures,
+        thresholds=settings.place,
+    )
     results = candidate_results()
     # bootstrap over record blocks: the sims are fixed, the records resampled
     rng = generator(settings.seed, "gap/bootstrap")
@@ -642,8 +793,11 @@ def diagnose(model: IdentifiedModel, records: Mapping[str, RecordHarmonics], cal
         boots[name] = after_b
         k = LIBRARY[name].n_parameters(len(records[cases[0]].sensors))
         # does the candidate make the structure and sensor model consistent with the calibration record?
-        res_after = float(np.sqrt(np.mean(identified_forces(cal.model, cal.augmentation,
-                                                            records[calibration_case]).residual[[0, 2]] ** 2)))
+        res_after = float(
+            np.sqrt(
+                np.mean(identified_forces(cal.model, cal.augmentation, records[calibration_case]).residual[[0, 2]] ** 2)
+            )
+        )
         noise = where["identification_noise"][calibration_case]
         acts_on = LIBRARY[name].acts_on
         # a winner must act where the localisation puts the gap; the structure/sensor misfit left by the
@@ -651,34 +805,61 @@ def diagnose(model: IdentifiedModel, records: Mapping[str, RecordHarmonics], cal
         consistent = acts_where(acts_on, where["place"])
         score = n_data * np.log(after**2 / before**2) + 2 * k if np.isfinite(after) else np.inf
         red_b = 1 - after_b / before_b
-        rows.append({"effect": name, "heldout_gap_before": before, "heldout_gap_after": after, "score": float(score),
-                     "reduction": 1 - after / before if np.isfinite(after) else -np.inf, "reduction_interval": [float(np.percentile(red_b, 2.5)),
-                                                                            float(np.percentile(red_b, 97.5))],
-                     "heldout_gap_after_interval": [float(np.percentile(after_b, 2.5)), float(np.percentile(after_b, 97.5))],
-                     "n_parameters": k, "parameters": _parameter_values(name, cal),
-                     "calibration_gap": cal.gap, "friction": [float(x) for x in cal.friction],
-                     "heldout_gap_after_by_case": {c: gap_value(r) for c, r in res.items()},
-                     "identification_residual_after": res_after, "identification_noise": noise, "acts_on": acts_on, "consistent": bool(consistent),
-                     "evaluations": cal.evaluations})
+        rows.append(
+            {
+                "effect": name,
+                "heldout_gap_before": before,
+                "heldout_gap_after": after,
+                "score": float(score),
+                "reduction": 1 - after / before if np.isfinite(after) else -np.inf,
+                "reduction_interval": [float(np.percentile(red_b, 2.5)), float(np.percentile(red_b, 97.5))],
+                "heldout_gap_after_interval": [float(np.percentile(after_b, 2.5)), float(np.percentile(after_b, 97.5))],
+                "n_parameters": k,
+                "parameters": _parameter_values(name, cal),
+                "calibration_gap": cal.gap,
+                "friction": [float(x) for x in cal.friction],
+                "heldout_gap_after_by_case": {c: gap_value(r) for c, r in res.items()},
+                "identification_residual_after": res_after,
+                "identification_noise": noise,
+                "acts_on": acts_on,
+                "consistent": bool(consistent),
+                "evaluations": cal.evaluations,
+            }
+        )
     # by score; scores equal to 3 decimals are a tie (the same model solved from other starts): library order
     rows.sort(key=lambda r: round(r["score"], 3) if np.isfinite(r["score"]) else np.inf)
     scatter = float(np.std(before_b))
     verdict, reason = _verdict(rows, before, scatter, where["place"], settings, boots)
     shrink = {}
     for label, r in zip(("winner", "runner_up"), rows[:2]):
-        shrink[label] = {"effect": r["effect"],
-                         **shrink_views(records, score_cases, base_sims, results[r["effect"]][1], boot, H)}
+        shrink[label] = {
+            "effect": r["effect"],
+            **shrink_views(records, score_cases, base_sims, results[r["effect"]][1], boot, H),
+        }
     where["heldout_gap_before"] = before
     where["heldout_gap_before_interval"] = [float(np.percentile(before_b, 2.5)), float(np.percentile(before_b, 97.5))]
     where["record_scatter"] = scatter
 
     def next_pass(remaining, cal):
-        starts = {calibration_case: cal.simulation if cal.simulation is not None else base_sims[calibration_case],
-                  **{c: s for c, s in results[cal.candidate][1].items() if s is not None}}
-        return _candidates(remaining, workers, model=cal.model, records=records, calibration_case=calibration_case,
-                           score_cases=score_cases, base_sims=starts, fit_settings=fit_settings, H=H,
-                           max_evaluations=settings.max_evaluations, base_steps=cal.steps,
-                           joint=settings.joint_refit, alone={n: r[0].theta for n, r in results.items()})()
+        starts = {
+            calibration_case: cal.simulation if cal.simulation is not None else base_sims[calibration_case],
+            **{c: s for c, s in results[cal.candidate][1].items() if s is not None},
+        }
+        return _candidates(
+            remaining,
+            workers,
+            model=cal.model,
+            records=records,
+            calibration_case=calibration_case,
+            score_cases=score_cases,
+            base_sims=starts,
+            fit_settings=fit_settings,
+            H=H,
+            max_evaluations=settings.max_evaluations,
+            base_steps=cal.steps,
+            joint=settings.joint_refit,
+            alone={n: r[0].theta for n, r in results.items()},
+        )()
 
     later = retried({n: r[0].theta for n, r in results.items()}, LIBRARY, settings)
     steps, left, last = explain(results, names, before, scatter, settings, heldout_gap, next_pass, later)
@@ -687,40 +868,84 @@ def diagnose(model: IdentifiedModel, records: Mapping[str, RecordHarmonics], cal
         where["model_updating"] = updating.summary()
         # the friction law the candidates start from (refitted with the updated structure when accepted)
         e_f, k_c, e_t, kappa, mu = model.friction
-        where["model_updating"]["friction"] = {"e_f": e_f, "k_c": k_c, "e_t": e_t, "kappa": kappa, "mu": mu,
-                                               "e0_at_preload": float(stiction_shear_stiffness(model.preload, e_f, k_c))}
+        where["model_updating"]["friction"] = {
+            "e_f": e_f,
+            "k_c": k_c,
+            "e_t": e_t,
+            "kappa": kappa,
+            "mu": mu,
+            "e0_at_preload": float(stiction_shear_stiffness(model.preload, e_f, k_c)),
+        }
     if identified is not None and updating is not None and updating.accepted:
         id_sims = {c: baseline(identified, records[c], H)[1] for c in score_cases}
         first_before = heldout_gap(id_sims)
         where["heldout_gap_identified"] = first_before
-        steps.insert(0, {"effect": "model_updating", "parameters": {**updating.factors, "k_t": updating.k_t,
-                                                                    "k_n": updating.k_n},
-                         "heldout_gap_before": first_before, "heldout_gap_after": before})
+        steps.insert(
+            0,
+            {
+                "effect": "model_updating",
+                "parameters": {**updating.factors, "k_t": updating.k_t, "k_n": updating.k_n},
+                "heldout_gap_before": first_before,
+                "heldout_gap_after": before,
+            },
+        )
         log.info("explanation step 0: model updating takes the held-out gap from %.4g to %.4g", first_before, before)
     shares, left_share = gap_shares(first_before, [s["heldout_gap_after"] for s in steps])
     for s, share in zip(steps, shares):
         s["share"] = share
-    if steps and steps[0]["effect"] == "model_updating" and verdict == "none" and shares[0] == max(shares) \
-            and explains_materially(first_before, before, scatter, settings):
+    if (
+        steps
+        and steps[0]["effect"] == "model_updating"
+        and verdict == "none"
+        and shares[0] == max(shares)
+        and explains_materially(first_before, before, scatter, settings)
+    ):
         # the update explains most of the gap: if it amounts to one effect of the library in use, that is the verdict
         effect = updating_effect(updating.factors, updating.identifiability)
         if effect is not None and effect in names:
             verdict = effect
-            reason = (f"model updating ({', '.join(f'{k} {v:.3g}' for k, v in updating.factors.items())}) takes the "
-                      f"held-out gap from {first_before:.3g} to {before:.3g} ({shares[0]:.0%} of its power); only "
-                      f"the {effect.replace('_error', '')} factor moved beyond {UPDATING_Z:g} standard deviations")
-    remaining = {"heldout_gap": left, "share": left_share,
-                 "at_floor": at_floor(left, settings), "floor": settings.min_gap, "min_reduction": settings.min_reduction,
-                 "place": where["place"], "place_reason": where["place_reason"]}
+            reason = (
+                f"model updating ({', '.join(f'{k} {v:.3g}' for k, v in updating.factors.items())}) takes the "
+                f"held-out gap from {first_before:.3g} to {before:.3g} ({shares[0]:.0%} of its power); only "
+                f"the {effect.replace('_error', '')} factor moved beyond {UPDATING_Z:g} standard deviations"
+            )
+    remaining = {
+        "heldout_gap": left,
+        "share": left_share,
+        "at_floor": at_floor(left, settings),
+        "floor": settings.min_gap,
+        "min_reduction": settings.min_reduction,
+        "place": where["place"],
+        "place_reason": where["place_reason"],
+    }
     if last is not None and not remaining["at_floor"]:  # where what is left lies, with the explanation's effects in
         cal, sims = last
         all_sims = {c: (cal.simulation if c == calibration_case else sims[c]) for c in cases}
         if all(s is not None for s in all_sims.values()):
-            where_left, _ = localise(cal.model, dict(records), all_sims, H, linear, aug=cal.augmentation,
-                                     eta_limit=settings.eta_observability_limit, structures=structures,
-                                     thresholds=settings.place)
+            where_left, _ = localise(
+                cal.model,
+                dict(records),
+                all_sims,
+                H,
+                linear,
+                aug=cal.augmentation,
+                eta_limit=settings.eta_observability_limit,
+                structures=structures,
+                thresholds=settings.place,
+            )
             remaining["place"] = where_left["place"]
             remaining["place_reason"] = where_left["place_reason"]
-    diag = Diagnosis(verdict, reason, rows, where, calibration_case, held, arrays,
-                     {"base": base_sims, **{n: r[1] for n, r in results.items()}}, shrink, steps, remaining)
+    diag = Diagnosis(
+        verdict,
+        reason,
+        rows,
+        where,
+        calibration_case,
+        held,
+        arrays,
+        {"base": base_sims, **{n: r[1] for n, r in results.items()}},
+        shrink,
+        steps,
+        remaining,
+    )
     return diag

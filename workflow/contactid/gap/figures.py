@@ -78,9 +78,13 @@ def force_state(ds: xr.Dataset, path: str):
     fig, axes = plt.subplots(2, n, figsize=(3.3 * n, 5.6), squeeze=False)
     for i, c in enumerate(ds["case"].values):
         m = ds["force_state_map"].sel(case=c)
-        for row, (x, y, r, lab) in enumerate((("xi", "xi_dot", "S_residual", "S"), ("eta", "eta_dot", "N_residual", "N"))):
+        for row, (x, y, r, lab) in enumerate(
+            (("xi", "xi_dot", "S_residual", "S"), ("eta", "eta_dot", "N_residual", "N"))
+        ):
             ax = axes[row, i]
-            sc = ax.scatter(1e6 * m.sel(map_field=x), 1e3 * m.sel(map_field=y), c=m.sel(map_field=r), cmap="coolwarm", s=6)
+            sc = ax.scatter(
+                1e6 * m.sel(map_field=x), 1e3 * m.sel(map_field=y), c=m.sel(map_field=r), cmap="coolwarm", s=6
+            )
             fig.colorbar(sc, ax=ax, label=f"{lab} residual (N)")
             ax.set_xlabel(f"{x} (um)")
             ax.set_ylabel(f"{y} (mm/s)")
@@ -96,13 +100,17 @@ def ranking(diag: dict, path: str):
     lo = np.array([100 * _num(r["heldout_gap_after_interval"][0]) for r in rows])
     hi = np.array([100 * _num(r["heldout_gap_after_interval"][1]) for r in rows])
     y = np.arange(len(rows))
-    ax.barh(y, after, xerr=[np.maximum(after - lo, 0), np.maximum(hi - after, 0)], color="tab:blue", label="with the effect")
+    ax.barh(
+        y, after, xerr=[np.maximum(after - lo, 0), np.maximum(hi - after, 0)], color="tab:blue", label="with the effect"
+    )
     if rows:
         ax.axvline(100 * rows[0]["heldout_gap_before"], color="k", ls="--", label="identified model (before)")
     ax.set_yticks(y, names)
     ax.invert_yaxis()
     finite = hi[np.isfinite(hi)]
-    ax.set_xlim(0, 1.15 * max(finite.max() if finite.size else 1.0, 100 * rows[0]["heldout_gap_before"] if rows else 1.0))
+    ax.set_xlim(
+        0, 1.15 * max(finite.max() if finite.size else 1.0, 100 * rows[0]["heldout_gap_before"] if rows else 1.0)
+    )
     ax.set_xlabel("held-out gap (%)")
     ax.set_title(f"Candidates ranked; verdict: {diag['verdict']}")
     ax.legend(fontsize=7)
@@ -125,14 +133,28 @@ def shrink(diag: dict, path: str):
         a = np.array([100 * bc[c]["after"] for c in cases])
         lo = np.array([100 * bc[c]["after_interval"][0] for c in cases])
         hi = np.array([100 * bc[c]["after_interval"][1] for c in cases])
-        axes[0].bar(x + 0.27 * i, a, 0.27, yerr=[np.maximum(a - lo, 0), np.maximum(hi - a, 0)],
-                    label=f"+ {v['effect']} ({label.replace('_', '-')})")
-        axes[1].semilogy(np.arange(1, len(v["by_harmonic"]["after"]) + 1), 100 * np.array(v["by_harmonic"]["after"]),
-                         "o-", label=f"+ {v['effect']}")
+        axes[0].bar(
+            x + 0.27 * i,
+            a,
+            0.27,
+            yerr=[np.maximum(a - lo, 0), np.maximum(hi - a, 0)],
+            label=f"+ {v['effect']} ({label.replace('_', '-')})",
+        )
+        axes[1].semilogy(
+            np.arange(1, len(v["by_harmonic"]["after"]) + 1),
+            100 * np.array(v["by_harmonic"]["after"]),
+            "o-",
+            label=f"+ {v['effect']}",
+        )
     if sh:
         v = next(iter(sh.values()))
-        axes[1].semilogy(np.arange(1, len(v["by_harmonic"]["before"]) + 1), 100 * np.array(v["by_harmonic"]["before"]),
-                         "s--", color="0.4", label="identified model")
+        axes[1].semilogy(
+            np.arange(1, len(v["by_harmonic"]["before"]) + 1),
+            100 * np.array(v["by_harmonic"]["before"]),
+            "s--",
+            color="0.4",
+            label="identified model",
+        )
     axes[0].set_xticks(x, cases)
     axes[0].set_ylabel("held-out gap (%)")
     axes[0].set_title("before and after, per held-out case (95 % bootstrap)")
@@ -165,11 +187,15 @@ def explanation(diag: dict, path: str):
     x = np.arange(len(labels))
     ax.bar(x, heights, bottom=bottoms, color=colors, width=0.6)
     if left.get("floor") is not None:
-        ax.axhline(100 * left["floor"], color="k", ls=":", lw=1, label=f"floor gap.min_gap = {100 * left['floor']:.2g} %")
+        ax.axhline(
+            100 * left["floor"], color="k", ls=":", lw=1, label=f"floor gap.min_gap = {100 * left['floor']:.2g} %"
+        )
         ax.legend(fontsize=8, loc="upper right")
     ax.set_xticks(x, labels, fontsize=8)
     ax.set_ylabel("held-out gap (%)")
-    ax.set_title("The held-out gap explained step by step" if steps else "No effect explains the held-out gap materially")
+    ax.set_title(
+        "The held-out gap explained step by step" if steps else "No effect explains the held-out gap materially"
+    )
     _save(fig, path)
 
 

@@ -55,8 +55,9 @@ class Augmentation:
 
     def merge(self, other: "Augmentation") -> "Augmentation":
         """Both augmentations' effects (other's non-default fields win)."""
-        changes = {f.name: getattr(other, f.name) for f in dataclasses.fields(other)
-                   if getattr(other, f.name) != f.default}
+        changes = {
+            f.name: getattr(other, f.name) for f in dataclasses.fields(other) if getattr(other, f.name) != f.default
+        }
         return dataclasses.replace(self, **changes)
 
 
@@ -85,8 +86,9 @@ class IdentifiedModel:
         p = self.structure
         if aug.mass_error:
             m = 1.0 + aug.mass_error
-            p = p.replace(sensor_masses=tuple(m * x for x in p.sensor_masses),
-                          force_transducer_mass=m * p.force_transducer_mass)
+            p = p.replace(
+                sensor_masses=tuple(m * x for x in p.sensor_masses), force_transducer_mass=m * p.force_transducer_mass
+            )
             if self.frequencies:
                 p = _refit_contact(p, self.frequencies)
         return p
@@ -95,16 +97,27 @@ class IdentifiedModel:
         return dataclasses.replace(self, friction=tuple(float(x) for x in friction))
 
 
-def identified_model(structure_cfg: Mapping, linear_modes: xr.Dataset, modal: xr.Dataset, friction_fit: xr.Dataset,
-                     n_modes: int = 8, oversampling: int = 8) -> IdentifiedModel:
+def identified_model(
+    structure_cfg: Mapping,
+    linear_modes: xr.Dataset,
+    modal: xr.Dataset,
+    friction_fit: xr.Dataset,
+    n_modes: int = 8,
+    oversampling: int = 8,
+) -> IdentifiedModel:
     """The identified model from the chain's datasets (linear_modes.nc, modal.nc, friction_fit.nc)."""
     k_t, k_n = float(linear_modes["k_t"]), float(linear_modes["k_n"])
     params = structure_from_config(structure_cfg, k_t, k_n)
-    return IdentifiedModel(params, tuple(float(z) for z in modal["damping_ratio"].values),
-                           tuple(float(x) for x in friction_fit["parameter_value"].values),
-                           float(structure_cfg["preload_n"]), int(n_modes), int(oversampling),
-                           tuple(float(f) for f in modal["natural_frequency"].values),
-                           str(friction_fit.attrs["regularization"]))
+    return IdentifiedModel(
+        params,
+        tuple(float(z) for z in modal["damping_ratio"].values),
+        tuple(float(x) for x in friction_fit["parameter_value"].values),
+        float(structure_cfg["preload_n"]),
+        int(n_modes),
+        int(oversampling),
+        tuple(float(f) for f in modal["natural_frequency"].values),
+        str(friction_fit.attrs["regularization"]),
+    )
 
 
 @lru_cache(maxsize=64)
@@ -118,8 +131,14 @@ def _refit_contact(params: StructureParameters, frequencies: tuple) -> Structure
     f_id = np.asarray(frequencies)
     fmap = ContactFrequencyMap(params, len(f_id))
     x0 = np.log10([params.k_t, params.k_n])
-    res = least_squares(lambda x: fmap(10.0 ** x[0], 10.0 ** x[1]) / f_id - 1, x0, bounds=(x0 - 2, x0 + 2),
-                        x_scale=0.1, xtol=1e-10, ftol=1e-12)
+    res = least_squares(
+        lambda x: fmap(10.0 ** x[0], 10.0 ** x[1]) / f_id - 1,
+        x0,
+        bounds=(x0 - 2, x0 + 2),
+        x_scale=0.1,
+        xtol=1e-10,
+        ftol=1e-12,
+    )
     return params.with_contact(float(10.0 ** res.x[0]), float(10.0 ** res.x[1]))
 
 
@@ -142,11 +161,18 @@ def simulator(model: IdentifiedModel, aug: Augmentation, fs: float, f0: float | 
     zeta[red.beam_mode] += aug.extra_damping
     k_n = red.k_n * aug.normal_stiffness_factor
     p = aug.unilateral_exponent if aug.unilateral_exponent >= 1.0 else 1.0
-    contact = ContactParameters(friction=tuple(model.friction), preload=model.preload,
-                                static_approach=p * model.preload / k_n, exponent=p,
-                                hunt_crossley=aug.hunt_crossley, viscous=aug.viscous, iwan_share=aug.iwan_share,
-                                preload_drift=aug.preload_drift, unilateral=aug.unilateral_exponent >= 1.0,
-                                regularization=model.regularization)
+    contact = ContactParameters(
+        friction=tuple(model.friction),
+        preload=model.preload,
+        static_approach=p * model.preload / k_n,
+        exponent=p,
+        hunt_crossley=aug.hunt_crossley,
+        viscous=aug.viscous,
+        iwan_share=aug.iwan_share,
+        preload_drift=aug.preload_drift,
+        unilateral=aug.unilateral_exponent >= 1.0,
+        regularization=model.regularization,
+    )
     q = max(int(model.oversampling), int(np.ceil(red.omega.max() / (1.6 * fs))))
     dt = 1.0 / (q * fs)
     if f0:
@@ -186,9 +212,19 @@ STEADY_STATE = contextvars.ContextVar("steady_state", default="harmonic_balance"
 CLOSED_CONTACT_HB = contextvars.ContextVar("closed_contact_hb", default=True)
 
 
-def simulate(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, record_periods: int = 16,
-             force_harmonics: int = 5, tol: float = 2e-5, grid: int = 256, start: "SimResult | None" = None,
-             method: str | None = None, hb_harmonics: int | None = None, polish: bool = True) -> SimResult:
+def simulate(
+    model: IdentifiedModel,
+    aug: Augmentation,
+    rec: RecordHarmonics,
+    record_periods: int = 16,
+    force_harmonics: int = 5,
+    tol: float = 2e-5,
+    grid: int = 256,
+    start: "SimResult | None" = None,
+    method: str | None = None,
+    hb_harmonics: int | None = None,
+    polish: bool = True,
+) -> SimResult:
     """Steady-state response of the (augmented) identified model to the record's measured force
     (its first ``force_harmonics`` harmonics), in the record's harmonics.
 
@@ -286,27 +322,46 @@ def _period_grid(contact: dict, means: dict, f0: float, H: int, grid: int) -> di
     return grids
 
 
-def _periodic_result(periodic, sim, model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics,
-                     grid: int) -> SimResult:
+def _periodic_result(
+    periodic, sim, model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, grid: int
+) -> SimResult:
     w = periodic.w
     H = rec.acceleration.shape[1]
     g = periodic.grid
     n_per = g["t"].size
     acc = np.zeros((periodic.A.shape[0], H + 1), dtype=complex)
-    acc[:, :periodic.A.shape[1]] = periodic.A[:, :H + 1]
+    acc[:, : periodic.A.shape[1]] = periodic.A[:, : H + 1]
     A = _delay(sim.red.sensors @ acc[:, 1:], aug.delays, w)
     sig = {"S": g["S"], "N": g["N"], "xi": g["xi"], "eta": g["eta"], "xi_dot": g["dxi"], "eta_dot": g["deta"]}
     contact, means = _contact_harmonics(sig, 0.0, w, n_per, H)
     dt = 2 * np.pi / w / n_per
     e_t = float(np.sum(g["S"] * g["dxi"]) * dt)
     e_n = float(-np.sum((g["N"] - model.preload) * g["deta"]) * dt)
-    return SimResult(A, contact, _period_grid(contact, means, rec.f0, H, grid), {"tangential_j": e_t, "normal_j": e_n},
-                     True, None, None, {"means": means, "Z": periodic.Z, "method": "harmonic_balance",
-                                        "iterations": periodic.iterations})
+    return SimResult(
+        A,
+        contact,
+        _period_grid(contact, means, rec.f0, H, grid),
+        {"tangential_j": e_t, "normal_j": e_n},
+        True,
+        None,
+        None,
+        {"means": means, "Z": periodic.Z, "method": "harmonic_balance", "iterations": periodic.iterations},
+    )
 
 
-def _marched_result(sim, model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, coef, w, H, n_per,
-                    record_periods, settled, grid) -> SimResult:
+def _marched_result(
+    sim,
+    model: IdentifiedModel,
+    aug: Augmentation,
+    rec: RecordHarmonics,
+    coef,
+    w,
+    H,
+    n_per,
+    record_periods,
+    settled,
+    grid,
+) -> SimResult:
     first = last = None
     if not settled and not aug.preload_drift:
         # the motion does not settle (impacts): average over as many periods as the record holds, as the
@@ -332,11 +387,25 @@ def _marched_result(sim, model: IdentifiedModel, aug: Augmentation, rec: RecordH
         first = _delay(periodic_harmonics(acc[:, :third], t1, w, n_per, H), aug.delays, w)
         last = _delay(periodic_harmonics(acc[:, -third:], out["t"][n_rec - third], w, n_per, H), aug.delays, w)
     A = _delay(periodic_harmonics(acc, t1, w, n_per, H), aug.delays, w)
-    sig = {"S": out["S"], "N": out["N"], "xi": out["xi"], "eta": out["eta"], "xi_dot": out["dxi"],
-           "eta_dot": out["deta"]}
+    sig = {
+        "S": out["S"],
+        "N": out["N"],
+        "xi": out["xi"],
+        "eta": out["eta"],
+        "xi_dot": out["dxi"],
+        "eta_dot": out["deta"],
+    }
     contact, means = _contact_harmonics(sig, t1, w, n_per, H)
     cyc = slice(n_rec - n_per, n_rec)  # the last period for the cycle energies
     e_t = float(np.sum(out["S"][cyc] * out["dxi"][cyc]) * sim.dt)
     e_n = float(-np.sum((out["N"][cyc] - model.preload) * out["deta"][cyc]) * sim.dt)
-    return SimResult(A, contact, _period_grid(contact, means, rec.f0, H, grid), {"tangential_j": e_t, "normal_j": e_n},
-                     bool(settled), first, last, {"means": means, "method": "time_marching"})
+    return SimResult(
+        A,
+        contact,
+        _period_grid(contact, means, rec.f0, H, grid),
+        {"tangential_j": e_t, "normal_j": e_n},
+        bool(settled),
+        first,
+        last,
+        {"means": means, "method": "time_marching"},
+    )

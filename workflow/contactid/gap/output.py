@@ -39,14 +39,52 @@ def gap_dataset(diag: Diagnosis, records: dict, n_harmonics: int) -> xr.Dataset:
     a = diag.arrays
     parts = ["stick", "slip", "velocity_reversal", "peak_compression"]
     data = {
-        "gap_by_sensor": (("case", "sensor"), a["gap_by_sensor"], {"units": "1", "long_name": "|A_sim - A_rec| / |A_rec| per sensor (harmonics 1..H)"}),
-        "gap_by_harmonic": (("case", "harmonic"), a["gap_by_harmonic"], {"units": "1", "long_name": "residual per harmonic over all sensors / |A_rec|"}),
-        "gap_by_cycle_part": (("case", "cycle_part"), a["gap_by_cycle_part"], {"units": "1", "long_name": "rms driving-point acceleration residual in each part of the cycle / rms acceleration"}),
-        "energy_tangential": (("case", "source"), a["energy_tangential"], {"units": "J", "long_name": "energy dissipated per cycle by friction"}),
-        "energy_normal": (("case", "source"), a["energy_normal"], {"units": "J", "long_name": "energy dissipated per cycle in the normal direction"}),
-        "force_state_map": (("case", "map_field", "phase"), a["force_state_map"], {"units": "SI (m, m/s, N)", "long_name": "identified motion and the residual force (identified - law) over one period"}),
-        "acceleration_record_real": (("case", "sensor", "harmonic"), np.array([records[c].acceleration[:, :H].real for c in cases]), {"units": "m/s^2", "long_name": "record harmonics (force phase 0), real part"}),
-        "acceleration_record_imag": (("case", "sensor", "harmonic"), np.array([records[c].acceleration[:, :H].imag for c in cases]), {"units": "m/s^2", "long_name": "record harmonics, imaginary part"}),
+        "gap_by_sensor": (
+            ("case", "sensor"),
+            a["gap_by_sensor"],
+            {"units": "1", "long_name": "|A_sim - A_rec| / |A_rec| per sensor (harmonics 1..H)"},
+        ),
+        "gap_by_harmonic": (
+            ("case", "harmonic"),
+            a["gap_by_harmonic"],
+            {"units": "1", "long_name": "residual per harmonic over all sensors / |A_rec|"},
+        ),
+        "gap_by_cycle_part": (
+            ("case", "cycle_part"),
+            a["gap_by_cycle_part"],
+            {
+                "units": "1",
+                "long_name": "rms driving-point acceleration residual in each part of the cycle / rms acceleration",
+            },
+        ),
+        "energy_tangential": (
+            ("case", "source"),
+            a["energy_tangential"],
+            {"units": "J", "long_name": "energy dissipated per cycle by friction"},
+        ),
+        "energy_normal": (
+            ("case", "source"),
+            a["energy_normal"],
+            {"units": "J", "long_name": "energy dissipated per cycle in the normal direction"},
+        ),
+        "force_state_map": (
+            ("case", "map_field", "phase"),
+            a["force_state_map"],
+            {
+                "units": "SI (m, m/s, N)",
+                "long_name": "identified motion and the residual force (identified - law) over one period",
+            },
+        ),
+        "acceleration_record_real": (
+            ("case", "sensor", "harmonic"),
+            np.array([records[c].acceleration[:, :H].real for c in cases]),
+            {"units": "m/s^2", "long_name": "record harmonics (force phase 0), real part"},
+        ),
+        "acceleration_record_imag": (
+            ("case", "sensor", "harmonic"),
+            np.array([records[c].acceleration[:, :H].imag for c in cases]),
+            {"units": "m/s^2", "long_name": "record harmonics, imaginary part"},
+        ),
     }
     models = {"base": diag.sims["base"]}
     for r in diag.ranking[:2]:
@@ -56,16 +94,61 @@ def gap_dataset(diag: Diagnosis, records: dict, n_harmonics: int) -> xr.Dataset:
         for i, c in enumerate(cases):
             if sims.get(c) is not None:
                 arr[i] = sims[c].acceleration[:, :H]
-        data[f"acceleration_{label}_real"] = (("case", "sensor", "harmonic"), arr.real, {"units": "m/s^2", "long_name": f"simulated harmonics, {label} model, real part", "nonfinite_meaning": "NaN: not simulated (calibration case of a candidate)"})
-        data[f"acceleration_{label}_imag"] = (("case", "sensor", "harmonic"), arr.imag, {"units": "m/s^2", "long_name": f"simulated harmonics, {label} model, imaginary part", "nonfinite_meaning": "NaN: not simulated"})
+        data[f"acceleration_{label}_real"] = (
+            ("case", "sensor", "harmonic"),
+            arr.real,
+            {
+                "units": "m/s^2",
+                "long_name": f"simulated harmonics, {label} model, real part",
+                "nonfinite_meaning": "NaN: not simulated (calibration case of a candidate)",
+            },
+        )
+        data[f"acceleration_{label}_imag"] = (
+            ("case", "sensor", "harmonic"),
+            arr.imag,
+            {
+                "units": "m/s^2",
+                "long_name": f"simulated harmonics, {label} model, imaginary part",
+                "nonfinite_meaning": "NaN: not simulated",
+            },
+        )
     effects = [r["effect"] for r in diag.ranking]
-    data["heldout_gap_after"] = ("effect", [r["heldout_gap_after"] for r in diag.ranking], {"units": "1", "long_name": "held-out gap with the candidate added"})
-    data["heldout_gap_after_low"] = ("effect", [r["heldout_gap_after_interval"][0] for r in diag.ranking], {"units": "1", "long_name": "bootstrap 2.5 % quantile"})
-    data["heldout_gap_after_high"] = ("effect", [r["heldout_gap_after_interval"][1] for r in diag.ranking], {"units": "1", "long_name": "bootstrap 97.5 % quantile"})
-    data["score"] = ("effect", [r["score"] for r in diag.ranking], {"units": "1", "long_name": "n ln(after^2/before^2) + 2 k (lower is better)"})
-    return xr.Dataset(data, coords={"case": cases, "sensor": sensors, "harmonic": np.arange(1, H + 1), "cycle_part": parts,
-                                    "source": ["identified", "simulated"], "phase": np.arange(a["force_state_map"].shape[-1]),
-                                    "map_field": ["xi", "xi_dot", "S_residual", "eta", "eta_dot", "N_residual"],
-                                    "effect": effects},
-                      attrs={"verdict": diag.verdict, "reason": diag.reason, "calibration_case": diag.calibration_case,
-                             "heldout_gap_before": diag.where["heldout_gap_before"]})
+    data["heldout_gap_after"] = (
+        "effect",
+        [r["heldout_gap_after"] for r in diag.ranking],
+        {"units": "1", "long_name": "held-out gap with the candidate added"},
+    )
+    data["heldout_gap_after_low"] = (
+        "effect",
+        [r["heldout_gap_after_interval"][0] for r in diag.ranking],
+        {"units": "1", "long_name": "bootstrap 2.5 % quantile"},
+    )
+    data["heldout_gap_after_high"] = (
+        "effect",
+        [r["heldout_gap_after_interval"][1] for r in diag.ranking],
+        {"units": "1", "long_name": "bootstrap 97.5 % quantile"},
+    )
+    data["score"] = (
+        "effect",
+        [r["score"] for r in diag.ranking],
+        {"units": "1", "long_name": "n ln(after^2/before^2) + 2 k (lower is better)"},
+    )
+    return xr.Dataset(
+        data,
+        coords={
+            "case": cases,
+            "sensor": sensors,
+            "harmonic": np.arange(1, H + 1),
+            "cycle_part": parts,
+            "source": ["identified", "simulated"],
+            "phase": np.arange(a["force_state_map"].shape[-1]),
+            "map_field": ["xi", "xi_dot", "S_residual", "eta", "eta_dot", "N_residual"],
+            "effect": effects,
+        },
+        attrs={
+            "verdict": diag.verdict,
+            "reason": diag.reason,
+            "calibration_case": diag.calibration_case,
+            "heldout_gap_before": diag.where["heldout_gap_before"],
+        },
+    )

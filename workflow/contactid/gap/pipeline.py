@@ -23,12 +23,14 @@ def linear_chain(cfg: Mapping, raw_random: xr.Dataset, return_frf: bool = False)
     out of ``cfg`` take the schema's defaults (``config.with_defaults``), as in the workflow."""
     cfg = with_defaults(cfg)
     f, m, st, lm = (cfg[k] for k in ("frf", "modal", "stiction", "linear_modes"))
-    frf = frf_dataset(raw_random, int(f["segment_length"]), float(f["overlap"]), f["window"],
-                      int(m["uncertainty_blocks"]))
+    frf = frf_dataset(
+        raw_random, int(f["segment_length"]), float(f["overlap"]), f["window"], int(m["uncertainty_blocks"])
+    )
     modal = modal_dataset(frf, int(m["n_modes"]), m["band_hz"], int(m["order"]))
     stiction = stiction_dataset(modal, cfg["structure"], st)
-    modes = linear_modes_dataset(stiction, cfg["structure"], int(lm["n_modes"]), int(lm["grid_points"]),
-                                 float(st["k_n_prior_n_per_m"]))
+    modes = linear_modes_dataset(
+        stiction, cfg["structure"], int(lm["n_modes"]), int(lm["grid_points"]), float(st["k_n_prior_n_per_m"])
+    )
     return (modes, modal, frf) if return_frf else (modes, modal)
 
 
@@ -42,13 +44,15 @@ def identify(cfg: Mapping, raw_random: xr.Dataset, raw_calibration: xr.Dataset, 
     modes, modal, frf = linear_chain(cfg, raw_random, return_frf=True)
     K = int(cfg["nonlinear"]["n_harmonics"])
     settings = settings_from_config(cfg["friction"])
-    unfitted = xr.Dataset({"parameter_value": ("parameter", np.ones(5))},
-                          attrs={"regularization": settings.regularization})
+    unfitted = xr.Dataset(
+        {"parameter_value": ("parameter", np.ones(5))}, attrs={"regularization": settings.regularization}
+    )
     model = identified_model(cfg["structure"], modes, modal, unfitted, n_modes=n_modes)
     rec = record_harmonics(raw_calibration, "calibration", K)
     forces = identified_forces(model, NONE, rec)
-    fit = fit_friction_law(forces.xi, forces.N_dyn, forces.S, rec.f0, model.preload, settings, int(cfg["seed"]), K,
-                           intervals=False)
+    fit = fit_friction_law(
+        forces.xi, forces.N_dyn, forces.S, rec.f0, model.preload, settings, int(cfg["seed"]), K, intervals=False
+    )
     return model.with_friction(fit.params), modes, modal, frf
 
 
@@ -64,11 +68,21 @@ def rig_records(cfg: Mapping, effects: Mapping, seed: int, cases, random_test: b
     rig["effects"] = dict(effects)
     out, converged = {}, {}
     if random_test:
-        out["random_test"] = random_test_datasets(cfg["structure"], random_test_rig_config(rig), cfg["random_test"], seed)[0]
+        out["random_test"] = random_test_datasets(
+            cfg["structure"], random_test_rig_config(rig), cfg["random_test"], seed
+        )[0]
     fs = float(cfg["random_test"]["sampling_rate_hz"])
     for case in cases:
-        raw, truth = dual_sine_test(cfg["structure"], rig, cfg["load_cases"][case], fs, float(rig["noise_fraction"]),
-                                    seed, case, cfg["structure"]["sensors"]["names"])
+        raw, truth = dual_sine_test(
+            cfg["structure"],
+            rig,
+            cfg["load_cases"][case],
+            fs,
+            float(rig["noise_fraction"]),
+            seed,
+            case,
+            cfg["structure"]["sensors"]["names"],
+        )
         converged[case] = int(truth.attrs["control_converged"])
         out[case] = raw
     return out, converged
@@ -84,13 +98,29 @@ def structure_update(structure, modal: xr.Dataset, settings):
         return None
     f = modal["natural_frequency"].values
     sigma = frequency_sigma(f, modal["natural_frequency_std"].values, settings.frequency_floor)
-    return update_structure(structure, f, sigma, modal["residue_abs"].values, settings.residue_accuracy,
-                            settings.updating_parameters, confidence=settings.updating_confidence,
-                            prior_sd=dict(settings.updating_prior_sd))
+    return update_structure(
+        structure,
+        f,
+        sigma,
+        modal["residue_abs"].values,
+        settings.residue_accuracy,
+        settings.updating_parameters,
+        confidence=settings.updating_confidence,
+        prior_sd=dict(settings.updating_prior_sd),
+    )
 
 
-def diagnosed_model(structure_cfg: Mapping, modes: xr.Dataset, modal: xr.Dataset, fit: xr.Dataset, calibration,
-                    updating_summary: Mapping, fit_settings, settings, seed: int):
+def diagnosed_model(
+    structure_cfg: Mapping,
+    modes: xr.Dataset,
+    modal: xr.Dataset,
+    fit: xr.Dataset,
+    calibration,
+    updating_summary: Mapping,
+    fit_settings,
+    settings,
+    seed: int,
+):
     """The models a diagnosis of the workflow's datasets works with: (the chain's own model from linear_modes.nc,
     modal.nc and friction_fit.nc; the model to diagnose, the chain's updated by model_updating.json's summary
     (``updated_model``) or the chain's own when updating is off; the UpdatingResult or None)."""
@@ -121,13 +151,33 @@ def updated_model(model, modal: xr.Dataset, calibration, fit_settings, settings,
         return model, None
     factors = ", ".join(f"{k} {v:.4g}" for k, v in upd.factors.items())
     if not upd.accepted:
-        log.info("model updating: not accepted (chi2 %.3g -> %.3g for %d factors); the chain's structure is kept",
-                 upd.chi2_nominal, upd.chi2_updated, len(upd.factors))
+        log.info(
+            "model updating: not accepted (chi2 %.3g -> %.3g for %d factors); the chain's structure is kept",
+            upd.chi2_nominal,
+            upd.chi2_updated,
+            len(upd.factors),
+        )
         return model, upd
-    log.info("model updating: accepted (chi2 %.3g -> %.3g): %s, k_t %.4g, k_n %.4g N/m; friction law refitted",
-             upd.chi2_nominal, upd.chi2_updated, factors, upd.k_t, upd.k_n)
+    log.info(
+        "model updating: accepted (chi2 %.3g -> %.3g): %s, k_t %.4g, k_n %.4g N/m; friction law refitted",
+        upd.chi2_nominal,
+        upd.chi2_updated,
+        factors,
+        upd.k_t,
+        upd.k_n,
+    )
     m2 = dataclasses.replace(model, structure=upd.structure)
     forces = identified_forces(m2, NONE, calibration)
-    fit = fit_friction_law(forces.xi, forces.N_dyn, forces.S, calibration.f0, m2.preload, fit_settings, int(seed),
-                           calibration.acceleration.shape[1], intervals=False, label="friction fit after updating")
+    fit = fit_friction_law(
+        forces.xi,
+        forces.N_dyn,
+        forces.S,
+        calibration.f0,
+        m2.preload,
+        fit_settings,
+        int(seed),
+        calibration.acceleration.shape[1],
+        intervals=False,
+        label="friction fit after updating",
+    )
     return m2.with_friction(fit.params), upd

@@ -82,6 +82,17 @@ def record_harmonics(raw: xr.Dataset, case: str, n_harmonics: int, n_blocks: int
         ft = _harmonics(force[sl], t[sl], w, H)[0]
         at = _harmonics(acc[:, sl], t[sl], w, H)
         thirds.append(_aligned(ft, at)[1])
-    return RecordHarmonics(case, f0, fs, periods, F_al, A_al, np.array(bf), np.array(ba), thirds[0], thirds[1],
-                           tuple(str(s) for s in raw["sensor"].values),
-                           np.asarray(raw["sensor_position"].values if "sensor_position" in raw else [], dtype=float))
+    return RecordHarmonics(
+        case,
+        f0,
+        fs,
+        periods,
+        F_al,
+        A_al,
+        np.array(bf),
+        np.array(ba),
+        thirds[0],
+        thirds[1],
+        tuple(str(s) for s in raw["sensor"].values),
+        np.asarray(raw["sensor_position"].values if "sensor_position" in raw else [], dtype=float),
+    )

@@ -36,6 +36,7 @@ log = logging.getLogger(__name__)
 # the gap
 # ------------------------------------------------------------------------------------------
 
+
 def gap_residual(sim: SimResult, rec: RecordHarmonics, n_harmonics: int) -> np.ndarray:
     """Residual (complex, scaled by the record's rms acceleration harmonic norm): the sensors'
     harmonics 1..H of the whole record, and the change from the first to the last third (drift)."""
@@ -57,6 +58,7 @@ def gap_value(residual: np.ndarray) -> float:
 # ------------------------------------------------------------------------------------------
 # identification with an augmented model
 # ------------------------------------------------------------------------------------------
+
 
 def augmented_zeta(fe, damping, extra: float) -> np.ndarray:
     """Damping ratio of every FE mode (``modal_damping_vector``) plus ``extra`` on the structural (beam) modes."""
@@ -167,19 +169,33 @@ class _AugmentedProblem(_Problem):
 
 def contact_grids(forces: InverseHarmonics, f0: float, preload: float, m: int) -> dict:
     """One period of the identified xi, xi_dot, N (total) and S (mean removed) on m points."""
-    return {"xi": periodic_grid(forces.xi, f0, m)[0], "xi_dot": periodic_grid(forces.xi_dot, f0, m)[0],
-            "N": preload + periodic_grid(forces.N_dyn, f0, m)[0], "S": periodic_grid(forces.S, f0, m)[0],
-            "eta": periodic_grid(forces.eta, f0, m)[0], "eta_dot": periodic_grid(forces.eta_dot, f0, m)[0]}
+    return {
+        "xi": periodic_grid(forces.xi, f0, m)[0],
+        "xi_dot": periodic_grid(forces.xi_dot, f0, m)[0],
+        "N": preload + periodic_grid(forces.N_dyn, f0, m)[0],
+        "S": periodic_grid(forces.S, f0, m)[0],
+        "eta": periodic_grid(forces.eta, f0, m)[0],
+        "eta_dot": periodic_grid(forces.eta_dot, f0, m)[0],
+    }
 
 
-def refit_friction(model: IdentifiedModel, aug: Augmentation, forces: InverseHarmonics, f0: float,
-                   bounds, grid: int = 512) -> tuple[np.ndarray, float]:
+def refit_friction(
+    model: IdentifiedModel, aug: Augmentation, forces: InverseHarmonics, f0: float, bounds, grid: int = 512
+) -> tuple[np.ndarray, float]:
     """The friction law (with the augmentation's terms) polished from the chain's fit to the
     identified forces; returns (e_f, k_c, e_t, kappa, mu) and the NRMSE of S (memoised: a candidate
     that changes neither the forces nor the law gets the same polish)."""
     law = (aug.iwan_share, aug.viscous, aug.preload_drift)
-    key = (model.friction, model.preload, model.regularization, law, id(forces), f0,
-           tuple(map(tuple, np.atleast_2d(bounds))), grid)
+    key = (
+        model.friction,
+        model.preload,
+        model.regularization,
+        law,
+        id(forces),
+        f0,
+        tuple(map(tuple, np.atleast_2d(bounds))),
+        grid,
+    )
 
     def compute():
         # a drifting preload: the record's harmonics see the mean preload over the record
@@ -195,6 +211,7 @@ def refit_friction(model: IdentifiedModel, aug: Augmentation, forces: InverseHar
 # ------------------------------------------------------------------------------------------
 # calibration of a candidate
 # ------------------------------------------------------------------------------------------
+
 
 @dataclass
 class Calibration:
@@ -213,8 +230,16 @@ class Calibration:
     steps: tuple = ()  # ((name, theta), ...) of every effect in the augmentation, the explanation's order
 
 
-def evaluate(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, bounds, n_harmonics: int,
-             refit: bool = True, start: SimResult | None = None, polish: bool = True):
+def evaluate(
+    model: IdentifiedModel,
+    aug: Augmentation,
+    rec: RecordHarmonics,
+    bounds,
+    n_harmonics: int,
+    refit: bool = True,
+    start: SimResult | None = None,
+    polish: bool = True,
+):
     """Redo the chain with ``aug`` on one record: (gap, model with refitted friction, simulation, misfit).
     ``start``: a neighbouring simulation of the record to warm-start the steady state from; ``polish``: see
     ``simulate`` (False: the harmonic-balance state itself, where it converges)."""
@@ -231,9 +256,17 @@ def evaluate(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, bo
 POLISH_SEARCH = contextvars.ContextVar("polish_search", default=False)
 
 
-def calibrate(model: IdentifiedModel, cand: Candidate, rec: RecordHarmonics, settings: FitSettings,
-              n_harmonics: int, max_evaluations: int = 12, start: SimResult | None = None,
-              base: Augmentation = NONE, starts=()) -> Calibration:
+def calibrate(
+    model: IdentifiedModel,
+    cand: Candidate,
+    rec: RecordHarmonics,
+    settings: FitSettings,
+    n_harmonics: int,
+    max_evaluations: int = 12,
+    start: SimResult | None = None,
+    base: Augmentation = NONE,
+    starts=(),
+) -> Calibration:
     """theta of ``cand`` minimising the calibration case's gap (friction law refitted at each theta);
     each simulation starts from the previous one's steady state (``start``: the model's own). ``base``:
     effects already added (the additive explanation's earlier steps); the candidate's are added to them. ``starts``:
@@ -274,9 +307,17 @@ def calibrate(model: IdentifiedModel, cand: Candidate, rec: RecordHarmonics, set
         p = cand.parameters[0]
         step = 0.1 * (p.high - p.low)
         simplex = np.vstack([np.zeros(j), step * np.eye(j)])
-        res = minimize(lambda x: run(np.clip(x, p.low, p.high))[0], np.zeros(j), method="Nelder-Mead",
-                       options={"initial_simplex": simplex, "maxfev": 5 * max_evaluations,
-                                "xatol": 1e-3 * (p.high - p.low), "fatol": 1e-6})
+        res = minimize(
+            lambda x: run(np.clip(x, p.low, p.high))[0],
+            np.zeros(j),
+            method="Nelder-Mead",
+            options={
+                "initial_simplex": simplex,
+                "maxfev": 5 * max_evaluations,
+                "xatol": 1e-3 * (p.high - p.low),
+                "fatol": 1e-6,
+            },
+        )
         theta = np.clip(res.x, p.low, p.high)
         if run(np.zeros(j))[0] <= run(theta)[0]:
             theta = np.zeros(j)
@@ -290,10 +331,15 @@ def calibrate(model: IdentifiedModel, cand: Candidate, rec: RecordHarmonics, set
         p = cand.parameters[0]
         grid = p.low + (p.high - p.low) * np.array([0.0, 1 / 32, 1 / 8, 1 / 4, 1 / 2, 3 / 4, 1.0])
         best = min(range(1, 6), key=lambda i: run(np.array([grid[i]]))[0])
-        res = minimize_scalar(lambda x: run(np.array([x]))[0], bounds=(grid[best - 1], grid[best + 1]),
-                              method="bounded", options={"xatol": 1e-3 * (p.high - p.low), "maxiter": max_evaluations})
-        theta = np.array([res.x]) if run(np.array([res.x]))[0] <= run(np.array([grid[best]]))[0] \
-            else np.array([grid[best]])
+        res = minimize_scalar(
+            lambda x: run(np.array([x]))[0],
+            bounds=(grid[best - 1], grid[best + 1]),
+            method="bounded",
+            options={"xatol": 1e-3 * (p.high - p.low), "maxiter": max_evaluations},
+        )
+        theta = (
+            np.array([res.x]) if run(np.array([res.x]))[0] <= run(np.array([grid[best]]))[0] else np.array([grid[best]])
+        )
         # the bounded search never tries the ends: compare with "off" (the low end or zero)
         off = np.array([p.off])
         if run(off)[0] < run(theta)[0]:
@@ -316,17 +362,23 @@ def calibrate(model: IdentifiedModel, cand: Candidate, rec: RecordHarmonics, set
         size = 0.1 if joint else 0.25
         step = np.where(x0 + size <= 1.0, size, -size)
         simplex = np.vstack([x0, x0 + np.diag(step)])
-        res = minimize(lambda x: run(lo + np.clip(x, 0, 1) * (hi - lo))[0], x0, method="Nelder-Mead",
-                       options={"initial_simplex": simplex, "maxfev": max_evaluations * lo.size, "xatol": 1e-3,
-                                "fatol": 1e-6})
+        res = minimize(
+            lambda x: run(lo + np.clip(x, 0, 1) * (hi - lo))[0],
+            x0,
+            method="Nelder-Mead",
+            options={"initial_simplex": simplex, "maxfev": max_evaluations * lo.size, "xatol": 1e-3, "fatol": 1e-6},
+        )
         theta = lo + np.clip(res.x, 0, 1) * (hi - lo)
     g, m2, sim, misfit, aug = run(theta, polish=True)
     if not np.isfinite(g):  # nothing in the range could be simulated: the effect off
-        theta = np.array([p.off for p in cand.parameters]) \
-            if not cand.per_channel else np.zeros_like(np.atleast_1d(theta))
+        theta = (
+            np.array([p.off for p in cand.parameters]) if not cand.per_channel else np.zeros_like(np.atleast_1d(theta))
+        )
         g, m2, sim, misfit, aug = run(theta, polish=True)
     theta = np.atleast_1d(theta)
-    return Calibration(cand.name, theta, np.asarray(m2.friction), g, m2, aug, n_eval, misfit, sim, ((cand.name, theta),))
+    return Calibration(
+        cand.name, theta, np.asarray(m2.friction), g, m2, aug, n_eval, misfit, sim, ((cand.name, theta),)
+    )
 
 
 def baseline(model: IdentifiedModel, rec: RecordHarmonics, n_harmonics: int) -> tuple[float, SimResult]:

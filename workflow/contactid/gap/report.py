@@ -13,8 +13,13 @@ def _bound_text(c: dict) -> str:
     b = c.get("perturbation_only_median_abs_bound_error")
     if not b or any(v is None for v in b.values()):
         return ""
-    return (r" What the data bind, with the model's lever arm $a$ against the rig's: median errors $\mu a$ " +
-            _pct(b["mu_a"]) + r", $e_0 a^2$ " + _pct(b["e0_a2"]) + ".")
+    return (
+        r" What the data bind, with the model's lever arm $a$ against the rig's: median errors $\mu a$ "
+        + _pct(b["mu_a"])
+        + r", $e_0 a^2$ "
+        + _pct(b["e0_a2"])
+        + "."
+    )
 
 
 def _coverage_text(c: dict) -> str:
@@ -22,12 +27,16 @@ def _coverage_text(c: dict) -> str:
     cov, hw = c.get("perturbation_only_interval_coverage"), c.get("perturbation_only_median_interval_halfwidth")
     if not cov or any(v is None for v in cov.values()):
         return ""
-    return (r" The 95\,\% intervals with the model-form term (spread over load cases and over the structures "
-            r"the random test allows) held the truth in: " +
-            ", ".join(f"{sym} {_pct(cov[k])}" for k, sym in (("mu", r"$\mu$"), ("kappa", r"$\kappa$"), ("e0", "$e_0$"))) +
-            r" of these sets, with median half-widths " +
-            ", ".join(sym + r" $\pm$\," + _pct(hw[k]) for k, sym in (("mu", r"$\mu$"), ("kappa", r"$\kappa$"), ("e0", "$e_0$")))
-            + ".")
+    return (
+        r" The 95\,\% intervals with the model-form term (spread over load cases and over the structures "
+        r"the random test allows) held the truth in: "
+        + ", ".join(f"{sym} {_pct(cov[k])}" for k, sym in (("mu", r"$\mu$"), ("kappa", r"$\kappa$"), ("e0", "$e_0$")))
+        + r" of these sets, with median half-widths "
+        + ", ".join(
+            sym + r" $\pm$\," + _pct(hw[k]) for k, sym in (("mu", r"$\mu$"), ("kappa", r"$\kappa$"), ("e0", "$e_0$"))
+        )
+        + "."
+    )
 
 
 def _num(x) -> float:
@@ -43,19 +52,41 @@ def explanation_text(diag: dict) -> str:
     """The additive explanation in words (Fig. gap_explanation)."""
     steps, left = diag.get("explanation") or [], diag.get("remaining_gap") or {}
     if not steps:
-        text = (r"No candidate shrinks the held-out gap materially (by gap.min\_reduction $=" +
-                _fmt(left.get("min_reduction", float("nan")), 2) + r"$ of it, beyond the records' scatter), so "
-                r"nothing is added to the identified model. ")
+        text = (
+            r"No candidate shrinks the held-out gap materially (by gap.min\_reduction $="
+            + _fmt(left.get("min_reduction", float("nan")), 2)
+            + r"$ of it, beyond the records' scatter), so "
+            r"nothing is added to the identified model. "
+        )
     else:
-        parts = [_t(s["effect"]) + r" (refitted: " + ", ".join(f"{_t(k)} $= {_fmt(v, 3)}$" for k, v in s["parameters"].items()) +
-                 r") takes the held-out gap from " + _pct(s["heldout_gap_before"]) + " to " + _pct(s["heldout_gap_after"]) +
-                 r" (" + _pct(s["share"]) + r" of its power)" for s in steps]
+        parts = [
+            _t(s["effect"])
+            + r" (refitted: "
+            + ", ".join(f"{_t(k)} $= {_fmt(v, 3)}$" for k, v in s["parameters"].items())
+            + r") takes the held-out gap from "
+            + _pct(s["heldout_gap_before"])
+            + " to "
+            + _pct(s["heldout_gap_after"])
+            + r" ("
+            + _pct(s["share"])
+            + r" of its power)"
+            for s in steps
+        ]
         text = r"Added one after the other, each refitted on top of the ones before: " + "; then ".join(parts) + ". "
     if left:
-        text += (r"What remains is " + _pct(left["heldout_gap"]) + r" (" + _pct(left["share"]) + r" of the power), " +
-                 (r"at the identification's own floor (gap.min\_gap " + _pct(left["floor"]) + ")"
-                  if left["at_floor"] else r"in \emph{" + _t(left["place"]) + r"} (" + _t(left["place_reason"]) + ")") +
-                 r"; Fig.~\ref{fig:gap_explanation}.")
+        text += (
+            r"What remains is "
+            + _pct(left["heldout_gap"])
+            + r" ("
+            + _pct(left["share"])
+            + r" of the power), "
+            + (
+                r"at the identification's own floor (gap.min\_gap " + _pct(left["floor"]) + ")"
+                if left["at_floor"]
+                else r"in \emph{" + _t(left["place"]) + r"} (" + _t(left["place_reason"]) + ")"
+            )
+            + r"; Fig.~\ref{fig:gap_explanation}."
+        )
     return text
 
 
@@ -64,22 +95,59 @@ def intervals_text(intervals: dict | None) -> str:
     if not intervals:
         return ""
     par = intervals["parameters"]
-    names = {"e_f": "e_f (N/m)", "k_c": "k_c (1/m)", "e_t": "e_t (N/m)", "kappa": "kappa", "mu": "mu",
-             "e0": "e_0 at N_0 (N/m)"}
-    rows = pd.DataFrame([{"p": names[n], "value": v["value"], "plo": v["profile_interval"][0],
-                          "phi": v["profile_interval"][1], "sdc": v["sd_cases"], "sds": v["sd_structure"],
-                          "lo": v["interval"][0], "hi": v["interval"][1]} for n, v in par.items() if n in names])
-    text = (r"\paragraph{Friction law with model-form uncertainty.} The profile-likelihood intervals hold if the model "
-            r"is right. The law of the " + _t(intervals["model"]) + r" model was refitted on each other load case and "
-            r"on the calibration forces identified with each of the " + str(intervals["n_structures"]) + r" structures "
-            r"the random test allows ($\pm$1 posterior standard deviation along each principal axis of the model "
-            r"updating); their spreads (sd, on a log scale for the positive parameters) widen the intervals. The "
-            r"tangential lever arm, which the linear data do not bound, sets most of the structural term of $\mu$ and "
-            r"$e_0$: the data bind $\mu a$ and $e_0 a^2$.")
-    return text + "\n" + tabular(rows, {"p": "parameter", "value": "value", "plo": "profile low", "phi": "profile high",
-                                          "sdc": "sd cases", "sds": "sd structure", "lo": "low", "hi": "high"},
-                                   "Friction law: profile-likelihood interval and the 95\\,\\% interval with the "
-                                   "model-form term (spreads over load cases and structures).", "tab:intervals")
+    names = {
+        "e_f": "e_f (N/m)",
+        "k_c": "k_c (1/m)",
+        "e_t": "e_t (N/m)",
+        "kappa": "kappa",
+        "mu": "mu",
+        "e0": "e_0 at N_0 (N/m)",
+    }
+    rows = pd.DataFrame(
+        [
+            {
+                "p": names[n],
+                "value": v["value"],
+                "plo": v["profile_interval"][0],
+                "phi": v["profile_interval"][1],
+                "sdc": v["sd_cases"],
+                "sds": v["sd_structure"],
+                "lo": v["interval"][0],
+                "hi": v["interval"][1],
+            }
+            for n, v in par.items()
+            if n in names
+        ]
+    )
+    text = (
+        r"\paragraph{Friction law with model-form uncertainty.} The profile-likelihood intervals hold if the model "
+        r"is right. The law of the " + _t(intervals["model"]) + r" model was refitted on each other load case and "
+        r"on the calibration forces identified with each of the " + str(intervals["n_structures"]) + r" structures "
+        r"the random test allows ($\pm$1 posterior standard deviation along each principal axis of the model "
+        r"updating); their spreads (sd, on a log scale for the positive parameters) widen the intervals. The "
+        r"tangential lever arm, which the linear data do not bound, sets most of the structural term of $\mu$ and "
+        r"$e_0$: the data bind $\mu a$ and $e_0 a^2$."
+    )
+    return (
+        text
+        + "\n"
+        + tabular(
+            rows,
+            {
+                "p": "parameter",
+                "value": "value",
+                "plo": "profile low",
+                "phi": "profile high",
+                "sdc": "sd cases",
+                "sds": "sd structure",
+                "lo": "low",
+                "hi": "high",
+            },
+            "Friction law: profile-likelihood interval and the 95\\,\\% interval with the "
+            "model-form term (spreads over load cases and structures).",
+            "tab:intervals",
+        )
+    )
 
 
 def gap_section(diag: dict, bench: dict | None, intervals: dict | None = None) -> str:
@@ -88,19 +156,45 @@ def gap_section(diag: dict, bench: dict | None, intervals: dict | None = None) -
     lines = [
         r"The identified model (linear stiffnesses and damping of the linear chain, the fitted friction law, the",
         r"linear normal spring of Eq.~13) is simulated under each load case's measured force and compared with the",
-        r"records at every level of the chain. The friction law was fitted on " + _t(diag["calibration_case"]) +
-        r"; the other load cases are held out.",
+        r"records at every level of the chain. The friction law was fitted on "
+        + _t(diag["calibration_case"])
+        + r"; the other load cases are held out.",
         "",
-        r"\paragraph{Where the gap lies.} Held-out gap (sensor harmonics 1--" + str(len(w["by_harmonic"])) + r"): " +
-        _pct(w["heldout_gap_before"]) + r" (bootstrap 95\,\% " + _pct(w["heldout_gap_before_interval"][0]) + "--" +
-        _pct(w["heldout_gap_before_interval"][1]) + r"; the records' own scatter " + _pct(w["record_scatter"]) + "). "
-        r"By stage: accelerations " + _pct(st["accelerations"]) + r", generalized coordinates " +
-        _pct(st["generalized_coordinates"]) + r", inverse-identification sensor misfit " +
-        _pct(st.get("identification_residual")) + r", friction law against identified $S$ " + _pct(st["contact_force_S"]) +
-        r", best elastic normal law against identified $N$ " + _pct(st["contact_force_N"]) + r", dissipated energy per cycle "
-        r"(tangential) " + _pct(st["energy_tangential"]) + r", random-test FRF peaks " + _pct(st.get("frf_peak_amplitude")) +
-        r". Worst sensor " + _t(w["worst_sensor"]) + r", worst harmonic " + str(w["worst_harmonic"]) + r" (even harmonics carry " +
-        _pct(w["even_share"]) + r" of the residual), worst part of the cycle: " + _t(w["worst_cycle_part"]) + r". "
+        r"\paragraph{Where the gap lies.} Held-out gap (sensor harmonics 1--"
+        + str(len(w["by_harmonic"]))
+        + r"): "
+        + _pct(w["heldout_gap_before"])
+        + r" (bootstrap 95\,\% "
+        + _pct(w["heldout_gap_before_interval"][0])
+        + "--"
+        + _pct(w["heldout_gap_before_interval"][1])
+        + r"; the records' own scatter "
+        + _pct(w["record_scatter"])
+        + "). "
+        r"By stage: accelerations "
+        + _pct(st["accelerations"])
+        + r", generalized coordinates "
+        + _pct(st["generalized_coordinates"])
+        + r", inverse-identification sensor misfit "
+        + _pct(st.get("identification_residual"))
+        + r", friction law against identified $S$ "
+        + _pct(st["contact_force_S"])
+        + r", best elastic normal law against identified $N$ "
+        + _pct(st["contact_force_N"])
+        + r", dissipated energy per cycle "
+        r"(tangential) "
+        + _pct(st["energy_tangential"])
+        + r", random-test FRF peaks "
+        + _pct(st.get("frf_peak_amplitude"))
+        + r". Worst sensor "
+        + _t(w["worst_sensor"])
+        + r", worst harmonic "
+        + str(w["worst_harmonic"])
+        + r" (even harmonics carry "
+        + _pct(w["even_share"])
+        + r" of the residual), worst part of the cycle: "
+        + _t(w["worst_cycle_part"])
+        + r". "
         r"The localisation places the gap in: \emph{" + _t(w["place"]) + r"} (" + _t(w["place_reason"]) + ").",
         "",
         r"\paragraph{Which effect.} Verdict: \textbf{" + _t(diag["verdict"]) + r"} --- " + _t(diag["reason"]) + ".",
@@ -108,61 +202,120 @@ def gap_section(diag: dict, bench: dict | None, intervals: dict | None = None) -
         r"\paragraph{Step by step.} " + explanation_text(diag),
         "",
     ]
-    rows = pd.DataFrame([{"effect": r["effect"], "k": r["n_parameters"], "before": 100 * _num(r["heldout_gap_before"]),
-                          "after": 100 * _num(r["heldout_gap_after"]), "low": 100 * _num(r["heldout_gap_after_interval"][0]),
-                          "high": 100 * _num(r["heldout_gap_after_interval"][1]), "reduction": 100 * _num(r["reduction"]),
-                          "score": _num(r["score"])} for r in diag["ranking"]])
+    rows = pd.DataFrame(
+        [
+            {
+                "effect": r["effect"],
+                "k": r["n_parameters"],
+                "before": 100 * _num(r["heldout_gap_before"]),
+                "after": 100 * _num(r["heldout_gap_after"]),
+                "low": 100 * _num(r["heldout_gap_after_interval"][0]),
+                "high": 100 * _num(r["heldout_gap_after_interval"][1]),
+                "reduction": 100 * _num(r["reduction"]),
+                "score": _num(r["score"]),
+            }
+            for r in diag["ranking"]
+        ]
+    )
     out = "\n".join(lines) + "\n"
     if len(rows):
-        out += tabular(rows, {"effect": "candidate", "k": "$k$", "before": "before (\\%)", "after": "after (\\%)",
-                              "low": "2.5\\,\\%", "high": "97.5\\,\\%", "reduction": "shrink (\\%)", "score": "score"},
-                       "Candidate effects refitted on the calibration case and scored on the held-out cases "
-                       "(held-out gap before and after, bootstrap interval of after, score $n\\ln(g_a^2/g_b^2)+2k$).",
-                       "tab:gap")
-    out += ("\\begin{figure}[H]\\centering\\includegraphics[width=0.49\\textwidth]{gap_stages.png}"
-            "\\includegraphics[width=0.49\\textwidth]{gap_ranking.png}\n"
-            "\\includegraphics[width=0.49\\textwidth]{gap_harmonics.png}"
-            "\\includegraphics[width=0.49\\textwidth]{gap_cycle.png}\n"
-            "\\includegraphics[width=0.49\\textwidth]{gap_shrink.png}"
-            "\\includegraphics[width=0.49\\textwidth]{gap_force_state.png}\n"
-            "\\caption{The gap by stage, the candidates ranked, by harmonic and sensor, by part of the cycle and "
-            "dissipation in each direction, the held-out gap before and after the two best candidates, and the residual "
-            "force-state maps.}\\label{fig:gap}\\end{figure}\n")
-    out += ("\\begin{figure}[H]\\centering\\includegraphics[width=0.7\\textwidth]{gap_explanation.png}"
-            "\\caption{The held-out gap explained step by step: the identified model, what each added effect removes, "
-            "what remains (dotted: the identification's floor).}\\label{fig:gap_explanation}\\end{figure}\n")
+        out += tabular(
+            rows,
+            {
+                "effect": "candidate",
+                "k": "$k$",
+                "before": "before (\\%)",
+                "after": "after (\\%)",
+                "low": "2.5\\,\\%",
+                "high": "97.5\\,\\%",
+                "reduction": "shrink (\\%)",
+                "score": "score",
+            },
+            "Candidate effects refitted on the calibration case and scored on the held-out cases "
+            "(held-out gap before and after, bootstrap interval of after, score $n\\ln(g_a^2/g_b^2)+2k$).",
+            "tab:gap",
+        )
+    out += (
+        "\\begin{figure}[H]\\centering\\includegraphics[width=0.49\\textwidth]{gap_stages.png}"
+        "\\includegraphics[width=0.49\\textwidth]{gap_ranking.png}\n"
+        "\\includegraphics[width=0.49\\textwidth]{gap_harmonics.png}"
+        "\\includegraphics[width=0.49\\textwidth]{gap_cycle.png}\n"
+        "\\includegraphics[width=0.49\\textwidth]{gap_shrink.png}"
+        "\\includegraphics[width=0.49\\textwidth]{gap_force_state.png}\n"
+        "\\caption{The gap by stage, the candidates ranked, by harmonic and sensor, by part of the cycle and "
+        "dissipation in each direction, the held-out gap before and after the two best candidates, and the residual "
+        "force-state maps.}\\label{fig:gap}\\end{figure}\n"
+    )
+    out += (
+        "\\begin{figure}[H]\\centering\\includegraphics[width=0.7\\textwidth]{gap_explanation.png}"
+        "\\caption{The held-out gap explained step by step: the identified model, what each added effect removes, "
+        "what remains (dotted: the identification's floor).}\\label{fig:gap_explanation}\\end{figure}\n"
+    )
     out += intervals_text(intervals)
     if bench is None:
-        out += ("\n\\paragraph{Blind benchmark.} Not built with this report (\\texttt{gap\\_benchmark.in\\_report: "
-                "false}); run \\texttt{snakemake gap\\_benchmark}.\n")
+        out += (
+            "\n\\paragraph{Blind benchmark.} Not built with this report (\\texttt{gap\\_benchmark.in\\_report: "
+            "false}); run \\texttt{snakemake gap\\_benchmark}.\n"
+        )
         return out
     lo = bench["leave_out"]
-    out += ("\n\\paragraph{Blind benchmark.} " + str(bench["n_blind"]) + r" rig data sets, each with one effect on at a "
-            r"random (seeded) magnitude, diagnosed from their raw records alone: top-1 accuracy " +
-            _pct(bench["top1_accuracy"]) + r"; false alarms on effect-free data: " + str(bench["false_alarms"]) + " of " +
-            str(bench["n_effect_free"]) + r"; held-out gap shrink of the correctly named effects: smallest " +
-            _pct(bench["shrink_of_correct"]["min"]) + r", median " + _pct(bench["shrink_of_correct"]["median"]) +
-            r". With the effect left out of the library (" + str(lo["n"]) + r" data sets) the verdict was ``none'' in " +
-            str(lo["verdict_none"]) + r" and the localisation named the right place in " + str(lo["place_right"]) +
-            r". Diagnosis time per data set (three load cases): median " + f"${bench['diagnosis_seconds']['median']:.0f}$" +
-            "\\,s.\n")
+    out += (
+        "\n\\paragraph{Blind benchmark.} " + str(bench["n_blind"]) + r" rig data sets, each with one effect on at a "
+        r"random (seeded) magnitude, diagnosed from their raw records alone: top-1 accuracy "
+        + _pct(bench["top1_accuracy"])
+        + r"; false alarms on effect-free data: "
+        + str(bench["false_alarms"])
+        + " of "
+        + str(bench["n_effect_free"])
+        + r"; held-out gap shrink of the correctly named effects: smallest "
+        + _pct(bench["shrink_of_correct"]["min"])
+        + r", median "
+        + _pct(bench["shrink_of_correct"]["median"])
+        + r". With the effect left out of the library ("
+        + str(lo["n"])
+        + r" data sets) the verdict was ``none'' in "
+        + str(lo["verdict_none"])
+        + r" and the localisation named the right place in "
+        + str(lo["place_right"])
+        + r". Diagnosis time per data set (three load cases): median "
+        + f"${bench['diagnosis_seconds']['median']:.0f}$"
+        + "\\,s.\n"
+    )
     c = bench.get("compound")
     if c:
         err = c["perturbation_only_median_abs_error"]
-        out += ("\n\\paragraph{Compound benchmark.} " + str(c["n"]) + r" rig data sets whose structure (E, transducer "
-                r"masses, tangential lever arm), normal law and damping form differ from the model's at random, with 0, 1 "
-                r"or 2 effects (" + ", ".join(f"{v} with {k}" for k, v in c["n_by_effect_count"].items()) + r"), diagnosed "
-                r"with model updating and scored on the additive explanation. Perturbation only: no contact effect named "
-                r"in " + _pct(c["perturbation_only_no_contact_effect"]) + r"; one effect: named in " +
-                _pct(c["one_effect_named"]) + r", no absent contact effect in " + _pct(c["one_effect_no_absent_contact_effect"]) +
-                r"; two effects: both named in " + _pct(c["two_effects_both_named"]) + r", at least one in " +
-                _pct(c["two_effects_one_named"]) + r". Median remaining held-out gap " + _pct(c["remaining_gap_median"]) +
-                r". Perturbation only, after updating, median errors: $\mu$ " + _pct(err["mu"]) + r", $\kappa$ " +
-                _pct(err["kappa"]) + r", $e_0$ " + _pct(err["e0"]) + r" (the tangential lever arm, which linear data do not "
-                r"bound, scales the identified $S$ and so $\mu$)." + _bound_text(c) + _coverage_text(c)) + "\n"
+        out += (
+            "\n\\paragraph{Compound benchmark.} " + str(c["n"]) + r" rig data sets whose structure (E, transducer "
+            r"masses, tangential lever arm), normal law and damping form differ from the model's at random, with 0, 1 "
+            r"or 2 effects (" + ", ".join(f"{v} with {k}" for k, v in c["n_by_effect_count"].items()) + r"), diagnosed "
+            r"with model updating and scored on the additive explanation. Perturbation only: no contact effect named "
+            r"in "
+            + _pct(c["perturbation_only_no_contact_effect"])
+            + r"; one effect: named in "
+            + _pct(c["one_effect_named"])
+            + r", no absent contact effect in "
+            + _pct(c["one_effect_no_absent_contact_effect"])
+            + r"; two effects: both named in "
+            + _pct(c["two_effects_both_named"])
+            + r", at least one in "
+            + _pct(c["two_effects_one_named"])
+            + r". Median remaining held-out gap "
+            + _pct(c["remaining_gap_median"])
+            + r". Perturbation only, after updating, median errors: $\mu$ "
+            + _pct(err["mu"])
+            + r", $\kappa$ "
+            + _pct(err["kappa"])
+            + r", $e_0$ "
+            + _pct(err["e0"])
+            + r" (the tangential lever arm, which linear data do not "
+            r"bound, scales the identified $S$ and so $\mu$)." + _bound_text(c) + _coverage_text(c)
+        ) + "\n"
     acc = pd.DataFrame([{"effect": e, "accuracy": 100 * a} for e, a in bench["per_effect_accuracy"].items()])
-    out += tabular(acc, {"effect": "effect", "accuracy": "top-1 (\\%)"}, "Blind benchmark: accuracy per effect.",
-                   "tab:bench")
-    out += ("\\begin{figure}[H]\\centering\\includegraphics[width=0.6\\textwidth]{confusion.png}"
-            "\\caption{Blind benchmark: confusion matrix.}\\label{fig:confusion}\\end{figure}\n")
+    out += tabular(
+        acc, {"effect": "effect", "accuracy": "top-1 (\\%)"}, "Blind benchmark: accuracy per effect.", "tab:bench"
+    )
+    out += (
+        "\\begin{figure}[H]\\centering\\includegraphics[width=0.6\\textwidth]{confusion.png}"
+        "\\caption{Blind benchmark: confusion matrix.}\\label{fig:confusion}\\end{figure}\n"
+    )
     return out

@@ -74,11 +74,17 @@ class FrictionUncertainty:
 
     def summary(self) -> dict:
         """JSON-ready {name: {value, profile_interval, sd_cases, sd_structure, interval, scale}}."""
-        return {n: {"value": float(self.value[i]), "profile_interval": [float(v) for v in self.profile[i]],
-                    "sd_cases": float(self.sd_cases[i]), "sd_structure": float(self.sd_structure[i]),
-                    "interval": [float(v) for v in self.interval[i]],
-                    "scale": "log" if LOG_SCALE[i] else "linear"}
-                for i, n in enumerate(NAMES)} | {"confidence": self.confidence}
+        return {
+            n: {
+                "value": float(self.value[i]),
+                "profile_interval": [float(v) for v in self.profile[i]],
+                "sd_cases": float(self.sd_cases[i]),
+                "sd_structure": float(self.sd_structure[i]),
+                "interval": [float(v) for v in self.interval[i]],
+                "scale": "log" if LOG_SCALE[i] else "linear",
+            }
+            for i, n in enumerate(NAMES)
+        } | {"confidence": self.confidence}
 
 
 def with_e0(params, preload: float) -> np.ndarray:
@@ -119,15 +125,28 @@ def widened_interval(profile: np.ndarray, sd: np.ndarray, confidence: float, bou
     return np.column_stack([np.clip(lo, b[:, 0], b[:, 1]), np.clip(hi, b[:, 0], b[:, 1])])
 
 
-def _refit(model: IdentifiedModel, rec: RecordHarmonics, settings: FitSettings, seed: int, label: str,
-           intervals: bool = False):
+def _refit(
+    model: IdentifiedModel, rec: RecordHarmonics, settings: FitSettings, seed: int, label: str, intervals: bool = False
+):
     forces = identified_forces(model, NONE, rec)
-    return fit_friction_law(forces.xi, forces.N_dyn, forces.S, rec.f0, model.preload, settings, int(seed),
-                            rec.acceleration.shape[1], intervals=intervals, label=label, start=model.friction)
+    return fit_friction_law(
+        forces.xi,
+        forces.N_dyn,
+        forces.S,
+        rec.f0,
+        model.preload,
+        settings,
+        int(seed),
+        rec.acceleration.shape[1],
+        intervals=intervals,
+        label=label,
+        start=model.friction,
+    )
 
 
-def friction_uncertainty(model: IdentifiedModel, records: Mapping, calibration: str, settings: FitSettings,
-                         seed: int, structures=()) -> FrictionUncertainty:
+def friction_uncertainty(
+    model: IdentifiedModel, records: Mapping, calibration: str, settings: FitSettings, seed: int, structures=()
+) -> FrictionUncertainty:
     """The friction law of ``model`` (fitted on ``records[calibration]``) with its profile intervals and the
     model-form spreads over the other load cases in ``records`` and over ``structures`` (see the module)."""
     quiet = logging.getLogger("contactid.friction_fit")
@@ -136,19 +155,39 @@ def friction_uncertainty(model: IdentifiedModel, records: Mapping, calibration: 
     fit = _refit(model, cal, settings, seed, "friction intervals", intervals=True)
     value = with_e0(fit.params, model.preload)
     profile = np.vstack([fit.intervals, np.array(fit.e0_interval)[None, :]])
-    quiet.setLevel(logging.ERROR)  # the refits' progress lines (and bound warnings the fit itself gave) would bury the log
+    quiet.setLevel(
+        logging.ERROR
+    )  # the refits' progress lines (and bound warnings the fit itself gave) would bury the log
     try:
-        cases = {c: with_e0(_refit(model, r, settings, seed, f"refit on {c}").params, model.preload)
-                 for c, r in records.items() if c != calibration}
-        structs = [with_e0(_refit(dataclasses.replace(model, structure=p), cal, settings, seed,
-                                  "refit on a posterior structure").params, model.preload) for p in structures]
+        cases = {
+            c: with_e0(_refit(model, r, settings, seed, f"refit on {c}").params, model.preload)
+            for c, r in records.items()
+            if c != calibration
+        }
+        structs = [
+            with_e0(
+                _refit(
+                    dataclasses.replace(model, structure=p), cal, settings, seed, "refit on a posterior structure"
+                ).params,
+                model.preload,
+            )
+            for p in structures
+        ]
     finally:
         quiet.setLevel(level)
     sd_c = spread_sd(value, list(cases.values()))
     sd_s = spread_sd(value, structs, pairs=True)
     interval = widened_interval(profile, np.hypot(sd_c, sd_s), settings.confidence, settings.bounds)
     for i, n in enumerate(NAMES):
-        log.info("friction intervals: %s = %.4g, profile [%.4g, %.4g], model-form sd %.3g (cases) %.3g (structure)%s"
-                 " -> [%.4g, %.4g]", n, value[i], *profile[i], sd_c[i], sd_s[i], " on ln" if LOG_SCALE[i] else "",
-                 *interval[i])
+        log.info(
+            "friction intervals: %s = %.4g, profile [%.4g, %.4g], model-form sd %.3g (cases) %.3g (structure)%s"
+            " -> [%.4g, %.4g]",
+            n,
+            value[i],
+            *profile[i],
+            sd_c[i],
+            sd_s[i],
+            " on ln" if LOG_SCALE[i] else "",
+            *interval[i],
+        )
     return FrictionUncertainty(value, profile, sd_c, sd_s, interval, float(settings.confidence), cases, structs)

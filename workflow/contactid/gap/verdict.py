@@ -12,6 +12,7 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
+
 @dataclass(frozen=True)
 class PlaceThresholds:
     """The place's thresholds (config ``gap.place``; measured on rig data with each effect, docs/gap.md; the
@@ -46,9 +47,15 @@ def acts_where(acts_on: str, place: str) -> bool:
     return acts_on in ("any", place) or (place == "contact" and acts_on in ("normal_contact", "tangential_contact"))
 
 
-def place(drift: Mapping[str, Mapping], stage: Mapping[str, float], id_res, scatter,
-          eta_observable: bool = True, eta_spread: float = 0.0,
-          thresholds: PlaceThresholds = DEFAULT_PLACE) -> tuple[str, str]:
+def place(
+    drift: Mapping[str, Mapping],
+    stage: Mapping[str, float],
+    id_res,
+    scatter,
+    eta_observable: bool = True,
+    eta_spread: float = 0.0,
+    thresholds: PlaceThresholds = DEFAULT_PLACE,
+) -> tuple[str, str]:
     """Where the gap lies, with the reason: (place, reason).
 
     drift: per load case {"change": relative change over the record, "z": its size in standard errors};
@@ -65,32 +72,49 @@ def place(drift: Mapping[str, Mapping], stage: Mapping[str, float], id_res, scat
     z = np.array([v["z"] for v in drift.values()])
     if np.median(z) > thresholds.drift_z:
         change = np.median([v["change"] for v in drift.values()])
-        return "non_stationary", (f"the records' harmonics drift by {change:.2g} over a record "
-                                  f"({np.median(z):.0f} standard errors)")
+        return "non_stationary", (
+            f"the records' harmonics drift by {change:.2g} over a record ({np.median(z):.0f} standard errors)"
+        )
     if np.median(id_res / scatter) > thresholds.residual_factor:
-        return "structure_or_measurement", (f"the linear structure and sensor model cannot fit the records at w "
-                                            f"and 3w (sensor misfit {np.median(id_res):.2g}, "
-                                            f"{np.median(id_res / scatter):.0f} x the scatter)")
+        return "structure_or_measurement", (
+            f"the linear structure and sensor model cannot fit the records at w "
+            f"and 3w (sensor misfit {np.median(id_res):.2g}, "
+            f"{np.median(id_res / scatter):.0f} x the scatter)"
+        )
     if stage["open_fraction"] > 0:
-        return "normal_contact", (f"the identified normal force falls to zero over {stage['open_fraction']:.0%} of the "
-                                  "cycle in the hardest load case: the contact opens")
+        return "normal_contact", (
+            f"the identified normal force falls to zero over {stage['open_fraction']:.0%} of the "
+            "cycle in the hardest load case: the contact opens"
+        )
     if not eta_observable:
-        return "contact", (f"the identified normal motion eta is not observable (it moves by {eta_spread:.0%} over "
-                           "the structures the random test allows), so no normal law can be tested against it and the "
-                           "normal and the tangential contact cannot be told apart")
+        return "contact", (
+            f"the identified normal motion eta is not observable (it moves by {eta_spread:.0%} over "
+            "the structures the random test allows), so no normal law can be tested against it and the "
+            "normal and the tangential contact cannot be told apart"
+        )
     if stage["contact_force_N"] > thresholds.normal_limit:
-        return "normal_contact", (f"no elastic normal law fits the identified N(eta): {stage['contact_force_N']:.0%} "
-                                  "of N is left (dissipation or opening in the normal direction)")
-    return "tangential_contact", (f"structure, sensors and normal contact are consistent with the records; the "
-                                  f"friction law leaves {stage['contact_force_S']:.1%} of S")
+        return "normal_contact", (
+            f"no elastic normal law fits the identified N(eta): {stage['contact_force_N']:.0%} "
+            "of N is left (dissipation or opening in the normal direction)"
+        )
+    return "tangential_contact", (
+        f"structure, sensors and normal contact are consistent with the records; the "
+        f"friction law leaves {stage['contact_force_S']:.1%} of S"
+    )
 
 
 def _setting(settings, name: str) -> float:
     return float(settings[name] if isinstance(settings, Mapping) else getattr(settings, name))
 
 
-def verdict(rows: Sequence[Mapping], before: float, scatter: float, place: str, settings,
-            boots: Mapping[str, np.ndarray] | None = None) -> tuple[str, str]:
+def verdict(
+    rows: Sequence[Mapping],
+    before: float,
+    scatter: float,
+    place: str,
+    settings,
+    boots: Mapping[str, np.ndarray] | None = None,
+) -> tuple[str, str]:
     """The verdict of the diagnosis and its reason: (effect name or "none", reason).
 
     rows: the candidates, best score first, each with "effect", "acts_on", "consistent" (acts where
@@ -108,23 +132,31 @@ def verdict(rows: Sequence[Mapping], before: float, scatter: float, place: str, 
     verdict, reason = "none", ""
     eligible = [r for r in rows if r["consistent"]]
     if rows and not eligible:
-        reason = (f"the gap lies in {place} and no candidate of the library acts there and explains it "
-                  f"(best by score: {rows[0]['effect']}, acting on {rows[0]['acts_on']}, {rows[0]['reduction']:.1%})")
+        reason = (
+            f"the gap lies in {place} and no candidate of the library acts there and explains it "
+            f"(best by score: {rows[0]['effect']}, acting on {rows[0]['acts_on']}, {rows[0]['reduction']:.1%})"
+        )
     elif rows:
         best = eligible[0]
         second = next((r for r in rows if r is not best), None)
         if before < min_gap:
-            reason = (f"the held-out gap {before:.3g} is below gap.min_gap = {min_gap:g}: the identified model "
-                      f"reproduces the records as well as the chain's own identification allows (best candidate "
-                      f"{best['effect']}: {best['reduction']:.1%})")
+            reason = (
+                f"the held-out gap {before:.3g} is below gap.min_gap = {min_gap:g}: the identified model "
+                f"reproduces the records as well as the chain's own identification allows (best candidate "
+                f"{best['effect']}: {best['reduction']:.1%})"
+            )
         elif before < noise_factor * scatter:
             reason = f"the held-out gap {before:.3g} is within {noise_factor} x the records' scatter {scatter:.2g}"
         elif best["reduction"] < min_reduction or best["reduction_interval"][0] <= 0:
-            reason = (f"no candidate shrinks the held-out gap by {min_reduction:.0%} (best: {best['effect']}, "
-                      f"{best['reduction']:.1%})")
+            reason = (
+                f"no candidate shrinks the held-out gap by {min_reduction:.0%} (best: {best['effect']}, "
+                f"{best['reduction']:.1%})"
+            )
         elif second is not None and second["heldout_gap_after"] < separation * best["heldout_gap_after"]:
-            reason = (f"{best['effect']} and {second['effect']} explain the gap about equally (held-out gaps "
-                      f"{best['heldout_gap_after']:.3g}, {second['heldout_gap_after']:.3g}; separation {separation})")
+            reason = (
+                f"{best['effect']} and {second['effect']} explain the gap about equally (held-out gaps "
+                f"{best['heldout_gap_after']:.3g}, {second['heldout_gap_after']:.3g}; separation {separation})"
+            )
         else:
             verdict = best["effect"]
             if second is None:
@@ -133,9 +165,11 @@ def verdict(rows: Sequence[Mapping], before: float, scatter: float, place: str, 
                 p_better = float("nan")
             else:
                 p_better = float(np.mean(np.asarray(boots[best["effect"]]) < np.asarray(boots[second["effect"]])))
-            reason = (f"{best['effect']} shrinks the held-out gap from {before:.3g} to {best['heldout_gap_after']:.3g} "
-                      f"({best['reduction']:.1%}); runner-up {second['effect'] if second else '-'} "
-                      f"{second['heldout_gap_after'] if second else float('nan'):.3g}; bootstrap P(better) {p_better:.2f}")
+            reason = (
+                f"{best['effect']} shrinks the held-out gap from {before:.3g} to {best['heldout_gap_after']:.3g} "
+                f"({best['reduction']:.1%}); runner-up {second['effect'] if second else '-'} "
+                f"{second['heldout_gap_after'] if second else float('nan'):.3g}; bootstrap P(better) {p_better:.2f}"
+            )
     return verdict, reason
 
 
@@ -146,7 +180,9 @@ def explains_materially(gap: float, after: float, scatter: float, settings) -> b
     if not (np.isfinite(gap) and np.isfinite(after)):
         return False
     drop = gap - after
-    return bool(drop >= _setting(settings, "min_reduction") * gap and drop > _setting(settings, "noise_factor") * scatter)
+    return bool(
+        drop >= _setting(settings, "min_reduction") * gap and drop > _setting(settings, "noise_factor") * scatter
+    )
 
 
 def retried(first_thetas: Mapping[str, Sequence], library: Mapping, settings) -> list:
@@ -191,6 +227,7 @@ UPDATING_Z = 2.0  # a factor moved when |ln factor| exceeds this many posterior 
 def updating_effect(factors: Mapping[str, float], identifiability: Mapping[str, Mapping]) -> str | None:
     """The library effect an accepted model update amounts to: when exactly one structural factor moved
     (|ln factor| > UPDATING_Z posterior sd) and it maps to an effect (UPDATING_EFFECTS), that effect; else None."""
-    moved = [f for f, v in factors.items()
-             if abs(np.log(v)) > UPDATING_Z * max(identifiability[f]["posterior_sd"], 1e-12)]
+    moved = [
+        f for f, v in factors.items() if abs(np.log(v)) > UPDATING_Z * max(identifiability[f]["posterior_sd"], 1e-12)
+    ]
     return UPDATING_EFFECTS.get(moved[0]) if len(moved) == 1 else None

@@ -41,11 +41,14 @@ def record_spec(block: Mapping, where: str) -> ImportSpec:
     if fmt == "csv":
         side = sidecar_path(file, block.get("sidecar"))
         if block.get("channels"):
-            raise RawDataError(f"{where}: a CSV import takes its channel map from the sidecar {side}; "
-                               "move 'channels' there")
+            raise RawDataError(
+                f"{where}: a CSV import takes its channel map from the sidecar {side}; move 'channels' there"
+            )
         if not os.path.exists(side):
-            raise RawDataError(f"{where}: the sidecar {side} of {file} is missing; write the channel map there "
-                               "(see config/README.md, importers)")
+            raise RawDataError(
+                f"{where}: the sidecar {side} of {file} is missing; write the channel map there "
+                "(see config/README.md, importers)"
+            )
         try:
             meta = yaml.safe_load(Path(side).read_text())
         except (yaml.YAMLError, UnicodeDecodeError) as exc:
@@ -66,15 +69,19 @@ def _sampling_rate(spec: ImportSpec, samples: dict) -> float:
     tol = RATE_TOLERANCE[spec.format]
     rates = sorted(set(stated.values()))
     if rates and (rates[-1] - rates[0]) > tol * rates[-1]:
-        raise RawDataError(f"{spec.file}: the channels are sampled at different rates "
-                           f"({ {r: round(v, 6) for r, v in stated.items()} } Hz); resample to one rate before importing")
+        raise RawDataError(
+            f"{spec.file}: the channels are sampled at different rates "
+            f"({ {r: round(v, 6) for r, v in stated.items()} } Hz); resample to one rate before importing"
+        )
     fs_file = rates[0] if rates else None
     fs = spec.sampling_rate_hz
     if fs is None and fs_file is None:
         raise RawDataError(f"{spec.where}: the file states no sampling interval; give sampling_rate_hz")
     if fs is not None and fs_file is not None and abs(fs - fs_file) > tol * fs:
-        raise RawDataError(f"{spec.file}: the file is sampled at {fs_file:.9g} Hz but {spec.where} says "
-                           f"sampling_rate_hz = {fs:g}; correct the map")
+        raise RawDataError(
+            f"{spec.file}: the file is sampled at {fs_file:.9g} Hz but {spec.where} says "
+            f"sampling_rate_hz = {fs:g}; correct the map"
+        )
     return float(fs if fs is not None else fs_file)
 
 
@@ -91,23 +98,34 @@ def import_record(block: Mapping, where: str, dual_sine: bool) -> xr.Dataset:
         raise RawDataError(f"{spec.file}: the channels hold no samples")
     fs = _sampling_rate(spec, samples)
     if dual_sine and spec.excitation_frequency_hz is None:
-        raise RawDataError(f"{spec.where}: excitation_frequency_hz is missing: declare the dual-sine test frequency "
-                           "(the validation recovers it from the data and checks it)")
+        raise RawDataError(
+            f"{spec.where}: excitation_frequency_hz is missing: declare the dual-sine test frequency "
+            "(the validation recovers it from the data and checks it)"
+        )
     with np.errstate(over="ignore", invalid="ignore"):
         converted = {c.role: samples[c.role].values * c.factor() for c in spec.channels}
     for c in spec.channels:
         bad = np.flatnonzero(~np.isfinite(converted[c.role]))
         if bad.size:
-            raise RawDataError(f"{spec.file}: channel {c.channel!r} ({c.role}): sample {int(bad[0])} is "
-                               f"{samples[c.role].values[bad[0]]!r} ({bad.size} samples not finite in N or m/s^2); "
-                               "a record with gaps or overflow cannot be identified")
+            raise RawDataError(
+                f"{spec.file}: channel {c.channel!r} ({c.role}): sample {int(bad[0])} is "
+                f"{samples[c.role].values[bad[0]]!r} ({bad.size} samples not finite in N or m/s^2); "
+                "a record with gaps or overflow cannot be identified"
+            )
     force = converted["force"]
     acc = np.vstack([converted[s.role] for s in spec.sensors])
-    attrs = {"source_format": spec.format, "source_file": os.path.basename(spec.file),
-             "conversion": "; ".join(f"{c.role} <- {c.channel!r} x {c.factor():.9g} ({c.units}"
-                                     + (f", {c.sensitivity:g} {c.sensitivity_units}" if c.sensitivity else "") + ")"
-                                     for c in spec.channels)}
+    attrs = {
+        "source_format": spec.format,
+        "source_file": os.path.basename(spec.file),
+        "conversion": "; ".join(
+            f"{c.role} <- {c.channel!r} x {c.factor():.9g} ({c.units}"
+            + (f", {c.sensitivity:g} {c.sensitivity_units}" if c.sensitivity else "")
+            + ")"
+            for c in spec.channels
+        ),
+    }
     if dual_sine:
         attrs["excitation_frequency_hz"] = float(spec.excitation_frequency_hz)
-    return raw_dataset(np.arange(n) / fs, force, acc, [s.role for s in spec.sensors],
-                       [s.position_m for s in spec.sensors], fs, attrs)
+    return raw_dataset(
+        np.arange(n) / fs, force, acc, [s.role for s in spec.sensors], [s.position_m for s in spec.sensors], fs, attrs
+    )

@@ -21,9 +21,23 @@ PHYSICAL = {
 # electrical units, factor to mV
 ELECTRICAL = {"mV": 1.0, "V": 1.0e3}
 # spellings of the same unit met in files, mapped to the names above
-ALIASES = {"m/s2": "m/s^2", "m s-2": "m/s^2", "m/s**2": "m/s^2", "m/s/s": "m/s^2", "ms-2": "m/s^2",
-           "newton": "N", "n": "N", "g0": "g", "gn": "g", "mv": "mV", "v": "V", "volt": "V", "volts": "V",
-           "kn": "kN", "mm/s2": "mm/s^2"}
+ALIASES = {
+    "m/s2": "m/s^2",
+    "m s-2": "m/s^2",
+    "m/s**2": "m/s^2",
+    "m/s/s": "m/s^2",
+    "ms-2": "m/s^2",
+    "newton": "N",
+    "n": "N",
+    "g0": "g",
+    "gn": "g",
+    "mv": "mV",
+    "v": "V",
+    "volt": "V",
+    "volts": "V",
+    "kn": "kN",
+    "mm/s2": "mm/s^2",
+}
 
 FORMATS = ("netcdf", "uff58", "tdms", "csv")
 
@@ -92,26 +106,36 @@ def _channel(entry, role: str, where: str) -> ChannelSpec:
         raise RawDataError(f"{where}: {role}.channel is missing: name the channel of the file that holds it")
     units = entry.get("units")
     if units is None:
-        raise RawDataError(f"{where}: {role}.units is missing: state the units the file stores "
-                           f"({', '.join(PHYSICAL[quantity])}, or V / mV with a sensitivity); units are never guessed")
+        raise RawDataError(
+            f"{where}: {role}.units is missing: state the units the file stores "
+            f"({', '.join(PHYSICAL[quantity])}, or V / mV with a sensitivity); units are never guessed"
+        )
     units = canonical_unit(units)
     sens, sens_units = entry.get("sensitivity"), entry.get("sensitivity_units")
     if units in ELECTRICAL:
         if sens is None or sens_units is None:
-            raise RawDataError(f"{where}: {role} is stored in {units}: give sensitivity and sensitivity_units "
-                               f"(for example sensitivity: 10.2, sensitivity_units: mV/{'N' if quantity == 'force' else 'g'})")
+            raise RawDataError(
+                f"{where}: {role} is stored in {units}: give sensitivity and sensitivity_units "
+                f"(for example sensitivity: 10.2, sensitivity_units: mV/{'N' if quantity == 'force' else 'g'})"
+            )
         sens = _positive_or_none(entry, "sensitivity", f"{where}: {role}")
         parts = str(sens_units).split("/", 1)
         den = parts[1].strip().strip("()") if len(parts) == 2 else ""
         if len(parts) != 2 or parts[0].strip() not in ELECTRICAL or den not in PHYSICAL[quantity]:
-            raise RawDataError(f"{where}: {role}.sensitivity_units = {sens_units!r}: give <V or mV>/<unit>, the unit one of "
-                               f"{', '.join(PHYSICAL[quantity])} (for example mV/{'N' if quantity == 'force' else 'g'})")
+            raise RawDataError(
+                f"{where}: {role}.sensitivity_units = {sens_units!r}: give <V or mV>/<unit>, the unit one of "
+                f"{', '.join(PHYSICAL[quantity])} (for example mV/{'N' if quantity == 'force' else 'g'})"
+            )
         sens_units = f"{parts[0].strip()}/{den}"
     elif units not in PHYSICAL[quantity]:
-        raise RawDataError(f"{where}: {role}.units = {entry.get('units')!r} is not a {quantity} unit; give one of "
-                           f"{', '.join(PHYSICAL[quantity])}, or V / mV with a sensitivity")
+        raise RawDataError(
+            f"{where}: {role}.units = {entry.get('units')!r} is not a {quantity} unit; give one of "
+            f"{', '.join(PHYSICAL[quantity])}, or V / mV with a sensitivity"
+        )
     elif sens is not None:
-        raise RawDataError(f"{where}: {role} has a sensitivity but units {units}: a sensitivity applies to V or mV only")
+        raise RawDataError(
+            f"{where}: {role} has a sensitivity but units {units}: a sensitivity applies to V or mV only"
+        )
     pos = entry.get("position_m")
     if role != "force":
         if pos is None:
@@ -119,7 +143,9 @@ def _channel(entry, role: str, where: str) -> ChannelSpec:
         try:
             pos = float(pos)
         except (TypeError, ValueError):
-            raise RawDataError(f"{where}: sensor {role}: position_m = {pos!r}: give a number (m from the clamp)") from None
+            raise RawDataError(
+                f"{where}: sensor {role}: position_m = {pos!r}: give a number (m from the clamp)"
+            ) from None
     return ChannelSpec(role, str(ch), units, sens, sens_units, pos)
 
 
@@ -146,7 +172,9 @@ def import_spec(block: Mapping, where: str, fmt: str, file: str) -> ImportSpec:
         raise RawDataError(f"{where}: expected a mapping with 'channels', got {type(block).__name__}")
     chans = block.get("channels")
     if not isinstance(chans, Mapping) or "force" not in chans or not chans.get("sensors"):
-        raise RawDataError(f"{where}: channels must give 'force' and a list 'sensors' (see config/README.md, importers)")
+        raise RawDataError(
+            f"{where}: channels must give 'force' and a list 'sensors' (see config/README.md, importers)"
+        )
     sensors = chans["sensors"]
     if not isinstance(sensors, (list, tuple)):
         raise RawDataError(f"{where}: channels.sensors must be a list of {{name, channel, units, position_m}}")
@@ -164,8 +192,15 @@ def import_spec(block: Mapping, where: str, fmt: str, file: str) -> ImportSpec:
     if dup:
         raise RawDataError(f"{where}: channel(s) {dup} are mapped twice; each role needs its own channel")
     tc = block.get("time_column")
-    return ImportSpec(fmt, str(file), tuple(specs), _positive_or_none(block, "sampling_rate_hz", where),
-                      _positive_or_none(block, "excitation_frequency_hz", where), str(tc) if tc else None, where)
+    return ImportSpec(
+        fmt,
+        str(file),
+        tuple(specs),
+        _positive_or_none(block, "sampling_rate_hz", where),
+        _positive_or_none(block, "excitation_frequency_hz", where),
+        str(tc) if tc else None,
+        where,
+    )
 
 
 def check_file_unit(spec: ChannelSpec, label, path: str) -> None:
@@ -174,5 +209,7 @@ def check_file_unit(spec: ChannelSpec, label, path: str) -> None:
         return
     found = canonical_unit(label)
     if found != spec.units:
-        raise RawDataError(f"{path}: channel {spec.channel!r} ({spec.role}) is labelled {str(label).strip()!r} in the "
-                           f"file but the channel map says units: {spec.units}; correct the map (or the file)")
+        raise RawDataError(
+            f"{path}: channel {spec.channel!r} ({spec.role}) is labelled {str(label).strip()!r} in the "
+            f"file but the channel map says units: {spec.units}; correct the map (or the file)"
+        )

@@ -36,8 +36,10 @@ def _channel_map(raw: xr.Dataset, names: Mapping, storage: Mapping) -> dict:
             e.update(sensitivity=sens, sensitivity_units=sens_units)
         return e
 
-    sensors = [entry("acceleration", names[str(s)], name=str(s), position_m=float(p))
-               for s, p in zip(raw["sensor"].values, raw["position"].values)]
+    sensors = [
+        entry("acceleration", names[str(s)], name=str(s), position_m=float(p))
+        for s, p in zip(raw["sensor"].values, raw["position"].values)
+    ]
     return {"force": entry("force", names["force"]), "sensors": sensors}
 
 
@@ -70,22 +72,61 @@ def export_uff58(raw: xr.Dataset, path, storage: Mapping | None = None) -> dict:
     uff = pyuff.UFF(str(path))
     for node, (role, values, units) in enumerate(_series(raw, storage), start=1):
         force = role == "force"
-        uff.write_sets({
-            "type": 58, "binary": 1, "id1": role, "id2": "contactid export", "id3": "", "id4": "", "id5": "",
-            "func_type": 1, "func_id": node, "ver_num": 0, "load_case_id": 0,
-            "rsp_ent_name": "beam", "rsp_node": node, "rsp_dir": 3, "ref_ent_name": "beam", "ref_node": 1, "ref_dir": 3,
-            "ord_data_type": 4, "num_pts": n, "abscissa_spacing": 1, "abscissa_min": 0.0, "abscissa_inc": 1.0 / fs,
-            "z_axis_value": 0.0, "abscissa_spec_data_type": 17, "abscissa_len_unit_exp": 0,
-            "abscissa_force_unit_exp": 0, "abscissa_temp_unit_exp": 0, "abscissa_axis_lab": "Time",
-            "abscissa_axis_units_lab": "s", "ordinate_spec_data_type": 13 if force else 12,
-            "ordinate_len_unit_exp": 0 if force else 1, "ordinate_force_unit_exp": 1 if force else 0,
-            "ordinate_temp_unit_exp": 0, "ordinate_axis_lab": "Force" if force else "Acceleration",
-            "ordinate_axis_units_lab": units, "orddenom_spec_data_type": 0, "orddenom_len_unit_exp": 0,
-            "orddenom_force_unit_exp": 0, "orddenom_temp_unit_exp": 0, "orddenom_axis_lab": "NONE",
-            "orddenom_axis_units_lab": "NONE", "z_axis_spec_data_type": 0, "z_axis_len_unit_exp": 0,
-            "z_axis_force_unit_exp": 0, "z_axis_temp_unit_exp": 0, "z_axis_axis_lab": "NONE",
-            "z_axis_axis_units_lab": "NONE", "data": np.asarray(values, dtype=np.float64),
-            "x": np.arange(n) / fs}, mode="add", force_double=True)
+        uff.write_sets(
+            {
+                "type": 58,
+                "binary": 1,
+                "id1": role,
+                "id2": "contactid export",
+                "id3": "",
+                "id4": "",
+                "id5": "",
+                "func_type": 1,
+                "func_id": node,
+                "ver_num": 0,
+                "load_case_id": 0,
+                "rsp_ent_name": "beam",
+                "rsp_node": node,
+                "rsp_dir": 3,
+                "ref_ent_name": "beam",
+                "ref_node": 1,
+                "ref_dir": 3,
+                "ord_data_type": 4,
+                "num_pts": n,
+                "abscissa_spacing": 1,
+                "abscissa_min": 0.0,
+                "abscissa_inc": 1.0 / fs,
+                "z_axis_value": 0.0,
+                "abscissa_spec_data_type": 17,
+                "abscissa_len_unit_exp": 0,
+                "abscissa_force_unit_exp": 0,
+                "abscissa_temp_unit_exp": 0,
+                "abscissa_axis_lab": "Time",
+                "abscissa_axis_units_lab": "s",
+                "ordinate_spec_data_type": 13 if force else 12,
+                "ordinate_len_unit_exp": 0 if force else 1,
+                "ordinate_force_unit_exp": 1 if force else 0,
+                "ordinate_temp_unit_exp": 0,
+                "ordinate_axis_lab": "Force" if force else "Acceleration",
+                "ordinate_axis_units_lab": units,
+                "orddenom_spec_data_type": 0,
+                "orddenom_len_unit_exp": 0,
+                "orddenom_force_unit_exp": 0,
+                "orddenom_temp_unit_exp": 0,
+                "orddenom_axis_lab": "NONE",
+                "orddenom_axis_units_lab": "NONE",
+                "z_axis_spec_data_type": 0,
+                "z_axis_len_unit_exp": 0,
+                "z_axis_force_unit_exp": 0,
+                "z_axis_temp_unit_exp": 0,
+                "z_axis_axis_lab": "NONE",
+                "z_axis_axis_units_lab": "NONE",
+                "data": np.asarray(values, dtype=np.float64),
+                "x": np.arange(n) / fs,
+            },
+            mode="add",
+            force_double=True,
+        )
     # the header keeps the increment to 6 digits: state the exact rate in the map, as the rig's software knows it
     return {**_block("uff58", path, raw, {r: r for r, _, _ in _series(raw, storage)}, storage), "sampling_rate_hz": fs}
 
@@ -97,10 +138,17 @@ def export_tdms(raw: xr.Dataset, path, storage: Mapping | None = None, group: st
     storage = dict(storage or {})
     fs = float(raw.attrs["sampling_rate_hz"])
     with TdmsWriter(str(path)) as w:
-        w.write_segment([ChannelObject(group, role, np.asarray(values, dtype=np.float64),
-                                       properties={"wf_increment": 1.0 / fs, "wf_start_offset": 0.0,
-                                                   "unit_string": units})
-                         for role, values, units in _series(raw, storage)])
+        w.write_segment(
+            [
+                ChannelObject(
+                    group,
+                    role,
+                    np.asarray(values, dtype=np.float64),
+                    properties={"wf_increment": 1.0 / fs, "wf_start_offset": 0.0, "unit_string": units},
+                )
+                for role, values, units in _series(raw, storage)
+            ]
+        )
     return _block("tdms", path, raw, {r: f"{group}/{r}" for r, _, _ in _series(raw, storage)}, storage)
 
 
@@ -114,8 +162,11 @@ def export_csv(raw: xr.Dataset, path, storage: Mapping | None = None) -> dict:
     cols = ["time"] + [f"{r} [{u}]" for r, _, u in series]
     data = np.column_stack([np.arange(raw.sizes["time"]) / fs] + [v for _, v, _ in series])
     np.savetxt(path, data, delimiter=",", header=",".join(cols), comments="", fmt="%.17g")
-    side = {"sampling_rate_hz": fs, "time_column": "time",
-            "channels": _channel_map(raw, {r: f"{r} [{u}]" for r, _, u in series}, storage)}
+    side = {
+        "sampling_rate_hz": fs,
+        "time_column": "time",
+        "channels": _channel_map(raw, {r: f"{r} [{u}]" for r, _, u in series}, storage),
+    }
     if "excitation_frequency_hz" in raw.attrs:
         side["excitation_frequency_hz"] = float(raw.attrs["excitation_frequency_hz"])
     path.with_suffix(".yaml").write_text(yaml.safe_dump(side, sort_keys=False))

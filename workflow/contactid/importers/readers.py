@@ -46,8 +46,10 @@ def read_uff58(spec: ImportSpec) -> dict:
     try:
         sets = pyuff.UFF(path).read_sets()
     except Exception as exc:  # noqa: BLE001 - pyuff raises anything on a malformed file
-        raise RawDataError(f"{path}: cannot be read as a universal file ({type(exc).__name__}: {exc}); "
-                           "write the time histories as datasets 58") from None
+        raise RawDataError(
+            f"{path}: cannot be read as a universal file ({type(exc).__name__}: {exc}); "
+            "write the time histories as datasets 58"
+        ) from None
     if isinstance(sets, dict):
         sets = [sets]
     by_id = {}
@@ -61,8 +63,10 @@ def read_uff58(spec: ImportSpec) -> dict:
             err = _missing(path, "dataset 58 with id1", ch.channel, list(by_id))
             raise RawDataError(f"{err} (or the file was cut short: it holds {len(by_id)} time histories)")
         if s.get("func_type") != 1:
-            raise RawDataError(f"{path}: dataset 58 {ch.channel!r} has function type {s.get('func_type')}, not 1 "
-                               "(time response); export the time histories, not spectra or FRFs")
+            raise RawDataError(
+                f"{path}: dataset 58 {ch.channel!r} has function type {s.get('func_type')}, not 1 "
+                "(time response); export the time histories, not spectra or FRFs"
+            )
         if s.get("abscissa_spacing") not in (1, None):
             raise RawDataError(f"{path}: dataset 58 {ch.channel!r} has an uneven abscissa; export evenly sampled data")
         check_file_unit(ch, s.get("ordinate_axis_units_lab"), path)
@@ -123,8 +127,10 @@ def read_csv(spec: ImportSpec) -> dict:
         if bad.size:
             cell = df[name].iloc[bad[0]]
             what = "an empty cell" if pd.isna(cell) else f"{str(cell)!r}"
-            raise RawDataError(f"{path}: column {name!r} line {int(bad[0]) + 2} holds {what}, not a number "
-                               "(text, a gap, or a truncated line)")
+            raise RawDataError(
+                f"{path}: column {name!r} line {int(bad[0]) + 2} holds {what}, not a number "
+                "(text, a gap, or a truncated line)"
+            )
         return _as_samples(v.to_numpy(), path, name)
 
     dt = None
@@ -134,8 +140,10 @@ def read_csv(spec: ImportSpec) -> dict:
             steps = np.diff(t)
             dt = float(np.mean(steps))
             if not (dt > 0 and np.allclose(steps, dt, rtol=1e-4, atol=1e-9 * abs(dt))):
-                raise RawDataError(f"{path}: time column {spec.time_column!r} is not evenly spaced and increasing "
-                                   f"(steps from {steps.min():g} to {steps.max():g} s)")
+                raise RawDataError(
+                    f"{path}: time column {spec.time_column!r} is not evenly spaced and increasing "
+                    f"(steps from {steps.min():g} to {steps.max():g} s)"
+                )
     return {ch.role: Samples(column(ch.channel), dt) for ch in spec.channels}
 
 

@@ -26,7 +26,9 @@ def _steady_harmonics(sim, F1, F3, w, harmonics=(1, 2, 3, 4, 5)):
     return harmonic_amplitudes(out["a"] @ sim.red.drive, out["t"], w, harmonics)
 
 
-def convergence_study(structure_cfg: Mapping, rig_cfg: Mapping, case_cfg: Mapping, sampling_rate_hz: float) -> pd.DataFrame:
+def convergence_study(
+    structure_cfg: Mapping, rig_cfg: Mapping, case_cfg: Mapping, sampling_rate_hz: float
+) -> pd.DataFrame:
     """Driving-point harmonics 1-5 at the controlled force of ``case_cfg`` for the default
     model, half the time step, and twice the retained modes; relative changes (%)."""
     s = dual_sine_settings(rig_cfg, case_cfg, sampling_rate_hz)
@@ -35,17 +37,21 @@ def convergence_study(structure_cfg: Mapping, rig_cfg: Mapping, case_cfg: Mappin
     ctl = control_response(sim, float(case_cfg["A1_m_per_s2"]), float(case_cfg["A2_m_per_s2"]), w)
     base = _steady_harmonics(sim, ctl.F1, ctl.F3, w)
     rows = []
-    for name, kw in (("half time step", {"oversampling": 2 * int(s["oversampling"])}),
-                     ("double modes", {"n_modes": 2 * int(s["n_modes"])})):
+    for name, kw in (
+        ("half time step", {"oversampling": 2 * int(s["oversampling"])}),
+        ("double modes", {"n_modes": 2 * int(s["n_modes"])}),
+    ):
         other = _steady_harmonics(build_simulator(structure_cfg, rig_cfg, s, **kw), ctl.F1, ctl.F3, w)
         for h, (a, b) in enumerate(zip(base, other), start=1):
-            rows.append({"variant": name, "harmonic": h, "amplitude_m_per_s2": abs(a),
-                         "change_pct": 100 * abs(b - a) / abs(a)})
+            rows.append(
+                {"variant": name, "harmonic": h, "amplitude_m_per_s2": abs(a), "change_pct": 100 * abs(b - a) / abs(a)}
+            )
     return pd.DataFrame(rows)
 
 
-def low_level_frf_check(structure_cfg: Mapping, rig_cfg: Mapping, sampling_rate_hz: float,
-                        frequency_hz: float = 54.4, level: float = 0.02) -> pd.DataFrame:
+def low_level_frf_check(
+    structure_cfg: Mapping, rig_cfg: Mapping, sampling_rate_hz: float, frequency_hz: float = 54.4, level: float = 0.02
+) -> pd.DataFrame:
     """Dual-sine test at a low level (the contact sticks) against the full FE model's
     stuck linear driving-point accelerance at f and 3f (with the rig's modal damping)."""
     case = {"A1_m_per_s2": level, "A2_m_per_s2": 2.5 * level, "excitation_frequency_hz": frequency_hz}
@@ -62,21 +68,36 @@ def low_level_frf_check(structure_cfg: Mapping, rig_cfg: Mapping, sampling_rate_
     for h, F, A in ((1, ctl.F1, ctl.A1), (3, ctl.F3, ctl.A3)):
         W = h * w
         H = -(W**2) * np.sum(b * b / (wn**2 - W**2 + 2j * zeta * wn * W))
-        rows.append({"harmonic": h, "frequency_hz": W / (2 * np.pi), "rig_accelerance": A / F,
-                     "fe_accelerance": abs(H), "difference_pct": 100 * (A / F / abs(H) - 1)})
+        rows.append(
+            {
+                "harmonic": h,
+                "frequency_hz": W / (2 * np.pi),
+                "rig_accelerance": A / F,
+                "fe_accelerance": abs(H),
+                "difference_pct": 100 * (A / F / abs(H) - 1),
+            }
+        )
     return pd.DataFrame(rows)
 
 
-def effect_study(structure_cfg: Mapping, rig_cfg: Mapping, case_cfg: Mapping, sampling_rate_hz: float,
-                 magnitudes: Mapping | None = None, seed: int = 0) -> pd.DataFrame:
+def effect_study(
+    structure_cfg: Mapping,
+    rig_cfg: Mapping,
+    case_cfg: Mapping,
+    sampling_rate_hz: float,
+    magnitudes: Mapping | None = None,
+    seed: int = 0,
+) -> pd.DataFrame:
     """Each effect alone at its typical magnitude (or ``magnitudes``) against the baseline,
     noise-free: change of the force amplitudes and NRMSE (%) of the recorded
     driving-point acceleration and force."""
+
     def run(effects):
         rc = copy.deepcopy(dict(rig_cfg))
         rc["effects"] = effects
-        raw, truth = dual_sine_test(structure_cfg, rc, case_cfg, sampling_rate_hz, 0.0, seed, "effect_study",
-                                    structure_cfg["sensors"]["names"])
+        raw, truth = dual_sine_test(
+            structure_cfg, rc, case_cfg, sampling_rate_hz, 0.0, seed, "effect_study", structure_cfg["sensors"]["names"]
+        )
         return raw, truth
 
     raw0, tr0 = run({})
@@ -89,10 +110,16 @@ def effect_study(structure_cfg: Mapping, rig_cfg: Mapping, case_cfg: Mapping, sa
     for name, spec in EFFECTS.items():
         mag = float((magnitudes or {}).get(name, spec.typical))
         raw, tr = run({name: mag})
-        rows.append({"effect": name, "magnitude": mag, "unit": spec.unit,
-                     "F1_change_pct": 100 * (tr.attrs["F1_n"] / tr0.attrs["F1_n"] - 1),
-                     "F3_change_pct": 100 * (tr.attrs["F3_n"] / tr0.attrs["F3_n"] - 1),
-                     "drive_acceleration_nrmse_pct": nrmse(raw["acceleration"].values[0], a0),
-                     "force_nrmse_pct": nrmse(raw["force"].values, f0),
-                     "min_normal_force_n": float(tr["N"].min())})
+        rows.append(
+            {
+                "effect": name,
+                "magnitude": mag,
+                "unit": spec.unit,
+                "F1_change_pct": 100 * (tr.attrs["F1_n"] / tr0.attrs["F1_n"] - 1),
+                "F3_change_pct": 100 * (tr.attrs["F3_n"] / tr0.attrs["F3_n"] - 1),
+                "drive_acceleration_nrmse_pct": nrmse(raw["acceleration"].values[0], a0),
+                "force_nrmse_pct": nrmse(raw["force"].values, f0),
+                "min_normal_force_n": float(tr["N"].min()),
+            }
+        )
     return pd.DataFrame(rows)

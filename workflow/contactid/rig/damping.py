@@ -42,5 +42,9 @@ def damping_ratios(frequencies_hz, ratio: float, form: str = "modal", reference_
 def rig_damping_ratios(rig_cfg: Mapping, frequencies_hz) -> np.ndarray:
     """The rig's damping ratio of each mode (rig.modal_damping_ratio spread by rig.true_damping)."""
     td = rig_cfg.get("true_damping") or {}
-    return damping_ratios(frequencies_hz, float(rig_cfg.get("modal_damping_ratio", 0.005)), td.get("form", "modal"),
-                          float(td.get("reference_frequency_hz", 54.4)))
+    return damping_ratios(
+        frequencies_hz,
+        float(rig_cfg.get("modal_damping_ratio", 0.005)),
+        td.get("form", "modal"),
+        float(td.get("reference_frequency_hz", 54.4)),
+    )

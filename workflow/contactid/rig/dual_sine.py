@@ -26,8 +26,14 @@ from .structure import channel_delays, rig_structure, true_structure_config
 
 log = logging.getLogger(__name__)
 
-DEFAULTS = {"excitation_frequency_hz": 54.4, "record_samples": 16384, "n_modes": 8, "oversampling": 8,
-            "control_tolerance": 0.001, "steady_state_tolerance": 1e-4}
+DEFAULTS = {
+    "excitation_frequency_hz": 54.4,
+    "record_samples": 16384,
+    "n_modes": 8,
+    "oversampling": 8,
+    "control_tolerance": 0.001,
+    "steady_state_tolerance": 1e-4,
+}
 
 
 def dual_sine_settings(rig_cfg: Mapping, case_cfg: Mapping, sampling_rate_hz: float) -> dict:
@@ -51,9 +57,14 @@ def contact_parameters(structure_cfg: Mapping, rig_cfg: Mapping) -> ContactParam
     law = NormalLaw(n0, float(truth["normal"]["stiffness_at_preload_n_per_m"]), float(truth["normal"]["exponent"]))
     eff = effect_magnitudes(rig_cfg.get("effects"))
     return ContactParameters(
-        friction=(fr.e_f, fr.k_c, fr.e_t, fr.kappa, fr.mu), preload=n0, static_approach=law.static_approach,
-        exponent=law.exponent, hunt_crossley=eff["normal_contact_damping"], viscous=eff["viscous_friction"],
-        iwan_share=eff["multi_asperity_friction"], preload_drift=eff["preload_drift"],
+        friction=(fr.e_f, fr.k_c, fr.e_t, fr.kappa, fr.mu),
+        preload=n0,
+        static_approach=law.static_approach,
+        exponent=law.exponent,
+        hunt_crossley=eff["normal_contact_damping"],
+        viscous=eff["viscous_friction"],
+        iwan_share=eff["multi_asperity_friction"],
+        preload_drift=eff["preload_drift"],
         regularization=str(truth["friction"].get("regularization", "none")),
         cubic=float(truth["normal"].get("cubic_n_per_m3", 0.0)),
     )
@@ -71,8 +82,9 @@ def normal_tangent_ratio(contact: ContactParameters, k_n: float, load: float) ->
 
     def normal(eta):  # N (N) and dN/deta (N/m) of the elastic law
         N, dN, dNd = np.empty(1), np.empty(1), np.empty(1)
-        _normal_path(np.array([eta]), np.zeros(1), c.preload, c.static_approach, c.exponent, c.cubic, 0.0, True,
-                     N, dN, dNd)
+        _normal_path(
+            np.array([eta]), np.zeros(1), c.preload, c.static_approach, c.exponent, c.cubic, 0.0, True, N, dN, dNd
+        )
         return N[0], dN[0]
 
     hi = c.static_approach  # compression -eta; doubled until N passes load x N0
@@ -82,8 +94,13 @@ def normal_tangent_ratio(contact: ContactParameters, k_n: float, load: float) ->
     return max(1.0, -normal(eta)[1] / k_n)
 
 
-def build_simulator(structure_cfg: Mapping, rig_cfg: Mapping, settings: Mapping, n_modes: int | None = None,
-                    oversampling: int | None = None) -> DualSineSimulator:
+def build_simulator(
+    structure_cfg: Mapping,
+    rig_cfg: Mapping,
+    settings: Mapping,
+    n_modes: int | None = None,
+    oversampling: int | None = None,
+) -> DualSineSimulator:
     """The rig's reduced model and integrator for the dual-sine tests."""
     params = rig_structure(structure_cfg, rig_cfg)
     model = assemble(params)
@@ -114,12 +131,25 @@ def energy_balance(out: dict, sim: DualSineSimulator) -> dict:
     w_fric = np.sum(out["S"] * out["dxi"]) * dt
     w_norm = -np.sum((out["N"] - sim.contact.preload) * out["deta"]) * dt
     dissipated = w_damp + w_fric + w_norm
-    return {"input_work_j": float(w_in), "damping_work_j": float(w_damp), "friction_work_j": float(w_fric),
-            "normal_work_j": float(w_norm), "energy_residual": float((w_in - dissipated) / w_in)}
+    return {
+        "input_work_j": float(w_in),
+        "damping_work_j": float(w_damp),
+        "friction_work_j": float(w_fric),
+        "normal_work_j": float(w_norm),
+        "energy_residual": float((w_in - dissipated) / w_in),
+    }
 
 
-def dual_sine_test(structure_cfg: Mapping, rig_cfg: Mapping, case_cfg: Mapping, sampling_rate_hz: float,
-                   noise_fraction: float, seed: int, case: str, sensor_names) -> tuple[xr.Dataset, xr.Dataset]:
+def dual_sine_test(
+    structure_cfg: Mapping,
+    rig_cfg: Mapping,
+    case_cfg: Mapping,
+    sampling_rate_hz: float,
+    noise_fraction: float,
+    seed: int,
+    case: str,
+    sensor_names,
+) -> tuple[xr.Dataset, xr.Dataset]:
     """Run the response-controlled dual-sine test of one load case.
 
     Returns (raw, truth). The raw record holds force and accelerations only (with
@@ -133,17 +163,38 @@ def dual_sine_test(structure_cfg: Mapping, rig_cfg: Mapping, case_cfg: Mapping, 
     target = (scale * float(case_cfg["A1_m_per_s2"]), scale * float(case_cfg["A2_m_per_s2"]))
     sim = build_simulator(structure_cfg, rig_cfg, s)
     w = 2 * np.pi * s["excitation_frequency_hz"]
-    log.info("%s: response control to A1 = %.4g, A3 = %.4g m/s^2 at %.4g Hz (%d modes, %d steps per sample)", case,
-             target[0], target[1], s["excitation_frequency_hz"], sim.red.omega.size, sim.oversampling)
+    log.info(
+        "%s: response control to A1 = %.4g, A3 = %.4g m/s^2 at %.4g Hz (%d modes, %d steps per sample)",
+        case,
+        target[0],
+        target[1],
+        s["excitation_frequency_hz"],
+        sim.red.omega.size,
+        sim.oversampling,
+    )
     ctl = control_response(sim, target[0], target[1], w, tol=float(s["control_tolerance"]))
     if not ctl.converged:
         F1, F3, A1, A3, steady = ctl.history[-1]
-        log.warning("%s: response control did not converge in %d iterations: F1 = %.4g N, F3 = %.4g N give "
-                    "A1 = %.4g, A3 = %.4g m/s^2 (targets %.4g, %.4g)%s", case, len(ctl.history), F1, F3, A1, A3,
-                    target[0], target[1], "" if steady else ", not steady")
+        log.warning(
+            "%s: response control did not converge in %d iterations: F1 = %.4g N, F3 = %.4g N give "
+            "A1 = %.4g, A3 = %.4g m/s^2 (targets %.4g, %.4g)%s",
+            case,
+            len(ctl.history),
+            F1,
+            F3,
+            A1,
+            A3,
+            target[0],
+            target[1],
+            "" if steady else ", not steady",
+        )
     else:
-        log.info("%s: response control converged in %d iterations; recording %d samples", case, len(ctl.history),
-                 int(s["record_samples"]))
+        log.info(
+            "%s: response control converged in %d iterations; recording %d samples",
+            case,
+            len(ctl.history),
+            int(s["record_samples"]),
+        )
     q = sim.oversampling
     n_rec = int(s["record_samples"]) * q
     margin = 64 * q * 8
@@ -162,8 +213,8 @@ def dual_sine_test(structure_cfg: Mapping, rig_cfg: Mapping, case_cfg: Mapping, 
     delays = channel_delays(rig_cfg, acc_sim.shape[0])
     if delays is not None:
         acc_sim = delay_channels(acc_sim, delays, 1.0 / sim.dt)
-    acc = anti_alias_decimate(acc_sim, q)[:, margin // q: (margin + n_rec) // q]
-    force = anti_alias_decimate(out["f"], q)[margin // q: (margin + n_rec) // q]
+    acc = anti_alias_decimate(acc_sim, q)[:, margin // q : (margin + n_rec) // q]
+    force = anti_alias_decimate(out["f"], q)[margin // q : (margin + n_rec) // q]
     rng = generator(seed, f"{case}/noise")
     force = add_noise(force, noise_fraction, rng)
     acc = add_noise(acc, noise_fraction, rng)
@@ -176,43 +227,86 @@ def dual_sine_test(structure_cfg: Mapping, rig_cfg: Mapping, case_cfg: Mapping, 
     h_first = np.abs(harmonic_amplitudes(drive[:third], rec["t"][:third], w, (1, 3)))
     h_last = np.abs(harmonic_amplitudes(drive[-third:], rec["t"][-third:], w, (1, 3)))
 
-    raw = raw_dataset(time, force, acc, sensor_names, tuple(structure_cfg["sensors"]["positions_m"]),
-                      sampling_rate_hz, attrs={"test": "dual_sine", "excitation_frequency_hz": s["excitation_frequency_hz"]})
+    raw = raw_dataset(
+        time,
+        force,
+        acc,
+        sensor_names,
+        tuple(structure_cfg["sensors"]["positions_m"]),
+        sampling_rate_hz,
+        attrs={"test": "dual_sine", "excitation_frequency_hz": s["excitation_frequency_hz"]},
+    )
     sub = slice(0, n_rec, q)
     hist = np.array(ctl.history, dtype=float)
     truth = xr.Dataset(
         {
             "S": ("time", rec["S"][sub], {"units": "N", "long_name": "true friction force S(t)"}),
-            "N": ("time", rec["N"][sub], {"units": "N", "long_name": "true total normal force N(t) (compression positive)"}),
+            "N": (
+                "time",
+                rec["N"][sub],
+                {"units": "N", "long_name": "true total normal force N(t) (compression positive)"},
+            ),
             "xi": ("time", rec["xi"][sub], {"units": "m", "long_name": "true tangential contact motion xi(t), Eq. 9"}),
             "eta": ("time", rec["eta"][sub], {"units": "m", "long_name": "true normal contact motion eta(t), Eq. 8"}),
             "xi_dot": ("time", rec["dxi"][sub], {"units": "m/s", "long_name": "true tangential contact velocity"}),
             "eta_dot": ("time", rec["deta"][sub], {"units": "m/s", "long_name": "true normal contact velocity"}),
             "force_true": ("time", rec["f"][sub], {"units": "N", "long_name": "excitation force without noise"}),
-            "acceleration_true": (("sensor", "time"), (rec["a"] @ red.sensors.T)[sub].T,
-                                  {"units": "m/s^2", "long_name": "accelerations without front end or noise"}),
-            "reduced_coordinate": (("time", "reduced_mode"), rec["z"][sub],
-                                   {"units": "kg^1/2 m", "long_name": "coordinates of the rig's reduced basis"}),
-            "reduced_frequency": ("reduced_mode", red.omega / (2 * np.pi),
-                                  {"units": "Hz", "long_name": "frequencies of the rig's reduced stuck basis"}),
-            "control_history": (("iteration", "control_field"), hist,
-                                {"units": "mixed", "long_name": "response control: F1 (N), F3 (N), A1, A3 (m/s^2), steady"}),
-            "steady_state_change": ("chunk", np.asarray(ctl.steady_state.change or [np.nan]),
-                                    {"units": "1", "long_name": "relative change of the driving-point harmonics between 8-period chunks", "nonfinite_meaning": "NaN: the first chunk already met the tolerance"}),
+            "acceleration_true": (
+                ("sensor", "time"),
+                (rec["a"] @ red.sensors.T)[sub].T,
+                {"units": "m/s^2", "long_name": "accelerations without front end or noise"},
+            ),
+            "reduced_coordinate": (
+                ("time", "reduced_mode"),
+                rec["z"][sub],
+                {"units": "kg^1/2 m", "long_name": "coordinates of the rig's reduced basis"},
+            ),
+            "reduced_frequency": (
+                "reduced_mode",
+                red.omega / (2 * np.pi),
+                {"units": "Hz", "long_name": "frequencies of the rig's reduced stuck basis"},
+            ),
+            "control_history": (
+                ("iteration", "control_field"),
+                hist,
+                {"units": "mixed", "long_name": "response control: F1 (N), F3 (N), A1, A3 (m/s^2), steady"},
+            ),
+            "steady_state_change": (
+                "chunk",
+                np.asarray(ctl.steady_state.change or [np.nan]),
+                {
+                    "units": "1",
+                    "long_name": "relative change of the driving-point harmonics between 8-period chunks",
+                    "nonfinite_meaning": "NaN: the first chunk already met the tolerance",
+                },
+            ),
         },
-        coords={"time": ("time", time, {"units": "s", "long_name": "time"}), "sensor": list(sensor_names),
-                "control_field": ["F1", "F3", "A1", "A3", "steady"]},
+        coords={
+            "time": ("time", time, {"units": "s", "long_name": "time"}),
+            "sensor": list(sensor_names),
+            "control_field": ["F1", "F3", "A1", "A3", "steady"],
+        },
         attrs={
-            "F1_n": ctl.F1, "F3_n": ctl.F3, "A1_m_per_s2": ctl.A1, "A2_m_per_s2": ctl.A3,
-            "target_A1_m_per_s2": target[0], "target_A2_m_per_s2": target[1], "control_converged": int(ctl.converged),
-            "excitation_frequency_hz": s["excitation_frequency_hz"], "periods": s["periods"],
+            "F1_n": ctl.F1,
+            "F3_n": ctl.F3,
+            "A1_m_per_s2": ctl.A1,
+            "A2_m_per_s2": ctl.A3,
+            "target_A1_m_per_s2": target[0],
+            "target_A2_m_per_s2": target[1],
+            "control_converged": int(ctl.converged),
+            "excitation_frequency_hz": s["excitation_frequency_hz"],
+            "periods": s["periods"],
             "stationarity_change_a1": float(abs(h_last[0] / h_first[0] - 1)),
             "stationarity_change_a3": float(abs(h_last[1] / h_first[1] - 1)),
             "effects": str({k: v for k, v in eff.items() if v}),
             **{f"friction_{k}": v for k, v in zip(("e_f", "k_c", "e_t", "kappa", "mu"), sim.contact.friction)},
-            "preload_n": sim.contact.preload, "normal_static_approach_m": sim.contact.static_approach,
-            "normal_exponent": sim.contact.exponent, "normal_cubic_n_per_m3": sim.contact.cubic,
-            "friction_regularization": sim.contact.regularization, "k_t": red.k_t, "k_n": red.k_n,
+            "preload_n": sim.contact.preload,
+            "normal_static_approach_m": sim.contact.static_approach,
+            "normal_exponent": sim.contact.exponent,
+            "normal_cubic_n_per_m3": sim.contact.cubic,
+            "friction_regularization": sim.contact.regularization,
+            "k_t": red.k_t,
+            "k_n": red.k_n,
             **{f"energy_{k}": v for k, v in energy.items()},
             **{f"setting_{k}": v for k, v in s.items()},
         },

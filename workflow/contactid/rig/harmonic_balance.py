@@ -141,8 +141,13 @@ def _friction_tangents(xi, N_from, N, S_val, fr, n_min, coef):
     for i in range(m):
         j = i - 1 if i > 0 else m - 1
         x = (S_val[j], xi[j], xi[i], N_from[i], N[i])
-        scale = (max(abs(S_val[j]), 1e-3), max(abs(xi[j]), abs(xi[i]), 1e-12), max(abs(xi[j]), abs(xi[i]), 1e-12),
-                 max(abs(N_from[i]), 1.0), max(abs(N[i]), 1.0))
+        scale = (
+            max(abs(S_val[j]), 1e-3),
+            max(abs(xi[j]), abs(xi[i]), 1e-12),
+            max(abs(xi[j]), abs(xi[i]), 1e-12),
+            max(abs(N_from[i]), 1.0),
+            max(abs(N[i]), 1.0),
+        )
         for k in range(5):
             h = 1e-7 * scale[k]
             xp = [x[0], x[1], x[2], x[3], x[4]]
@@ -248,8 +253,10 @@ class HarmonicBalance:
         den = a * a + b * b
         self.Linv = (1.0 / k2, a / den, b / den)
         xi, eta = red.xi, red.eta
-        self.C = {key: tuple(np.tensordot(wt, part, axes=(0, 0)) for part in self.Linv)
-                  for key, wt in (("11", xi * xi), ("12", xi * eta), ("22", eta * eta))}
+        self.C = {
+            key: tuple(np.tensordot(wt, part, axes=(0, 0)) for part in self.Linv)
+            for key, wt in (("11", xi * xi), ("12", xi * eta), ("22", eta * eta))
+        }
 
     # -- conversions ---------------------------------------------------------------------------
     def _block_apply(self, blk: tuple, X: np.ndarray) -> np.ndarray:
@@ -258,9 +265,9 @@ class HarmonicBalance:
         H = self.H
         c0, ca, cb = blk
         if np.ndim(c0) == 1:  # per mode, X (n, 2H + 1)
-            re, im = X[:, 1:H + 1], X[:, H + 1:]
+            re, im = X[:, 1 : H + 1], X[:, H + 1 :]
             return np.hstack([c0[:, None] * X[:, :1], ca * re + cb * im, ca * im - cb * re])
-        re, im = X[1:H + 1], X[H + 1:]
+        re, im = X[1 : H + 1], X[H + 1 :]
         ca, cb = ca.reshape((-1,) + (1,) * (X.ndim - 1)), cb.reshape((-1,) + (1,) * (X.ndim - 1))
         return np.concatenate([c0 * X[:1], ca * re + cb * im, ca * im - cb * re])
 
@@ -269,14 +276,14 @@ class HarmonicBalance:
         projection onto E's basis, E.T @ X scaled by 1 / M (mean) and 2 / M (harmonics)."""
         F = np.fft.rfft(X, axis=0)
         H, M = self.H, self.M
-        return np.concatenate([F[:1].real / M, F[1:H + 1].imag * (-2.0 / M), F[1:H + 1].real * (2.0 / M)])
+        return np.concatenate([F[:1].real / M, F[1 : H + 1].imag * (-2.0 / M), F[1 : H + 1].real * (2.0 / M)])
 
     def synthesise(self, U: np.ndarray) -> np.ndarray:
         """E @ U.T by inverse FFT: the signals (M, n) of the real-basis harmonics U (n, 2H + 1)."""
         H, M = self.H, self.M
         F = np.zeros((M // 2 + 1, U.shape[0]), dtype=complex)
         F[0] = U[:, 0] * M
-        F[1:H + 1] = (0.5 * M) * (U[:, H + 1:] - 1j * U[:, 1:H + 1]).T
+        F[1 : H + 1] = (0.5 * M) * (U[:, H + 1 :] - 1j * U[:, 1 : H + 1]).T
         return np.fft.irfft(F, n=M, axis=0)
 
     def to_real(self, Z: np.ndarray) -> np.ndarray:
@@ -285,13 +292,13 @@ class HarmonicBalance:
 
     def to_complex(self, U: np.ndarray) -> np.ndarray:
         H = self.H
-        return np.hstack([U[:, :1] + 0j, U[:, 1:H + 1] + 1j * U[:, H + 1:]])
+        return np.hstack([U[:, :1] + 0j, U[:, 1 : H + 1] + 1j * U[:, H + 1 :]])
 
     def force_vector(self, force_coef: np.ndarray) -> np.ndarray:
         """b f(t) in the real basis: (n, 2H + 1) from the force harmonics f = sum Im(F_h e^{ihwt})."""
         F = np.zeros(self.H + 1, dtype=complex)
         k = min(len(force_coef), self.H)
-        F[1:k + 1] = force_coef[:k]
+        F[1 : k + 1] = force_coef[:k]
         Fr = np.concatenate([[0.0], F[1:].real, F[1:].imag])
         return np.outer(self.red.force, Fr)
 
@@ -304,8 +311,19 @@ class HarmonicBalance:
     def _normal(self, eta, deta):
         c = self.contact
         N, dN, dNd = np.empty(self.M), np.empty(self.M), np.empty(self.M)
-        _normal_path(eta, deta, c.preload, c.static_approach, c.exponent, c.cubic, c.hunt_crossley, bool(c.unilateral),
-                     N, dN, dNd)
+        _normal_path(
+            eta,
+            deta,
+            c.preload,
+            c.static_approach,
+            c.exponent,
+            c.cubic,
+            c.hunt_crossley,
+            bool(c.unilateral),
+            N,
+            dN,
+            dNd,
+        )
         return N, dN, dNd
 
     def path(self, U: np.ndarray) -> dict:
@@ -327,17 +345,40 @@ class HarmonicBalance:
         M = self.M
         S, S_val = np.zeros(M), np.empty(M)
         iw_x, iw_flag = np.zeros((M, self.iw_w.size)), np.zeros((M, self.iw_w.size), dtype=np.int8)
-        _periodic_friction(xi, np.roll(N, 1), N_est, self.fr, c.n_min, c.iwan_share, self.iw_w, 1e-12, 400,
-                           S, S_val, iw_x, iw_flag)
+        _periodic_friction(
+            xi, np.roll(N, 1), N_est, self.fr, c.n_min, c.iwan_share, self.iw_w, 1e-12, 400, S, S_val, iw_x, iw_flag
+        )
         contact = N_est > 0.0
         if c.viscous:
             S = S + c.viscous * np.where(contact, dxi, 0.0)
-        g = (-dxi_dq * S[:, None] + np.outer(N - c.preload, r.eta) + r.k_t * np.outer(xi_lin, r.xi)
-             + r.k_n * np.outer(eta, r.eta))
-        return {"z": z, "v": v, "xi": xi, "xi_lin": xi_lin, "dxi": dxi, "eta": eta, "deta": v @ r.eta, "N": N,
-                "dN_deta": dN, "dN_ddeta": dNd, "N_est": N_est, "dNe_deta": dNe, "dNe_ddeta": dNed, "S": S,
-                "S_valanis": S_val, "iwan_x": iw_x, "iwan_flag": iw_flag, "g": g, "contact": contact,
-                "iwan_anchors": iw_x[0].copy()}
+        g = (
+            -dxi_dq * S[:, None]
+            + np.outer(N - c.preload, r.eta)
+            + r.k_t * np.outer(xi_lin, r.xi)
+            + r.k_n * np.outer(eta, r.eta)
+        )
+        return {
+            "z": z,
+            "v": v,
+            "xi": xi,
+            "xi_lin": xi_lin,
+            "dxi": dxi,
+            "eta": eta,
+            "deta": v @ r.eta,
+            "N": N,
+            "dN_deta": dN,
+            "dN_ddeta": dNd,
+            "N_est": N_est,
+            "dNe_deta": dNe,
+            "dNe_ddeta": dNed,
+            "S": S,
+            "S_valanis": S_val,
+            "iwan_x": iw_x,
+            "iwan_flag": iw_flag,
+            "g": g,
+            "contact": contact,
+            "iwan_anchors": iw_x[0].copy(),
+        }
 
     def residual(self, U: np.ndarray, Fb: np.ndarray, p: dict | None = None) -> tuple[np.ndarray, dict]:
         p = self.path(U) if p is None else p
@@ -352,8 +393,11 @@ class HarmonicBalance:
         r = self.red
         B = self.contact_blocks(p)
         nb = B.shape[0] // 2
-        Jnl = (np.kron(np.outer(r.xi, r.xi), B[:nb, :nb]) + np.kron(np.outer(r.xi, r.eta), B[:nb, nb:])
-               + np.kron(np.outer(r.eta, r.eta), B[nb:, nb:]))
+        Jnl = (
+            np.kron(np.outer(r.xi, r.xi), B[:nb, :nb])
+            + np.kron(np.outer(r.xi, r.eta), B[:nb, nb:])
+            + np.kron(np.outer(r.eta, r.eta), B[nb:, nb:])
+        )
         Jnl += np.kron(r.shortening, self.project(p["S"][:, None] * self.E))
         return scipy.linalg.block_diag(*self.L) - Jnl
 
@@ -378,8 +422,19 @@ class HarmonicBalance:
         dS *= (1.0 - c.iwan_share) * p["contact"][:, None]
         if c.iwan_share:  # the Iwan element's share, linearised with its sliders' memory
             dS_iw = np.empty_like(dS)
-            _iwan_propagate(p["xi"], p["N_est"], p["iwan_x"], p["iwan_flag"], self.iw_w, self.fr[0], self.fr[1],
-                            self.fr[4], dxi_cols, dN_est_cols, dS_iw)
+            _iwan_propagate(
+                p["xi"],
+                p["N_est"],
+                p["iwan_x"],
+                p["iwan_flag"],
+                self.iw_w,
+                self.fr[0],
+                self.fr[1],
+                self.fr[4],
+                dxi_cols,
+                dN_est_cols,
+                dS_iw,
+            )
             dS += c.iwan_share * dS_iw
         if c.viscous:
             dS[:, :nb] += c.viscous * p["contact"][:, None] * self.Eb
@@ -414,8 +469,9 @@ class HarmonicBalance:
         return hb._block_apply(hb.Linv, R + np.outer(xi, By[:nb]) + np.outer(eta, By[nb:]))
 
     # -- Newton --------------------------------------------------------------------------------
-    def solve(self, force_coef: np.ndarray, start: np.ndarray | None = None, tol: float = 1e-8,
-              max_iter: int = 40) -> PeriodicResponse:
+    def solve(
+        self, force_coef: np.ndarray, start: np.ndarray | None = None, tol: float = 1e-8, max_iter: int = 40
+    ) -> PeriodicResponse:
         """Newton iteration from ``start`` (Z, (n, H' + 1) complex, any H') or the linear solution.
         Converged when the residual is below ``tol`` of the force's norm (both in the real basis)."""
         Fb = self.force_vector(force_coef)

@@ -74,13 +74,23 @@ def reduced_model(model: FEModel, n_modes: int, static_correction: bool = True) 
     lam, vec = scipy.linalg.eigh(Kr, Mr)
     basis = fix_signs(phi @ vec)
     p = model.params
-    frac = (p.block_mass * ((model.block_lateral_vector @ basis) ** 2 + (model.block_axial_vector @ basis) ** 2)
-            + p.block_inertia * basis[model.thetas_dof] ** 2)
+    frac = (
+        p.block_mass * ((model.block_lateral_vector @ basis) ** 2 + (model.block_axial_vector @ basis) ** 2)
+        + p.block_inertia * basis[model.thetas_dof] ** 2
+    )
     G = shortening_matrix(model)
     return ReducedModel(
-        omega=np.sqrt(np.clip(lam, 0, None)), basis=basis, xi=model.xi_vector @ basis, eta=model.eta_vector @ basis,
-        shortening=basis.T @ G @ basis, force=basis.T @ model.force_vector, drive=model.force_vector @ basis,
-        sensors=model.sensor_vectors @ basis, beam_mode=frac < 0.5, k_t=p.k_t, k_n=p.k_n,
+        omega=np.sqrt(np.clip(lam, 0, None)),
+        basis=basis,
+        xi=model.xi_vector @ basis,
+        eta=model.eta_vector @ basis,
+        shortening=basis.T @ G @ basis,
+        force=basis.T @ model.force_vector,
+        drive=model.force_vector @ basis,
+        sensors=model.sensor_vectors @ basis,
+        beam_mode=frac < 0.5,
+        k_t=p.k_t,
+        k_n=p.k_n,
     )
 
 
@@ -170,9 +180,49 @@ def _excitation(f_sin, f_cos, w, t):
 
 
 @njit(cache=True)
-def integrate(z, v, state, t0, n_steps, dt, omega, zeta, xi_v, eta_v, G, bF, k_t, k_n,
-              f_sin, f_cos, w, fr, n0, delta0, p, cubic, hc, unilateral, visc, iw_share, iw_w, x_sl, drift_rate, drift_t0,
-              store_from, out_a, out_z, out_v, out_s, out_n, out_xi, out_eta, out_f, out_dxi, out_deta):
+def integrate(
+    z,
+    v,
+    state,
+    t0,
+    n_steps,
+    dt,
+    omega,
+    zeta,
+    xi_v,
+    eta_v,
+    G,
+    bF,
+    k_t,
+    k_n,
+    f_sin,
+    f_cos,
+    w,
+    fr,
+    n0,
+    delta0,
+    p,
+    cubic,
+    hc,
+    unilateral,
+    visc,
+    iw_share,
+    iw_w,
+    x_sl,
+    drift_rate,
+    drift_t0,
+    store_from,
+    out_a,
+    out_z,
+    out_v,
+    out_s,
+    out_n,
+    out_xi,
+    out_eta,
+    out_f,
+    out_dxi,
+    out_deta,
+):
     """Advance the reduced model ``n_steps`` steps of ``dt`` from time ``t0``.
 
     z, v (n_r,), state = [S_valanis, xi, N] and x_sl (Iwan anchors) are updated
@@ -200,8 +250,15 @@ def integrate(z, v, state, t0, n_steps, dt, omega, zeta, xi_v, eta_v, G, bF, k_t
     S_tot = (1.0 - iw_share) * S_val + iw_share * s_iw + (visc * dxi if N > 0.0 else 0.0)
     f = _excitation(f_sin, f_cos, w, t)
     for i in range(n):
-        a[i] = bF[i] * f - dxi_dq[i] * S_tot + eta_v[i] * (N - P) + k_t * xi_v[i] * xi_lin + k_n * eta_v[i] * eta \
-            - c[i] * v[i] - om2[i] * z[i]
+        a[i] = (
+            bF[i] * f
+            - dxi_dq[i] * S_tot
+            + eta_v[i] * (N - P)
+            + k_t * xi_v[i] * xi_lin
+            + k_n * eta_v[i] * eta
+            - c[i] * v[i]
+            - om2[i] * z[i]
+        )
     for step in range(n_steps):
         # half-step velocity, full-step position
         for i in range(n):
@@ -229,8 +286,14 @@ def integrate(z, v, state, t0, n_steps, dt, omega, zeta, xi_v, eta_v, G, bF, k_t
         uDu = 0.0
         uy = 0.0
         for i in range(n):
-            g = bF[i] * f - dxi_dq[i] * S_tot + eta_v[i] * (N_el - P) + k_t * xi_v[i] * xi_lin \
-                + k_n * eta_v[i] * eta - om2[i] * z[i]
+            g = (
+                bF[i] * f
+                - dxi_dq[i] * S_tot
+                + eta_v[i] * (N_el - P)
+                + k_t * xi_v[i] * xi_lin
+                + k_n * eta_v[i] * eta
+                - om2[i] * z[i]
+            )
             D = 1.0 + 0.5 * dt * c[i]
             a[i] = v[i]  # keep v_half
             v[i] = (v[i] + 0.5 * dt * g) / D  # implicit diagonal damping
@@ -350,12 +413,49 @@ class DualSineSimulator:
         c = self.contact
         r = self.red
         t_start = self.t
-        self.t = integrate(self.z, self.v, self.state, self.t, n_steps, self.dt, r.omega, self.zeta, r.xi, r.eta,
-                           r.shortening, r.force, r.k_t, r.k_n, np.ascontiguousarray(coef.real),
-                           np.ascontiguousarray(coef.imag), w, self.fr, c.preload, c.static_approach,
-                           c.exponent, c.cubic, c.hunt_crossley, bool(c.unilateral), c.viscous, c.iwan_share, self.iw_w, self.x_sl,
-                           self.drift_rate, self.drift_t0, n_steps if store_from is None else store_from, out_a, out_z, out_v,
-                           out["S"], out["N"], out["xi"], out["eta"], out["f"], out["dxi"], out["deta"])
+        self.t = integrate(
+            self.z,
+            self.v,
+            self.state,
+            self.t,
+            n_steps,
+            self.dt,
+            r.omega,
+            self.zeta,
+            r.xi,
+            r.eta,
+            r.shortening,
+            r.force,
+            r.k_t,
+            r.k_n,
+            np.ascontiguousarray(coef.real),
+            np.ascontiguousarray(coef.imag),
+            w,
+            self.fr,
+            c.preload,
+            c.static_approach,
+            c.exponent,
+            c.cubic,
+            c.hunt_crossley,
+            bool(c.unilateral),
+            c.viscous,
+            c.iwan_share,
+            self.iw_w,
+            self.x_sl,
+            self.drift_rate,
+            self.drift_t0,
+            n_steps if store_from is None else store_from,
+            out_a,
+            out_z,
+            out_v,
+            out["S"],
+            out["N"],
+            out["xi"],
+            out["eta"],
+            out["f"],
+            out["dxi"],
+            out["deta"],
+        )
         first = 1 + (n_steps if store_from is None else store_from)
         out["t"] = t_start + self.dt * np.arange(first, first + n_store)
         out["a"] = out_a
@@ -365,15 +465,24 @@ class DualSineSimulator:
 
     def snapshot(self) -> tuple:
         """The integrator's state (to return to with ``restore``)."""
-        return (self.z.copy(), self.v.copy(), self.state.copy(), self.x_sl.copy(), self.t, self.drift_rate, self.drift_t0)
+        return (
+            self.z.copy(),
+            self.v.copy(),
+            self.state.copy(),
+            self.x_sl.copy(),
+            self.t,
+            self.drift_rate,
+            self.drift_t0,
+        )
 
     def restore(self, snap: tuple) -> None:
         z, v, state, x_sl, t, rate, t0 = snap
         self.z[:], self.v[:], self.state[:], self.x_sl[:] = z, v, state, x_sl
         self.t, self.drift_rate, self.drift_t0 = t, rate, t0
 
-    def settle(self, F1, F3, w: float, chunk_periods: int = 8, tol: float = 1e-4,
-               min_chunks: int = 3, max_chunks: int = 200) -> tuple[np.ndarray, SteadyStateLog, bool]:
+    def settle(
+        self, F1, F3, w: float, chunk_periods: int = 8, tol: float = 1e-4, min_chunks: int = 3, max_chunks: int = 200
+    ) -> tuple[np.ndarray, SteadyStateLog, bool]:
         """Run chunks of ``chunk_periods`` periods until the driving-point harmonics
         at w and 3w change by less than ``tol`` (relative) from one chunk to the next.
         Returns ([A1, A3] complex of the last chunk, log, converged); the last chunk's signals (``run``'s dict)
@@ -411,8 +520,15 @@ class ControlResult:
     steady_state: SteadyStateLog
 
 
-def control_response(sim: DualSineSimulator, target_a1: float, target_a3: float, w: float, tol: float = 1e-3,
-                     max_iter: int = 40, max_unsteady: int = 12) -> ControlResult:
+def control_response(
+    sim: DualSineSimulator,
+    target_a1: float,
+    target_a3: float,
+    w: float,
+    tol: float = 1e-3,
+    max_iter: int = 40,
+    max_unsteady: int = 12,
+) -> ControlResult:
     """Tune F1, F3 until the driving-point acceleration harmonics at w and 3w
     equal the targets within ``tol`` (relative): Broyden's method on
     (F1, F3) -> (|A1|, |A3|), started from the stuck linear system's FRF. A trial force whose response is
@@ -440,13 +556,24 @@ def control_response(sim: DualSineSimulator, target_a1: float, target_a3: float,
         history.append((float(F[0]), float(F[1]), float(A[0]), float(A[1]), bool(ok)))
         unsteady = 0 if ok else unsteady + 1
         if unsteady >= max_unsteady and np.all(np.isfinite(A)):
-            progress.info("response control %d: F1 = %.4g N, F3 = %.4g N -> A1 = %.4g, A3 = %.4g m/s^2; not steady for "
-                          "%d iterations: the motion does not settle into a periodic state, the control stops here",
-                          it + 1, F[0], F[1], A[0], A[1], unsteady)
+            progress.info(
+                "response control %d: F1 = %.4g N, F3 = %.4g N -> A1 = %.4g, A3 = %.4g m/s^2; not steady for "
+                "%d iterations: the motion does not settle into a periodic state, the control stops here",
+                it + 1,
+                F[0],
+                F[1],
+                A[0],
+                A[1],
+                unsteady,
+            )
             break
         if not np.all(np.isfinite(A)) or not np.all(np.isfinite(sim.z)):
-            progress.info("response control %d: F1 = %.4g N, F3 = %.4g N -> the response is not finite; halving the "
-                          "step back", it + 1, F[0], F[1])
+            progress.info(
+                "response control %d: F1 = %.4g N, F3 = %.4g N -> the response is not finite; halving the step back",
+                it + 1,
+                F[0],
+                F[1],
+            )
             if good is None:
                 F = 0.5 * F
                 sim.start_from_linear(F[0], F[1], w)
@@ -456,9 +583,17 @@ def control_response(sim: DualSineSimulator, target_a1: float, target_a3: float,
             continue
         good = (F.copy(), sim.snapshot())
         r = A - target
-        progress.info("response control %d: F1 = %.4g N, F3 = %.4g N -> A1 = %.4g (target %.4g), A3 = %.4g "
-                      "(target %.4g) m/s^2%s", it + 1, F[0], F[1], A[0], target[0], A[1], target[1],
-                      "" if ok else ", not yet steady")
+        progress.info(
+            "response control %d: F1 = %.4g N, F3 = %.4g N -> A1 = %.4g (target %.4g), A3 = %.4g (target %.4g) m/s^2%s",
+            it + 1,
+            F[0],
+            F[1],
+            A[0],
+            target[0],
+            A[1],
+            target[1],
+            "" if ok else ", not yet steady",
+        )
         if ok and np.max(np.abs(r) / target) < tol:
             return ControlResult(float(F[0]), float(F[1]), float(A[0]), float(A[1]), True, history, log)
         if prev is not None:

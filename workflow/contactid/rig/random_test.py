@@ -100,10 +100,11 @@ def simulate_random_test(model: FEModel, settings: RandomTestSettings, seed: int
     lo, hi = s.band_hz
     sos = scipy.signal.butter(8, [lo, hi], btype="bandpass", fs=fs_sim, output="sos")
     f_sim = scipy.signal.sosfilt(sos, white)
-    f_sim *= s.force_rms_n / np.std(f_sim[n_settle * q:])
+    f_sim *= s.force_rms_n / np.std(f_sim[n_settle * q :])
 
     filters, sens = modal_acceleration_filters(
-        model, lambda f: damping_ratios(f, s.modal_damping_ratio, s.damping_form, s.damping_reference_hz), 1.0 / fs_sim)
+        model, lambda f: damping_ratios(f, s.modal_damping_ratio, s.damping_form, s.damping_reference_hz), 1.0 / fs_sim
+    )
     acc_sim = np.zeros((sens.shape[0], n_sim))
     for (num, den), part in zip(filters, sens.T):
         qdd = scipy.signal.lfilter(num, den, f_sim)
@@ -111,8 +112,8 @@ def simulate_random_test(model: FEModel, settings: RandomTestSettings, seed: int
 
     if s.channel_delays_s is not None:
         acc_sim = delay_channels(acc_sim, s.channel_delays_s, fs_sim)
-    force = anti_alias_decimate(f_sim, q)[n_settle:n_settle + n_out]
-    acc = anti_alias_decimate(acc_sim, q)[:, n_settle:n_settle + n_out]
+    force = anti_alias_decimate(f_sim, q)[n_settle : n_settle + n_out]
+    acc = anti_alias_decimate(acc_sim, q)[:, n_settle : n_settle + n_out]
     rng_noise = generator(seed, "random_test/noise")
     force = add_noise(force, s.noise_fraction, rng_noise)
     acc = add_noise(acc, s.noise_fraction, rng_noise)
@@ -159,22 +160,44 @@ def random_test_datasets(structure_cfg, rig_cfg, random_test_cfg, seed: int, n_t
     rec = simulate_random_test(model, settings, seed)
     names = structure_cfg["sensors"]["names"]
     # the raw record names the sensors where the tester believes them (the nominal structure)
-    raw = raw_dataset(rec.time, rec.force, rec.acceleration, names, tuple(structure_cfg["sensors"]["positions_m"]),
-                      settings.sampling_rate_hz, attrs={"test": "random"})
+    raw = raw_dataset(
+        rec.time,
+        rec.force,
+        rec.acceleration,
+        names,
+        tuple(structure_cfg["sensors"]["positions_m"]),
+        settings.sampling_rate_hz,
+        attrs={"test": "random"},
+    )
     modes = structural_modes(model, n_truth_modes)
     truth = xr.Dataset(
         {
-            "natural_frequency": ("mode", modes.frequencies_hz, {"units": "Hz", "long_name": "true undamped natural frequency"}),
-            "damping_ratio": ("mode", damping_ratios(modes.frequencies_hz, settings.modal_damping_ratio,
-                                                     settings.damping_form, settings.damping_reference_hz),
-                              {"units": "1", "long_name": "true modal damping ratio"}),
-            "mode_shape_at_sensor": (("sensor", "mode"), model.sensor_vectors @ modes.shapes,
-                                     {"units": "kg^-1/2", "long_name": "mass-normalised mode shape at the sensors"}),
+            "natural_frequency": (
+                "mode",
+                modes.frequencies_hz,
+                {"units": "Hz", "long_name": "true undamped natural frequency"},
+            ),
+            "damping_ratio": (
+                "mode",
+                damping_ratios(
+                    modes.frequencies_hz,
+                    settings.modal_damping_ratio,
+                    settings.damping_form,
+                    settings.damping_reference_hz,
+                ),
+                {"units": "1", "long_name": "true modal damping ratio"},
+            ),
+            "mode_shape_at_sensor": (
+                ("sensor", "mode"),
+                model.sensor_vectors @ modes.shapes,
+                {"units": "kg^-1/2", "long_name": "mass-normalised mode shape at the sensors"},
+            ),
             "k_t": ((), params.k_t, {"units": "N/m", "long_name": "true tangential contact stiffness at stiction"}),
             "k_n": ((), params.k_n, {"units": "N/m", "long_name": "true normal contact stiffness at the preload"}),
         },
         coords={"mode": np.arange(1, n_truth_modes + 1), "sensor": list(names)},
-        attrs={f"param_{k}": (str(v) if isinstance(v, (tuple, bool)) else v)
-               for k, v in dataclasses.asdict(params).items()},
+        attrs={
+            f"param_{k}": (str(v) if isinstance(v, (tuple, bool)) else v) for k, v in dataclasses.asdict(params).items()
+        },
     )
     return raw, truth

@@ -35,8 +35,9 @@ def rig_contact_stiffness(structure_cfg: Mapping, rig_cfg: Mapping) -> tuple[flo
     fr = ValanisParameters.from_config(truth["friction"])
     n0 = float(true_structure_config(structure_cfg, rig_cfg)["preload_n"])
     k_t = float(stiction_shear_stiffness(n0, fr.e_f, fr.k_c))
-    k_n = NormalLaw(n0, float(truth["normal"]["stiffness_at_preload_n_per_m"]),
-                    float(truth["normal"]["exponent"])).stiffness_at_preload
+    k_n = NormalLaw(
+        n0, float(truth["normal"]["stiffness_at_preload_n_per_m"]), float(truth["normal"]["exponent"])
+    ).stiffness_at_preload
     return k_t, float(k_n)
 
 
@@ -44,12 +45,15 @@ def rig_structure(structure_cfg: Mapping, rig_cfg: Mapping) -> StructureParamete
     """StructureParameters of the rig (finer mesh, true contact stiffnesses; the
     effect transducer_mass_error scales every transducer mass by 1 + m)."""
     k_t, k_n = rig_contact_stiffness(structure_cfg, rig_cfg)
-    p = structure_from_config(true_structure_config(structure_cfg, rig_cfg), k_t, k_n,
-                              n_elements=int(rig_cfg.get("fe_elements", 96)))
+    p = structure_from_config(
+        true_structure_config(structure_cfg, rig_cfg), k_t, k_n, n_elements=int(rig_cfg.get("fe_elements", 96))
+    )
     m = effect_magnitudes(rig_cfg.get("effects"))["transducer_mass_error"]
     if m:
-        p = p.replace(sensor_masses=tuple((1 + m) * x for x in p.sensor_masses),
-                      force_transducer_mass=(1 + m) * p.force_transducer_mass)
+        p = p.replace(
+            sensor_masses=tuple((1 + m) * x for x in p.sensor_masses),
+            force_transducer_mass=(1 + m) * p.force_transducer_mass,
+        )
     return p
 
 
