@@ -2,13 +2,14 @@
 #   make reproduce  - set up, then run the whole workflow
 #   make test       - set up, then run the test suite (unit and workflow integration tests)
 #   make test-fast  - set up, then run the unit tests alone (not the workflow nor the slow in-process ones)
+#   make lint       - ruff format --check and ruff check (`ruff format .` rewrites the code in the project's style)
 #   make env        - create .venv/ with the pinned packages (and TeX Live via apt where missing)
 
 VENV := .venv
 PY := $(VENV)/bin/python
 CORES ?= 2
 
-.PHONY: env reproduce test test-fast slurm-test clean-results tex
+.PHONY: env reproduce test test-fast lint slurm-test clean-results tex
 
 env: $(VENV)/.installed tex
 
@@ -35,6 +36,11 @@ test: env
 
 test-fast: env
 	$(PY) -m pytest -q -m "not workflow and not slow"
+
+# the formatter and the linter (pyproject.toml); `make test` checks both too
+lint: env
+	$(PY) -m ruff format --check .
+	$(PY) -m ruff check .
 
 # optional (not in CI by default): the noise-study sweep through a local single-node SLURM against -c2 here
 slurm-test: env

@@ -32,8 +32,8 @@ from pathlib import Path
 # one BLAS thread, as the gap_diagnosis rule runs (threads: 1); both diagnoses run under it
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
-import numpy as np  # noqa: E402
-import yaml  # noqa: E402
+import numpy as np
+import yaml
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "workflow"))
@@ -153,7 +153,8 @@ def compare(label, ds, raw, cfg) -> dict:
     print(
         f"{label}: before harmonic balance ({REFERENCE}) {t_old:.1f} s, now {t_new:.1f} s (x{row['ratio']:.1f}; now "
         f"forced to time marching without memos {t_plain:.1f} s; with two worker processes {t_two:.1f} s, "
-        f"{'same' if row['same_with_two_workers'] else 'OTHER'} ranking); verdict {old.verdict} / {new.verdict}; ranking "
+        f"{'same' if row['same_with_two_workers'] else 'OTHER'} ranking); "
+        f"verdict {old.verdict} / {new.verdict}; ranking "
         f"{'same' if row['same_ranking'] else 'DIFFERENT'}; held-out gap before {before[0]:.4%} / {before[1]:.4%}; "
         f"largest held-out gap difference {row['max_abs_gap_difference']:.2e} (absolute), "
         f"{row['max_rel_gap_difference']:.1%} (relative)",

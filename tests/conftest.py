@@ -7,8 +7,8 @@ from pathlib import Path
 # inherit it, as two jobs run side by side on --cores 2. A value set by the caller wins.
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
-import pytest  # noqa: E402
-import yaml  # noqa: E402
+import pytest
+import yaml
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "workflow"))

@@ -7,7 +7,9 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def test_every_requirement_is_pinned_and_mirrored_in_the_conda_env():
     reqs = [
-        l.strip() for l in (ROOT / "requirements.txt").read_text().splitlines() if l.strip() and not l.startswith("#")
+        line.strip()
+        for line in (ROOT / "requirements.txt").read_text().splitlines()
+        if line.strip() and not line.startswith("#")
     ]
     assert reqs and all("==" in r for r in reqs)
     env = yaml.safe_load((ROOT / "workflow" / "envs" / "contactid.yaml").read_text())
@@ -38,3 +40,14 @@ def test_stop_slurm_stops_only_the_daemons_start_slurm_recorded(tmp_path):
         for p in (ours, other, reused):
             p.kill()
             p.wait()
+
+
+def test_the_python_code_is_formatted_and_passes_the_linter():
+    """`ruff format --check` and `ruff check` (pyproject.toml: line length 120, pycodestyle, pyflakes, and no noqa
+    that suppresses nothing) over the package, the rule scripts, the tests and the benchmarks."""
+    import subprocess
+    import sys
+
+    for args in (["format", "--check"], ["check"]):
+        out = subprocess.run([sys.executable, "-m", "ruff", *args, "."], cwd=ROOT, capture_output=True, text=True)
+        assert out.returncode == 0, f"ruff {' '.join(args)}:\n{out.stdout[-3000:]}{out.stderr[-1000:]}"

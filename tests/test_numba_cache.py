@@ -25,7 +25,8 @@ RUN = """
 import json, os, {pkg}.probe_caller as m
 result = m.call()
 print(json.dumps({{"result": result, "cache_dir": os.environ.get("NUMBA_CACHE_DIR"),
-                   "loaded": sum(m.call.stats.cache_hits.values()), "compiled": sum(m.call.stats.cache_misses.values())}}))
+                   "loaded": sum(m.call.stats.cache_hits.values()),
+                   "compiled": sum(m.call.stats.cache_misses.values())}}))
 """
 
 

@@ -15,7 +15,7 @@ from workflow_projects import (
     copy_project,
     make_project,
     project_config,
-    small_project,  # noqa: F401
+    small_project,
     snakemake,
 )
 

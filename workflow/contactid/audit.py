@@ -28,7 +28,7 @@ def audit_dataset(path: Path, root: Path | None = None) -> dict:
     problems = []
     try:
         ds = xr.load_dataset(path, engine=ENGINE)
-    except Exception as exc:  # noqa: BLE001 - an unreadable file is an audit finding
+    except Exception as exc:
         return {"dataset": str(path), "producer": "?", "inputs": "", "status": "unreadable", "problems": str(exc)}
     producer = ds.attrs.get("producer_rule", "")
     if not producer:

@@ -66,8 +66,8 @@ def with_defaults(cfg: Mapping, schema=SCHEMA) -> dict:
 def numbers_written_as_text(cfg: dict, schema) -> list:
     """Make numbers, in place, of the values YAML 1.1 read as text where the schema (a path or a mapping) wants a
     number: ``channel_time_skew: 4e-05`` is the text '4e-05' to PyYAML (it wants 4.0e-05), which the schema would
-    refuse as "not of type 'number'". Returns [(dotted key, number)] of the values changed. Only values of that form where a number
-    is wanted: a name or a path that looks like one elsewhere stays text."""
+    refuse as "not of type 'number'". Returns [(dotted key, number)] of the values changed. Only values of that
+    form where a number is wanted: a name or a path that looks like one elsewhere stays text."""
 
     def texts(node):
         if isinstance(node, str):

@@ -180,7 +180,7 @@ def read_raw(
         raise RawDataError(f"{path}: file not found; set 'file:' to an existing netCDF raw record")
     try:
         ds = load_dataset(path)
-    except Exception as exc:  # noqa: BLE001 - any reader failure is a format problem for the user
+    except Exception as exc:
         raise RawDataError(
             f"{path}: cannot be read as netCDF ({exc}); write it in the raw format of config/README.md"
         ) from exc

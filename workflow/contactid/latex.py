@@ -180,7 +180,8 @@ def setup_table(structure_cfg: Mapping) -> str:
     lines = [
         r"\begin{table}[htbp]",
         r"\centering\footnotesize",
-        r"\caption{The structure model. Values marked \emph{ours} are not given by the paper; config/README.md gives the reasoning for each.}\label{tab:setup}",
+        r"\caption{The structure model. Values marked \emph{ours} are not given by the paper; "
+        r"config/README.md gives the reasoning for each.}\label{tab:setup}",
         r"\begin{tabular}{llc}",
         r"\toprule",
         r"quantity (config key) & value & source \\",

@@ -41,7 +41,8 @@ def noise_study_table(study_cfg: Mapping | None) -> pd.DataFrame:
 
 
 def e0_at(e_f: float, k_c: float, normal_force: float) -> float:
-    """Tangential stiffness e_0 (N/m) of the modified Valanis law at the normal force N (N): e_f (1 - exp(-k_c N / e_f)) (Eq. 22)."""
+    """Tangential stiffness e_0 (N/m) of the modified Valanis law at the normal force N (N):
+    e_f (1 - exp(-k_c N / e_f)) (Eq. 22)."""
     return float(stiction_shear_stiffness(normal_force, e_f, k_c))
 
 
@@ -180,7 +181,8 @@ def report_section(ds: xr.Dataset | None) -> str:
     n_points = ds.sizes["noise_fraction"] * ds.sizes["record_samples"] * ds.sizes["seed"]
     text = (
         f"Each of the {n_points} points of the parameter table (noise fractions "
-        f"{', '.join(f'{x:g}' for x in noise)}; records of {', '.join(str(int(r)) for r in ds['record_samples'].values)} "
+        f"{', '.join(f'{x:g}' for x in noise)}; records of "
+        f"{', '.join(str(int(r)) for r in ds['record_samples'].values)} "
         f"samples; {ds.sizes['seed']} seeds) is one Snakemake job: the rig records a random test and the calibration "
         f"case, the chain identifies $k_t$ and the friction law, and the errors against the rig's truth are gathered "
         f"(Fig.~\\ref{{fig:noise}}). With {longest}-sample records the median error of $\\mu$ is "

@@ -102,7 +102,8 @@ Path(out.contact).write_text(
             "p_xi": "$\\xi$ (paper)",
             "p_eta": "$\\eta$ (paper)",
         },
-        "NRMSE (\\%) of the identified contact forces and motions against the rig truth: working method and the paper's chain.",
+        "NRMSE (\\%) of the identified contact forces and motions against the rig truth: "
+        "working method and the paper's chain.",
         "tab:contact",
     )
 )

@@ -63,8 +63,9 @@ class GapSettings:
     must be at least this factor below the runner-up's; noise_factor: the gap before must exceed this
     many bootstrap standard deviations of the records' scatter; n_bootstrap: resamples of the
     record blocks; seed; eta_observability_limit: the normal motion eta counts as observable when it moves by at
-    most this (relative) over the structures the random test allows (``eta_model_spread``), else the place cannot be the normal
-    or the tangential contact alone; model_updating: update the base structure from the random test before the candidates
+    most this (relative) over the structures the random test allows (``eta_model_spread``), else the place cannot be
+    the normal or the tangential contact alone; model_updating: update the base structure from the random test before
+    the candidates
     (``contactid.updating``; updating_parameters the structural factors, residue_accuracy the residues' relative
     standard error, frequency_floor the relative model-form uncertainty added to each frequency,
     updating_confidence the significance an update needs to be accepted)."""

@@ -45,7 +45,7 @@ def read_uff58(spec: ImportSpec) -> dict:
     path = spec.file
     try:
         sets = pyuff.UFF(path).read_sets()
-    except Exception as exc:  # noqa: BLE001 - pyuff raises anything on a malformed file
+    except Exception as exc:
         raise RawDataError(
             f"{path}: cannot be read as a universal file ({type(exc).__name__}: {exc}); "
             "write the time histories as datasets 58"
@@ -89,7 +89,7 @@ def read_tdms(spec: ImportSpec) -> dict:
     try:
         f = TdmsFile.read(path)
         chans = {f"{g.name}/{c.name}": c for g in f.groups() for c in g.channels()}
-    except Exception as exc:  # noqa: BLE001 - nptdms raises anything on a malformed file
+    except Exception as exc:
         raise RawDataError(f"{path}: cannot be read as a TDMS file ({type(exc).__name__}: {exc})") from None
     out = {}
     for ch in spec.channels:
@@ -99,7 +99,7 @@ def read_tdms(spec: ImportSpec) -> dict:
         check_file_unit(ch, c.properties.get("unit_string"), path)
         try:
             data = c[:]
-        except Exception as exc:  # noqa: BLE001
+        except Exception as exc:
             raise RawDataError(f"{path}: channel {ch.channel!r} cannot be read ({type(exc).__name__}: {exc})") from None
         dt = c.properties.get("wf_increment")
         out[ch.role] = Samples(_as_samples(data, path, ch.channel), float(dt) if dt else None)
@@ -114,7 +114,7 @@ def read_csv(spec: ImportSpec) -> dict:
     path = spec.file
     try:
         df = pd.read_csv(path)
-    except Exception as exc:  # noqa: BLE001 - empty file, bad quoting, binary junk...
+    except Exception as exc:
         raise RawDataError(f"{path}: cannot be read as CSV with a header row ({type(exc).__name__}: {exc})") from None
     cols = [str(c) for c in df.columns]
     df.columns = cols

@@ -37,9 +37,9 @@ from .nonlinear import ContactParameters, ReducedModel, _normal_force, friction_
 @dataclass
 class PeriodicResponse:
     """A periodic steady state: Z (n_r, H + 1) complex harmonics of z (column 0 the mean, real) and A
-    those of the acceleration (as the integrator computes it); w (rad/s); the period's grid signals (M points from t = 0): z, v, a (M, n_r), f, S, N, xi,
-    eta, dxi, deta (M,), the friction law's own state S_valanis (M,) and the Iwan anchors at t = 0;
-    whether Newton converged, its iterations and the final relative residual."""
+    those of the acceleration (as the integrator computes it); w (rad/s); the period's grid signals (M points from
+    t = 0): z, v, a (M, n_r), f, S, N, xi, eta, dxi, deta (M,), the friction law's own state S_valanis (M,) and
+    the Iwan anchors at t = 0; whether Newton converged, its iterations and the final relative residual."""
 
     Z: np.ndarray
     A: np.ndarray
