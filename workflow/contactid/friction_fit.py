@@ -208,25 +208,12 @@ def _polish(problem: _Problem, u0, fixed: dict | None = None):
     return full(r.x), float(np.sum(r.fun**2)), r
 
 
-def fit_friction_law(
-    coef_xi,
-    coef_n,
-    coef_s,
-    f0: float,
-    preload: float,
-    settings: FitSettings,
-    seed: int,
-    n_harmonics_data: int | None = None,
-    intervals: bool = True,
-    label: str = "friction fit",
-    start=None,
-) -> FitResult:
-    """GA + polish on the calibration case's xi, N (total = preload + dynamic) and S harmonics,
-    with the grid refined until the parameters move by less than ``refine_tolerance``; then the
-    profile-likelihood intervals (skipped with ``intervals`` False: NaN intervals). ``label`` starts
-    the progress lines it logs. ``start`` (the 5 parameters) skips the GA: the polish starts there (a refit of
-    a known optimum on other forces, for example the model-form spread of ``contactid.gap.uncertainty``)."""
-    K = np.atleast_2d(coef_s).shape[1] if n_harmonics_data is None else n_harmonics_data
+def _refined_fit(
+    coef_xi, coef_n, coef_s, f0: float, preload: float, settings: FitSettings, seed: int, label: str, start=None
+):
+    """GA (or ``start``) and polish on the harmonics synthesised on a grid of one period, the grid doubled until
+    the parameters move by less than ``settings.refine_tolerance``. Returns (problem on the last grid, optimum in
+    the unit cube, its SSR, the polish's least-squares result, the grid's points, history, GA logbook)."""
     m = settings.grid_points
     history = []
     u_best = None
@@ -262,17 +249,29 @@ def fit_friction_law(
             break
         prev = p
         m *= 2
-    # profile likelihood: chi2 = (n_data / M) SSR / sigma^2 with the data's n_data = 2K independent
-    # Fourier coefficients; sigma (relative rms misfit per point) is the larger of the fit's own
-    # residual and the documented floor for the identified forces' accuracy
-    n_data = 2 * K
-    ssr_min = ssr
+    return problem, u_best, ssr, res, m, history, logbook
+
+
+def profile_intervals(
+    problem: _Problem,
+    u_best,
+    ssr_min: float,
+    n_data: int,
+    settings: FitSettings,
+    preload: float,
+    label: str = "friction fit",
+):
+    """Profile-likelihood intervals of the 5 parameters at ``settings.confidence``: each parameter stepped away from
+    the optimum ``u_best`` (unit cube) with the others repolished, until the SSR crosses the threshold
+    chi2 = (n_data / M) SSR / sigma^2 (``n_data`` = 2K independent Fourier coefficients; sigma, the relative rms
+    misfit per point, the larger of the fit's own residual and ``settings.misfit_floor``), the crossing bisected;
+    a side that reaches its search bound inside the threshold is not bounded by the data. Returns (intervals (5, 2),
+    bounded (5, 2), profiles {name: (value, SSR) rows}, e_0 at the preload of every profile point inside)."""
     m_pts = problem.S.size
     sigma2 = max(ssr_min / m_pts * n_data / max(n_data - 5, 1), settings.misfit_floor**2)
     from scipy.stats import chi2 as chi2_dist  # here: scipy.stats takes 0.3 s to import
 
     thr = ssr_min + chi2_dist.ppf(settings.confidence, 1) * sigma2 * m_pts / n_data
-    want_intervals = intervals
     intervals = np.full((5, 2), np.nan)
     bounded = np.zeros((5, 2), dtype=bool)
     profiles = {}
@@ -286,13 +285,10 @@ def fit_friction_law(
         profiles.setdefault(PARAMETER_NAMES[i], []).append((float(problem.physical(u)[0][i]), s_j))
         return u, s_j
 
-    if want_intervals:
-        log.info(
-            "%s: profile-likelihood intervals of the 5 parameters (%.0f %% confidence)",
-            label,
-            100 * settings.confidence,
-        )
-    for i in range(5 if want_intervals else 0):
+    log.info(
+        "%s: profile-likelihood intervals of the 5 parameters (%.0f %% confidence)", label, 100 * settings.confidence
+    )
+    for i in range(5):
         for side, direction in ((0, -1.0), (1, +1.0)):
             edge = 0.0 if direction < 0 else 1.0
             inside_v, start = u_best[i], u_best.copy()
@@ -324,38 +320,77 @@ def fit_friction_law(
             unit = u_best.copy()
             unit[i] = crossing
             intervals[i, side] = problem.physical(unit)[0][i]
+        unbounded = [f"not bounded {end} by the data" for end, b in zip(("below", "above"), bounded[i]) if not b]
         log.info(
             "%s: %s in [%.4g, %.4g]%s",
             label,
             PARAMETER_NAMES[i],
             intervals[i, 0],
             intervals[i, 1],
-            ""
-            if bounded[i].all()
-            else " ("
-            + " and ".join(f"not bounded {end} by the data" for end, b in zip(("below", "above"), bounded[i]) if not b)
-            + ")",
+            f" ({' and '.join(unbounded)})" if unbounded else "",
         )
-    profiles = {k: np.array(sorted(v)) for k, v in profiles.items()}
-    # correlation from the Jacobian at the optimum (unit-cube coordinates), for sensitive parameters
-    J = res.jac
+    return intervals, bounded, {k: np.array(sorted(v)) for k, v in profiles.items()}, e0_vals
+
+
+def parameter_correlation(jacobian: np.ndarray) -> np.ndarray:
+    """(5, 5) correlation of the parameters from the least-squares Jacobian at the optimum (unit-cube coordinates);
+    NaN for the parameters the misfit is not sensitive to."""
     corr = np.full((5, 5), np.nan)
-    sens = np.linalg.norm(J, axis=0) > 1e-8 * np.max(np.linalg.norm(J, axis=0))
+    norms = np.linalg.norm(jacobian, axis=0)
+    sens = norms > 1e-8 * np.max(norms)
     if sens.sum() >= 2:
-        cov = np.linalg.pinv(J[:, sens].T @ J[:, sens])
+        cov = np.linalg.pinv(jacobian[:, sens].T @ jacobian[:, sens])
         d = np.sqrt(np.clip(np.diag(cov), 1e-300, None))
         corr[np.ix_(sens, sens)] = cov / np.outer(d, d)
+    return corr
+
+
+def bound_warnings(u_best, params, settings: FitSettings) -> list:
+    """A warning for each parameter at a search bound (within 1e-3 of the unit cube's side), where the bounds may
+    exclude the best value; e_t at a lower bound of zero is its natural value, not a warning."""
+    warnings = []
+    for i, name in enumerate(PARAMETER_NAMES):
+        for edge, which in ((0.0, "lower"), (1.0, "upper")):
+            if abs(u_best[i] - edge) < 1e-3 and not (name == "e_t" and edge == 0.0 and settings.bounds[2][0] == 0.0):
+                warnings.append(
+                    f"{name} = {params[i]:.4g} sits at its {which} search bound {settings.bounds[i][int(edge)]:.4g}: "
+                    f"the bounds may exclude the best value; widen friction.bounds.{name}"
+                )
+    return warnings
+
+
+def fit_friction_law(
+    coef_xi,
+    coef_n,
+    coef_s,
+    f0: float,
+    preload: float,
+    settings: FitSettings,
+    seed: int,
+    n_harmonics_data: int | None = None,
+    intervals: bool = True,
+    label: str = "friction fit",
+    start=None,
+) -> FitResult:
+    """GA + polish on the calibration case's xi, N (total = preload + dynamic) and S harmonics,
+    with the grid refined until the parameters move by less than ``refine_tolerance`` (``_refined_fit``); then the
+    profile-likelihood intervals (``profile_intervals``; skipped with ``intervals`` False: NaN intervals).
+    ``label`` starts the progress lines it logs. ``start`` (the 5 parameters) skips the GA: the polish starts there
+    (a refit of a known optimum on other forces, for example the model-form spread of ``contactid.gap.uncertainty``)."""
+    K = np.atleast_2d(coef_s).shape[1] if n_harmonics_data is None else n_harmonics_data
+    problem, u_best, ssr_min, res, m, history, logbook = _refined_fit(
+        coef_xi, coef_n, coef_s, f0, preload, settings, seed, label, start
+    )
+    if intervals:
+        bounds, bounded, profiles, e0_vals = profile_intervals(
+            problem, u_best, ssr_min, 2 * K, settings, preload, label
+        )
+    else:
+        bounds, bounded, profiles, e0_vals = np.full((5, 2), np.nan), np.zeros((5, 2), dtype=bool), {}, []
     p = problem.physical(u_best)[0]
     e0 = float(stiction_shear_stiffness(preload, p[0], p[1]))
     e0_vals.append(e0)
-    warnings = []
-    for i, name in enumerate(PARAMETER_NAMES):
-        for edge, label in ((0.0, "lower"), (1.0, "upper")):
-            if abs(u_best[i] - edge) < 1e-3 and not (name == "e_t" and edge == 0.0 and settings.bounds[2][0] == 0.0):
-                warnings.append(
-                    f"{name} = {p[i]:.4g} sits at its {label} search bound {settings.bounds[i][int(edge)]:.4g}: "
-                    f"the bounds may exclude the best value; widen friction.bounds.{name}"
-                )
+    warnings = bound_warnings(u_best, p, settings)
     for w in warnings:
         log.warning("friction fit: %s", w)
     return FitResult(
@@ -364,10 +399,10 @@ def fit_friction_law(
         e0,
         logbook,
         history,
-        intervals,
+        bounds,
         bounded,
         (min(e0_vals), max(e0_vals)),
-        corr,
+        parameter_correlation(res.jac),
         m,
         profiles,
         warnings,
