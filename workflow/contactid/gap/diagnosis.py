@@ -710,6 +710,75 @@ def explain(
     return steps, gap, last
 
 
+def heldout_gap_of(
+    records: Mapping[str, RecordHarmonics], cases, H: int, sims_by_case: Mapping, resampled=None
+) -> float:
+    """The held-out gap of simulations ``sims_by_case`` on ``cases``: the rms over the cases of each case's residual
+    norm (the sensors' harmonics 1..H and the change from the first to the last third, relative to the record's
+    harmonics); ``resampled``: {case: (j, H) bootstrap harmonics} in place of the records' own."""
+    vals = []
+    for c in cases:
+        rec = records[c]
+        A = rec.acceleration[:, :H] if resampled is None else resampled[c]
+        As = sims_by_case[c].acceleration[:, :H]
+        d_meas = (rec.last - rec.first)[:, :H]
+        sim = sims_by_case[c]
+        d_sim = (sim.last - sim.first)[:, :H] if sim.first is not None else np.zeros_like(d_meas)
+        r = np.concatenate([(As - A).ravel(), (d_sim - d_meas).ravel()]) / np.linalg.norm(A)
+        vals.append(np.sum(np.abs(r) ** 2))
+    return float(np.sqrt(np.mean(vals)))
+
+
+def _ranking_row(
+    name: str,
+    cal,
+    res: Mapping,
+    after: float,
+    after_b,
+    before: float,
+    before_b,
+    n_data: int,
+    records: Mapping[str, RecordHarmonics],
+    calibration_case: str,
+    where: Mapping,
+) -> dict:
+    """A candidate's row of the ranking: its held-out gap (``after``, its bootstrap ``after_b``) against the
+    model's (``before``, ``before_b``), the score (n ln(gap^2 ratio) + 2 k over ``n_data`` residual entries), its
+    refitted parameters and friction law, the structure/sensor misfit it leaves on the calibration record, and
+    whether it acts where the localisation puts the gap."""
+    k = LIBRARY[name].n_parameters(len(records[calibration_case].sensors))
+    # does the candidate make the structure and sensor model consistent with the calibration record?
+    res_after = float(
+        np.sqrt(
+            np.mean(identified_forces(cal.model, cal.augmentation, records[calibration_case]).residual[[0, 2]] ** 2)
+        )
+    )
+    acts_on = LIBRARY[name].acts_on
+    score = n_data * np.log(after**2 / before**2) + 2 * k if np.isfinite(after) else np.inf
+    red_b = 1 - after_b / before_b
+    return {
+        "effect": name,
+        "heldout_gap_before": before,
+        "heldout_gap_after": after,
+        "score": float(score),
+        "reduction": 1 - after / before if np.isfinite(after) else -np.inf,
+        "reduction_interval": [float(np.percentile(red_b, 2.5)), float(np.percentile(red_b, 97.5))],
+        "heldout_gap_after_interval": [float(np.percentile(after_b, 2.5)), float(np.percentile(after_b, 97.5))],
+        "n_parameters": k,
+        "parameters": _parameter_values(name, cal),
+        "calibration_gap": cal.gap,
+        "friction": [float(x) for x in cal.friction],
+        "heldout_gap_after_by_case": {c: gap_value(r) for c, r in res.items()},
+        "identification_residual_after": res_after,
+        "identification_noise": where["identification_noise"][calibration_case],
+        "acts_on": acts_on,
+        # a winner must act where the localisation puts the gap; the structure/sensor misfit left by the candidate
+        # (identification_residual_after, against the noise level) is reported beside it
+        "consistent": bool(acts_where(acts_on, where["place"])),
+        "evaluations": cal.evaluations,
+    }
+
+
 def diagnose(
     model: IdentifiedModel,
     records: Mapping[str, RecordHarmonics],
@@ -769,17 +838,13 @@ def diagnose(
     boot = {c: _bootstrap_records(records[c], rng, settings.n_bootstrap, H) for c in score_cases}
 
     def heldout_gap(sims_by_case, boot_index=None):
-        vals = []
-        for c in score_cases:
-            rec = records[c]
-            A = rec.acceleration[:, :H] if boot_index is None else boot[c][boot_index]
-            As = sims_by_case[c].acceleration[:, :H]
-            d_meas = (rec.last - rec.first)[:, :H]
-            sim = sims_by_case[c]
-            d_sim = (sim.last - sim.first)[:, :H] if sim.first is not None else np.zeros_like(d_meas)
-            r = np.concatenate([(As - A).ravel(), (d_sim - d_meas).ravel()]) / np.linalg.norm(A)
-            vals.append(np.sum(np.abs(r) ** 2))
-        return float(np.sqrt(np.mean(vals)))
+        return heldout_gap_of(
+            records,
+            score_cases,
+            H,
+            sims_by_case,
+            None if boot_index is None else {c: boot[c][boot_index] for c in score_cases},
+        )
 
     before = heldout_gap(base_sims)
     before_b = np.array([heldout_gap(base_sims, b) for b in range(settings.n_bootstrap)])
@@ -792,40 +857,8 @@ def diagnose(
         if not np.isfinite(after):  # a held-out prediction diverged: the candidate explains nothing
             after, after_b = np.inf, np.full(settings.n_bootstrap, np.inf)
         boots[name] = after_b
-        k = LIBRARY[name].n_parameters(len(records[cases[0]].sensors))
-        # does the candidate make the structure and sensor model consistent with the calibration record?
-        res_after = float(
-            np.sqrt(
-                np.mean(identified_forces(cal.model, cal.augmentation, records[calibration_case]).residual[[0, 2]] ** 2)
-            )
-        )
-        noise = where["identification_noise"][calibration_case]
-        acts_on = LIBRARY[name].acts_on
-        # a winner must act where the localisation puts the gap; the structure/sensor misfit left by the
-        # candidate (res_after, against the noise level) is reported beside it
-        consistent = acts_where(acts_on, where["place"])
-        score = n_data * np.log(after**2 / before**2) + 2 * k if np.isfinite(after) else np.inf
-        red_b = 1 - after_b / before_b
         rows.append(
-            {
-                "effect": name,
-                "heldout_gap_before": before,
-                "heldout_gap_after": after,
-                "score": float(score),
-                "reduction": 1 - after / before if np.isfinite(after) else -np.inf,
-                "reduction_interval": [float(np.percentile(red_b, 2.5)), float(np.percentile(red_b, 97.5))],
-                "heldout_gap_after_interval": [float(np.percentile(after_b, 2.5)), float(np.percentile(after_b, 97.5))],
-                "n_parameters": k,
-                "parameters": _parameter_values(name, cal),
-                "calibration_gap": cal.gap,
-                "friction": [float(x) for x in cal.friction],
-                "heldout_gap_after_by_case": {c: gap_value(r) for c, r in res.items()},
-                "identification_residual_after": res_after,
-                "identification_noise": noise,
-                "acts_on": acts_on,
-                "consistent": bool(consistent),
-                "evaluations": cal.evaluations,
-            }
+            _ranking_row(name, cal, res, after, after_b, before, before_b, n_data, records, calibration_case, where)
         )
     # by score; scores equal to 3 decimals are a tie (the same model solved from other starts): library order
     rows.sort(key=lambda r: round(r["score"], 3) if np.isfinite(r["score"]) else np.inf)
