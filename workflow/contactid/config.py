@@ -63,6 +63,20 @@ def with_defaults(cfg: Mapping, schema=SCHEMA) -> dict:
     return filled
 
 
+@functools.lru_cache(maxsize=None)
+def _filled_empty() -> dict:
+    return with_defaults({})
+
+
+def schema_defaults(*path: str) -> dict:
+    """The schema's defaults of the block at ``path`` (for example "rig", "dual_sine"), for code that merges a
+    block's keys over its defaults: a copy, read from the schema, the one home of the defaults."""
+    node = _filled_empty()
+    for key in path:
+        node = node[key]
+    return copy.deepcopy(node)
+
+
 def numbers_written_as_text(cfg: dict, schema) -> list:
     """Make numbers, in place, of the values YAML 1.1 read as text where the schema (a path or a mapping) wants a
     number: ``channel_time_skew: 4e-05`` is the text '4e-05' to PyYAML (it wants 4.0e-05), which the schema would

@@ -75,19 +75,13 @@ def dual_sine_check_dataset(raw: xr.Dataset, structure_cfg: Mapping, path: str, 
 # beyond half its limit is a warning stored in the check dataset and shown in the report
 # ------------------------------------------------------------------------------------------
 
-CHECK_DEFAULTS = {
-    "clip_samples": 8,
-    "frequency_tolerance_cycles": 0.02,
-    "stationarity_tolerance": 0.05,
-    "min_coherence": 0.5,
-    "coherence_fraction": 0.5,
-    "max_frf_resolution_hz": 0.5,
-}
-
 
 def check_settings(checks: Mapping | None) -> dict:
-    """raw_checks with defaults filled in."""
-    return {**CHECK_DEFAULTS, **{k: v for k, v in dict(checks or {}).items() if v is not None}}
+    """raw_checks with the schema's defaults filled in (max_harmonic and min_periods, the record reader's, apart)."""
+    from .config import schema_defaults
+
+    defaults = {k: v for k, v in schema_defaults("raw_checks").items() if k not in ("max_harmonic", "min_periods")}
+    return {**defaults, **{k: v for k, v in dict(checks or {}).items() if v is not None}}
 
 
 # no force (N) or acceleration (m/s^2) of a vibration test comes near this: a larger value is a scaling error

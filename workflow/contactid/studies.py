@@ -19,14 +19,16 @@ import xarray as xr
 
 from .contact_laws import stiction_shear_stiffness
 
-DEFAULTS = {"noise_fractions": [0.0025, 0.005, 0.01, 0.02, 0.04], "record_samples": [8192, 16384], "seeds": [1, 2, 3]}
 QUANTITIES = ("mu", "e0", "k_t")
 
 
 def noise_study_table(study_cfg: Mapping | None) -> pd.DataFrame:
     """The parameter table: one row per (noise_fraction, record_samples, seed), in that order."""
-    c = {**DEFAULTS, **{k: v for k, v in dict(study_cfg or {}).items() if k in DEFAULTS}}
-    for key in DEFAULTS:
+    from .config import schema_defaults
+
+    axes = {k: v for k, v in schema_defaults("noise_study").items() if k != "in_report"}  # the schema's defaults
+    c = {**axes, **{k: v for k, v in dict(study_cfg or {}).items() if k in axes}}
+    for key in axes:
         if not c[key]:
             raise ValueError(f"noise_study.{key} is empty; give at least one value")
     if min(c["noise_fractions"]) < 0:

@@ -26,19 +26,13 @@ from .structure import channel_delays, rig_structure, true_structure_config
 
 log = logging.getLogger(__name__)
 
-DEFAULTS = {
-    "excitation_frequency_hz": 54.4,
-    "record_samples": 16384,
-    "n_modes": 8,
-    "oversampling": 8,
-    "control_tolerance": 0.001,
-    "steady_state_tolerance": 1e-4,
-}
-
 
 def dual_sine_settings(rig_cfg: Mapping, case_cfg: Mapping, sampling_rate_hz: float) -> dict:
-    """Merged settings of one load case: rig.dual_sine defaults, overridden per case."""
-    s = {**DEFAULTS, **(rig_cfg.get("dual_sine") or {})}
+    """Merged settings of one load case: rig.dual_sine (at the schema's defaults where left out), overridden per
+    case."""
+    from ..config import schema_defaults
+
+    s = {**schema_defaults("rig", "dual_sine"), **(rig_cfg.get("dual_sine") or {})}
     if "excitation_frequency_hz" in case_cfg:
         s["excitation_frequency_hz"] = case_cfg["excitation_frequency_hz"]
     n = int(s["record_samples"])
