@@ -17,6 +17,7 @@ from typing import Mapping
 
 import numpy as np
 
+from ..config import schema_defaults
 from ..random_streams import generator
 from ..rig.effects import EFFECTS
 
@@ -49,15 +50,16 @@ EXPECTED_PLACE = {
 
 
 def benchmark_items(cfg: Mapping, seed: int) -> dict:
-    """{name: spec} with spec = {effect, magnitude, seed, library (None = all), kind}."""
-    cfg = dict(cfg or {})
+    """{name: spec} with spec = {effect, magnitude, seed, library (None = all), kind}; ``cfg`` the gap_benchmark
+    block (keys left out: the schema's defaults)."""
+    cfg = {**schema_defaults("gap_benchmark"), **dict(cfg or {})}
     effects = cfg.get("effects") or list(EFFECTS)
     unknown = [e for e in effects if e not in EFFECTS]
     if unknown:
         raise ValueError(f"gap_benchmark.effects: unknown {unknown}; known: {', '.join(EFFECTS)}")
     ranges = {**RANGES, **{k: tuple(v) for k, v in (cfg.get("ranges") or {}).items()}}
-    n_mag = int(cfg.get("magnitudes", 3))
-    seeds = [int(s) for s in cfg.get("seeds", [1, 2])]
+    n_mag = int(cfg["magnitudes"])
+    seeds = [int(s) for s in cfg["seeds"]]
     items = {}
     for e in effects:
         lo, hi = ranges[e]
@@ -65,9 +67,9 @@ def benchmark_items(cfg: Mapping, seed: int) -> dict:
             for k in range(n_mag):
                 m = float(generator(seed, f"gap_benchmark/{e}/{k}/{s}").uniform(lo, hi))
                 items[f"{e}-{k}-s{s}"] = {"effect": e, "magnitude": m, "seed": s, "library": None, "kind": "blind"}
-    for s in seeds[: int(cfg.get("effect_free", len(seeds)))]:
+    for s in seeds[: int(cfg["effect_free"])]:
         items[f"none-0-s{s}"] = {"effect": None, "magnitude": 0.0, "seed": s, "library": None, "kind": "effect_free"}
-    if cfg.get("leave_out", True):
+    if cfg["leave_out"]:
         for e in effects:
             lo, hi = ranges[e]
             lib = [x for x in EFFECTS if x != e]
@@ -78,11 +80,8 @@ def benchmark_items(cfg: Mapping, seed: int) -> dict:
                 "library": lib,
                 "kind": "leave_out",
             }
-    items.update(compound_items(int(cfg.get("compound", 20)), seeds, seed, ranges))
+    items.update(compound_items(int(cfg["compound"]), seeds, seed, ranges))
     return items
-
-
-LADDER_FRACTIONS = (0.1, 1.0 / 3.0, 1.0)
 
 
 def ladder_typical(effect: str, ranges: Mapping = RANGES) -> float:
@@ -94,8 +93,8 @@ def ladder_typical(effect: str, ranges: Mapping = RANGES) -> float:
 def ladder_items(cfg: Mapping, seed: int) -> dict:
     """{name: spec} of the detection ladder (config gap_benchmark.ladder: fractions of each effect's typical
     magnitude, for every seed): single-effect items named ``ladder_<effect>-<k>-s<seed>``."""
-    cfg = dict(cfg or {})
-    fractions = [float(f) for f in cfg.get("ladder", LADDER_FRACTIONS)]
+    cfg = {**schema_defaults("gap_benchmark"), **dict(cfg or {})}
+    fractions = [float(f) for f in cfg["ladder"]]
     effects = cfg.get("effects") or list(EFFECTS)
     ranges = {**RANGES, **{k: tuple(v) for k, v in (cfg.get("ranges") or {}).items()}}
     items = {}
@@ -148,20 +147,23 @@ def _refitted(effect, ranking: Mapping, updating) -> float | None:
 
 
 def run_item(spec: Mapping, cfg: Mapping) -> dict:
-    """Generate the item's rig records, identify the model from them, diagnose; the result row."""
+    """Generate the item's rig records, identify the model from them, diagnose; the result row. ``cfg``: the base
+    config (keys left out: the schema's defaults)."""
+    from ..config import with_defaults
     from ..friction_fit import settings_from_config
     from .diagnosis import GapSettings, diagnose, linear_stage
     from .pipeline import identify, rig_records, updated_model
     from .records import record_harmonics
 
     t0 = time.perf_counter()
+    cfg = with_defaults(cfg)
     effects = {spec["effect"]: spec["magnitude"]} if spec["effect"] else {}
     compound = spec["kind"] == "compound"
     if compound:
         cfg = compound_config(cfg, spec)
         effects = dict(spec["effects"])
     cases = sorted(cfg["load_cases"], key=lambda c: int(c[2:]))
-    cal = cfg.get("nonlinear", {}).get("calibration_case", "lc1")
+    cal = cfg["nonlinear"]["calibration_case"]
     hidden = f"{spec['effect']} at {spec['magnitude']:.4g}" if spec["effect"] else "no effect"
     if compound:
         hidden = "perturbed rig with " + (", ".join(f"{e} at {m:.4g}" for e, m in effects.items()) or "no effect")
@@ -193,8 +195,8 @@ def run_item(spec: Mapping, cfg: Mapping) -> dict:
         }
     log.info("rig records made in %.1f s; identifying the model", t_rig)
     model, modes, modal, frf = identify(cfg, recs["random_test"], recs[cal])
-    K = int(cfg.get("nonlinear", {}).get("n_harmonics", 25))
-    fit_settings = settings_from_config(cfg.get("friction", {}))
+    K = int(cfg["nonlinear"]["n_harmonics"])
+    fit_settings = settings_from_config(cfg["friction"])
     records = {c: record_harmonics(recs[c], c, K) for c in cases}
     t_id = time.perf_counter() - t0 - t_rig
     gap_cfg = dict(cfg.get("gap", {}))

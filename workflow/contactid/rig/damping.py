@@ -41,10 +41,9 @@ def damping_ratios(frequencies_hz, ratio: float, form: str = "modal", reference_
 
 def rig_damping_ratios(rig_cfg: Mapping, frequencies_hz) -> np.ndarray:
     """The rig's damping ratio of each mode (rig.modal_damping_ratio spread by rig.true_damping)."""
-    td = rig_cfg.get("true_damping") or {}
-    return damping_ratios(
-        frequencies_hz,
-        float(rig_cfg.get("modal_damping_ratio", 0.005)),
-        td.get("form", "modal"),
-        float(td.get("reference_frequency_hz", 54.4)),
-    )
+    from ..config import schema_defaults
+
+    defaults = schema_defaults("rig")  # where rig_cfg leaves keys out
+    td = {**defaults["true_damping"], **(rig_cfg.get("true_damping") or {})}
+    ratio = rig_cfg.get("modal_damping_ratio", defaults["modal_damping_ratio"])
+    return damping_ratios(frequencies_hz, float(ratio), td["form"], float(td["reference_frequency_hz"]))

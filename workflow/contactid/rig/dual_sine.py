@@ -60,7 +60,7 @@ def contact_parameters(structure_cfg: Mapping, rig_cfg: Mapping) -> ContactParam
         iwan_share=eff["multi_asperity_friction"],
         preload_drift=eff["preload_drift"],
         regularization=str(truth["friction"].get("regularization", "none")),
-        cubic=float(truth["normal"].get("cubic_n_per_m3", 0.0)),
+        cubic=float(truth["normal"].get("cubic_n_per_m3", 0.0)),  # the schema's default: no cubic term
     )
 
 

@@ -122,21 +122,25 @@ def simulate_random_test(model: FEModel, settings: RandomTestSettings, seed: int
 
 
 def settings_from_config(random_test_cfg, rig_cfg, n_channels: int = 3) -> RandomTestSettings:
-    """RandomTestSettings from the ``random_test`` and ``rig`` config blocks."""
+    """RandomTestSettings from the ``random_test`` and ``rig`` config blocks (keys left out: the schema's defaults)."""
+    from ..config import schema_defaults
     from .structure import channel_delays
 
-    d = RandomTestSettings()
+    rt = {**schema_defaults("random_test"), **dict(random_test_cfg or {})}
+    rig_defaults = schema_defaults("rig")
+    rig = {**rig_defaults, **dict(rig_cfg or {})}
+    td = {**rig_defaults["true_damping"], **(rig.get("true_damping") or {})}
     return RandomTestSettings(
-        sampling_rate_hz=float(random_test_cfg.get("sampling_rate_hz", d.sampling_rate_hz)),
-        duration_s=float(random_test_cfg.get("duration_s", d.duration_s)),
-        band_hz=tuple(float(x) for x in random_test_cfg.get("band_hz", d.band_hz)),
-        force_rms_n=float(random_test_cfg.get("force_rms_n", d.force_rms_n)),
-        noise_fraction=float(rig_cfg.get("noise_fraction", d.noise_fraction)),
-        modal_damping_ratio=float(rig_cfg.get("modal_damping_ratio", d.modal_damping_ratio)),
-        oversampling=int(rig_cfg.get("oversampling", d.oversampling)),
+        sampling_rate_hz=float(rt["sampling_rate_hz"]),
+        duration_s=float(rt["duration_s"]),
+        band_hz=tuple(float(x) for x in rt["band_hz"]),
+        force_rms_n=float(rt["force_rms_n"]),
+        noise_fraction=float(rig["noise_fraction"]),
+        modal_damping_ratio=float(rig["modal_damping_ratio"]),
+        oversampling=int(rig["oversampling"]),
         channel_delays_s=channel_delays(rig_cfg, n_channels),
-        damping_form=str((rig_cfg.get("true_damping") or {}).get("form", "modal")),
-        damping_reference_hz=float((rig_cfg.get("true_damping") or {}).get("reference_frequency_hz", 54.4)),
+        damping_form=str(td["form"]),
+        damping_reference_hz=float(td["reference_frequency_hz"]),
     )
 
 

@@ -41,12 +41,21 @@ def rig_contact_stiffness(structure_cfg: Mapping, rig_cfg: Mapping) -> tuple[flo
     return k_t, float(k_n)
 
 
+def _rig_default(key: str):
+    from ..config import schema_defaults
+
+    return schema_defaults("rig")[key]
+
+
 def rig_structure(structure_cfg: Mapping, rig_cfg: Mapping) -> StructureParameters:
     """StructureParameters of the rig (finer mesh, true contact stiffnesses; the
     effect transducer_mass_error scales every transducer mass by 1 + m)."""
     k_t, k_n = rig_contact_stiffness(structure_cfg, rig_cfg)
     p = structure_from_config(
-        true_structure_config(structure_cfg, rig_cfg), k_t, k_n, n_elements=int(rig_cfg.get("fe_elements", 96))
+        true_structure_config(structure_cfg, rig_cfg),
+        k_t,
+        k_n,
+        n_elements=int(rig_cfg.get("fe_elements", _rig_default("fe_elements"))),
     )
     m = effect_magnitudes(rig_cfg.get("effects"))["transducer_mass_error"]
     if m:
