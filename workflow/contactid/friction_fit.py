@@ -585,8 +585,12 @@ def validation_dataset(forces, fit, preload: float, n_harmonics: int, truth=None
 
 
 def settings_from_config(cfg) -> FitSettings:
-    """FitSettings from the ``friction`` config block; bounds that are not (low < high) are refused."""
+    """FitSettings from the ``friction`` config block (keys left out: the schema's defaults; the search bounds left
+    out: Table 4's neighbourhood, ``FitSettings.bounds``); bounds that are not (low < high) are refused."""
+    from .config import schema_defaults
+
     d = FitSettings()
+    cfg = {**schema_defaults("friction"), **dict(cfg or {})}
     b = cfg.get("bounds") or {}
     names = {"e_f": "e_f_n_per_m", "k_c": "k_c_per_m", "e_t": "e_t_n_per_m", "kappa": "kappa", "mu": "mu"}
     bounds = []
@@ -597,11 +601,11 @@ def settings_from_config(cfg) -> FitSettings:
         bounds.append((float(lo), float(hi)))
     return FitSettings(
         bounds=tuple(bounds),
-        population=int(cfg.get("population", d.population)),
-        generations=int(cfg.get("generations", d.generations)),
-        grid_points=int(cfg.get("grid_points", d.grid_points)),
-        max_grid_points=int(cfg.get("max_grid_points", d.max_grid_points)),
-        confidence=float(cfg.get("confidence", d.confidence)),
-        misfit_floor=float(cfg.get("misfit_floor", d.misfit_floor)),
-        regularization=str(cfg.get("regularization", d.regularization)),
+        population=int(cfg["population"]),
+        generations=int(cfg["generations"]),
+        grid_points=int(cfg["grid_points"]),
+        max_grid_points=int(cfg["max_grid_points"]),
+        confidence=float(cfg["confidence"]),
+        misfit_floor=float(cfg["misfit_floor"]),
+        regularization=str(cfg["regularization"]),
     )

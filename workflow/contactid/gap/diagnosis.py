@@ -99,30 +99,32 @@ class GapSettings:
 
     @classmethod
     def from_config(cls, gap_cfg: Mapping | None, seed: int, n_harmonics_id: int) -> "GapSettings":
-        g = dict(gap_cfg or {})
-        d = cls()
+        from ..config import schema_defaults
+
+        defaults = schema_defaults("gap")  # keys left out take the schema's defaults
+        g = {**defaults, **dict(gap_cfg or {})}
         cands = g.get("candidates")
         if cands is not None:
             unknown = [c for c in cands if c not in LIBRARY]
             if unknown:
                 raise ValueError(f"gap.candidates: unknown {unknown}; the library has {', '.join(LIBRARY)}")
         s = cls(
-            n_harmonics=int(g.get("n_harmonics", d.n_harmonics)),
+            n_harmonics=int(g["n_harmonics"]),
             identification_harmonics=int(n_harmonics_id),
             candidates=tuple(cands) if cands is not None else None,
-            min_gap=float(g.get("min_gap", d.min_gap)),
-            min_reduction=float(g.get("min_reduction", d.min_reduction)),
-            separation=float(g.get("separation", d.separation)),
-            noise_factor=float(g.get("noise_factor", d.noise_factor)),
-            n_bootstrap=int(g.get("n_bootstrap", d.n_bootstrap)),
+            min_gap=float(g["min_gap"]),
+            min_reduction=float(g["min_reduction"]),
+            separation=float(g["separation"]),
+            noise_factor=float(g["noise_factor"]),
+            n_bootstrap=int(g["n_bootstrap"]),
             seed=int(seed),
-            max_evaluations=int(g.get("max_evaluations", d.max_evaluations)),
-            eta_observability_limit=float(g.get("eta_observability_limit", d.eta_observability_limit)),
-            joint_refit=bool(g.get("joint_refit", d.joint_refit)),
-            pair_lookahead=float(g.get("pair_lookahead", d.pair_lookahead)),
-            retry_unmoved=bool(g.get("retry_unmoved", d.retry_unmoved)),
+            max_evaluations=int(g["max_evaluations"]),
+            eta_observability_limit=float(g["eta_observability_limit"]),
+            joint_refit=bool(g["joint_refit"]),
+            pair_lookahead=float(g["pair_lookahead"]),
+            retry_unmoved=bool(g["retry_unmoved"]),
             place=PlaceThresholds.from_config(g.get("place")),
-            **_updating_settings(g.get("model_updating"), d),
+            **_updating_settings({**defaults["model_updating"], **(g.get("model_updating") or {})}),
         )
         if not 0.0 < s.min_reduction < 1.0:
             raise ValueError(f"gap.min_reduction = {s.min_reduction}: give a fraction in (0, 1)")
@@ -135,21 +137,20 @@ class GapSettings:
         return s
 
 
-def _updating_settings(block, d: "GapSettings") -> dict:
-    """GapSettings fields of the config block gap.model_updating (absent: the defaults)."""
+def _updating_settings(b: Mapping) -> dict:
+    """GapSettings fields of the config block gap.model_updating (its defaults filled in)."""
     from ..updating import FACTORS
 
-    b = dict(block or {})
-    params = tuple(b.get("parameters", d.updating_parameters))
+    params = tuple(b["parameters"])
     unknown = [x for x in params if x not in FACTORS]
     if unknown:
         raise ValueError(f"gap.model_updating.parameters: unknown {unknown}; choose from {', '.join(FACTORS)}")
     return {
-        "model_updating": bool(b.get("enabled", True)),
+        "model_updating": bool(b["enabled"]),
         "updating_parameters": params,
-        "residue_accuracy": float(b.get("residue_accuracy", d.residue_accuracy)),
-        "updating_confidence": float(b.get("confidence", d.updating_confidence)),
-        "frequency_floor": float(b.get("frequency_floor", d.frequency_floor)),
+        "residue_accuracy": float(b["residue_accuracy"]),
+        "updating_confidence": float(b["confidence"]),
+        "frequency_floor": float(b["frequency_floor"]),
         "updating_prior_sd": _prior_sd(b.get("prior_sd"), FACTORS),
     }
 
