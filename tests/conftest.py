@@ -25,8 +25,6 @@ SHARED_RUNS = {
     "small_run": (wp.prepare_small_run, None, 0),
     "default_run": (wp.prepare_default_run, "small_run", 0),
     "measured_run": (lambda d: wp.prepare_measured_run(d, _runs["small_run"].proj), "small_run", 10),
-    "noisy_run": (wp.prepare_noisy_run, "small_run", 10),
-    "same_seed_run": (wp.prepare_same_seed_run, "small_run", 10),
     "other_seed_run": (wp.prepare_other_seed_run, "small_run", 10),
     "rig_run": (wp.prepare_rig_run, "small_run", 10),
     "noise_sweep_run": (wp.prepare_noise_sweep_run, "small_run", 10),
@@ -96,20 +94,8 @@ def measured_run(pytestconfig, small_run):
 
 
 @pytest.fixture(scope="session")
-def noisy_run(pytestconfig):
-    """lc1's contact forces on the small config with ten times its sensor noise."""
-    return _wait(pytestconfig, "noisy_run")
-
-
-@pytest.fixture(scope="session")
-def same_seed_run(pytestconfig):
-    """The random test's chain and lc1's record on the small config (the small run's seed)."""
-    return _wait(pytestconfig, "same_seed_run")
-
-
-@pytest.fixture(scope="session")
 def other_seed_run(pytestconfig):
-    """The same with seed 1234."""
+    """lc1's rig record on the small config with seed 1234."""
     return _wait(pytestconfig, "other_seed_run")
 
 

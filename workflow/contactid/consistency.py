@@ -15,7 +15,6 @@ from typing import Mapping
 
 import numpy as np
 import pandas as pd
-from scipy.optimize import least_squares
 
 from .beam_model import natural_frequencies
 from .contact_laws import ValanisParameters, stiction_shear_stiffness
@@ -50,6 +49,8 @@ def fit_scenario(base: StructureParameters, scenario: Scenario, target_hz=TABLE1
 
     x0 = [np.log10(getattr(p0, n)) if n in LOG_FIELDS else getattr(p0, n) for n in names]
     lower = [-np.inf if n in LOG_FIELDS else 0.0 for n in names]  # masses, lengths stay non-negative
+    from scipy.optimize import least_squares  # here: the report's figures import this module's tables
+
     r = least_squares(
         lambda x: natural_frequencies(build(x)[0], len(target_hz)) / target_hz - 1.0,
         x0,

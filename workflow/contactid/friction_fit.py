@@ -12,7 +12,6 @@ from dataclasses import dataclass, field
 
 import numba
 import numpy as np
-from scipy.optimize import least_squares
 
 from .contact_laws import stiction_shear_stiffness
 from .friction import PARAMETER_NAMES, REGULARIZATIONS, valanis_friction_force
@@ -196,6 +195,8 @@ def _polish(problem: _Problem, u0, fixed: dict | None = None):
         X = x + np.diag(h)
         R = problem.residuals(problem.physical(np.array([full(row) for row in X])))
         return ((R - r0) / h[:, None]).T
+
+    from scipy.optimize import least_squares  # here: validation and the gap's modules import this one without it
 
     threads = numba.get_num_threads()
     numba.set_num_threads(1)  # a handful of sets per call: parallel threads cost more than they give
