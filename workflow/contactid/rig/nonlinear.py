@@ -24,6 +24,7 @@ rate; the friction state is advanced with Heun's method in xi per step.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 import scipy.linalg
@@ -179,57 +180,78 @@ def _excitation(f_sin, f_cos, w, t):
     return f
 
 
+class KernelModel(NamedTuple):
+    """The reduced model as the time-stepping kernel reads it (arrays float64): omega (n_r,) rad/s; zeta (n_r,);
+    xi_v, eta_v (n_r,) the linear contact coordinates; G (n_r, n_r) the shortening; bF (n_r,) the generalized
+    force of a unit force at d_p; k_t, k_n (N/m) the linear springs built into omega."""
+
+    omega: np.ndarray
+    zeta: np.ndarray
+    xi_v: np.ndarray
+    eta_v: np.ndarray
+    G: np.ndarray
+    bF: np.ndarray
+    k_t: float
+    k_n: float
+
+
+class KernelContact(NamedTuple):
+    """The contact laws as the kernel reads them: fr the friction record (``friction_record``); the normal law
+    n0 (N), delta0 (m), p, cubic (N/m^3), hc (s/m), unilateral; visc (N s/m) the viscous friction; iw_share and
+    iw_w the Iwan share and slider weights (``ContactParameters``)."""
+
+    fr: np.ndarray
+    n0: float
+    delta0: float
+    p: float
+    cubic: float
+    hc: float
+    unilateral: bool
+    visc: float
+    iw_share: float
+    iw_w: np.ndarray
+
+
+class KernelDrive(NamedTuple):
+    """The excitation f = sum_h f_sin[h-1] sin(h w t) + f_cos[h-1] cos(h w t) (N) at w (rad/s), and the static
+    preload's drift P(t) = n0 (1 + drift_rate (t - drift_t0)) after drift_t0 (s)."""
+
+    f_sin: np.ndarray
+    f_cos: np.ndarray
+    w: float
+    drift_rate: float
+    drift_t0: float
+
+
+class KernelRecord(NamedTuple):
+    """Where the kernel writes the stored steps (row = step - store_from): a, z, v (n_store, n_r); s, n, xi, eta,
+    f, dxi, deta (n_store,)."""
+
+    a: np.ndarray
+    z: np.ndarray
+    v: np.ndarray
+    s: np.ndarray
+    n: np.ndarray
+    xi: np.ndarray
+    eta: np.ndarray
+    f: np.ndarray
+    dxi: np.ndarray
+    deta: np.ndarray
+
+
 @njit(cache=True)
-def integrate(
-    z,
-    v,
-    state,
-    t0,
-    n_steps,
-    dt,
-    omega,
-    zeta,
-    xi_v,
-    eta_v,
-    G,
-    bF,
-    k_t,
-    k_n,
-    f_sin,
-    f_cos,
-    w,
-    fr,
-    n0,
-    delta0,
-    p,
-    cubic,
-    hc,
-    unilateral,
-    visc,
-    iw_share,
-    iw_w,
-    x_sl,
-    drift_rate,
-    drift_t0,
-    store_from,
-    out_a,
-    out_z,
-    out_v,
-    out_s,
-    out_n,
-    out_xi,
-    out_eta,
-    out_f,
-    out_dxi,
-    out_deta,
-):
+def integrate(z, v, state, x_sl, t0, n_steps, dt, model, contact, drive, store_from, out):
     """Advance the reduced model ``n_steps`` steps of ``dt`` from time ``t0``.
 
-    z, v (n_r,), state = [S_valanis, xi, N] and x_sl (Iwan anchors) are updated
-    in place. From step ``store_from`` on, the acceleration, coordinates,
-    contact forces and motions, velocities and the force are written to the out arrays
-    (row = step - store_from). Returns the time reached.
+    z, v (n_r,), state = [S_valanis, xi, N] and x_sl (Iwan anchors) are updated in place; ``model``
+    (KernelModel), ``contact`` (KernelContact) and ``drive`` (KernelDrive) are read. From step ``store_from`` on,
+    the acceleration, coordinates, contact forces and motions, velocities and the force are written to ``out``
+    (KernelRecord; row = step - store_from). Returns the time reached.
     """
+    omega, zeta, xi_v, eta_v, G, bF, k_t, k_n = model
+    fr, n0, delta0, p, cubic, hc, unilateral, visc, iw_share, iw_w = contact
+    f_sin, f_cos, w, drift_rate, drift_t0 = drive
+    out_a, out_z, out_v, out_s, out_n, out_xi, out_eta, out_f, out_dxi, out_deta = out
     e_f, k_c, e_t, kappa, mu, slip_limit = fr[0], fr[1], fr[2], fr[3], fr[4], fr[5] > 0.5
     n = z.size
     c = 2.0 * zeta * omega
@@ -417,44 +439,34 @@ class DualSineSimulator:
             self.z,
             self.v,
             self.state,
+            self.x_sl,
             self.t,
             n_steps,
             self.dt,
-            r.omega,
-            self.zeta,
-            r.xi,
-            r.eta,
-            r.shortening,
-            r.force,
-            r.k_t,
-            r.k_n,
-            np.ascontiguousarray(coef.real),
-            np.ascontiguousarray(coef.imag),
-            w,
-            self.fr,
-            c.preload,
-            c.static_approach,
-            c.exponent,
-            c.cubic,
-            c.hunt_crossley,
-            bool(c.unilateral),
-            c.viscous,
-            c.iwan_share,
-            self.iw_w,
-            self.x_sl,
-            self.drift_rate,
-            self.drift_t0,
+            KernelModel(r.omega, self.zeta, r.xi, r.eta, r.shortening, r.force, float(r.k_t), float(r.k_n)),
+            KernelContact(
+                self.fr,
+                float(c.preload),
+                float(c.static_approach),
+                float(c.exponent),
+                float(c.cubic),
+                float(c.hunt_crossley),
+                bool(c.unilateral),
+                float(c.viscous),
+                float(c.iwan_share),
+                self.iw_w,
+            ),
+            KernelDrive(
+                np.ascontiguousarray(coef.real),
+                np.ascontiguousarray(coef.imag),
+                float(w),
+                float(self.drift_rate),
+                float(self.drift_t0),
+            ),
             n_steps if store_from is None else store_from,
-            out_a,
-            out_z,
-            out_v,
-            out["S"],
-            out["N"],
-            out["xi"],
-            out["eta"],
-            out["f"],
-            out["dxi"],
-            out["deta"],
+            KernelRecord(
+                out_a, out_z, out_v, out["S"], out["N"], out["xi"], out["eta"], out["f"], out["dxi"], out["deta"]
+            ),
         )
         first = 1 + (n_steps if store_from is None else store_from)
         out["t"] = t_start + self.dt * np.arange(first, first + n_store)
