@@ -28,6 +28,7 @@ SHARED_RUNS = {
     "other_seed_run": (wp.prepare_other_seed_run, "small_run", 10),
     "rig_run": (wp.prepare_rig_run, "small_run", 10),
     "noise_sweep_run": (wp.prepare_noise_sweep_run, "small_run", 10),
+    "lower_confidence_run": (lambda d: wp.prepare_lower_confidence_run(d, _runs["default_run"].proj), "default_run", 0),
 }
 _runs: dict = {}
 
@@ -103,6 +104,14 @@ def other_seed_run(pytestconfig):
 def rig_run(pytestconfig):
     """`snakemake rig` on the small config with load cases lc1 and lc3."""
     return _wait(pytestconfig, "rig_run")
+
+
+@pytest.fixture(scope="session")
+def lower_confidence_run(pytestconfig):
+    """A copy of the acceptance run, its PDF's numbers made again with friction.confidence 0.9
+    (workflow_projects.prepare_lower_confidence_run). Returns (project, snakemake's output)."""
+    proj = _wait(pytestconfig, "lower_confidence_run")
+    return proj, _runs["lower_confidence_run"].output()
 
 
 @pytest.fixture(scope="session")
