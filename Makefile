@@ -2,7 +2,8 @@
 #   make reproduce  - set up, then run the whole workflow
 #   make test       - set up, then run the test suite (unit and workflow integration tests)
 #   make test-fast  - set up, then run the unit tests alone (not the workflow nor the slow in-process ones)
-#   make lint       - ruff format --check and ruff check (`ruff format .` rewrites the code in the project's style)
+#   make lint       - ruff format --check, ruff check, snakefmt --check and snakemake --lint (`ruff format .` and
+#                     `snakefmt --no-sort Snakefile workflow/rules` rewrite the code in the project's style)
 #   make env        - create .venv/ with the pinned packages (and TeX Live via apt where missing)
 
 VENV := .venv
@@ -45,6 +46,8 @@ test-fast: env
 lint: env
 	$(PY) -m ruff format --check .
 	$(PY) -m ruff check .
+	$(VENV)/bin/snakefmt --no-sort --check Snakefile workflow/rules
+	$(VENV)/bin/snakemake --lint
 
 # optional (not in CI by default): the noise-study sweep through a local single-node SLURM against -c2 here
 slurm-test: env

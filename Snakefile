@@ -21,8 +21,11 @@ from contactid.config import numbers_written_as_text
 
 # 4e-05 is text to YAML 1.1 (4.0e-05 is a number): such values where the schema wants a number are read as numbers
 for _key, _value in numbers_written_as_text(config, "workflow/schemas/config.schema.yaml"):
-    print(f"config: {_key}: read as the number {_value!r} (YAML 1.1 reads exponent notation "
-          "without a decimal point as text; 4.0e-05 is a number to every reader)", file=sys.stderr)
+    print(
+        f"config: {_key}: read as the number {_value!r} (YAML 1.1 reads exponent notation "
+        "without a decimal point as text; 4.0e-05 is a number to every reader)",
+        file=sys.stderr,
+    )
 validate(config, "workflow/schemas/config.schema.yaml")
 
 
@@ -51,6 +54,7 @@ include: "workflow/rules/studies.smk"
 
 
 rule all:
+    """The default target: the paper's reproduction (Tables 1-4, Figs. 3-9), the gap diagnosis of the configured load cases and the PDF report."""
     input:
         all_outputs(),
     default_target: True

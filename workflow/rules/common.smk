@@ -111,9 +111,14 @@ def figure_case():
 
 
 def contact_forces_inputs(wildcards):
-    inputs = {"raw": raw_record(wildcards.case), "reduced": f"results/{wildcards.case}/reduced_model.nc",
-              "modes": "results/linear/linear_modes.nc", "modal": "results/linear/modal.nc",
-              "stiction": "results/linear/stiction.nc", "updating": "results/gap/model_updating.json"}
+    inputs = {
+        "raw": raw_record(wildcards.case),
+        "reduced": f"results/{wildcards.case}/reduced_model.nc",
+        "modes": "results/linear/linear_modes.nc",
+        "modal": "results/linear/modal.nc",
+        "stiction": "results/linear/stiction.nc",
+        "updating": "results/gap/model_updating.json",
+    }
     if wildcards.case in rig_cases():
         inputs["truth"] = f"data/truth/{wildcards.case}.nc"
     return inputs
@@ -128,7 +133,11 @@ def validate_inputs(wildcards):
 
 def summary_inputs(wildcards):
     """Everything the headline numbers are read from, named for the summary script."""
-    inputs = {"modal": "results/linear/modal.nc", "stiction": "results/linear/stiction.nc", "frf": "results/linear/frf.nc"}
+    inputs = {
+        "modal": "results/linear/modal.nc",
+        "stiction": "results/linear/stiction.nc",
+        "frf": "results/linear/frf.nc",
+    }
     if not _is_measured(config.get("random_test")):
         inputs["truth"] = "data/truth/random_test.nc"
     for c in load_cases():
@@ -155,11 +164,27 @@ def all_outputs():
         *[f"results/{c}/raw_check.nc" for c in load_cases()],
         *[f"results/{c}/contact_forces.nc" for c in load_cases()],
         *[f"results/{c}/validation.nc" for c in load_cases()],
-        *(["results/tables/table4.csv", "results/figures/fig07_e0.png", "results/figures/fig08_s_xi.png",
-           "results/figures/fig09_s_xidot.png", "results/figures/friction_convergence.png"] if load_cases() else []),
+        *(
+            [
+                "results/tables/table4.csv",
+                "results/figures/fig07_e0.png",
+                "results/figures/fig08_s_xi.png",
+                "results/figures/fig09_s_xidot.png",
+                "results/figures/friction_convergence.png",
+            ]
+            if load_cases()
+            else []
+        ),
         *(["results/studies/harmonic_count.csv"] if calibration_case() in rig_cases() else []),
-        *(["results/figures/fig04_generalized_coordinates.png", "results/figures/fig05_reconstruction.png",
-           "results/figures/fig06_contact_forces.png"] if load_cases() else []),
+        *(
+            [
+                "results/figures/fig04_generalized_coordinates.png",
+                "results/figures/fig05_reconstruction.png",
+                "results/figures/fig06_contact_forces.png",
+            ]
+            if load_cases()
+            else []
+        ),
         "results/summary.json",
         *(gap_outputs() if load_cases() else []),
         *(["results/studies/noise_study.nc", "results/figures/noise_study.png"] if noise_study_in_report() else []),
@@ -169,17 +194,25 @@ def all_outputs():
 
 def gap_inputs(wildcards):
     """The diagnosis reads the raw records of every load case and the chain's identified model."""
-    inputs = {"modes": "results/linear/linear_modes.nc", "modal": "results/linear/modal.nc",
-              "frf": "results/linear/frf.nc", "fit": "results/friction/friction_fit.nc",
-              "updating": "results/gap/model_updating.json"}
+    inputs = {
+        "modes": "results/linear/linear_modes.nc",
+        "modal": "results/linear/modal.nc",
+        "frf": "results/linear/frf.nc",
+        "fit": "results/friction/friction_fit.nc",
+        "updating": "results/gap/model_updating.json",
+    }
     inputs["raw"] = [raw_record(c) for c in load_cases()]
-    inputs["checks"] = [f"results/{c}/raw_check.nc" for c in load_cases()]  # a record that fails validation stops the gap
+    inputs["checks"] = [
+        f"results/{c}/raw_check.nc" for c in load_cases()
+    ]  # a record that fails validation stops the gap
     return inputs
 
 
 def gap_outputs():
     return ["results/gap/diagnosis.json", "results/gap/gap.nc", "results/gap/friction_intervals.json"] + [
-        f"results/gap/gap_{v}.png" for v in ("stages", "harmonics", "cycle", "force_state", "ranking", "shrink", "explanation")]
+        f"results/gap/gap_{v}.png"
+        for v in ("stages", "harmonics", "cycle", "force_state", "ranking", "shrink", "explanation")
+    ]
 
 
 def benchmark_base_config():
@@ -216,8 +249,19 @@ NOISE_SPACE = Paramspace(noise_study_table(config.get("noise_study")), filename_
 
 def study_base_config():
     """What a study point depends on: the rig, the structure and the identification settings."""
-    keys = ("seed", "structure", "random_test", "rig", "frf", "modal", "stiction", "linear_modes", "nonlinear",
-            "friction", "load_cases")
+    keys = (
+        "seed",
+        "structure",
+        "random_test",
+        "rig",
+        "frf",
+        "modal",
+        "stiction",
+        "linear_modes",
+        "nonlinear",
+        "friction",
+        "load_cases",
+    )
     return {k: config[k] for k in keys if k in config}
 
 

@@ -2,6 +2,7 @@
 
 
 rule friction_fit:
+    """The modified Valanis law (Eqs. 21-22) fitted by a genetic algorithm and a polish to S(t) of the calibration case, with profile-likelihood intervals (Table 4)."""
     priority: CRITICAL_PATH
     input:
         forces=lambda wc: f"results/{calibration_case()}/contact_forces.nc",
@@ -24,6 +25,7 @@ rule friction_fit:
 
 
 rule validate:
+    """The fitted friction law predicting one load case's S(t) from its identified motion and N(t) (Fig. 9)."""
     input:
         unpack(validate_inputs),
     output:

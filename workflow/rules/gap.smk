@@ -3,11 +3,13 @@
 
 
 rule gap:
+    """Target: the sim-to-real gap diagnosis of the configured data, its figures and report section (results/gap/)."""
     input:
         gap_outputs(),
 
 
 rule model_updating:
+    """Structural updating from the random test's modal data before the gap candidates (results/gap/model_updating.json)."""
     input:
         modal="results/linear/modal.nc",
         modes="results/linear/linear_modes.nc",
@@ -54,6 +56,7 @@ rule friction_intervals:
 
 
 rule gap_diagnosis:
+    """Where the identified model and the records disagree and which unmodelled effect explains it, checked on held-out load cases (results/gap/diagnosis.json, gap.nc)."""
     priority: CRITICAL_PATH
     input:
         unpack(gap_inputs),
@@ -90,6 +93,7 @@ rule gap_diagnosis:
 
 
 rule gap_figures:
+    """The gap diagnosis' figures: the gap by stage, the ranked candidates and the diagnostic views (results/gap/*.png)."""
     input:
         diagnosis="results/gap/diagnosis.json",
         dataset="results/gap/gap.nc",
@@ -112,6 +116,7 @@ rule gap_figures:
 
 
 rule gap_benchmark_item:
+    """One blind-benchmark item: rig records with a hidden effect, the chain's identification and the gap diagnosis, scored against the hidden truth."""
     output:
         item="results/gap_benchmark/items/{item}.json",
     params:
@@ -133,12 +138,17 @@ rule gap_benchmark_item:
 
 
 rule gap_benchmark:
+    """The blind benchmark's summary: top-1 accuracy, false alarms and confusion over every item (results/gap_benchmark/benchmark.json)."""
     input:
         rows=expand("results/gap_benchmark/items/{item}.json", item=list(benchmark_items())),
     output:
         summary="results/gap_benchmark/benchmark.json",
-        confusion=report("results/gap_benchmark/confusion.csv", caption="../report/gap_benchmark.rst", category="Gap diagnosis"),
-        figure=report("results/gap_benchmark/confusion.png", caption="../report/gap_benchmark.rst", category="Gap diagnosis"),
+        confusion=report(
+            "results/gap_benchmark/confusion.csv", caption="../report/gap_benchmark.rst", category="Gap diagnosis"
+        ),
+        figure=report(
+            "results/gap_benchmark/confusion.png", caption="../report/gap_benchmark.rst", category="Gap diagnosis"
+        ),
     params:
         code=CODE_DIGEST,
     conda:
@@ -168,6 +178,7 @@ rule gap_ladder:
 
 
 rule gap_report_fragment:
+    """The report's gap section in LaTeX (results/report/gap.tex)."""
     input:
         unpack(gap_report_inputs),
     output:

@@ -6,6 +6,7 @@
 for _fmt in ("uff58", "tdms", "csv"):
 
     rule:
+        """One measured record in a test rig's file format (UFF58, TDMS or CSV with its sidecar YAML) converted to the raw netCDF format with its channel map (data/imported/)."""
         name:
             f"import_{_fmt}"
         input:

@@ -2,6 +2,7 @@
 
 
 rule frf:
+    """H1 frequency response functions and coherence of every sensor from the random test (results/linear/frf.nc)."""
     priority: CRITICAL_PATH + 2
     input:
         raw=random_test_raw(),
@@ -25,6 +26,7 @@ rule frf:
 
 
 rule modal:
+    """Natural frequencies, damping and mode shapes by LSCF/LSFD on the FRFs, with their uncertainty (results/linear/modal.nc; Table 1)."""
     priority: CRITICAL_PATH + 2
     input:
         frf="results/linear/frf.nc",
@@ -44,6 +46,7 @@ rule modal:
 
 
 rule stiction_stiffness:
+    """The contact stiffnesses at stiction k_t and k_n fitted to the natural frequencies, with the intervals the data allow (results/linear/stiction.nc; Table 3)."""
     priority: CRITICAL_PATH + 2
     input:
         modal="results/linear/modal.nc",
@@ -64,6 +67,7 @@ rule stiction_stiffness:
 
 
 rule linear_modes:
+    """The stuck structure's linear modes on a grid (Eqs. 15-17's basis; results/linear/linear_modes.nc)."""
     priority: CRITICAL_PATH + 2
     input:
         stiction="results/linear/stiction.nc",
@@ -82,4 +86,3 @@ rule linear_modes:
         "benchmarks/rules/linear_modes.tsv"
     script:
         "../scripts/linear_modes.py"
-

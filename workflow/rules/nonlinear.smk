@@ -1,6 +1,8 @@
 # The dual-sine records of the load cases (Sections 3-5): checks, and later the nonlinear chain.
 
+
 rule raw_check:
+    """Reads and checks one load case's dual-sine record (periods, clipping, frequency, stationarity) and its harmonic content."""
     priority: CRITICAL_PATH
     input:
         raw=lambda wc: raw_record(wc.case),
@@ -20,6 +22,7 @@ rule raw_check:
 
 
 rule generalized_coordinates:
+    """The generalized coordinates of one load case from its accelerations (Eqs. 15-17; Fig. 4)."""
     priority: CRITICAL_PATH
     input:
         raw=lambda wc: raw_record(wc.case),
@@ -39,6 +42,7 @@ rule generalized_coordinates:
 
 
 rule nonlinear_modes:
+    """One load case's nonlinear normal modes (Eq. 20) and their phase check (Section 4)."""
     priority: CRITICAL_PATH
     input:
         raw=lambda wc: raw_record(wc.case),
@@ -59,6 +63,7 @@ rule nonlinear_modes:
 
 
 rule reduced_model:
+    """One load case's Galerkin reduced model (Eqs. 11-12; Fig. 5's reconstruction)."""
     priority: CRITICAL_PATH
     input:
         raw=lambda wc: raw_record(wc.case),
@@ -79,6 +84,7 @@ rule reduced_model:
 
 
 rule contact_forces:
+    """One load case's contact forces S(t) and N(t) by force-state mapping, by the working method and the paper's chain (Fig. 6)."""
     priority: CRITICAL_PATH
     input:
         unpack(contact_forces_inputs),
@@ -99,6 +105,7 @@ rule contact_forces:
 
 
 rule harmonic_study:
+    """How the identified contact forces and the friction fit move with the number of harmonics K (results/studies/harmonic_count.csv)."""
     input:
         raw=lambda wc: raw_record(calibration_case()),
         truth=lambda wc: f"data/truth/{calibration_case()}.nc",

@@ -2,6 +2,7 @@
 
 
 rule paper_consistency:
+    """The paper's Tables 1 and 3 against a faithful model of the test structure: where the paper's own numbers disagree."""
     output:
         table=report(
             "results/tables/paper_consistency.csv",
@@ -23,6 +24,7 @@ rule paper_consistency:
 
 
 rule linear_tables:
+    """Tables 1-3: measured (identified), model and paper frequencies and the stiction stiffnesses (results/tables/)."""
     input:
         modal="results/linear/modal.nc",
         stiction="results/linear/stiction.nc",
@@ -41,6 +43,7 @@ rule linear_tables:
 
 
 rule fig03_frf:
+    """Fig. 3: the driving-point FRF and its coherence (results/figures/fig03_frf.png)."""
     input:
         frf="results/linear/frf.nc",
         modal="results/linear/modal.nc",
@@ -58,6 +61,7 @@ rule fig03_frf:
 
 
 rule summary:
+    """Every identified number, its interval and, on rig data, its truth in one file (results/summary.json)."""
     input:
         unpack(summary_inputs),
     output:
@@ -73,10 +77,13 @@ rule summary:
 
 
 rule fig04_generalized_coordinates:
+    """Fig. 4: the generalized coordinates of the figure case."""
     input:
         gc=lambda wc: f"results/{figure_case()}/generalized_coordinates.nc",
     output:
-        png=report("results/figures/fig04_generalized_coordinates.png", caption="../report/fig04.rst", category="Figures"),
+        png=report(
+            "results/figures/fig04_generalized_coordinates.png", caption="../report/fig04.rst", category="Figures"
+        ),
         pdf="results/figures/fig04_generalized_coordinates.pdf",
     params:
         code=CODE_DIGEST,
@@ -90,6 +97,7 @@ rule fig04_generalized_coordinates:
 
 
 rule fig05_reconstruction:
+    """Fig. 5: the measured accelerations against the reduced model's reconstruction."""
     input:
         nnm=lambda wc: f"results/{figure_case()}/nonlinear_modes.nc",
     output:
@@ -107,6 +115,7 @@ rule fig05_reconstruction:
 
 
 rule fig06_contact_forces:
+    """Fig. 6: the identified contact forces and hysteresis loops of every load case."""
     input:
         forces=expand("results/{case}/contact_forces.nc", case=load_cases()),
     output:
@@ -124,6 +133,7 @@ rule fig06_contact_forces:
 
 
 rule friction_outputs:
+    """Table 4 and Figs. 7-9: the fitted friction law, its intervals and the validation on every load case."""
     input:
         fit="results/friction/friction_fit.nc",
         validations=expand("results/{case}/validation.nc", case=load_cases()),
@@ -135,12 +145,17 @@ rule friction_outputs:
         fig08_pdf="results/figures/fig08_s_xi.pdf",
         fig09_png=report("results/figures/fig09_s_xidot.png", caption="../report/fig09.rst", category="Figures"),
         fig09_pdf="results/figures/fig09_s_xidot.pdf",
-        convergence_png=report("results/figures/friction_convergence.png", caption="../report/convergence.rst",
-                               category="Figures"),
+        convergence_png=report(
+            "results/figures/friction_convergence.png", caption="../report/convergence.rst", category="Figures"
+        ),
     params:
         code=CODE_DIGEST,
         cases=load_cases(),
-        truth_friction=None if _is_measured(config["load_cases"].get(calibration_case())) else config["rig"].get("truth", {}).get("friction"),
+        truth_friction=(
+            None
+            if _is_measured(config["load_cases"].get(calibration_case()))
+            else config["rig"].get("truth", {}).get("friction")
+        ),
     conda:
         "../envs/contactid.yaml"
     log:

@@ -2,6 +2,7 @@
 
 
 rule report_fragments:
+    """The numbers and tables the PDF prints, as LaTeX fragments (results/report/numbers.tex and tables)."""
     input:
         summary="results/summary.json",
         table1="results/tables/table1.csv",
@@ -29,6 +30,7 @@ rule report_fragments:
 
 
 rule report:
+    """The PDF report compiled with latexmk from paper/report.tex and the fragments (results/report/report.pdf)."""
     input:
         tex="paper/report.tex",
         fragments=rules.report_fragments.output,
@@ -39,11 +41,7 @@ rule report:
             f"results/gap/gap_{v}.png"
             for v in ("stages", "harmonics", "cycle", "ranking", "shrink", "force_state", "explanation")
         ],
-        benchmark_figure=(
-            ["results/gap_benchmark/confusion.png"]
-            if gap_benchmark_in_report()
-            else []
-        ),
+        benchmark_figure=(["results/gap_benchmark/confusion.png"] if gap_benchmark_in_report() else []),
         figures=expand(
             "results/figures/{fig}.pdf",
             fig=[

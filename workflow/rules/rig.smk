@@ -2,11 +2,13 @@
 
 
 rule rig:
+    """Target: the virtual rig's raw records (data/raw/) and their truth (data/truth/) for every configured record."""
     input:
         rig_outputs(),
 
 
 rule rig_random_test:
+    """The virtual rig's random test: force and accelerations with noise (data/raw/random_test.nc) and its truth."""
     priority: CRITICAL_PATH + 2
     output:
         raw="data/raw/random_test.nc",
@@ -28,6 +30,7 @@ rule rig_random_test:
 
 
 rule rig_dual_sine:
+    """The virtual rig's response-controlled dual-sine test of one load case (data/raw/{case}.nc) and its truth."""
     priority: CRITICAL_PATH
     output:
         raw="data/raw/{case}.nc",

@@ -2,7 +2,9 @@
 # (snakemake.utils.Paramspace), with declared resources, and a gathering rule. Run them on one
 # machine or through a cluster executor (profiles/default, profiles/slurm; docs/studies.md, "Running on a cluster").
 
+
 rule noise_study_point:
+    """One point of the noise and record-length study: rig records, identification and the errors against the truth."""
     output:
         point=f"results/studies/noise/{NOISE_SPACE.wildcard_pattern}.json",
     params:
@@ -22,6 +24,7 @@ rule noise_study_point:
 
 
 rule noise_study:
+    """The noise and record-length study gathered: errors of mu, e_0 and k_t over the points (results/studies/noise_study.nc, figure)."""
     input:
         points=expand("results/studies/noise/{params}.json", params=NOISE_SPACE.instance_patterns),
     output:
@@ -44,6 +47,7 @@ rule noise_study:
 
 
 rule noise_report_fragment:
+    """The report's noise-study section in LaTeX (results/report/noise.tex; empty unless noise_study.in_report)."""
     input:
         unpack(noise_report_inputs),
     output:
