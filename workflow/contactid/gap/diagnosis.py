@@ -198,6 +198,65 @@ def cycle_parts(g: dict, k_t: float) -> dict:
     return {"stick": stick, "slip": slip, "velocity_reversal": reversal, "peak_compression": peak}
 
 
+def _response_gaps(fe, records: dict, sims: dict, H: int) -> dict:
+    """The gap of the accelerations and of the generalized coordinates (the sensors projected on the first
+    structural modes) per load case, and by sensor and by harmonic (rows: load cases)."""
+    cases = list(records)
+    phi_s = fe.sensor_vectors @ structural_modes(fe, min(3, len(records[cases[0]].sensors))).shapes
+    pinv = np.linalg.pinv(phi_s)
+    out = {"accelerations": [], "generalized_coordinates": [], "by_sensor": [], "by_harmonic": []}
+    for c in cases:
+        A, As = records[c].acceleration[:, :H], sims[c].acceleration[:, :H]
+        out["accelerations"].append(_rel(As, A))
+        out["generalized_coordinates"].append(_rel(pinv @ As, pinv @ A))
+        out["by_sensor"].append(np.linalg.norm(As - A, axis=1) / np.linalg.norm(A, axis=1))
+        out["by_harmonic"].append(np.linalg.norm(As - A, axis=0) / np.linalg.norm(A))
+    return {k: np.array(v) for k, v in out.items()}
+
+
+CYCLE_PARTS = ("stick", "slip", "velocity_reversal", "peak_compression")
+
+
+def _contact_gaps(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, sim, H: int, open_limit: float):
+    """One load case's contact-force stage: the contact forces identified from the record (inverse) against the
+    laws at the identified motion, the inverse identification's residual and noise, the contact's open fraction,
+    the energy per cycle (J; identified, simulated), the driving-point residual by part of the cycle and the
+    force-state map of what the laws leave."""
+    forces = identified_forces(model, aug, rec)
+    g = contact_grids(forces, rec.f0, model.preload, 256)
+    S_law = law_friction_force(g["xi"], g["xi_dot"], g["N"], np.asarray(model.friction), aug, model.regularization)[0]
+    S_law -= S_law.mean()
+    N_id = g["N"] - model.preload
+    # the best elastic normal law at the identified motion (stiffness + hardening): what it leaves
+    # is dissipation or opening in the normal direction
+    A_el = np.column_stack([-g["eta"], g["eta"] ** 2 - np.mean(g["eta"] ** 2)])
+    N_law = A_el @ np.linalg.lstsq(A_el, N_id, rcond=None)[0]
+    T = 1.0 / rec.f0
+    # part of the cycle: driving-point acceleration residual over one period
+    r_t = periodic_grid(sim.acceleration[0, :H] - rec.acceleration[0, :H], rec.f0, 256)[0]
+    a_rms = np.sqrt(np.mean(periodic_grid(rec.acceleration[0, :H], rec.f0, 256)[0] ** 2))
+    parts = cycle_parts(g, model.structure.k_t)
+    return {
+        # the sensors' misfit of the inverse identification at the driven harmonics (1 and 3): the
+        # structure and sensor model's consistency with the records, whatever the contact does
+        "identification_residual": float(np.sqrt(np.mean(forces.residual[[0, 2]] ** 2))),
+        "identification_noise": identification_noise(model, rec),
+        "S": _rel(S_law, g["S"]),
+        "N": _rel(N_law, N_id),
+        "open_fraction": open_fraction(g["N"], model.preload, open_limit),
+        "energy_tangential": (float(np.mean(g["S"] * g["xi_dot"]) * T), sim.energy["tangential_j"]),
+        "energy_normal": (float(-np.mean(N_id * g["eta_dot"]) * T), sim.energy["normal_j"]),
+        "cycle_parts": [
+            float(np.sqrt(np.mean(r_t[parts[p]] ** 2)) / a_rms) if parts[p].any() else 0.0 for p in CYCLE_PARTS
+        ],
+        "map": np.array([g["xi"], g["xi_dot"], g["S"] - S_law, g["eta"], g["eta_dot"], N_id - N_law]),
+    }
+
+
+def _rms(x) -> float:
+    return float(np.sqrt(np.mean(np.square(x))))
+
+
 def localise(
     model: IdentifiedModel,
     records: dict,
@@ -213,117 +272,36 @@ def localise(
     as the chain left it, or with the effects ``aug`` added). Returns (summary for diagnosis.json, arrays for
     gap.nc)."""
     H = n_harmonics
-    fe = fe_model(model, aug)
     cases = list(records)
-    arrays = {}
-    stage = {}
-    # accelerations and generalized coordinates
-    phi_s = fe.sensor_vectors @ structural_modes(fe, min(3, len(records[cases[0]].sensors))).shapes
-    pinv = np.linalg.pinv(phi_s)
-    acc_gap, gc_gap, per_sensor, per_harm = [], [], [], []
-    for c in cases:
-        A, As = records[c].acceleration[:, :H], sims[c].acceleration[:, :H]
-        acc_gap.append(_rel(As, A))
-        gc_gap.append(_rel(pinv @ As, pinv @ A))
-        per_sensor.append(np.linalg.norm(As - A, axis=1) / np.linalg.norm(A, axis=1))
-        per_harm.append(np.linalg.norm(As - A, axis=0) / np.linalg.norm(A))
-    arrays["gap_by_sensor"] = np.array(per_sensor)
-    arrays["gap_by_harmonic"] = np.array(per_harm)
-    stage["accelerations"] = float(np.sqrt(np.mean(np.square(acc_gap))))
-    stage["generalized_coordinates"] = float(np.sqrt(np.mean(np.square(gc_gap))))
-    # contact forces: identified (inverse, from the record) against the laws at the identified motion
-    s_res, n_res, e_t, e_n, parts_rms, id_res, scatter, open_frac = [], [], [], [], [], [], [], []
-    maps = []
-    part_names = ("stick", "slip", "velocity_reversal", "peak_compression")
-    for c in cases:
-        rec = records[c]
-        forces = identified_forces(model, aug, rec)
-        # the sensors' misfit of the inverse identification at the driven harmonics (1 and 3): the
-        # structure and sensor model's consistency with the records, whatever the contact does
-        id_res.append(float(np.sqrt(np.mean(forces.residual[[0, 2]] ** 2))))
-        scatter.append(identification_noise(model, rec))
-        g = contact_grids(forces, rec.f0, model.preload, 256)
-        S_law = law_friction_force(g["xi"], g["xi_dot"], g["N"], np.asarray(model.friction), aug, model.regularization)[
-            0
-        ]
-        S_law -= S_law.mean()
-        N_id = g["N"] - model.preload
-        # the best elastic normal law at the identified motion (stiffness + hardening): what it leaves
-        # is dissipation or opening in the normal direction
-        A_el = np.column_stack([-g["eta"], g["eta"] ** 2 - np.mean(g["eta"] ** 2)])
-        N_law = A_el @ np.linalg.lstsq(A_el, N_id, rcond=None)[0]
-        s_res.append(_rel(S_law, g["S"]))
-        n_res.append(_rel(N_law, N_id))
-        open_frac.append(open_fraction(g["N"], model.preload, thresholds.open_limit))
-        # energy per cycle (J): identified from the record vs the simulation
-        T = 1.0 / rec.f0
-        et_id = float(np.mean(g["S"] * g["xi_dot"]) * T)
-        en_id = float(-np.mean(N_id * g["eta_dot"]) * T)
-        e_t.append((et_id, sims[c].energy["tangential_j"]))
-        e_n.append((en_id, sims[c].energy["normal_j"]))
-        # part of the cycle: driving-point acceleration residual over one period
-        r_t = periodic_grid(sims[c].acceleration[0, :H] - rec.acceleration[0, :H], rec.f0, 256)[0]
-        a_rms = np.sqrt(np.mean(periodic_grid(rec.acceleration[0, :H], rec.f0, 256)[0] ** 2))
-        parts = cycle_parts(g, model.structure.k_t)
-        parts_rms.append(
-            [float(np.sqrt(np.mean(r_t[parts[p]] ** 2)) / a_rms) if parts[p].any() else 0.0 for p in part_names]
-        )
-        maps.append(np.array([g["xi"], g["xi_dot"], g["S"] - S_law, g["eta"], g["eta_dot"], N_id - N_law]))
-    stage["identification_residual"] = float(np.sqrt(np.mean(np.square(id_res))))
-    stage["open_fraction"] = float(np.max(open_frac))
-    stage["contact_force_S"] = float(np.sqrt(np.mean(np.square(s_res))))
-    stage["contact_force_N"] = float(np.sqrt(np.mean(np.square(n_res))))
-    e_t, e_n = np.array(e_t), np.array(e_n)
+    resp = _response_gaps(fe_model(model, aug), records, sims, H)
+    contact = [_contact_gaps(model, aug, records[c], sims[c], H, thresholds.open_limit) for c in cases]
+    per_case = {k: [row[k] for row in contact] for k in contact[0]}
+    e_t, e_n = np.array(per_case["energy_tangential"]), np.array(per_case["energy_normal"])
     scale_e = np.abs(e_t[:, 0])
-    stage["energy_tangential"] = float(np.sqrt(np.mean(((e_t[:, 1] - e_t[:, 0]) / scale_e) ** 2)))
-    stage["energy_normal"] = float(np.sqrt(np.mean(((e_n[:, 1] - e_n[:, 0]) / scale_e) ** 2)))
+    stage = {
+        "accelerations": _rms(resp["accelerations"]),
+        "generalized_coordinates": _rms(resp["generalized_coordinates"]),
+        "identification_residual": _rms(per_case["identification_residual"]),
+        "open_fraction": float(np.max(per_case["open_fraction"])),
+        "contact_force_S": _rms(per_case["S"]),
+        "contact_force_N": _rms(per_case["N"]),
+        "energy_tangential": _rms((e_t[:, 1] - e_t[:, 0]) / scale_e),
+        "energy_normal": _rms((e_n[:, 1] - e_n[:, 0]) / scale_e),
+    }
     if linear is not None:
         stage.update(linear)
-    arrays["energy_tangential"] = e_t
-    arrays["energy_normal"] = e_n
-    arrays["gap_by_cycle_part"] = np.array(parts_rms)
-    arrays["force_state_map"] = np.array(maps)
-    ph = np.mean(arrays["gap_by_harmonic"] ** 2, axis=0)
-    odd = float(np.sum(ph[0::2]))
-    even = float(np.sum(ph[1::2]))
-    worst_h = int(np.argmax(ph)) + 1
-    part_mean = np.mean(arrays["gap_by_cycle_part"], axis=0)
-    sensors = records[cases[0]].sensors
-    amps = [float(np.abs(records[c].acceleration[0, 0])) for c in cases]
-    slope = (
-        float(np.polyfit(np.log(amps), np.log(np.maximum(acc_gap, 1e-12)), 1)[0]) if len(cases) > 1 else float("nan")
-    )
-    direction = (
-        "normal" if stage["contact_force_N"] > thresholds.normal_limit or stage["open_fraction"] > 0 else "tangential"
-    )
-    summary = {
-        "stage": stage,
-        "largest_stage": max(
-            (
-                "accelerations",
-                "generalized_coordinates",
-                "contact_force_S",
-                "contact_force_N",
-                "energy_tangential",
-                "energy_normal",
-            ),
-            key=lambda k: stage[k],
-        ),
-        "direction": direction,
-        "by_sensor": {s: float(v) for s, v in zip(sensors, np.sqrt(np.mean(arrays["gap_by_sensor"] ** 2, axis=0)))},
-        "worst_sensor": sensors[int(np.argmax(np.mean(arrays["gap_by_sensor"] ** 2, axis=0)))],
-        "by_harmonic": {int(h): float(np.sqrt(v)) for h, v in enumerate(ph, start=1)},
-        "worst_harmonic": worst_h,
-        "even_share": even / max(odd + even, 1e-300),
-        "harmonic_class": "even" if even > odd else "odd",
-        "by_cycle_part": {p: float(v) for p, v in zip(part_names, part_mean)},
-        "worst_cycle_part": part_names[int(np.argmax(part_mean))],
-        "by_load_case": {c: float(g) for c, g in zip(cases, acc_gap)},
-        "load_exponent": slope,
-        "drift": {c: dict(zip(("change", "z"), record_drift(records[c], H))) for c in cases},
+    arrays = {
+        "gap_by_sensor": resp["by_sensor"],
+        "gap_by_harmonic": resp["by_harmonic"],
+        "energy_tangential": e_t,
+        "energy_normal": e_n,
+        "gap_by_cycle_part": np.array(per_case["cycle_parts"]),
+        "force_state_map": np.array(per_case["map"]),
     }
-    summary["identification_residual"] = {c: v for c, v in zip(cases, id_res)}
-    summary["identification_noise"] = {c: v for c, v in zip(cases, scatter)}
+    summary = {"stage": stage, **_gap_patterns(stage, arrays, records, resp["accelerations"], thresholds)}
+    summary["drift"] = {c: dict(zip(("change", "z"), record_drift(records[c], H))) for c in cases}
+    summary["identification_residual"] = dict(zip(cases, per_case["identification_residual"]))
+    summary["identification_noise"] = dict(zip(cases, per_case["identification_noise"]))
     spread = {c: eta_model_spread(model, aug, records[c], structures) for c in cases}
     finite = [v for v in spread.values() if np.isfinite(v)]
     worst = max(finite) if finite else float("nan")
@@ -335,8 +313,8 @@ def localise(
     summary["place"], summary["place_reason"] = _place_of(
         summary["drift"],
         stage,
-        np.array(id_res),
-        np.array(scatter),
+        np.array(per_case["identification_residual"]),
+        np.array(per_case["identification_noise"]),
         summary["eta_observability"]["observable"],
         worst,
         thresholds,
@@ -344,6 +322,39 @@ def localise(
     if not summary["eta_observability"]["observable"]:
         summary["direction"] = "unresolved"  # the normal direction's numbers rest on an unobservable eta
     return summary, arrays
+
+
+def _gap_patterns(stage: dict, arrays: dict, records: dict, acc_gap, thresholds: PlaceThresholds) -> dict:
+    """Where the gap lies: the largest stage, the direction (normal when the normal contact force's gap exceeds
+    ``thresholds.normal_limit`` or the contact opens), by sensor, harmonic (odd or even), part of the cycle and
+    load case, and the gap's growth with the load (the exponent of gap ~ A1^n over the load cases)."""
+    cases = list(records)
+    ph = np.mean(arrays["gap_by_harmonic"] ** 2, axis=0)
+    odd, even = float(np.sum(ph[0::2])), float(np.sum(ph[1::2]))
+    part_mean = np.mean(arrays["gap_by_cycle_part"], axis=0)
+    sensors = records[cases[0]].sensors
+    by_sensor = np.mean(arrays["gap_by_sensor"] ** 2, axis=0)
+    amps = [float(np.abs(records[c].acceleration[0, 0])) for c in cases]
+    slope = (
+        float(np.polyfit(np.log(amps), np.log(np.maximum(acc_gap, 1e-12)), 1)[0]) if len(cases) > 1 else float("nan")
+    )
+    largest = ("accelerations", "generalized_coordinates", "contact_force_S", "contact_force_N")
+    largest += ("energy_tangential", "energy_normal")
+    normal = stage["contact_force_N"] > thresholds.normal_limit or stage["open_fraction"] > 0
+    return {
+        "largest_stage": max(largest, key=lambda k: stage[k]),
+        "direction": "normal" if normal else "tangential",
+        "by_sensor": {s: float(v) for s, v in zip(sensors, np.sqrt(by_sensor))},
+        "worst_sensor": sensors[int(np.argmax(by_sensor))],
+        "by_harmonic": {int(h): float(np.sqrt(v)) for h, v in enumerate(ph, start=1)},
+        "worst_harmonic": int(np.argmax(ph)) + 1,
+        "even_share": even / max(odd + even, 1e-300),
+        "harmonic_class": "even" if even > odd else "odd",
+        "by_cycle_part": {p: float(v) for p, v in zip(CYCLE_PARTS, part_mean)},
+        "worst_cycle_part": CYCLE_PARTS[int(np.argmax(part_mean))],
+        "by_load_case": {c: float(g) for c, g in zip(cases, acc_gap)},
+        "load_exponent": slope,
+    }
 
 
 def record_drift(rec: RecordHarmonics, H: int) -> tuple[float, float]:
@@ -780,6 +791,87 @@ def _ranking_row(
     }
 
 
+def _ranking(results, heldout_gap, n_bootstrap, before, before_b, n_data, records, calibration_case, where):
+    """The candidates' ranking rows, sorted by score (scores equal to 3 decimals are a tie, the same model solved
+    from other starts: library order), and each candidate's bootstrap held-out gaps."""
+    rows, boots = [], {}
+    for name, (cal, sims, res) in results.items():
+        after = heldout_gap(sims)
+        after_b = np.array([heldout_gap(sims, b) for b in range(n_bootstrap)])
+        if not np.isfinite(after):  # a held-out prediction diverged: the candidate explains nothing
+            after, after_b = np.inf, np.full(n_bootstrap, np.inf)
+        boots[name] = after_b
+        rows.append(
+            _ranking_row(name, cal, res, after, after_b, before, before_b, n_data, records, calibration_case, where)
+        )
+    rows.sort(key=lambda r: round(r["score"], 3) if np.isfinite(r["score"]) else np.inf)
+    return rows, boots
+
+
+def _updating_summary(updating, model: IdentifiedModel) -> dict:
+    """diagnosis.json's model_updating block: the update's summary and the friction law the candidates start
+    from (refitted with the updated structure when the update is accepted)."""
+    e_f, k_c, e_t, kappa, mu = model.friction
+    return {
+        **updating.summary(),
+        "friction": {
+            "e_f": e_f,
+            "k_c": k_c,
+            "e_t": e_t,
+            "kappa": kappa,
+            "mu": mu,
+            "e0_at_preload": float(stiction_shear_stiffness(model.preload, e_f, k_c)),
+        },
+    }
+
+
+def _updating_step(updating, gap_before: float, gap_after: float) -> dict:
+    """The explanation's step 0 when the model updating was accepted: the factors and the held-out gap it took
+    away."""
+    return {
+        "effect": "model_updating",
+        "parameters": {**updating.factors, "k_t": updating.k_t, "k_n": updating.k_n},
+        "heldout_gap_before": gap_before,
+        "heldout_gap_after": gap_after,
+    }
+
+
+def _updating_verdict(updating, names, gap_before, gap_after, shares, scatter, settings) -> tuple[str, str] | None:
+    """(verdict, reason) when the accepted update explains most of the gap (the largest share, materially) and
+    amounts to one effect of the library in use; otherwise None."""
+    if shares[0] != max(shares) or not explains_materially(gap_before, gap_after, scatter, settings):
+        return None
+    effect = updating_effect(updating.factors, updating.identifiability)
+    if effect is None or effect not in names:
+        return None
+    return effect, (
+        f"model updating ({', '.join(f'{k} {v:.3g}' for k, v in updating.factors.items())}) takes the "
+        f"held-out gap from {gap_before:.3g} to {gap_after:.3g} ({shares[0]:.0%} of its power); only "
+        f"the {effect.replace('_error', '')} factor moved beyond {UPDATING_Z:g} standard deviations"
+    )
+
+
+def _place_left(last, records, calibration_case, H, linear, structures, settings) -> dict | None:
+    """The localisation of what the explanation leaves, with its effects in the model (``last``: the last step's
+    calibration and held-out simulations); None where a simulation is missing."""
+    cal, sims = last
+    all_sims = {c: (cal.simulation if c == calibration_case else sims[c]) for c in records}
+    if any(s is None for s in all_sims.values()):
+        return None
+    where_left, _ = localise(
+        cal.model,
+        dict(records),
+        all_sims,
+        H,
+        linear,
+        aug=cal.augmentation,
+        eta_limit=settings.eta_observability_limit,
+        structures=structures,
+        thresholds=settings.place,
+    )
+    return where_left
+
+
 def diagnose(
     model: IdentifiedModel,
     records: Mapping[str, RecordHarmonics],
@@ -801,12 +893,7 @@ def diagnose(
     cases = list(records)
     held = [c for c in cases if c != calibration_case]
     score_cases = held or [calibration_case]
-    base_sims = {}
-    base_res = {}
-    for c in cases:
-        g, sim = baseline(model, records[c], H)
-        base_sims[c] = sim
-        base_res[c] = gap_residual(sim, records[c], H)
+    base_sims = {c: baseline(model, records[c], H)[1] for c in cases}
     # candidates: calibrate, predict the held-out cases (forked before the localisation runs numba's
     # parallel friction kernel in this process)
     names = list(settings.candidates or tuple(LIBRARY))
@@ -849,20 +936,10 @@ def diagnose(
 
     before = heldout_gap(base_sims)
     before_b = np.array([heldout_gap(base_sims, b) for b in range(settings.n_bootstrap)])
-    n_data = 2 * sum(base_res[c].size for c in score_cases)
-    rows = []
-    boots = {}
-    for name, (cal, sims, res) in results.items():
-        after = heldout_gap(sims)
-        after_b = np.array([heldout_gap(sims, b) for b in range(settings.n_bootstrap)])
-        if not np.isfinite(after):  # a held-out prediction diverged: the candidate explains nothing
-            after, after_b = np.inf, np.full(settings.n_bootstrap, np.inf)
-        boots[name] = after_b
-        rows.append(
-            _ranking_row(name, cal, res, after, after_b, before, before_b, n_data, records, calibration_case, where)
-        )
-    # by score; scores equal to 3 decimals are a tie (the same model solved from other starts): library order
-    rows.sort(key=lambda r: round(r["score"], 3) if np.isfinite(r["score"]) else np.inf)
+    n_data = 2 * sum(gap_residual(base_sims[c], records[c], H).size for c in score_cases)
+    rows, boots = _ranking(
+        results, heldout_gap, settings.n_bootstrap, before, before_b, n_data, records, calibration_case, where
+    )
     scatter = float(np.std(before_b))
     verdict, reason = _verdict(rows, before, scatter, where["place"], settings, boots)
     shrink = {}
@@ -900,50 +977,20 @@ def diagnose(
     steps, left, last = explain(results, names, before, scatter, settings, heldout_gap, next_pass, later)
     first_before = before
     if updating is not None:
-        where["model_updating"] = updating.summary()
-        # the friction law the candidates start from (refitted with the updated structure when accepted)
-        e_f, k_c, e_t, kappa, mu = model.friction
-        where["model_updating"]["friction"] = {
-            "e_f": e_f,
-            "k_c": k_c,
-            "e_t": e_t,
-            "kappa": kappa,
-            "mu": mu,
-            "e0_at_preload": float(stiction_shear_stiffness(model.preload, e_f, k_c)),
-        }
+        where["model_updating"] = _updating_summary(updating, model)
     if identified is not None and updating is not None and updating.accepted:
-        id_sims = {c: baseline(identified, records[c], H)[1] for c in score_cases}
-        first_before = heldout_gap(id_sims)
+        first_before = heldout_gap({c: baseline(identified, records[c], H)[1] for c in score_cases})
         where["heldout_gap_identified"] = first_before
-        steps.insert(
-            0,
-            {
-                "effect": "model_updating",
-                "parameters": {**updating.factors, "k_t": updating.k_t, "k_n": updating.k_n},
-                "heldout_gap_before": first_before,
-                "heldout_gap_after": before,
-            },
-        )
+        steps.insert(0, _updating_step(updating, first_before, before))
         log.info("explanation step 0: model updating takes the held-out gap from %.4g to %.4g", first_before, before)
     shares, left_share = gap_shares(first_before, [s["heldout_gap_after"] for s in steps])
     for s, share in zip(steps, shares):
         s["share"] = share
-    if (
-        steps
-        and steps[0]["effect"] == "model_updating"
-        and verdict == "none"
-        and shares[0] == max(shares)
-        and explains_materially(first_before, before, scatter, settings)
-    ):
-        # the update explains most of the gap: if it amounts to one effect of the library in use, that is the verdict
-        effect = updating_effect(updating.factors, updating.identifiability)
-        if effect is not None and effect in names:
-            verdict = effect
-            reason = (
-                f"model updating ({', '.join(f'{k} {v:.3g}' for k, v in updating.factors.items())}) takes the "
-                f"held-out gap from {first_before:.3g} to {before:.3g} ({shares[0]:.0%} of its power); only "
-                f"the {effect.replace('_error', '')} factor moved beyond {UPDATING_Z:g} standard deviations"
-            )
+    if verdict == "none" and steps and steps[0]["effect"] == "model_updating":
+        verdict, reason = _updating_verdict(updating, names, first_before, before, shares, scatter, settings) or (
+            verdict,
+            reason,
+        )
     remaining = {
         "heldout_gap": left,
         "share": left_share,
@@ -954,20 +1001,8 @@ def diagnose(
         "place_reason": where["place_reason"],
     }
     if last is not None and not remaining["at_floor"]:  # where what is left lies, with the explanation's effects in
-        cal, sims = last
-        all_sims = {c: (cal.simulation if c == calibration_case else sims[c]) for c in cases}
-        if all(s is not None for s in all_sims.values()):
-            where_left, _ = localise(
-                cal.model,
-                dict(records),
-                all_sims,
-                H,
-                linear,
-                aug=cal.augmentation,
-                eta_limit=settings.eta_observability_limit,
-                structures=structures,
-                thresholds=settings.place,
-            )
+        where_left = _place_left(last, records, calibration_case, H, linear, structures, settings)
+        if where_left is not None:
             remaining["place"] = where_left["place"]
             remaining["place_reason"] = where_left["place_reason"]
     diag = Diagnosis(
