@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import logging
 import time
+from dataclasses import dataclass
 from typing import Mapping
 
 import numpy as np
@@ -146,54 +147,71 @@ def _refitted(effect, ranking: Mapping, updating) -> float | None:
     return m
 
 
-def run_item(spec: Mapping, cfg: Mapping) -> dict:
-    """Generate the item's rig records, identify the model from them, diagnose; the result row. ``cfg``: the base
-    config (keys left out: the schema's defaults)."""
-    from ..config import with_defaults
-    from ..friction_fit import settings_from_config
-    from .diagnosis import GapSettings, diagnose, linear_stage
-    from .pipeline import identify, rig_records, updated_model
-    from .records import record_harmonics
-
-    t0 = time.perf_counter()
-    cfg = with_defaults(cfg)
+def item_config(cfg: Mapping, spec: Mapping) -> tuple[dict, dict]:
+    """The config of an item's rig (a compound item's perturbed as ``compound_config`` says) and the effects it hides
+    {effect: magnitude (rig units)}; ``cfg``: the base config with the schema's defaults."""
     effects = {spec["effect"]: spec["magnitude"]} if spec["effect"] else {}
-    compound = spec["kind"] == "compound"
-    if compound:
+    if spec["kind"] == "compound":
         cfg = compound_config(cfg, spec)
         effects = dict(spec["effects"])
-    cases = sorted(cfg["load_cases"], key=lambda c: int(c[2:]))
-    cal = cfg["nonlinear"]["calibration_case"]
+    return cfg, effects
+
+
+def hidden_text(spec: Mapping, effects: Mapping) -> str:
+    """What an item hides, in words (for the log)."""
     hidden = f"{spec['effect']} at {spec['magnitude']:.4g}" if spec["effect"] else "no effect"
-    if compound:
+    if spec["kind"] == "compound":
         hidden = "perturbed rig with " + (", ".join(f"{e} at {m:.4g}" for e, m in effects.items()) or "no effect")
-    log.info(
-        "benchmark item (%s, seed %d): %s; making the rig records of %s",
-        spec["kind"],
-        int(spec["seed"]),
-        hidden,
-        ", ".join(["random_test", *cases]),
-    )
-    recs, converged = rig_records(cfg, effects, int(spec["seed"]), cases)
-    t_rig = time.perf_counter() - t0
-    bad = [
+    return hidden
+
+
+def nonfinite_records(recs: Mapping) -> list:
+    """The names of the rig records whose acceleration or force is not finite everywhere."""
+    return [
         n
         for n, ds in recs.items()
         if not (np.isfinite(ds["acceleration"].values).all() and np.isfinite(ds["force"].values).all())
     ]
-    if bad:  # the rig could not simulate this data set: say so, score it apart
-        log.warning(
-            "benchmark item (%s): the rig's records of %s are not finite; not diagnosed", spec["kind"], ", ".join(bad)
-        )
-        return {
-            **dict(spec),
-            "failed": f"rig records not finite: {', '.join(bad)}",
-            "verdict": None,
-            "correct": False,
-            "control_converged": converged,
-            "seconds": {"rig": t_rig},
-        }
-    log.info("rig records made in %.1f s; identifying the model", t_rig)
+
+
+def failed_row(spec: Mapping, bad: list, converged, t_rig: float) -> dict:
+    """The result row of an item whose rig records are not finite (not diagnosed, scored apart); ``t_rig`` in s."""
+    return {
+        **dict(spec),
+        "failed": f"rig records not finite: {', '.join(bad)}",
+        "verdict": None,
+        "correct": False,
+        "control_converged": converged,
+        "seconds": {"rig": t_rig},
+    }
+
+
+@dataclass(frozen=True)
+class ItemDiagnosis:
+    """An item's identification and diagnosis: the diagnosis, the model it diagnosed (after model updating) and the
+    chain's, the model update (None: off), the records' harmonics {case: record}, the friction fit's settings; the
+    identification's time, the diagnosis' start (``time.perf_counter``) and its time, in s."""
+
+    diag: object
+    model: object
+    chain_model: object
+    updating: object
+    records: dict
+    fit_settings: object
+    t_id: float
+    t1: float
+    t_diag: float
+
+
+def diagnose_item(spec: Mapping, cfg: Mapping, recs: Mapping, cases: list, t0: float, t_rig: float) -> ItemDiagnosis:
+    """Identify the model from an item's rig records ``recs`` (the chain, then model updating) and diagnose it with
+    the item's library; ``t0`` the item's start (``time.perf_counter``, s), ``t_rig`` the rig's time (s)."""
+    from ..friction_fit import settings_from_config
+    from .diagnosis import GapSettings, diagnose, linear_stage
+    from .pipeline import identify, updated_model
+    from .records import record_harmonics
+
+    cal = cfg["nonlinear"]["calibration_case"]
     model, modes, modal, frf = identify(cfg, recs["random_test"], recs[cal])
     K = int(cfg["nonlinear"]["n_harmonics"])
     fit_settings = settings_from_config(cfg["friction"])
@@ -222,63 +240,123 @@ def run_item(spec: Mapping, cfg: Mapping) -> dict:
         updating=updating,
     )
     t_diag = time.perf_counter() - t1
-    by = {r["effect"]: r for r in diag.ranking}
-    if compound:
-        from .uncertainty import NAMES, friction_uncertainty
+    return ItemDiagnosis(diag, model, chain_model, updating, records, fit_settings, t_id, t1, t_diag)
 
-        named = [s["effect"] for s in diag.explanation if s["effect"] != "model_updating"]
-        preload = float(cfg["structure"]["preload_n"])
-        t_unc = time.perf_counter()
-        unc = friction_uncertainty(
-            model,
-            records,
-            cal,
-            fit_settings,
-            int(cfg["seed"]),
-            updating.posterior_structures() if updating is not None else (),
+
+def compound_row(spec: Mapping, cfg: Mapping, effects: Mapping, item: ItemDiagnosis, converged, t_rig: float) -> dict:
+    """A compound item's result row: the additive explanation scored against the hidden ``effects``, the friction
+    law's errors (relative) and its intervals with the model-form term; seconds of each step."""
+    from .uncertainty import NAMES, friction_uncertainty
+
+    diag, model, updating = item.diag, item.model, item.updating
+    cal = cfg["nonlinear"]["calibration_case"]
+    named = [s["effect"] for s in diag.explanation if s["effect"] != "model_updating"]
+    preload = float(cfg["structure"]["preload_n"])
+    t_unc = time.perf_counter()
+    unc = friction_uncertainty(
+        model,
+        item.records,
+        cal,
+        item.fit_settings,
+        int(cfg["seed"]),
+        updating.posterior_structures() if updating is not None else (),
+    )
+    t_unc = time.perf_counter() - t_unc
+    truth = cfg["rig"]["truth"]["friction"]
+    return {
+        **dict(spec),
+        "verdict": diag.verdict,
+        "reason": diag.reason,
+        "explanation": diag.explanation,
+        "remaining_gap": diag.remaining_gap,
+        "named": named,
+        "correct": set(named) == set(effects),
+        "updating_accepted": bool(updating is not None and updating.accepted),
+        "heldout_gap_before": diag.where.get("heldout_gap_identified", diag.where["heldout_gap_before"]),
+        "friction_errors": friction_errors(model, truth, preload),
+        "friction_errors_chain": friction_errors(item.chain_model, truth, preload),
+        "bound_errors": bound_errors(
+            model, truth, preload, cfg["rig"]["true_structure"]["contact_geometry"]["tangential_lever_arm_m"]
+        ),
+        "friction_intervals": {n: [float(v) for v in unc.interval[NAMES.index(n)]] for n in ("mu", "kappa", "e0")},
+        "friction_covered": unc.covers(friction_truth(truth, preload)),
+        "friction_interval_halfwidth": unc.relative_halfwidth(("mu", "kappa", "e0")),
+        "where": diag.where,
+        "control_converged": converged,
+        "seconds": {
+            "rig": t_rig,
+            "identification": item.t_id,
+            "diagnosis": time.perf_counter() - item.t1 - t_unc,
+            "intervals": t_unc,
+        },
+    }
+
+
+def blind_row(spec: Mapping, item: ItemDiagnosis, converged, t_rig: float) -> dict:
+    """A single-effect (blind, effect-free, left-out or ladder) item's result row: the verdict against the hidden
+    effect, the true effect's held-out gap, refitted magnitude and shrink, the ranking; seconds of each step."""
+    diag, true = item.diag, spec["effect"]
+    by = {r["effect"]: r for r in diag.ranking}
+    return {
+        **dict(spec),
+        "verdict": diag.verdict,
+        "reason": diag.reason,
+        "correct": (diag.verdict == (true or "none")) if spec["kind"] != "leave_out" else diag.verdict == "none",
+        "heldout_gap_before": diag.where["heldout_gap_before"],
+        "heldout_gap_identified": diag.where.get("heldout_gap_identified", diag.where["heldout_gap_before"]),
+        "heldout_gap_after_true": by[true]["heldout_gap_after"] if true in by else None,
+        "refitted_magnitude": _refitted(true, by, item.updating),
+        "shrink_true": by[true]["reduction"] if true in by else None,
+        "ranking": [
+            {k: r[k] for k in ("effect", "heldout_gap_before", "heldout_gap_after", "score", "reduction")}
+            for r in diag.ranking
+        ],
+        "where": diag.where,
+        "control_converged": converged,
+        "seconds": {"rig": t_rig, "identification": item.t_id, "diagnosis": item.t_diag},
+    }
+
+
+def run_item(spec: Mapping, cfg: Mapping) -> dict:
+    """Generate the item's rig records, identify the model from them, diagnose; the result row. ``cfg``: the base
+    config (keys left out: the schema's defaults)."""
+    from ..config import with_defaults
+    from .pipeline import rig_records
+
+    t0 = time.perf_counter()
+    cfg, effects = item_config(with_defaults(cfg), spec)
+    cases = sorted(cfg["load_cases"], key=lambda c: int(c[2:]))
+    hidden = hidden_text(spec, effects)
+    log.info(
+        "benchmark item (%s, seed %d): %s; making the rig records of %s",
+        spec["kind"],
+        int(spec["seed"]),
+        hidden,
+        ", ".join(["random_test", *cases]),
+    )
+    recs, converged = rig_records(cfg, effects, int(spec["seed"]), cases)
+    t_rig = time.perf_counter() - t0
+    bad = nonfinite_records(recs)
+    if bad:  # the rig could not simulate this data set: say so, score it apart
+        log.warning(
+            "benchmark item (%s): the rig's records of %s are not finite; not diagnosed", spec["kind"], ", ".join(bad)
         )
-        t_unc = time.perf_counter() - t_unc
-        row = {
-            **dict(spec),
-            "verdict": diag.verdict,
-            "reason": diag.reason,
-            "explanation": diag.explanation,
-            "remaining_gap": diag.remaining_gap,
-            "named": named,
-            "correct": set(named) == set(effects),
-            "updating_accepted": bool(updating is not None and updating.accepted),
-            "heldout_gap_before": diag.where.get("heldout_gap_identified", diag.where["heldout_gap_before"]),
-            "friction_errors": friction_errors(model, cfg["rig"]["truth"]["friction"], preload),
-            "friction_errors_chain": friction_errors(chain_model, cfg["rig"]["truth"]["friction"], preload),
-            "bound_errors": bound_errors(
-                model,
-                cfg["rig"]["truth"]["friction"],
-                preload,
-                cfg["rig"]["true_structure"]["contact_geometry"]["tangential_lever_arm_m"],
-            ),
-            "friction_intervals": {n: [float(v) for v in unc.interval[NAMES.index(n)]] for n in ("mu", "kappa", "e0")},
-            "friction_covered": unc.covers(friction_truth(cfg["rig"]["truth"]["friction"], preload)),
-            "friction_interval_halfwidth": unc.relative_halfwidth(("mu", "kappa", "e0")),
-            "where": diag.where,
-            "control_converged": converged,
-            "seconds": {
-                "rig": t_rig,
-                "identification": t_id,
-                "diagnosis": time.perf_counter() - t1 - t_unc,
-                "intervals": t_unc,
-            },
-        }
+        return failed_row(spec, bad, converged, t_rig)
+    log.info("rig records made in %.1f s; identifying the model", t_rig)
+    item = diagnose_item(spec, cfg, recs, cases, t0, t_rig)
+    diag = item.diag
+    if spec["kind"] == "compound":
+        row = compound_row(spec, cfg, effects, item, converged, t_rig)
         log.info(
             "benchmark item (compound): %s -> explanation %s (remaining gap %.3g), mu error %.2g %%, %.1f s",
             hidden,
-            ", ".join(["model_updating"] * row["updating_accepted"] + named) or "none",
+            ", ".join(["model_updating"] * row["updating_accepted"] + row["named"]) or "none",
             diag.remaining_gap["heldout_gap"],
             100 * row["friction_errors"]["mu"],
             time.perf_counter() - t0,
         )
         return row
-    true = spec["effect"]
-    expected = "none" if spec["kind"] == "leave_out" else (true or "none")
+    expected = "none" if spec["kind"] == "leave_out" else (spec["effect"] or "none")
     log.info(
         "benchmark item (%s): %s -> verdict %s (expected %s: %s), %.1f s in all",
         spec["kind"],
@@ -288,24 +366,7 @@ def run_item(spec: Mapping, cfg: Mapping) -> dict:
         "right" if diag.verdict == expected else "wrong",
         time.perf_counter() - t0,
     )
-    return {
-        **dict(spec),
-        "verdict": diag.verdict,
-        "reason": diag.reason,
-        "correct": (diag.verdict == (true or "none")) if spec["kind"] != "leave_out" else diag.verdict == "none",
-        "heldout_gap_before": diag.where["heldout_gap_before"],
-        "heldout_gap_identified": diag.where.get("heldout_gap_identified", diag.where["heldout_gap_before"]),
-        "heldout_gap_after_true": by[true]["heldout_gap_after"] if true in by else None,
-        "refitted_magnitude": _refitted(true, by, updating),
-        "shrink_true": by[true]["reduction"] if true in by else None,
-        "ranking": [
-            {k: r[k] for k in ("effect", "heldout_gap_before", "heldout_gap_after", "score", "reduction")}
-            for r in diag.ranking
-        ],
-        "where": diag.where,
-        "control_converged": converged,
-        "seconds": {"rig": t_rig, "identification": t_id, "diagnosis": t_diag},
-    }
+    return blind_row(spec, item, converged, t_rig)
 
 
 def score(rows: list) -> dict:

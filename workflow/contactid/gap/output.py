@@ -31,14 +31,10 @@ def diagnosis_json(diag: Diagnosis, extra: dict | None = None) -> str:
     return json.dumps(_clean({**diag.summary(), **(extra or {})}), indent=2)
 
 
-def gap_dataset(diag: Diagnosis, records: dict, n_harmonics: int) -> xr.Dataset:
-    """The localisation arrays and the measured and simulated harmonics (base model, winner, runner-up)."""
-    cases = list(records)
-    sensors = list(records[cases[0]].sensors)
-    H = n_harmonics
-    a = diag.arrays
-    parts = ["stick", "slip", "velocity_reversal", "peak_compression"]
-    data = {
+def localisation_variables(a: dict) -> dict:
+    """The localisation arrays as dataset variables {name: (dims, values, attrs)}: the gap by sensor, harmonic and
+    part of the cycle (relative, 1), the energy dissipated per cycle (J) and the force-state maps (SI)."""
+    return {
         "gap_by_sensor": (
             ("case", "sensor"),
             a["gap_by_sensor"],
@@ -75,6 +71,14 @@ def gap_dataset(diag: Diagnosis, records: dict, n_harmonics: int) -> xr.Dataset:
                 "long_name": "identified motion and the residual force (identified - law) over one period",
             },
         ),
+    }
+
+
+def record_variables(records: dict, n_harmonics: int) -> dict:
+    """The records' acceleration harmonics 1..H (m/s^2, force phase 0), real and imaginary parts, as dataset
+    variables {name: (dims, values, attrs)}."""
+    cases, H = list(records), n_harmonics
+    return {
         "acceleration_record_real": (
             ("case", "sensor", "harmonic"),
             np.array([records[c].acceleration[:, :H].real for c in cases]),
@@ -86,9 +90,18 @@ def gap_dataset(diag: Diagnosis, records: dict, n_harmonics: int) -> xr.Dataset:
             {"units": "m/s^2", "long_name": "record harmonics, imaginary part"},
         ),
     }
+
+
+def simulated_variables(diag: Diagnosis, records: dict, n_harmonics: int) -> dict:
+    """The simulated acceleration harmonics 1..H (m/s^2) of the base model, the winner and the runner-up, real and
+    imaginary parts (NaN where not simulated), as dataset variables {name: (dims, values, attrs)}."""
+    cases = list(records)
+    sensors = list(records[cases[0]].sensors)
+    H = n_harmonics
     models = {"base": diag.sims["base"]}
     for r in diag.ranking[:2]:
         models[r["effect"]] = diag.sims[r["effect"]]
+    data = {}
     for label, sims in models.items():
         arr = np.full((len(cases), len(sensors), H), np.nan + 0j)
         for i, c in enumerate(cases):
@@ -112,38 +125,59 @@ def gap_dataset(diag: Diagnosis, records: dict, n_harmonics: int) -> xr.Dataset:
                 "nonfinite_meaning": "NaN: not simulated",
             },
         )
-    effects = [r["effect"] for r in diag.ranking]
-    data["heldout_gap_after"] = (
-        "effect",
-        [r["heldout_gap_after"] for r in diag.ranking],
-        {"units": "1", "long_name": "held-out gap with the candidate added"},
-    )
-    data["heldout_gap_after_low"] = (
-        "effect",
-        [r["heldout_gap_after_interval"][0] for r in diag.ranking],
-        {"units": "1", "long_name": "bootstrap 2.5 % quantile"},
-    )
-    data["heldout_gap_after_high"] = (
-        "effect",
-        [r["heldout_gap_after_interval"][1] for r in diag.ranking],
-        {"units": "1", "long_name": "bootstrap 97.5 % quantile"},
-    )
-    data["score"] = (
-        "effect",
-        [r["score"] for r in diag.ranking],
-        {"units": "1", "long_name": "n ln(after^2/before^2) + 2 k (lower is better)"},
-    )
+    return data
+
+
+def ranking_variables(ranking: list) -> dict:
+    """The candidates' held-out gap after (relative, 1) with its bootstrap 95 % interval and their scores, along
+    ``effect``, as dataset variables {name: (dims, values, attrs)}."""
+    return {
+        "heldout_gap_after": (
+            "effect",
+            [r["heldout_gap_after"] for r in ranking],
+            {"units": "1", "long_name": "held-out gap with the candidate added"},
+        ),
+        "heldout_gap_after_low": (
+            "effect",
+            [r["heldout_gap_after_interval"][0] for r in ranking],
+            {"units": "1", "long_name": "bootstrap 2.5 % quantile"},
+        ),
+        "heldout_gap_after_high": (
+            "effect",
+            [r["heldout_gap_after_interval"][1] for r in ranking],
+            {"units": "1", "long_name": "bootstrap 97.5 % quantile"},
+        ),
+        "score": (
+            "effect",
+            [r["score"] for r in ranking],
+            {"units": "1", "long_name": "n ln(after^2/before^2) + 2 k (lower is better)"},
+        ),
+    }
+
+
+def gap_dataset(diag: Diagnosis, records: dict, n_harmonics: int) -> xr.Dataset:
+    """The localisation arrays and the measured and simulated harmonics (base model, winner, runner-up)."""
+    cases = list(records)
+    sensors = list(records[cases[0]].sensors)
+    H = n_harmonics
+    a = diag.arrays
+    data = {
+        **localisation_variables(a),
+        **record_variables(records, H),
+        **simulated_variables(diag, records, H),
+        **ranking_variables(diag.ranking),
+    }
     return xr.Dataset(
         data,
         coords={
             "case": cases,
             "sensor": sensors,
             "harmonic": np.arange(1, H + 1),
-            "cycle_part": parts,
+            "cycle_part": ["stick", "slip", "velocity_reversal", "peak_compression"],
             "source": ["identified", "simulated"],
             "phase": np.arange(a["force_state_map"].shape[-1]),
             "map_field": ["xi", "xi_dot", "S_residual", "eta", "eta_dot", "N_residual"],
-            "effect": effects,
+            "effect": [r["effect"] for r in diag.ranking],
         },
         attrs={
             "verdict": diag.verdict,

@@ -150,16 +150,23 @@ def intervals_text(intervals: dict | None) -> str:
     )
 
 
-def gap_section(diag: dict, bench: dict | None, intervals: dict | None = None) -> str:
-    w = diag["where"]
-    st = w["stage"]
-    lines = [
+def comparison_lines(diag: dict) -> list[str]:
+    """The section's opening lines: what is compared with what, and the calibration case."""
+    return [
         r"The identified model (linear stiffnesses and damping of the linear chain, the fitted friction law, the",
         r"linear normal spring of Eq.~13) is simulated under each load case's measured force and compared with the",
         r"records at every level of the chain. The friction law was fitted on "
         + _t(diag["calibration_case"])
         + r"; the other load cases are held out.",
-        "",
+    ]
+
+
+def where_paragraph(diag: dict) -> str:
+    """The paragraph 'Where the gap lies': the held-out gap (%), by stage, the worst sensor, harmonic and part of
+    the cycle, and the place the localisation names."""
+    w = diag["where"]
+    st = w["stage"]
+    return (
         r"\paragraph{Where the gap lies.} Held-out gap (sensor harmonics 1--"
         + str(len(w["by_harmonic"]))
         + r"): "
@@ -195,13 +202,29 @@ def gap_section(diag: dict, bench: dict | None, intervals: dict | None = None) -
         + r" of the residual), worst part of the cycle: "
         + _t(w["worst_cycle_part"])
         + r". "
-        r"The localisation places the gap in: \emph{" + _t(w["place"]) + r"} (" + _t(w["place_reason"]) + ").",
+        r"The localisation places the gap in: \emph{" + _t(w["place"]) + r"} (" + _t(w["place_reason"]) + ")."
+    )
+
+
+def diagnosis_paragraphs(diag: dict) -> str:
+    """The diagnosis in words (newline-terminated lines): the comparison, where the gap lies, which effect, and the
+    additive explanation step by step."""
+    lines = [
+        *comparison_lines(diag),
+        "",
+        where_paragraph(diag),
         "",
         r"\paragraph{Which effect.} Verdict: \textbf{" + _t(diag["verdict"]) + r"} --- " + _t(diag["reason"]) + ".",
         "",
         r"\paragraph{Step by step.} " + explanation_text(diag),
         "",
     ]
+    return "\n".join(lines) + "\n"
+
+
+def candidates_table(diag: dict) -> str:
+    """The table of the candidates (held-out gap before and after, its bootstrap interval and the shrink in %, the
+    score); empty without candidates."""
     rows = pd.DataFrame(
         [
             {
@@ -217,49 +240,53 @@ def gap_section(diag: dict, bench: dict | None, intervals: dict | None = None) -
             for r in diag["ranking"]
         ]
     )
-    out = "\n".join(lines) + "\n"
-    if len(rows):
-        out += tabular(
-            rows,
-            {
-                "effect": "candidate",
-                "k": "$k$",
-                "before": "before (\\%)",
-                "after": "after (\\%)",
-                "low": "2.5\\,\\%",
-                "high": "97.5\\,\\%",
-                "reduction": "shrink (\\%)",
-                "score": "score",
-            },
-            "Candidate effects refitted on the calibration case and scored on the held-out cases "
-            "(held-out gap before and after, bootstrap interval of after, score $n\\ln(g_a^2/g_b^2)+2k$).",
-            "tab:gap",
-        )
-    out += (
-        "\\begin{figure}[H]\\centering\\includegraphics[width=0.49\\textwidth]{gap_stages.png}"
-        "\\includegraphics[width=0.49\\textwidth]{gap_ranking.png}\n"
-        "\\includegraphics[width=0.49\\textwidth]{gap_harmonics.png}"
-        "\\includegraphics[width=0.49\\textwidth]{gap_cycle.png}\n"
-        "\\includegraphics[width=0.49\\textwidth]{gap_shrink.png}"
-        "\\includegraphics[width=0.49\\textwidth]{gap_force_state.png}\n"
-        "\\caption{The gap by stage, the candidates ranked, by harmonic and sensor, by part of the cycle and "
-        "dissipation in each direction, the held-out gap before and after the two best candidates, and the residual "
-        "force-state maps.}\\label{fig:gap}\\end{figure}\n"
+    if not len(rows):
+        return ""
+    return tabular(
+        rows,
+        {
+            "effect": "candidate",
+            "k": "$k$",
+            "before": "before (\\%)",
+            "after": "after (\\%)",
+            "low": "2.5\\,\\%",
+            "high": "97.5\\,\\%",
+            "reduction": "shrink (\\%)",
+            "score": "score",
+        },
+        "Candidate effects refitted on the calibration case and scored on the held-out cases "
+        "(held-out gap before and after, bootstrap interval of after, score $n\\ln(g_a^2/g_b^2)+2k$).",
+        "tab:gap",
     )
-    out += (
-        "\\begin{figure}[H]\\centering\\includegraphics[width=0.7\\textwidth]{gap_explanation.png}"
-        "\\caption{The held-out gap explained step by step: the identified model, what each added effect removes, "
-        "what remains (dotted: the identification's floor).}\\label{fig:gap_explanation}\\end{figure}\n"
-    )
-    out += intervals_text(intervals)
-    if bench is None:
-        out += (
-            "\n\\paragraph{Blind benchmark.} Not built with this report (\\texttt{gap\\_benchmark.in\\_report: "
-            "false}); run \\texttt{snakemake gap\\_benchmark}.\n"
-        )
-        return out
+
+
+# the diagnosis' figures (results/gap/*.png) and the additive explanation's
+GAP_FIGURES = (
+    "\\begin{figure}[H]\\centering\\includegraphics[width=0.49\\textwidth]{gap_stages.png}"
+    "\\includegraphics[width=0.49\\textwidth]{gap_ranking.png}\n"
+    "\\includegraphics[width=0.49\\textwidth]{gap_harmonics.png}"
+    "\\includegraphics[width=0.49\\textwidth]{gap_cycle.png}\n"
+    "\\includegraphics[width=0.49\\textwidth]{gap_shrink.png}"
+    "\\includegraphics[width=0.49\\textwidth]{gap_force_state.png}\n"
+    "\\caption{The gap by stage, the candidates ranked, by harmonic and sensor, by part of the cycle and "
+    "dissipation in each direction, the held-out gap before and after the two best candidates, and the residual "
+    "force-state maps.}\\label{fig:gap}\\end{figure}\n"
+    "\\begin{figure}[H]\\centering\\includegraphics[width=0.7\\textwidth]{gap_explanation.png}"
+    "\\caption{The held-out gap explained step by step: the identified model, what each added effect removes, "
+    "what remains (dotted: the identification's floor).}\\label{fig:gap_explanation}\\end{figure}\n"
+)
+
+NO_BENCHMARK = (
+    "\n\\paragraph{Blind benchmark.} Not built with this report (\\texttt{gap\\_benchmark.in\\_report: "
+    "false}); run \\texttt{snakemake gap\\_benchmark}.\n"
+)
+
+
+def blind_paragraph(bench: dict) -> str:
+    """The blind benchmark in words: top-1 accuracy, false alarms, shrink of the correctly named effects (%), the
+    left-out items and the median diagnosis time (s)."""
     lo = bench["leave_out"]
-    out += (
+    return (
         "\n\\paragraph{Blind benchmark.} " + str(bench["n_blind"]) + r" rig data sets, each with one effect on at a "
         r"random (seeded) magnitude, diagnosed from their raw records alone: top-1 accuracy "
         + _pct(bench["top1_accuracy"])
@@ -281,41 +308,70 @@ def gap_section(diag: dict, bench: dict | None, intervals: dict | None = None) -
         + f"${bench['diagnosis_seconds']['median']:.0f}$"
         + "\\,s.\n"
     )
-    c = bench.get("compound")
-    if c:
-        err = c["perturbation_only_median_abs_error"]
-        out += (
-            "\n\\paragraph{Compound benchmark.} " + str(c["n"]) + r" rig data sets whose structure (E, transducer "
-            r"masses, tangential lever arm), normal law and damping form differ from the model's at random, with 0, 1 "
-            r"or 2 effects (" + ", ".join(f"{v} with {k}" for k, v in c["n_by_effect_count"].items()) + r"), diagnosed "
-            r"with model updating and scored on the additive explanation. Perturbation only: no contact effect named "
-            r"in "
-            + _pct(c["perturbation_only_no_contact_effect"])
-            + r"; one effect: named in "
-            + _pct(c["one_effect_named"])
-            + r", no absent contact effect in "
-            + _pct(c["one_effect_no_absent_contact_effect"])
-            + r"; two effects: both named in "
-            + _pct(c["two_effects_both_named"])
-            + r", at least one in "
-            + _pct(c["two_effects_one_named"])
-            + r". Median remaining held-out gap "
-            + _pct(c["remaining_gap_median"])
-            + r". Perturbation only, after updating, median errors: $\mu$ "
-            + _pct(err["mu"])
-            + r", $\kappa$ "
-            + _pct(err["kappa"])
-            + r", $e_0$ "
-            + _pct(err["e0"])
-            + r" (the tangential lever arm, which linear data do not "
-            r"bound, scales the identified $S$ and so $\mu$)." + _bound_text(c) + _coverage_text(c)
-        ) + "\n"
+
+
+def compound_paragraph(c: dict) -> str:
+    """The compound benchmark in words: effects named (%), the remaining held-out gap and the friction law's errors
+    after updating (%), with what the data bind and the intervals' coverage when scored."""
+    err = c["perturbation_only_median_abs_error"]
+    return (
+        "\n\\paragraph{Compound benchmark.} " + str(c["n"]) + r" rig data sets whose structure (E, transducer "
+        r"masses, tangential lever arm), normal law and damping form differ from the model's at random, with 0, 1 "
+        r"or 2 effects (" + ", ".join(f"{v} with {k}" for k, v in c["n_by_effect_count"].items()) + r"), diagnosed "
+        r"with model updating and scored on the additive explanation. Perturbation only: no contact effect named "
+        r"in "
+        + _pct(c["perturbation_only_no_contact_effect"])
+        + r"; one effect: named in "
+        + _pct(c["one_effect_named"])
+        + r", no absent contact effect in "
+        + _pct(c["one_effect_no_absent_contact_effect"])
+        + r"; two effects: both named in "
+        + _pct(c["two_effects_both_named"])
+        + r", at least one in "
+        + _pct(c["two_effects_one_named"])
+        + r". Median remaining held-out gap "
+        + _pct(c["remaining_gap_median"])
+        + r". Perturbation only, after updating, median errors: $\mu$ "
+        + _pct(err["mu"])
+        + r", $\kappa$ "
+        + _pct(err["kappa"])
+        + r", $e_0$ "
+        + _pct(err["e0"])
+        + r" (the tangential lever arm, which linear data do not "
+        r"bound, scales the identified $S$ and so $\mu$)." + _bound_text(c) + _coverage_text(c)
+    ) + "\n"
+
+
+def accuracy_table(bench: dict) -> str:
+    """The blind benchmark's top-1 accuracy per effect (%) as a table, and the confusion matrix's figure."""
     acc = pd.DataFrame([{"effect": e, "accuracy": 100 * a} for e, a in bench["per_effect_accuracy"].items()])
-    out += tabular(
+    return tabular(
         acc, {"effect": "effect", "accuracy": "top-1 (\\%)"}, "Blind benchmark: accuracy per effect.", "tab:bench"
-    )
-    out += (
+    ) + (
         "\\begin{figure}[H]\\centering\\includegraphics[width=0.6\\textwidth]{confusion.png}"
         "\\caption{Blind benchmark: confusion matrix.}\\label{fig:confusion}\\end{figure}\n"
     )
-    return out
+
+
+def benchmark_text(bench: dict | None) -> str:
+    """The benchmarks' part of the section: the blind benchmark, the compound one when built, the accuracy table;
+    a note when the benchmark was not built (``bench`` None)."""
+    if bench is None:
+        return NO_BENCHMARK
+    out = blind_paragraph(bench)
+    c = bench.get("compound")
+    if c:
+        out += compound_paragraph(c)
+    return out + accuracy_table(bench)
+
+
+def gap_section(diag: dict, bench: dict | None, intervals: dict | None = None) -> str:
+    """The report's section on the gap (LaTeX) from diagnosis.json, benchmark.json (None: not built) and
+    friction_intervals.json (None: left out)."""
+    return (
+        diagnosis_paragraphs(diag)
+        + candidates_table(diag)
+        + GAP_FIGURES
+        + intervals_text(intervals)
+        + benchmark_text(bench)
+    )
