@@ -21,7 +21,7 @@ from .damping import rig_damping_ratios
 from .effects import effect_magnitudes
 from .frontend import add_noise, anti_alias_decimate, delay_channels
 from ..harmonics import harmonic_amplitudes
-from .nonlinear import ContactParameters, DualSineSimulator, control_response, reduced_model
+from .nonlinear import ContactParameters, ControlResult, DualSineSimulator, control_response, reduced_model
 from .structure import channel_delays, rig_structure, true_structure_config
 
 log = logging.getLogger(__name__)
@@ -134,6 +134,169 @@ def energy_balance(out: dict, sim: DualSineSimulator) -> dict:
     }
 
 
+def _response_targets(case_cfg: Mapping, eff: Mapping) -> tuple[float, float]:
+    """The driving-point targets (A1, A3) of the load case (m/s^2), scaled by the contact-separation effect."""
+    scale = eff["contact_separation"] or 1.0
+    return (scale * float(case_cfg["A1_m_per_s2"]), scale * float(case_cfg["A2_m_per_s2"]))
+
+
+def _log_control_outcome(case: str, ctl: ControlResult, target: tuple, n_samples: int) -> None:
+    """Log whether the response control converged: a warning with the last force (N) and response (m/s^2) when
+    it did not."""
+    if not ctl.converged:
+        F1, F3, A1, A3, steady = ctl.history[-1]
+        log.warning(
+            "%s: response control did not converge in %d iterations: F1 = %.4g N, F3 = %.4g N give "
+            "A1 = %.4g, A3 = %.4g m/s^2 (targets %.4g, %.4g)%s",
+            case,
+            len(ctl.history),
+            F1,
+            F3,
+            A1,
+            A3,
+            target[0],
+            target[1],
+            "" if steady else ", not steady",
+        )
+    else:
+        log.info(
+            "%s: response control converged in %d iterations; recording %d samples", case, len(ctl.history), n_samples
+        )
+
+
+def _recorded_response(sim: DualSineSimulator, ctl: ControlResult, w: float, n_samples: int) -> tuple[dict, int, int]:
+    """The simulated response at the controlled force (``run``'s dict at the integration rate): the record of
+    ``n_samples`` samples with a margin of 512 samples either side for the anti-alias filter; a preload drift (effect)
+    runs over the record. Returns (signals, steps of the record, steps of one margin)."""
+    q = sim.oversampling
+    n_rec = n_samples * q
+    margin = 64 * q * 8
+    # preload drift (effect) runs over the recorded window
+    if sim.contact.preload_drift:
+        sim.drift_t0 = sim.t + margin * sim.dt
+        sim.drift_rate = sim.contact.preload_drift / (n_rec * sim.dt)
+    out = sim.run(ctl.F1, ctl.F3, w, n_rec + 2 * margin, store_from=0)
+    return out, n_rec, margin
+
+
+def _measured_record(
+    out: dict,
+    sim: DualSineSimulator,
+    rig_cfg: Mapping,
+    margin: int,
+    n_rec: int,
+    noise_fraction: float,
+    rng: np.random.Generator,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The force (N) and accelerations (m/s^2, (sensors, samples)) as the front end records them: channel delays
+    if that effect is on, anti-alias filtering and decimation to the sampling rate over the record, and sensor
+    noise (``noise_fraction`` of each channel's rms, from ``rng``)."""
+    q = sim.oversampling
+    acc_sim = out["a"] @ sim.red.sensors.T  # (n, sensors)
+    acc_sim = acc_sim.T
+    delays = channel_delays(rig_cfg, acc_sim.shape[0])
+    if delays is not None:
+        acc_sim = delay_channels(acc_sim, delays, 1.0 / sim.dt)
+    acc = anti_alias_decimate(acc_sim, q)[:, margin // q : (margin + n_rec) // q]
+    force = anti_alias_decimate(out["f"], q)[margin // q : (margin + n_rec) // q]
+    force = add_noise(force, noise_fraction, rng)
+    acc = add_noise(acc, noise_fraction, rng)
+    return force, acc
+
+
+def _stationarity_changes(rec: dict, sim: DualSineSimulator, w: float, n_rec: int) -> tuple[float, float]:
+    """Stationarity of the recorded window: the relative change of the driving-point harmonics |A1| and |A3| from
+    the first to the last third of the record."""
+    drive = rec["a"] @ sim.red.drive
+    third = n_rec // 3
+    h_first = np.abs(harmonic_amplitudes(drive[:third], rec["t"][:third], w, (1, 3)))
+    h_last = np.abs(harmonic_amplitudes(drive[-third:], rec["t"][-third:], w, (1, 3)))
+    return float(abs(h_last[0] / h_first[0] - 1)), float(abs(h_last[1] / h_first[1] - 1))
+
+
+def _truth_variables(rec: dict, sim: DualSineSimulator, ctl: ControlResult, sub: slice) -> dict:
+    """The truth's data variables: the contact forces and motions, the force and accelerations without front end
+    or noise and the reduced coordinates at the sampling rate (``sub`` of the record), the reduced basis'
+    frequencies and the control and steady-state histories."""
+    red = sim.red
+    hist = np.array(ctl.history, dtype=float)
+    return {
+        "S": ("time", rec["S"][sub], {"units": "N", "long_name": "true friction force S(t)"}),
+        "N": (
+            "time",
+            rec["N"][sub],
+            {"units": "N", "long_name": "true total normal force N(t) (compression positive)"},
+        ),
+        "xi": ("time", rec["xi"][sub], {"units": "m", "long_name": "true tangential contact motion xi(t), Eq. 9"}),
+        "eta": ("time", rec["eta"][sub], {"units": "m", "long_name": "true normal contact motion eta(t), Eq. 8"}),
+        "xi_dot": ("time", rec["dxi"][sub], {"units": "m/s", "long_name": "true tangential contact velocity"}),
+        "eta_dot": ("time", rec["deta"][sub], {"units": "m/s", "long_name": "true normal contact velocity"}),
+        "force_true": ("time", rec["f"][sub], {"units": "N", "long_name": "excitation force without noise"}),
+        "acceleration_true": (
+            ("sensor", "time"),
+            (rec["a"] @ red.sensors.T)[sub].T,
+            {"units": "m/s^2", "long_name": "accelerations without front end or noise"},
+        ),
+        "reduced_coordinate": (
+            ("time", "reduced_mode"),
+            rec["z"][sub],
+            {"units": "kg^1/2 m", "long_name": "coordinates of the rig's reduced basis"},
+        ),
+        "reduced_frequency": (
+            "reduced_mode",
+            red.omega / (2 * np.pi),
+            {"units": "Hz", "long_name": "frequencies of the rig's reduced stuck basis"},
+        ),
+        "control_history": (
+            ("iteration", "control_field"),
+            hist,
+            {"units": "mixed", "long_name": "response control: F1 (N), F3 (N), A1, A3 (m/s^2), steady"},
+        ),
+        "steady_state_change": (
+            "chunk",
+            np.asarray(ctl.steady_state.change or [np.nan]),
+            {
+                "units": "1",
+                "long_name": "relative change of the driving-point harmonics between 8-period chunks",
+                "nonfinite_meaning": "NaN: the first chunk already met the tolerance",
+            },
+        ),
+    }
+
+
+def _truth_attrs(
+    ctl: ControlResult, target: tuple, s: Mapping, eff: Mapping, sim: DualSineSimulator, stationarity, energy
+) -> dict:
+    """The truth's attributes: the controlled force amplitudes (N) and response (m/s^2) with their targets, the
+    stationarity changes (``stationarity``: A1, A3), the effects, the true contact laws, the linear contact springs
+    (N/m), the energy balance (J) and the test's settings ``s``."""
+    c = sim.contact
+    return {
+        "F1_n": ctl.F1,
+        "F3_n": ctl.F3,
+        "A1_m_per_s2": ctl.A1,
+        "A2_m_per_s2": ctl.A3,
+        "target_A1_m_per_s2": target[0],
+        "target_A2_m_per_s2": target[1],
+        "control_converged": int(ctl.converged),
+        "excitation_frequency_hz": s["excitation_frequency_hz"],
+        "periods": s["periods"],
+        "stationarity_change_a1": stationarity[0],
+        "stationarity_change_a3": stationarity[1],
+        "effects": str({k: v for k, v in eff.items() if v}),
+        **{f"friction_{k}": v for k, v in zip(("e_f", "k_c", "e_t", "kappa", "mu"), c.friction)},
+        "preload_n": c.preload,
+        "normal_static_approach_m": c.static_approach,
+        "normal_exponent": c.exponent,
+        "normal_cubic_n_per_m3": c.cubic,
+        "friction_regularization": c.regularization,
+        "k_t": sim.red.k_t,
+        "k_n": sim.red.k_n,
+        **{f"energy_{k}": v for k, v in energy.items()},
+        **{f"setting_{k}": v for k, v in s.items()},
+    }
+
+
 def dual_sine_test(
     structure_cfg: Mapping,
     rig_cfg: Mapping,
@@ -153,8 +316,7 @@ def dual_sine_test(
     """
     s = dual_sine_settings(rig_cfg, case_cfg, sampling_rate_hz)
     eff = effect_magnitudes(rig_cfg.get("effects"))
-    scale = eff["contact_separation"] or 1.0
-    target = (scale * float(case_cfg["A1_m_per_s2"]), scale * float(case_cfg["A2_m_per_s2"]))
+    target = _response_targets(case_cfg, eff)
     sim = build_simulator(structure_cfg, rig_cfg, s)
     w = 2 * np.pi * s["excitation_frequency_hz"]
     log.info(
@@ -167,60 +329,16 @@ def dual_sine_test(
         sim.oversampling,
     )
     ctl = control_response(sim, target[0], target[1], w, tol=float(s["control_tolerance"]))
-    if not ctl.converged:
-        F1, F3, A1, A3, steady = ctl.history[-1]
-        log.warning(
-            "%s: response control did not converge in %d iterations: F1 = %.4g N, F3 = %.4g N give "
-            "A1 = %.4g, A3 = %.4g m/s^2 (targets %.4g, %.4g)%s",
-            case,
-            len(ctl.history),
-            F1,
-            F3,
-            A1,
-            A3,
-            target[0],
-            target[1],
-            "" if steady else ", not steady",
-        )
-    else:
-        log.info(
-            "%s: response control converged in %d iterations; recording %d samples",
-            case,
-            len(ctl.history),
-            int(s["record_samples"]),
-        )
-    q = sim.oversampling
-    n_rec = int(s["record_samples"]) * q
-    margin = 64 * q * 8
-    # preload drift (effect) runs over the recorded window
-    if sim.contact.preload_drift:
-        sim.drift_t0 = sim.t + margin * sim.dt
-        sim.drift_rate = sim.contact.preload_drift / (n_rec * sim.dt)
-    out = sim.run(ctl.F1, ctl.F3, w, n_rec + 2 * margin, store_from=0)
+    n_out = int(s["record_samples"])
+    _log_control_outcome(case, ctl, target, n_out)
+    out, n_rec, margin = _recorded_response(sim, ctl, w, n_out)
     win = slice(margin, margin + n_rec)
     rec = {k: v[win] for k, v in out.items()}
     energy = energy_balance(rec, sim) if not sim.contact.preload_drift else {}
-
-    red = sim.red
-    acc_sim = out["a"] @ red.sensors.T  # (n, sensors)
-    acc_sim = acc_sim.T
-    delays = channel_delays(rig_cfg, acc_sim.shape[0])
-    if delays is not None:
-        acc_sim = delay_channels(acc_sim, delays, 1.0 / sim.dt)
-    acc = anti_alias_decimate(acc_sim, q)[:, margin // q : (margin + n_rec) // q]
-    force = anti_alias_decimate(out["f"], q)[margin // q : (margin + n_rec) // q]
     rng = generator(seed, f"{case}/noise")
-    force = add_noise(force, noise_fraction, rng)
-    acc = add_noise(acc, noise_fraction, rng)
-    n_out = int(s["record_samples"])
+    force, acc = _measured_record(out, sim, rig_cfg, margin, n_rec, noise_fraction, rng)
     time = np.arange(n_out) / sampling_rate_hz
-
-    # stationarity of the recorded window: harmonics of the first and last thirds
-    drive = rec["a"] @ red.drive
-    third = n_rec // 3
-    h_first = np.abs(harmonic_amplitudes(drive[:third], rec["t"][:third], w, (1, 3)))
-    h_last = np.abs(harmonic_amplitudes(drive[-third:], rec["t"][-third:], w, (1, 3)))
-
+    stationarity = _stationarity_changes(rec, sim, w, n_rec)
     raw = raw_dataset(
         time,
         force,
@@ -230,79 +348,13 @@ def dual_sine_test(
         sampling_rate_hz,
         attrs={"test": "dual_sine", "excitation_frequency_hz": s["excitation_frequency_hz"]},
     )
-    sub = slice(0, n_rec, q)
-    hist = np.array(ctl.history, dtype=float)
     truth = xr.Dataset(
-        {
-            "S": ("time", rec["S"][sub], {"units": "N", "long_name": "true friction force S(t)"}),
-            "N": (
-                "time",
-                rec["N"][sub],
-                {"units": "N", "long_name": "true total normal force N(t) (compression positive)"},
-            ),
-            "xi": ("time", rec["xi"][sub], {"units": "m", "long_name": "true tangential contact motion xi(t), Eq. 9"}),
-            "eta": ("time", rec["eta"][sub], {"units": "m", "long_name": "true normal contact motion eta(t), Eq. 8"}),
-            "xi_dot": ("time", rec["dxi"][sub], {"units": "m/s", "long_name": "true tangential contact velocity"}),
-            "eta_dot": ("time", rec["deta"][sub], {"units": "m/s", "long_name": "true normal contact velocity"}),
-            "force_true": ("time", rec["f"][sub], {"units": "N", "long_name": "excitation force without noise"}),
-            "acceleration_true": (
-                ("sensor", "time"),
-                (rec["a"] @ red.sensors.T)[sub].T,
-                {"units": "m/s^2", "long_name": "accelerations without front end or noise"},
-            ),
-            "reduced_coordinate": (
-                ("time", "reduced_mode"),
-                rec["z"][sub],
-                {"units": "kg^1/2 m", "long_name": "coordinates of the rig's reduced basis"},
-            ),
-            "reduced_frequency": (
-                "reduced_mode",
-                red.omega / (2 * np.pi),
-                {"units": "Hz", "long_name": "frequencies of the rig's reduced stuck basis"},
-            ),
-            "control_history": (
-                ("iteration", "control_field"),
-                hist,
-                {"units": "mixed", "long_name": "response control: F1 (N), F3 (N), A1, A3 (m/s^2), steady"},
-            ),
-            "steady_state_change": (
-                "chunk",
-                np.asarray(ctl.steady_state.change or [np.nan]),
-                {
-                    "units": "1",
-                    "long_name": "relative change of the driving-point harmonics between 8-period chunks",
-                    "nonfinite_meaning": "NaN: the first chunk already met the tolerance",
-                },
-            ),
-        },
+        _truth_variables(rec, sim, ctl, slice(0, n_rec, sim.oversampling)),
         coords={
             "time": ("time", time, {"units": "s", "long_name": "time"}),
             "sensor": list(sensor_names),
             "control_field": ["F1", "F3", "A1", "A3", "steady"],
         },
-        attrs={
-            "F1_n": ctl.F1,
-            "F3_n": ctl.F3,
-            "A1_m_per_s2": ctl.A1,
-            "A2_m_per_s2": ctl.A3,
-            "target_A1_m_per_s2": target[0],
-            "target_A2_m_per_s2": target[1],
-            "control_converged": int(ctl.converged),
-            "excitation_frequency_hz": s["excitation_frequency_hz"],
-            "periods": s["periods"],
-            "stationarity_change_a1": float(abs(h_last[0] / h_first[0] - 1)),
-            "stationarity_change_a3": float(abs(h_last[1] / h_first[1] - 1)),
-            "effects": str({k: v for k, v in eff.items() if v}),
-            **{f"friction_{k}": v for k, v in zip(("e_f", "k_c", "e_t", "kappa", "mu"), sim.contact.friction)},
-            "preload_n": sim.contact.preload,
-            "normal_static_approach_m": sim.contact.static_approach,
-            "normal_exponent": sim.contact.exponent,
-            "normal_cubic_n_per_m3": sim.contact.cubic,
-            "friction_regularization": sim.contact.regularization,
-            "k_t": red.k_t,
-            "k_n": red.k_n,
-            **{f"energy_{k}": v for k, v in energy.items()},
-            **{f"setting_{k}": v for k, v in s.items()},
-        },
+        attrs=_truth_attrs(ctl, target, s, eff, sim, stationarity, energy),
     )
     return raw, truth

@@ -23,6 +23,7 @@ rate; the friction state is advanced with Heun's method in xi per step.
 
 from __future__ import annotations
 
+import logging
 from dataclasses import dataclass, field
 from typing import NamedTuple
 
@@ -33,6 +34,8 @@ from numba import njit
 from ..beam_model import FEModel, all_modes, fix_signs, shortening_matrix
 from ..friction import initial_stiffness, iwan_force, slip_limit_flag, valanis_step
 from ..harmonics import harmonic_amplitudes
+
+progress = logging.getLogger(__name__)  # the response control's iterations
 
 
 @dataclass(frozen=True)
@@ -240,6 +243,114 @@ class KernelRecord(NamedTuple):
 
 
 @njit(cache=True)
+def _initial_friction_force(S_val, xi, dxi, N, x_sl, contact, no_flags):
+    """The total tangential force at the start of a run, S = (1 - s) S_valanis + s S_iwan + sigma_2 dxi/dt (N),
+    with s the Iwan share; the Iwan and viscous parts only while the contact is closed (N > 0)."""
+    fr = contact.fr
+    e0 = initial_stiffness(max(N, 1e-12), fr[0], fr[1])
+    s_iw = 0.0
+    if contact.iw_share > 0.0 and N > 0.0:
+        s_iw = iwan_force(xi, x_sl, contact.iw_w, e0, fr[4] * N, no_flags)
+    return (1.0 - contact.iw_share) * S_val + contact.iw_share * s_iw + (contact.visc * dxi if N > 0.0 else 0.0)
+
+
+@njit(cache=True)
+def _friction_force(S_val, xi, dxi, N, x_sl, contact, no_flags):
+    """The total tangential force after a step, S = (1 - s) S_valanis + s S_iwan + sigma_2 dxi/dt (N), with s the
+    Iwan share; zero once the contact opens (N <= 0), and the Iwan sliders' anchors (m) then follow xi."""
+    if N > 0.0:
+        fr = contact.fr
+        e0 = initial_stiffness(N, fr[0], fr[1])
+        s_iw = iwan_force(xi, x_sl, contact.iw_w, e0, fr[4] * N, no_flags) if contact.iw_share > 0.0 else 0.0
+        return (1.0 - contact.iw_share) * S_val + contact.iw_share * s_iw + contact.visc * dxi
+    for k in range(x_sl.size):
+        x_sl[k] = xi
+    return 0.0
+
+
+@njit(cache=True)
+def _static_preload(t, n0, drive):
+    """The static preload P(t) = N0 (1 + drift_rate (t - drift_t0)) after drift_t0 while it drifts, N0 otherwise
+    (N)."""
+    if drive.drift_rate != 0.0 and t > drive.drift_t0:
+        return n0 * (1.0 + drive.drift_rate * (t - drive.drift_t0))
+    return n0
+
+
+@njit(cache=True)
+def _modal_load(i, f, S_tot, N, P, xi_lin, eta, dxi_dq, model):
+    """The generalized force on mode i (N kg^-1/2): F f - dxi/dq S + deta/dq (N - P) with the linear contact
+    springs built into omega (k_t xi_lin, k_n eta) removed again; the modal damping and stiffness are the
+    caller's."""
+    return (
+        model.bF[i] * f
+        - dxi_dq[i] * S_tot
+        + model.eta_v[i] * (N - P)
+        + model.k_t * model.xi_v[i] * xi_lin
+        + model.k_n * model.eta_v[i] * eta
+    )
+
+
+@njit(cache=True)
+def _damped_velocity(z, v, a, dt, c, om2, f, S_tot, N_el, P, xi_lin, eta, dxi_dq, model):
+    """Second half-step of the velocity (m kg^1/2/s, in place) under the elastic normal force N_el (N), with the
+    diagonal modal damping c = 2 zeta omega (1/s) taken implicitly: v = (v_half + dt/2 g) / (1 + dt/2 c). The half-step
+    velocity v_half is kept in ``a``. Returns (sum eta_v^2 / D, eta_v . v) for the normal damping's correction."""
+    eta_v = model.eta_v
+    uDu = 0.0
+    uy = 0.0
+    for i in range(z.size):
+        g = _modal_load(i, f, S_tot, N_el, P, xi_lin, eta, dxi_dq, model) - om2[i] * z[i]
+        D = 1.0 + 0.5 * dt * c[i]
+        a[i] = v[i]  # keep v_half
+        v[i] = (v[i] + 0.5 * dt * g) / D  # implicit diagonal damping
+        uDu += eta_v[i] * eta_v[i] / D
+        uy += eta_v[i] * v[i]
+    return uDu, uy
+
+
+@njit(cache=True)
+def _damped_normal_force(v, N_el, uDu, uy, dt, c, eta_v, hc, unilateral):
+    """The total normal force N = N_el (1 - hc deta/dt) (N) with the Hunt-Crossley damping taken implicitly (it is
+    stiff): the velocities (in place) are corrected along eta_v by the damping force at the end of the step. A
+    unilateral contact's damping cannot pull: N drops to zero and only N_el is taken off again."""
+    c_n = hc * N_el
+    if c_n > 0.0:
+        beta = 0.5 * dt * c_n
+        corr = beta * uy / (1.0 + beta * uDu)
+        deta_new = 0.0
+        for i in range(v.size):
+            deta_new += eta_v[i] * (v[i] - corr * eta_v[i] / (1.0 + 0.5 * dt * c[i]))
+        N = N_el * (1.0 - hc * deta_new)
+        if N >= 0.0 or not unilateral:
+            for i in range(v.size):
+                v[i] -= corr * eta_v[i] / (1.0 + 0.5 * dt * c[i])
+        else:  # the damping cannot pull: the contact force drops to zero
+            N = 0.0
+            for i in range(v.size):
+                v[i] -= 0.5 * dt * eta_v[i] * N_el / (1.0 + 0.5 * dt * c[i])
+    else:
+        N = N_el
+    return N
+
+
+@njit(cache=True)
+def _store_step(out, r, a, z, v, S_tot, N, xi, eta, f, dxi, deta):
+    """Write one step to row r of ``out`` (KernelRecord)."""
+    for i in range(a.size):
+        out.a[r, i] = a[i]
+        out.z[r, i] = z[i]
+        out.v[r, i] = v[i]
+    out.s[r] = S_tot
+    out.n[r] = N
+    out.xi[r] = xi
+    out.eta[r] = eta
+    out.f[r] = f
+    out.dxi[r] = dxi
+    out.deta[r] = deta
+
+
+@njit(cache=True)
 def integrate(z, v, state, x_sl, t0, n_steps, dt, model, contact, drive, store_from, out):
     """Advance the reduced model ``n_steps`` steps of ``dt`` from time ``t0``.
 
@@ -248,10 +359,10 @@ def integrate(z, v, state, x_sl, t0, n_steps, dt, model, contact, drive, store_f
     the acceleration, coordinates, contact forces and motions, velocities and the force are written to ``out``
     (KernelRecord; row = step - store_from). Returns the time reached.
     """
-    omega, zeta, xi_v, eta_v, G, bF, k_t, k_n = model
-    fr, n0, delta0, p, cubic, hc, unilateral, visc, iw_share, iw_w = contact
-    f_sin, f_cos, w, drift_rate, drift_t0 = drive
-    out_a, out_z, out_v, out_s, out_n, out_xi, out_eta, out_f, out_dxi, out_deta = out
+    omega, zeta, xi_v, eta_v, G = model.omega, model.zeta, model.xi_v, model.eta_v, model.G
+    fr, n0, delta0, p, cubic, hc = contact.fr, contact.n0, contact.delta0, contact.p, contact.cubic, contact.hc
+    unilateral = contact.unilateral
+    f_sin, f_cos, w = drive.f_sin, drive.f_cos, drive.w
     e_f, k_c, e_t, kappa, mu, slip_limit = fr[0], fr[1], fr[2], fr[3], fr[4], fr[5] > 0.5
     n = z.size
     c = 2.0 * zeta * omega
@@ -265,22 +376,10 @@ def integrate(z, v, state, x_sl, t0, n_steps, dt, model, contact, drive, store_f
     no_flags = np.empty(0, dtype=np.int8)  # the Iwan sliders' flags are not kept here
 
     # acceleration at the start
-    e0 = initial_stiffness(max(N, 1e-12), e_f, k_c)
-    s_iw = 0.0
-    if iw_share > 0.0 and N > 0.0:
-        s_iw = iwan_force(xi, x_sl, iw_w, e0, mu * N, no_flags)
-    S_tot = (1.0 - iw_share) * S_val + iw_share * s_iw + (visc * dxi if N > 0.0 else 0.0)
+    S_tot = _initial_friction_force(S_val, xi, dxi, N, x_sl, contact, no_flags)
     f = _excitation(f_sin, f_cos, w, t)
     for i in range(n):
-        a[i] = (
-            bF[i] * f
-            - dxi_dq[i] * S_tot
-            + eta_v[i] * (N - P)
-            + k_t * xi_v[i] * xi_lin
-            + k_n * eta_v[i] * eta
-            - c[i] * v[i]
-            - om2[i] * z[i]
-        )
+        a[i] = _modal_load(i, f, S_tot, N, P, xi_lin, eta, dxi_dq, model) - c[i] * v[i] - om2[i] * z[i]
     for step in range(n_steps):
         # half-step velocity, full-step position
         for i in range(n):
@@ -292,66 +391,17 @@ def integrate(z, v, state, x_sl, t0, n_steps, dt, model, contact, drive, store_f
         xi_lin, xi, dxi_dq, eta, deta, dxi = _contact_state(z, v, xi_v, eta_v, G)
         N = _normal_force(eta, deta, n0, delta0, p, hc, unilateral, cubic)  # explicit estimate for the friction law
         S_val = valanis_step(S_val, xi_old, xi, N_old, N, e_f, k_c, e_t, kappa, mu, 1e-6, slip_limit)
-        if N > 0.0:
-            e0 = initial_stiffness(N, e_f, k_c)
-            s_iw = iwan_force(xi, x_sl, iw_w, e0, mu * N, no_flags) if iw_share > 0.0 else 0.0
-            S_tot = (1.0 - iw_share) * S_val + iw_share * s_iw + visc * dxi
-        else:
-            S_tot = 0.0
-            for k in range(x_sl.size):
-                x_sl[k] = xi
-        P = n0 * (1.0 + drift_rate * (t - drift_t0)) if (drift_rate != 0.0 and t > drift_t0) else n0
+        S_tot = _friction_force(S_val, xi, dxi, N, x_sl, contact, no_flags)
+        P = _static_preload(t, n0, drive)
         f = _excitation(f_sin, f_cos, w, t)
         # normal force: elastic part explicit, Hunt-Crossley damping implicit (it is stiff)
         N_el = _normal_force(eta, 0.0, n0, delta0, p, 0.0, unilateral, cubic)
-        c_n = hc * N_el
-        uDu = 0.0
-        uy = 0.0
-        for i in range(n):
-            g = (
-                bF[i] * f
-                - dxi_dq[i] * S_tot
-                + eta_v[i] * (N_el - P)
-                + k_t * xi_v[i] * xi_lin
-                + k_n * eta_v[i] * eta
-                - om2[i] * z[i]
-            )
-            D = 1.0 + 0.5 * dt * c[i]
-            a[i] = v[i]  # keep v_half
-            v[i] = (v[i] + 0.5 * dt * g) / D  # implicit diagonal damping
-            uDu += eta_v[i] * eta_v[i] / D
-            uy += eta_v[i] * v[i]
-        if c_n > 0.0:
-            beta = 0.5 * dt * c_n
-            corr = beta * uy / (1.0 + beta * uDu)
-            deta_new = 0.0
-            for i in range(n):
-                deta_new += eta_v[i] * (v[i] - corr * eta_v[i] / (1.0 + 0.5 * dt * c[i]))
-            N = N_el * (1.0 - hc * deta_new)
-            if N >= 0.0 or not unilateral:
-                for i in range(n):
-                    v[i] -= corr * eta_v[i] / (1.0 + 0.5 * dt * c[i])
-            else:  # the damping cannot pull: the contact force drops to zero
-                N = 0.0
-                for i in range(n):
-                    v[i] -= 0.5 * dt * eta_v[i] * N_el / (1.0 + 0.5 * dt * c[i])
-        else:
-            N = N_el
+        uDu, uy = _damped_velocity(z, v, a, dt, c, om2, f, S_tot, N_el, P, xi_lin, eta, dxi_dq, model)
+        N = _damped_normal_force(v, N_el, uDu, uy, dt, c, eta_v, hc, unilateral)
         for i in range(n):
             a[i] = 2.0 * (v[i] - a[i]) / dt
         if step >= store_from:
-            r = step - store_from
-            for i in range(n):
-                out_a[r, i] = a[i]
-                out_z[r, i] = z[i]
-                out_v[r, i] = v[i]
-            out_s[r] = S_tot
-            out_n[r] = N
-            out_xi[r] = xi
-            out_eta[r] = eta
-            out_f[r] = f
-            out_dxi[r] = dxi
-            out_deta[r] = deta
+            _store_step(out, step - store_from, a, z, v, S_tot, N, xi, eta, f, dxi, deta)
     state[0] = S_val
     state[1] = xi
     state[2] = N
@@ -532,6 +582,74 @@ class ControlResult:
     steady_state: SteadyStateLog
 
 
+def _log_unsteady_stop(it: int, F: np.ndarray, A: np.ndarray, unsteady: int) -> None:
+    """Log that the control stops at iteration ``it`` (from 0): force (N) and response (m/s^2) not steady for
+    ``unsteady`` iterations."""
+    progress.info(
+        "response control %d: F1 = %.4g N, F3 = %.4g N -> A1 = %.4g, A3 = %.4g m/s^2; not steady for "
+        "%d iterations: the motion does not settle into a periodic state, the control stops here",
+        it + 1,
+        F[0],
+        F[1],
+        A[0],
+        A[1],
+        unsteady,
+    )
+
+
+def _log_iteration(it: int, F: np.ndarray, A: np.ndarray, target: np.ndarray, ok: bool) -> None:
+    """Log iteration ``it`` (from 0) of the control: force (N), response and targets (m/s^2), steady or not."""
+    progress.info(
+        "response control %d: F1 = %.4g N, F3 = %.4g N -> A1 = %.4g (target %.4g), A3 = %.4g (target %.4g) m/s^2%s",
+        it + 1,
+        F[0],
+        F[1],
+        A[0],
+        target[0],
+        A[1],
+        target[1],
+        "" if ok else ", not yet steady",
+    )
+
+
+def _backed_off_force(sim: DualSineSimulator, F: np.ndarray, good: tuple | None, w: float, it: int) -> np.ndarray:
+    """The force amplitudes (N) to try after the trial force F of iteration ``it`` gave a response that is not
+    finite: half of F from the stuck linear steady state when no force has given a finite response yet, else
+    halfway back to the last force that did (``good``: force and simulator state), from that force's state."""
+    progress.info(
+        "response control %d: F1 = %.4g N, F3 = %.4g N -> the response is not finite; halving the step back",
+        it + 1,
+        F[0],
+        F[1],
+    )
+    if good is None:
+        F = 0.5 * F
+        sim.start_from_linear(F[0], F[1], w)
+    else:
+        F = 0.5 * (F + good[0])
+        sim.restore(good[1])
+    return F
+
+
+def _broyden_jacobian(J: np.ndarray, dF: np.ndarray, dA: np.ndarray) -> np.ndarray:
+    """Broyden's rank-one update of the Jacobian d|A|/dF (m/s^2/N) from the last change of the force dF (N) and of
+    the response dA (m/s^2); J itself when the force did not change."""
+    if dF @ dF > 0:
+        J = J + np.outer(dA - J @ dF, dF) / (dF @ dF)
+    return J
+
+
+def _next_force(J: np.ndarray, F: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """The next force amplitudes (N): the Newton step on the Jacobian J (m/s^2/N) for the residual r (m/s^2), or
+    its diagonal where J is singular, each amplitude kept within a factor of 3 of F."""
+    try:
+        step = np.linalg.solve(J, -r)
+    except np.linalg.LinAlgError:
+        step = -r / np.diag(J)
+    F_new = F + step
+    return np.clip(F_new, 0.3 * F, 3.0 * F)  # keep each update within a factor of 3
+
+
 def control_response(
     sim: DualSineSimulator,
     target_a1: float,
@@ -549,9 +667,6 @@ def control_response(
     ``max_unsteady`` iterations in a row (impacts that keep the motion from becoming periodic) ends the control
     there, unconverged, as a test engineer would stop (the blind benchmark's contact-separation items ran all 40
     iterations on lc3, 22 s each, without settling)."""
-    import logging
-
-    progress = logging.getLogger(__name__)
     h1, h3 = abs(sim.linear_frf(w)), abs(sim.linear_frf(3 * w))
     target = np.array([target_a1, target_a3])
     F = target / np.array([h1, h3])
@@ -568,56 +683,19 @@ def control_response(
         history.append((float(F[0]), float(F[1]), float(A[0]), float(A[1]), bool(ok)))
         unsteady = 0 if ok else unsteady + 1
         if unsteady >= max_unsteady and np.all(np.isfinite(A)):
-            progress.info(
-                "response control %d: F1 = %.4g N, F3 = %.4g N -> A1 = %.4g, A3 = %.4g m/s^2; not steady for "
-                "%d iterations: the motion does not settle into a periodic state, the control stops here",
-                it + 1,
-                F[0],
-                F[1],
-                A[0],
-                A[1],
-                unsteady,
-            )
+            _log_unsteady_stop(it, F, A, unsteady)
             break
         if not np.all(np.isfinite(A)) or not np.all(np.isfinite(sim.z)):
-            progress.info(
-                "response control %d: F1 = %.4g N, F3 = %.4g N -> the response is not finite; halving the step back",
-                it + 1,
-                F[0],
-                F[1],
-            )
-            if good is None:
-                F = 0.5 * F
-                sim.start_from_linear(F[0], F[1], w)
-            else:
-                F = 0.5 * (F + good[0])
-                sim.restore(good[1])
+            F = _backed_off_force(sim, F, good, w, it)
             continue
         good = (F.copy(), sim.snapshot())
         r = A - target
-        progress.info(
-            "response control %d: F1 = %.4g N, F3 = %.4g N -> A1 = %.4g (target %.4g), A3 = %.4g (target %.4g) m/s^2%s",
-            it + 1,
-            F[0],
-            F[1],
-            A[0],
-            target[0],
-            A[1],
-            target[1],
-            "" if ok else ", not yet steady",
-        )
+        _log_iteration(it, F, A, target, ok)
         if ok and np.max(np.abs(r) / target) < tol:
             return ControlResult(float(F[0]), float(F[1]), float(A[0]), float(A[1]), True, history, log)
         if prev is not None:
-            dF, dA = F - prev[0], A - prev[1]
-            if dF @ dF > 0:
-                J = J + np.outer(dA - J @ dF, dF) / (dF @ dF)
+            J = _broyden_jacobian(J, F - prev[0], A - prev[1])
         prev = (F.copy(), A.copy())
-        try:
-            step = np.linalg.solve(J, -r)
-        except np.linalg.LinAlgError:
-            step = -r / np.diag(J)
-        F_new = F + step
-        F = np.clip(F_new, 0.3 * F, 3.0 * F)  # keep each update within a factor of 3
+        F = _next_force(J, F, r)
     c = history[-1]
     return ControlResult(c[0], c[1], c[2], c[3], False, history, log)
