@@ -872,6 +872,107 @@ def _place_left(last, records, calibration_case, H, linear, structures, settings
     return where_left
 
 
+@dataclass
+class _DiagnosisRun:
+    """What every pass of one diagnosis shares: the records, the calibration and scored cases, the settings,
+    the baseline simulations and (once drawn) the bootstrap resamples of the scored cases' records."""
+
+    records: Mapping[str, RecordHarmonics]
+    calibration_case: str
+    score_cases: list
+    settings: GapSettings
+    fit_settings: FitSettings
+    workers: int
+    base_sims: dict
+    boot: dict = field(default_factory=dict)
+
+    @property
+    def H(self) -> int:
+        return self.settings.n_harmonics
+
+    def candidates(self, names, model: IdentifiedModel, base_sims: dict, **extra):
+        """The candidates ``names`` calibrated on the calibration case and predicting the scored cases, in
+        ``workers`` processes (``_candidates``; call the result to collect them)."""
+        return _candidates(
+            names,
+            self.workers,
+            model=model,
+            records=self.records,
+            calibration_case=self.calibration_case,
+            score_cases=self.score_cases,
+            base_sims=base_sims,
+            fit_settings=self.fit_settings,
+            H=self.H,
+            max_evaluations=self.settings.max_evaluations,
+            **extra,
+        )
+
+    def draw_bootstrap(self) -> None:
+        """Bootstrap over record blocks: the simulations stay fixed, the records are resampled."""
+        rng = generator(self.settings.seed, "gap/bootstrap")
+        self.boot = {
+            c: _bootstrap_records(self.records[c], rng, self.settings.n_bootstrap, self.H) for c in self.score_cases
+        }
+
+    def heldout_gap(self, sims_by_case, boot_index=None) -> float:
+        """The held-out gap of these simulations (``heldout_gap_of``), on the records or on one bootstrap draw."""
+        return heldout_gap_of(
+            self.records,
+            self.score_cases,
+            self.H,
+            sims_by_case,
+            None if boot_index is None else {c: self.boot[c][boot_index] for c in self.score_cases},
+        )
+
+    def heldout_gaps(self, sims_by_case) -> tuple[float, np.ndarray]:
+        """The held-out gap and its bootstrap draws."""
+        draws = np.array([self.heldout_gap(sims_by_case, b) for b in range(self.settings.n_bootstrap)])
+        return self.heldout_gap(sims_by_case), draws
+
+    def next_pass(self, results: dict):
+        """The explanation's next pass: the remaining candidates refitted jointly with the steps so far, started
+        from the last step's simulations (``explain``)."""
+
+        def run(remaining, cal):
+            starts = {
+                self.calibration_case: cal.simulation
+                if cal.simulation is not None
+                else self.base_sims[self.calibration_case],
+                **{c: s for c, s in results[cal.candidate][1].items() if s is not None},
+            }
+            return self.candidates(
+                remaining,
+                cal.model,
+                starts,
+                base_steps=cal.steps,
+                joint=self.settings.joint_refit,
+                alone={n: r[0].theta for n, r in results.items()},
+            )()
+
+        return run
+
+
+def _remaining_gap(left, left_share, where, last, run: _DiagnosisRun, linear, structures) -> dict:
+    """diagnosis.json's ``remaining``: the held-out gap the explanation leaves, its share, whether it is at the
+    floor, and where it lies (localised again with the explanation's effects in, where it is above the floor)."""
+    settings = run.settings
+    remaining = {
+        "heldout_gap": left,
+        "share": left_share,
+        "at_floor": at_floor(left, settings),
+        "floor": settings.min_gap,
+        "min_reduction": settings.min_reduction,
+        "place": where["place"],
+        "place_reason": where["place_reason"],
+    }
+    if last is not None and not remaining["at_floor"]:
+        where_left = _place_left(last, run.records, run.calibration_case, run.H, linear, structures, settings)
+        if where_left is not None:
+            remaining["place"] = where_left["place"]
+            remaining["place_reason"] = where_left["place_reason"]
+    return remaining
+
+
 def diagnose(
     model: IdentifiedModel,
     records: Mapping[str, RecordHarmonics],
@@ -890,25 +991,15 @@ def diagnose(
     H = settings.n_harmonics
     if calibration_case not in records:
         raise ValueError(f"gap: the calibration case {calibration_case!r} is not among the load cases {list(records)}")
-    cases = list(records)
-    held = [c for c in cases if c != calibration_case]
-    score_cases = held or [calibration_case]
-    base_sims = {c: baseline(model, records[c], H)[1] for c in cases}
+    held = [c for c in records if c != calibration_case]
+    base_sims = {c: baseline(model, records[c], H)[1] for c in records}
+    run = _DiagnosisRun(
+        records, calibration_case, held or [calibration_case], settings, fit_settings, workers, base_sims
+    )
     # candidates: calibrate, predict the held-out cases (forked before the localisation runs numba's
     # parallel friction kernel in this process)
     names = list(settings.candidates or tuple(LIBRARY))
-    candidate_results = _candidates(
-        names,
-        workers,
-        model=model,
-        records=records,
-        calibration_case=calibration_case,
-        score_cases=score_cases,
-        base_sims=base_sims,
-        fit_settings=fit_settings,
-        H=H,
-        max_evaluations=settings.max_evaluations,
-    )
+    candidate_results = run.candidates(names, model, base_sims)
     structures = tuple(updating.posterior_structures()) if updating is not None else ()
     where, arrays = localise(
         model,
@@ -921,65 +1012,33 @@ def diagnose(
         thresholds=settings.place,
     )
     results = candidate_results()
-    # bootstrap over record blocks: the sims are fixed, the records resampled
-    rng = generator(settings.seed, "gap/bootstrap")
-    boot = {c: _bootstrap_records(records[c], rng, settings.n_bootstrap, H) for c in score_cases}
-
-    def heldout_gap(sims_by_case, boot_index=None):
-        return heldout_gap_of(
-            records,
-            score_cases,
-            H,
-            sims_by_case,
-            None if boot_index is None else {c: boot[c][boot_index] for c in score_cases},
-        )
-
-    before = heldout_gap(base_sims)
-    before_b = np.array([heldout_gap(base_sims, b) for b in range(settings.n_bootstrap)])
-    n_data = 2 * sum(gap_residual(base_sims[c], records[c], H).size for c in score_cases)
+    run.draw_bootstrap()
+    before, before_b = run.heldout_gaps(base_sims)
+    n_data = 2 * sum(gap_residual(base_sims[c], records[c], H).size for c in run.score_cases)
     rows, boots = _ranking(
-        results, heldout_gap, settings.n_bootstrap, before, before_b, n_data, records, calibration_case, where
+        results, run.heldout_gap, settings.n_bootstrap, before, before_b, n_data, records, calibration_case, where
     )
     scatter = float(np.std(before_b))
     verdict, reason = _verdict(rows, before, scatter, where["place"], settings, boots)
-    shrink = {}
-    for label, r in zip(("winner", "runner_up"), rows[:2]):
-        shrink[label] = {
+    shrink = {
+        label: {
             "effect": r["effect"],
-            **shrink_views(records, score_cases, base_sims, results[r["effect"]][1], boot, H),
+            **shrink_views(records, run.score_cases, base_sims, results[r["effect"]][1], run.boot, H),
         }
+        for label, r in zip(("winner", "runner_up"), rows[:2])
+    }
     where["heldout_gap_before"] = before
     where["heldout_gap_before_interval"] = [float(np.percentile(before_b, 2.5)), float(np.percentile(before_b, 97.5))]
     where["record_scatter"] = scatter
-
-    def next_pass(remaining, cal):
-        starts = {
-            calibration_case: cal.simulation if cal.simulation is not None else base_sims[calibration_case],
-            **{c: s for c, s in results[cal.candidate][1].items() if s is not None},
-        }
-        return _candidates(
-            remaining,
-            workers,
-            model=cal.model,
-            records=records,
-            calibration_case=calibration_case,
-            score_cases=score_cases,
-            base_sims=starts,
-            fit_settings=fit_settings,
-            H=H,
-            max_evaluations=settings.max_evaluations,
-            base_steps=cal.steps,
-            joint=settings.joint_refit,
-            alone={n: r[0].theta for n, r in results.items()},
-        )()
-
     later = retried({n: r[0].theta for n, r in results.items()}, LIBRARY, settings)
-    steps, left, last = explain(results, names, before, scatter, settings, heldout_gap, next_pass, later)
+    steps, left, last = explain(
+        results, names, before, scatter, settings, run.heldout_gap, run.next_pass(results), later
+    )
     first_before = before
     if updating is not None:
         where["model_updating"] = _updating_summary(updating, model)
     if identified is not None and updating is not None and updating.accepted:
-        first_before = heldout_gap({c: baseline(identified, records[c], H)[1] for c in score_cases})
+        first_before = run.heldout_gap({c: baseline(identified, records[c], H)[1] for c in run.score_cases})
         where["heldout_gap_identified"] = first_before
         steps.insert(0, _updating_step(updating, first_before, before))
         log.info("explanation step 0: model updating takes the held-out gap from %.4g to %.4g", first_before, before)
@@ -987,35 +1046,8 @@ def diagnose(
     for s, share in zip(steps, shares):
         s["share"] = share
     if verdict == "none" and steps and steps[0]["effect"] == "model_updating":
-        verdict, reason = _updating_verdict(updating, names, first_before, before, shares, scatter, settings) or (
-            verdict,
-            reason,
-        )
-    remaining = {
-        "heldout_gap": left,
-        "share": left_share,
-        "at_floor": at_floor(left, settings),
-        "floor": settings.min_gap,
-        "min_reduction": settings.min_reduction,
-        "place": where["place"],
-        "place_reason": where["place_reason"],
-    }
-    if last is not None and not remaining["at_floor"]:  # where what is left lies, with the explanation's effects in
-        where_left = _place_left(last, records, calibration_case, H, linear, structures, settings)
-        if where_left is not None:
-            remaining["place"] = where_left["place"]
-            remaining["place_reason"] = where_left["place_reason"]
-    diag = Diagnosis(
-        verdict,
-        reason,
-        rows,
-        where,
-        calibration_case,
-        held,
-        arrays,
-        {"base": base_sims, **{n: r[1] for n, r in results.items()}},
-        shrink,
-        steps,
-        remaining,
-    )
-    return diag
+        by_update = _updating_verdict(updating, names, first_before, before, shares, scatter, settings)
+        verdict, reason = by_update or (verdict, reason)
+    remaining = _remaining_gap(left, left_share, where, last, run, linear, structures)
+    sims = {"base": base_sims, **{n: r[1] for n, r in results.items()}}
+    return Diagnosis(verdict, reason, rows, where, calibration_case, held, arrays, sims, shrink, steps, remaining)
