@@ -162,12 +162,9 @@ def _true_structure_errors(structure: Mapping, changes: Mapping, path: str = "ri
     return errors
 
 
-def check_config(cfg: Mapping, source: str = "config/config.yaml") -> None:
-    """Raise :class:`ConfigError` on cross-field inconsistencies of ``cfg`` (its left-out keys at the schema's
-    defaults, ``with_defaults``)."""
-    cfg = with_defaults(cfg)
+def _sensor_errors(st: Mapping) -> list:
+    """The sensors' lists of one length, and the sensors and the excitation on the beam (0, L] (m)."""
     errors = []
-    st = cfg["structure"]
     L = st["beam"]["length_m"]
     sens = st["sensors"]
     n_sens = len(sens["positions_m"])
@@ -188,6 +185,13 @@ def check_config(cfg: Mapping, source: str = "config/config.yaml") -> None:
             f"structure.excitation_position_m = {st['excitation_position_m']} m lies outside the beam; "
             f"allowed range (0, {L}] m"
         )
+    return errors
+
+
+def _mode_count_errors(cfg: Mapping) -> list:
+    """No more modes than sensors in modal and linear_modes (Eq. 15)."""
+    errors = []
+    n_sens = len(cfg["structure"]["sensors"]["positions_m"])
     for block in ("modal", "linear_modes"):
         n_modes = cfg[block]["n_modes"]
         if n_modes > n_sens:
@@ -195,6 +199,13 @@ def check_config(cfg: Mapping, source: str = "config/config.yaml") -> None:
                 f"{block}.n_modes = {n_modes} exceeds the number of sensors ({n_sens}); "
                 f"Eq. 15 needs at least as many sensors as modes: lower {block}.n_modes or add sensors"
             )
+    return errors
+
+
+def _random_test_errors(cfg: Mapping) -> list:
+    """The random test: a measured record's file, its band (Hz) below the anti-alias limit, the modal band inside it,
+    and a rig record long enough for the FRF segments of every uncertainty block."""
+    errors = []
     rt = cfg["random_test"]
     if rt["source"] == "measured" and not rt.get("file"):
         errors.append(
@@ -223,10 +234,22 @@ def check_config(cfg: Mapping, source: str = "config/config.yaml") -> None:
             f"2 x frf.segment_length x modal.uncertainty_blocks = {2 * seg * blocks}; lengthen the record "
             "or shorten the segment"
         )
+    return errors
+
+
+def _stiction_bound_errors(cfg: Mapping) -> list:
+    """The stiffness search bounds (N/m) of the stiction fit, where given, with low < high."""
+    errors = []
     for name in ("k_t_bounds_n_per_m", "k_n_bounds_n_per_m"):
         b = cfg["stiction"].get(name)
         if b is not None and not b[0] < b[1]:
             errors.append(f"stiction.{name} = {b}: the lower bound must be below the upper")
+    return errors
+
+
+def _load_case_errors(cfg: Mapping) -> list:
+    """A measured load case names its file; a rig load case its target amplitudes A1, A2 (m/s^2, Table 2)."""
+    errors = []
     for case, lc in (cfg.get("load_cases") or {}).items():
         if lc.get("source", "rig") == "measured":
             if not lc.get("file"):
@@ -238,7 +261,14 @@ def check_config(cfg: Mapping, source: str = "config/config.yaml") -> None:
                         f"load_cases.{case}.{key} is missing: a rig load case needs its target "
                         "driving-point harmonic amplitudes (Table 2)"
                     )
-    for where, block in [("random_test", rt)] + [
+    return errors
+
+
+def _record_format_errors(cfg: Mapping) -> list:
+    """A measured record in another format than netCDF has a complete channel map (``importers.record_spec``); a
+    format other than netCDF is for measured records only."""
+    errors = []
+    for where, block in [("random_test", cfg["random_test"])] + [
         (f"load_cases.{c}", lc) for c, lc in (cfg.get("load_cases") or {}).items()
     ]:
         if block.get("source", "rig") == "measured" and block.get("format", "netcdf") != "netcdf" and block.get("file"):
@@ -251,12 +281,33 @@ def check_config(cfg: Mapping, source: str = "config/config.yaml") -> None:
                 errors.append(str(exc))
         elif block.get("format", "netcdf") != "netcdf" and block.get("source", "rig") != "measured":
             errors.append(f"{where}.format = {block['format']!r} applies to measured files only; set source: measured")
-    errors += _true_structure_errors(st, (cfg.get("rig") or {}).get("true_structure") or {})
+    return errors
+
+
+def _rig_errors(cfg: Mapping) -> list:
+    """The virtual rig's true structure (``_true_structure_errors``) and effects (``rig.effects.effect_magnitudes``)."""
+    errors = _true_structure_errors(cfg["structure"], (cfg.get("rig") or {}).get("true_structure") or {})
     try:
         from .rig.effects import effect_magnitudes
 
         effect_magnitudes((cfg.get("rig") or {}).get("effects"))
     except ValueError as exc:
         errors.append(str(exc))
+    return errors
+
+
+def check_config(cfg: Mapping, source: str = "config/config.yaml") -> None:
+    """Raise :class:`ConfigError` on cross-field inconsistencies of ``cfg`` (its left-out keys at the schema's
+    defaults, ``with_defaults``)."""
+    cfg = with_defaults(cfg)
+    errors = [
+        *_sensor_errors(cfg["structure"]),
+        *_mode_count_errors(cfg),
+        *_random_test_errors(cfg),
+        *_stiction_bound_errors(cfg),
+        *_load_case_errors(cfg),
+        *_record_format_errors(cfg),
+        *_rig_errors(cfg),
+    ]
     if errors:
         raise ConfigError(f"{source}: invalid configuration:\n  - " + "\n  - ".join(errors))

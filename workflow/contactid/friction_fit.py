@@ -410,22 +410,21 @@ def fit_friction_law(
     )
 
 
-def friction_fit_dataset(forces, preload: float, settings: FitSettings, seed: int, n_harmonics: int, paper_forces=None):
-    """Dataset of the fit on the calibration case's identified forces (working method), with the
-    paper's chain's forces fitted beside it when given (reproduction)."""
-    import xarray as xr
-
+def _fit_on_forces(
+    S, xi, N, fs: float, f0: float, preload: float, settings: FitSettings, seed: int, n_harmonics: int, label: str
+) -> FitResult:
+    """The law fitted (``fit_friction_law``) to one method's S (N), xi (m) and N_dyn (N) records, sampled at ``fs``
+    (Hz), through their first ``n_harmonics`` harmonics of ``f0`` (Hz)."""
     from .harmonics import fourier_series
 
-    fs = 1.0 / float(forces["time"].values[1] - forces["time"].values[0])
-    f0 = float(forces.attrs["excitation_frequency_hz"])
+    c = [fourier_series(x, fs, f0, n_harmonics)[0] for x in (xi, N, S)]
+    return fit_friction_law(*c, f0, preload, settings, seed, n_harmonics, label=label)
 
-    def run(S, xi, N, label):
-        c = [fourier_series(x, fs, f0, n_harmonics)[0] for x in (xi, N, S)]
-        return fit_friction_law(*c, f0, preload, settings, seed, n_harmonics, label=label)
 
-    res = run(forces["S"].values, forces["xi"].values, forces["N_dyn"].values, "friction fit")
-    data = {
+def _fit_variables(res: FitResult) -> dict:
+    """The dataset's variables of the working method's fit: parameters (e_f, k_c, e_t in N/m, 1/m, N/m; kappa, mu
+    dimensionless), their intervals and bounds, correlation, the GA's misfits per generation, the grid history."""
+    return {
         "parameter_value": (
             "parameter",
             res.params,
@@ -476,6 +475,13 @@ def friction_fit_dataset(forces, preload: float, settings: FitSettings, seed: in
             {"units": "mixed", "long_name": "grid points, e_f, k_c, e_t, kappa, mu, misfit per refinement"},
         ),
     }
+
+
+def _fit_attrs(
+    res: FitResult, forces, preload: float, f0: float, settings: FitSettings, seed: int, n_harmonics: int
+) -> dict:
+    """The dataset's attributes of the working method's fit: e_0 at the preload and its interval (N/m), misfit,
+    settings, and the share of the record with the contact open (identified N total <= ``N_OPEN``)."""
     attrs = {
         "e0_at_preload_n_per_m": res.e0_at_preload,
         "e0_interval_low": res.e0_interval[0],
@@ -493,40 +499,67 @@ def friction_fit_dataset(forces, preload: float, settings: FitSettings, seed: in
     }
     n_total = preload + forces["N_dyn"].values
     attrs["open_fraction"] = float(np.mean(n_total <= N_OPEN))  # share of the record with the contact open
+    return attrs
+
+
+def _paper_fit_outputs(paper_forces, preload: float, fit) -> tuple[dict, dict]:
+    """(variables, attributes) of the law fitted to the paper's chain's forces by ``fit`` (``_fit_on_forces`` with
+    the record's settings bound); when they cannot be fitted (its total N reaches 0 N, or the fit fails), no variable
+    and the reason as ``paper_fit_error``."""
+    try:
+        n_paper = preload + paper_forces["N_dyn_paper"].values
+        if np.min(n_paper) <= 0:  # not a separation the working method sees: the paper's N is wrong
+            raise ValueError(
+                f"the normal force reaches {np.min(n_paper):.3g} N <= 0 N, where the working "
+                "method's contact stays closed: the paper's N is not a physical normal force"
+            )
+        rp = fit(
+            paper_forces["S_paper"].values,
+            paper_forces["xi_paper"].values,
+            paper_forces["N_dyn_paper"].values,
+            "friction fit (paper's chain)",
+        )
+    except ValueError as exc:  # e.g. the paper's N reaches zero: the law is not defined there
+        log.warning("the paper's chain's forces cannot be fitted: %s", exc)
+        return {}, {"paper_fit_error": str(exc)}
+    data = {
+        "paper_parameter_value": (
+            "parameter",
+            rp.params,
+            {"units": "mixed", "long_name": "fitted to the paper's chain's forces"},
+        ),
+        "paper_interval_low": (
+            "parameter",
+            rp.intervals[:, 0],
+            {"units": "mixed", "long_name": "paper's chain: interval, lower end"},
+        ),
+        "paper_interval_high": (
+            "parameter",
+            rp.intervals[:, 1],
+            {"units": "mixed", "long_name": "paper's chain: interval, upper end"},
+        ),
+    }
+    return data, {"paper_e0_at_preload_n_per_m": rp.e0_at_preload, "paper_misfit_nrmse": rp.misfit}
+
+
+def friction_fit_dataset(forces, preload: float, settings: FitSettings, seed: int, n_harmonics: int, paper_forces=None):
+    """Dataset of the fit on the calibration case's identified forces (working method), with the
+    paper's chain's forces fitted beside it when given (reproduction)."""
+    import xarray as xr
+
+    fs = 1.0 / float(forces["time"].values[1] - forces["time"].values[0])
+    f0 = float(forces.attrs["excitation_frequency_hz"])
+
+    def run(S, xi, N, label):
+        return _fit_on_forces(S, xi, N, fs, f0, preload, settings, seed, n_harmonics, label)
+
+    res = run(forces["S"].values, forces["xi"].values, forces["N_dyn"].values, "friction fit")
+    data = _fit_variables(res)
+    attrs = _fit_attrs(res, forces, preload, f0, settings, seed, n_harmonics)
     if paper_forces is not None:
-        try:
-            n_paper = preload + paper_forces["N_dyn_paper"].values
-            if np.min(n_paper) <= 0:  # not a separation the working method sees: the paper's N is wrong
-                raise ValueError(
-                    f"the normal force reaches {np.min(n_paper):.3g} N <= 0 N, where the working "
-                    "method's contact stays closed: the paper's N is not a physical normal force"
-                )
-            rp = run(
-                paper_forces["S_paper"].values,
-                paper_forces["xi_paper"].values,
-                paper_forces["N_dyn_paper"].values,
-                "friction fit (paper's chain)",
-            )
-            data["paper_parameter_value"] = (
-                "parameter",
-                rp.params,
-                {"units": "mixed", "long_name": "fitted to the paper's chain's forces"},
-            )
-            data["paper_interval_low"] = (
-                "parameter",
-                rp.intervals[:, 0],
-                {"units": "mixed", "long_name": "paper's chain: interval, lower end"},
-            )
-            data["paper_interval_high"] = (
-                "parameter",
-                rp.intervals[:, 1],
-                {"units": "mixed", "long_name": "paper's chain: interval, upper end"},
-            )
-            attrs["paper_e0_at_preload_n_per_m"] = rp.e0_at_preload
-            attrs["paper_misfit_nrmse"] = rp.misfit
-        except ValueError as exc:  # e.g. the paper's N reaches zero: the law is not defined there
-            log.warning("the paper's chain's forces cannot be fitted: %s", exc)
-            attrs["paper_fit_error"] = str(exc)
+        paper_data, paper_attrs = _paper_fit_outputs(paper_forces, preload, run)
+        data.update(paper_data)
+        attrs.update(paper_attrs)
     return xr.Dataset(
         data,
         coords={

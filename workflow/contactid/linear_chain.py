@@ -109,12 +109,9 @@ def complex_frf(ds: xr.Dataset, prefix: str = "h1") -> np.ndarray:
     return ds[f"{prefix}_real"].values + 1j * ds[f"{prefix}_imag"].values
 
 
-def modal_dataset(frf: xr.Dataset, n_modes: int, band_hz, order: int) -> xr.Dataset:
-    """Natural frequencies and damping ratios of the first ``n_modes`` modes
-    (LSCF poles + LSFD residues), with standard uncertainties from the spread
-    of the sub-record estimates (batch means: std / sqrt(n_blocks))."""
-    f = frf["frequency"].values
-    est = fit_modes(f, complex_frf(frf), n_modes, tuple(band_hz), order)
+def _sub_record_uncertainties(f, frf: xr.Dataset, n_modes: int, band_hz, order: int) -> tuple:
+    """(standard uncertainty of the natural frequencies (Hz), of the damping ratios, sub-records fitted) from the
+    spread of the sub-records' fits (batch means: std / sqrt(n_blocks)); NaN with fewer than two fitted."""
     blocks_f, blocks_z = [], []
     bh = complex_frf(frf, "block_h1")
     for b in range(bh.shape[0]):
@@ -131,7 +128,12 @@ def modal_dataset(frf: xr.Dataset, n_modes: int, band_hz, order: int) -> xr.Data
     else:
         sf = np.full(n_modes, np.nan)
         sz = np.full(n_modes, np.nan)
-    # the poles must agree with neighbouring model orders (stabilisation check)
+    return sf, sz, len(blocks_f)
+
+
+def _order_spread(f, frf: xr.Dataset, est, n_modes: int, band_hz, order: int) -> np.ndarray:
+    """(n_modes,) largest change of the natural frequencies (Hz) of ``est`` at model order +-2 (the poles must agree
+    with neighbouring model orders: stabilisation check); NaN where no neighbouring order could be fitted."""
     spread = []
     for o in (order - 2, order + 2):
         try:
@@ -143,7 +145,17 @@ def modal_dataset(frf: xr.Dataset, n_modes: int, band_hz, order: int) -> xr.Data
             )
         except ValueError:
             pass
-    order_spread = np.max(spread, axis=0) if spread else np.full(n_modes, np.nan)
+    return np.max(spread, axis=0) if spread else np.full(n_modes, np.nan)
+
+
+def modal_dataset(frf: xr.Dataset, n_modes: int, band_hz, order: int) -> xr.Dataset:
+    """Natural frequencies and damping ratios of the first ``n_modes`` modes
+    (LSCF poles + LSFD residues), with standard uncertainties from the spread
+    of the sub-record estimates (batch means: std / sqrt(n_blocks))."""
+    f = frf["frequency"].values
+    est = fit_modes(f, complex_frf(frf), n_modes, tuple(band_hz), order)
+    sf, sz, n_blocks = _sub_record_uncertainties(f, frf, n_modes, band_hz, order)
+    order_spread = _order_spread(f, frf, est, n_modes, band_hz, order)
     return xr.Dataset(
         {
             "natural_frequency": (
@@ -191,7 +203,7 @@ def modal_dataset(frf: xr.Dataset, n_modes: int, band_hz, order: int) -> xr.Data
             "order": order,
             "band_low_hz": band_hz[0],
             "band_high_hz": band_hz[1],
-            "n_blocks_used": len(blocks_f),
+            "n_blocks_used": n_blocks,
         },
     )
 

@@ -184,30 +184,13 @@ def reduced_model_dataset(
     )
 
 
-def contact_forces_dataset(
-    raw: xr.Dataset,
-    paper: xr.Dataset,
-    linear_modes: xr.Dataset,
-    modal: xr.Dataset,
-    stiction: xr.Dataset,
-    structure_cfg: Mapping,
-    n_harmonics: int,
-    truth: xr.Dataset | None,
-    observability_limit: float = 0.1,
-    structures=(),
-) -> xr.Dataset:
-    """Both methods side by side: the working method (per-harmonic inverse identification) and the
-    paper's chain; the paper's error decomposed into k_t dxi and k_n deta; the working method's
-    sensitivity to the linear chain's stiffness intervals and to ``structures`` (the structures the random test
-    allows, ``UpdatingResult.posterior_structures``: E, masses, transducers and lever arm within their posterior,
-    which the k_t, k_n intervals alone miss); eta is called unobservable when it moves by more than
-    ``observability_limit`` NRMSE across them; errors against the truth."""
-    force, acc, fs, f0 = _record(raw)
-    model = linear_model(structure_cfg, linear_modes)
-    zeta = modal_damping_vector(model, modal["damping_ratio"].values)
-    inv = inverse_identification(model, zeta, force, acc, fs, f0, n_harmonics)
-    # sensitivity to the stiffness intervals of the linear chain
-    k_t, k_n = float(linear_modes["k_t"]), float(linear_modes["k_n"])
+def _stiffness_interval_spreads(
+    model: FEModel, modal: xr.Dataset, stiction: xr.Dataset, k_t: float, k_n: float, record, n_harmonics: int
+) -> dict:
+    """{"k_n" | "k_t": {quantity: NRMSE}}: how far S, N_dyn, xi and eta move between the two ends of the linear
+    chain's stiffness interval (N/m) of k_n (an open upper end: 10 x the larger of k_n and the lower end) and of k_t,
+    the other stiffness held; ``record``: (force, acceleration, fs, f0) of ``_record``."""
+    force, acc, fs, f0 = record
     lo_n, hi_n = (float(v) for v in stiction["k_n_interval"].values)
     hi_n = hi_n if np.isfinite(hi_n) else 10 * max(k_n, lo_n)
     spreads = {}
@@ -222,10 +205,16 @@ def contact_forces_dataset(
                 )
             )
         spreads[name] = {q: nrmse(getattr(res[0], q), getattr(res[1], q)) for q in ("S", "N_dyn", "xi", "eta")}
-    eta_spread = max(spreads["k_n"]["eta"], spreads["k_t"]["eta"])
+    return spreads
+
+
+def _structure_spreads(inv, structures, modal: xr.Dataset, record, n_harmonics: int) -> dict:
+    """{quantity: largest relative change} of S, N_dyn, xi and eta over ``structures`` (StructureParameters),
+    on the harmonics (the relative norm of the coefficients is the NRMSE of the periodic signals; no time synthesis
+    needed); empty without structures."""
     structure_spread = {}
-    if structures:  # the largest change over the structures the random test allows, per quantity, on the harmonics
-        # (the relative norm of the coefficients is the NRMSE of the periodic signals; no time synthesis needed)
+    if structures:
+        force, acc, fs, f0 = record
         F_coef = fourier_series(force, fs, f0, n_harmonics)[0]
         A_coef = fourier_series(acc, fs, f0, n_harmonics)
         own = {"S": inv.S_coef, "N_dyn": inv.N_coef, "xi": inv.xi_coef, "eta": inv.eta_coef}
@@ -236,32 +225,21 @@ def contact_forces_dataset(
             for q, c in own.items():
                 change = float(np.linalg.norm(other[q] - c) / max(np.linalg.norm(c), 1e-300))
                 structure_spread[q] = max(structure_spread.get(q, 0.0), change)
-    if structure_spread:
-        spreads["structure"] = structure_spread
-    eta_observable = max(eta_spread, structure_spread.get("eta", 0.0)) <= observability_limit
-    # the paper's error explained: S_paper ~ S - k_t dxi, N_paper ~ N_dyn + k_n deta
-    dxi = inv.xi - paper["xi"].values
-    deta = inv.eta - paper["eta"].values
-    S_expl = inv.S - k_t * dxi
-    N_expl = inv.N_dyn + k_n * deta
-    # normal stiffness and hardening from the N-eta relation: N_dyn = -k1 eta + k2 eta^2
+    return structure_spread
+
+
+def _normal_stiffness_and_hardening(inv) -> tuple[float, float]:
+    """(k1 in N/m, k2 in N/m^2) of the N-eta relation N_dyn = -k1 eta + k2 eta^2 (eta^2 mean removed), least
+    squares."""
     A = np.column_stack([-inv.eta, inv.eta**2 - np.mean(inv.eta**2)])
     k1, k2 = np.linalg.lstsq(A, inv.N_dyn, rcond=None)[0]
-    attrs = {
-        "method": "inverse: per-harmonic unknown-input identification with the identified linear model",
-        "n_harmonics": n_harmonics,
-        "excitation_frequency_hz": f0,
-        "eta_observable": int(eta_observable),
-        "eta_spread_over_stiffness_intervals": eta_spread,
-        "eta_spread_over_structures": structure_spread.get("eta", float("nan")),
-        "normal_stiffness_from_n_eta_n_per_m": float(k1),
-        "normal_hardening_n_per_m2": float(k2),
-        "paper_S_decomposition_nrmse": nrmse(paper["S"].values, S_expl),
-        "paper_N_decomposition_nrmse": nrmse(paper["N_dyn"].values, N_expl),
-        "paper_xi_unrepresented_fraction": nrmse(paper["xi"].values, inv.xi),
-        **{f"spread_{p}_{q}": v for p, d in spreads.items() for q, v in d.items()},
-    }
-    data = {
+    return k1, k2
+
+
+def _contact_force_variables(inv, paper: xr.Dataset, k_t: float, k_n: float, dxi, deta) -> dict:
+    """The dataset's variables: both methods' S, N_dyn (N), xi, eta (m), the working method's rates, the paper's
+    error terms k_t dxi and k_n deta (N) and the sensor misfit per harmonic."""
+    return {
         "S": ("time", inv.S, {"units": "N", "long_name": "friction force S(t), working method, mean removed"}),
         "N_dyn": (
             "time",
@@ -280,24 +258,91 @@ def contact_forces_dataset(
         "k_n_deta": ("time", k_n * deta, {"units": "N", "long_name": "k_n deta: the part of N the stuck NNMs add"}),
         "residual": ("harmonic", inv.residual, {"units": "1", "long_name": "relative sensor misfit per harmonic"}),
     }
+
+
+def _truth_scores(inv, paper: xr.Dataset, truth: xr.Dataset) -> tuple[dict, dict]:
+    """(attributes, variables) against the rig's truth: both methods' NRMSE of S, N, xi and eta, and the true S,
+    N - N0 (N), xi and eta (m) with their means removed."""
+    attrs = {}
+    tS, tN, txi, teta = (truth[k].values for k in ("S", "N", "xi", "eta"))
+    for method, (S, N, xi, eta) in {
+        "": (inv.S, inv.N_dyn, inv.xi, inv.eta),
+        "paper_": (paper["S"].values, paper["N_dyn"].values, paper["xi"].values, paper["eta"].values),
+    }.items():
+        attrs.update(
+            {
+                f"{method}S_nrmse": nrmse(S, tS),
+                f"{method}N_nrmse": nrmse(N, tN),
+                f"{method}xi_nrmse": nrmse(xi, txi),
+                f"{method}eta_nrmse": nrmse(eta, teta),
+            }
+        )
+    data = {
+        "S_truth": ("time", tS - tS.mean(), {"units": "N", "long_name": "true S, mean removed"}),
+        "N_dyn_truth": ("time", tN - tN.mean(), {"units": "N", "long_name": "true N - N0, mean removed"}),
+        "xi_truth": ("time", txi - txi.mean(), {"units": "m", "long_name": "true xi, mean removed"}),
+        "eta_truth": ("time", teta - teta.mean(), {"units": "m", "long_name": "true eta, mean removed"}),
+    }
+    return attrs, data
+
+
+def contact_forces_dataset(
+    raw: xr.Dataset,
+    paper: xr.Dataset,
+    linear_modes: xr.Dataset,
+    modal: xr.Dataset,
+    stiction: xr.Dataset,
+    structure_cfg: Mapping,
+    n_harmonics: int,
+    truth: xr.Dataset | None,
+    observability_limit: float = 0.1,
+    structures=(),
+) -> xr.Dataset:
+    """Both methods side by side: the working method (per-harmonic inverse identification) and the
+    paper's chain; the paper's error decomposed into k_t dxi and k_n deta; the working method's
+    sensitivity to the linear chain's stiffness intervals and to ``structures`` (the structures the random test
+    allows, ``UpdatingResult.posterior_structures``: E, masses, transducers and lever arm within their posterior,
+    which the k_t, k_n intervals alone miss); eta is called unobservable when it moves by more than
+    ``observability_limit`` NRMSE across them; errors against the truth."""
+    record = _record(raw)
+    force, acc, fs, f0 = record
+    model = linear_model(structure_cfg, linear_modes)
+    zeta = modal_damping_vector(model, modal["damping_ratio"].values)
+    inv = inverse_identification(model, zeta, force, acc, fs, f0, n_harmonics)
+    # sensitivity to the stiffness intervals of the linear chain
+    k_t, k_n = float(linear_modes["k_t"]), float(linear_modes["k_n"])
+    spreads = _stiffness_interval_spreads(model, modal, stiction, k_t, k_n, record, n_harmonics)
+    eta_spread = max(spreads["k_n"]["eta"], spreads["k_t"]["eta"])
+    # the largest change over the structures the random test allows, per quantity
+    structure_spread = _structure_spreads(inv, structures, modal, record, n_harmonics)
+    if structure_spread:
+        spreads["structure"] = structure_spread
+    eta_observable = max(eta_spread, structure_spread.get("eta", 0.0)) <= observability_limit
+    # the paper's error explained: S_paper ~ S - k_t dxi, N_paper ~ N_dyn + k_n deta
+    dxi = inv.xi - paper["xi"].values
+    deta = inv.eta - paper["eta"].values
+    S_expl = inv.S - k_t * dxi
+    N_expl = inv.N_dyn + k_n * deta
+    k1, k2 = _normal_stiffness_and_hardening(inv)
+    attrs = {
+        "method": "inverse: per-harmonic unknown-input identification with the identified linear model",
+        "n_harmonics": n_harmonics,
+        "excitation_frequency_hz": f0,
+        "eta_observable": int(eta_observable),
+        "eta_spread_over_stiffness_intervals": eta_spread,
+        "eta_spread_over_structures": structure_spread.get("eta", float("nan")),
+        "normal_stiffness_from_n_eta_n_per_m": float(k1),
+        "normal_hardening_n_per_m2": float(k2),
+        "paper_S_decomposition_nrmse": nrmse(paper["S"].values, S_expl),
+        "paper_N_decomposition_nrmse": nrmse(paper["N_dyn"].values, N_expl),
+        "paper_xi_unrepresented_fraction": nrmse(paper["xi"].values, inv.xi),
+        **{f"spread_{p}_{q}": v for p, d in spreads.items() for q, v in d.items()},
+    }
+    data = _contact_force_variables(inv, paper, k_t, k_n, dxi, deta)
     if truth is not None:
-        tS, tN, txi, teta = (truth[k].values for k in ("S", "N", "xi", "eta"))
-        for method, (S, N, xi, eta) in {
-            "": (inv.S, inv.N_dyn, inv.xi, inv.eta),
-            "paper_": (paper["S"].values, paper["N_dyn"].values, paper["xi"].values, paper["eta"].values),
-        }.items():
-            attrs.update(
-                {
-                    f"{method}S_nrmse": nrmse(S, tS),
-                    f"{method}N_nrmse": nrmse(N, tN),
-                    f"{method}xi_nrmse": nrmse(xi, txi),
-                    f"{method}eta_nrmse": nrmse(eta, teta),
-                }
-            )
-        data["S_truth"] = ("time", tS - tS.mean(), {"units": "N", "long_name": "true S, mean removed"})
-        data["N_dyn_truth"] = ("time", tN - tN.mean(), {"units": "N", "long_name": "true N - N0, mean removed"})
-        data["xi_truth"] = ("time", txi - txi.mean(), {"units": "m", "long_name": "true xi, mean removed"})
-        data["eta_truth"] = ("time", teta - teta.mean(), {"units": "m", "long_name": "true eta, mean removed"})
+        truth_attrs, truth_data = _truth_scores(inv, paper, truth)
+        attrs.update(truth_attrs)
+        data.update(truth_data)
     return xr.Dataset(data, coords={"time": raw["time"], "harmonic": np.arange(1, n_harmonics + 1)}, attrs=attrs)
 
 

@@ -176,6 +176,89 @@ def modal_predictions(params: StructureParameters, n_modes: int) -> tuple[np.nda
     return modes.frequencies_hz, np.abs(phi_s * phi_d[None, :]) / (2 * w[None, :])
 
 
+def _prior_sds(names: list, contact_prior_sd: float, prior_sd) -> np.ndarray:
+    """Prior sd of (ln k_t, ln k_n, ln factor for each of ``names``): ``contact_prior_sd`` for the contact, FACTORS'
+    spreads for the factors unless ``prior_sd`` ({factor: sd}) replaces them; an unknown factor is refused."""
+    for f in names:
+        if f not in FACTORS:
+            raise ValueError(f"gap.model_updating.parameters: unknown {f!r}; choose from {', '.join(FACTORS)}")
+    priors = {f: FACTORS[f].prior_sd for f in names} | {k: float(v) for k, v in dict(prior_sd or {}).items()}
+    return np.array([contact_prior_sd, contact_prior_sd] + [priors[f] for f in names])
+
+
+class _UpdatingProblem:
+    """The misfit of the structure x = (ln k_t, ln k_n, ln factors) to the modal data: frequencies (Hz) over their
+    standard errors and, unless ``R_id`` is None, residues over ``residue_accuracy`` of their value; ``sd`` the prior
+    sds of x."""
+
+    def __init__(self, params, names, f_id, f_sd, R_id, residue_accuracy, sd):
+        self.params, self.names, self.sd = params, names, sd
+        self.f_id, self.f_sd, self.R_id, self.residue_accuracy = f_id, f_sd, R_id, residue_accuracy
+        self.n = f_id.size
+
+    def structure(self, x) -> StructureParameters:
+        """The structure at x."""
+        return apply_factors(
+            self.params.with_contact(float(np.exp(x[0])), float(np.exp(x[1]))),
+            {f: float(np.exp(v)) for f, v in zip(self.names, x[2:])},
+        )
+
+    def data_residuals(self, x) -> np.ndarray:
+        """Scaled residuals of the frequencies, then of the residues (sensor by sensor); 1e3 each where the
+        structure has no modes to compare."""
+        n, R_id = self.n, self.R_id
+        try:
+            f, R = modal_predictions(self.structure(x), n)
+        except ValueError:
+            return np.full(n + (0 if R_id is None else R_id.size), 1e3)
+        r = [(f - self.f_id) / self.f_sd]
+        if R_id is not None:
+            r.append(((R - R_id) / (self.residue_accuracy * R_id)).ravel())
+        return np.concatenate(r)
+
+    def fit(self, x_centre, free):
+        """(x, least-squares result) of the maximum a posteriori fit of the ``free`` entries of x, the others held at
+        ``x_centre``, which is both the start and the centre of the prior."""
+        sd = self.sd
+
+        def res(z):
+            x = x_centre.copy()
+            x[free] = z
+            return np.concatenate([self.data_residuals(x), ((x - x_centre) / sd)[free]])
+
+        sol = least_squares(res, x_centre[free], x_scale=sd[free] * 0.1, xtol=1e-10, ftol=1e-12, max_nfev=400)
+        x = x_centre.copy()
+        x[free] = sol.x
+        return x, sol
+
+
+def _posterior_identifiability(jacobian, sd, labels: list) -> tuple[np.ndarray, dict]:
+    """(covariance of x from the Jacobian of the residuals (data + prior) at the optimum, the linearised posterior;
+    {label: posterior sd, prior sd, their ratio, whether the data bound it (ratio < IDENTIFIED), the parameter it
+    correlates with most and the correlation})."""
+    J = jacobian
+    try:
+        cov = np.linalg.inv(J.T @ J)
+    except np.linalg.LinAlgError:
+        cov = np.linalg.pinv(J.T @ J)
+    post_sd = np.sqrt(np.clip(np.diag(cov), 0, None))
+    corr = cov / np.outer(post_sd, post_sd)
+    ident = {}
+    for i, name in enumerate(labels):
+        others = [j for j in range(len(labels)) if j != i]
+        j = max(others, key=lambda j: abs(corr[i, j])) if others else None
+        ratio = float(post_sd[i] / sd[i])
+        ident[name] = {
+            "posterior_sd": float(post_sd[i]),
+            "prior_sd": float(sd[i]),
+            "posterior_over_prior": ratio,
+            "bound_by_data": bool(ratio < IDENTIFIED),
+            "most_correlated_with": labels[j] if j is not None else None,
+            "correlation": float(corr[i, j]) if j is not None else None,
+        }
+    return cov, ident
+
+
 def update_structure(
     params: StructureParameters,
     f_id_hz,
@@ -200,84 +283,28 @@ def update_structure(
     n = f_id.size
     R_id = None if residues is None else np.asarray(residues, float)
     names = [str(f) for f in factors]
-    for f in names:
-        if f not in FACTORS:
-            raise ValueError(f"gap.model_updating.parameters: unknown {f!r}; choose from {', '.join(FACTORS)}")
-    priors = {f: FACTORS[f].prior_sd for f in names} | {k: float(v) for k, v in dict(prior_sd or {}).items()}
-    sd = np.array([contact_prior_sd, contact_prior_sd] + [priors[f] for f in names])
+    sd = _prior_sds(names, contact_prior_sd, prior_sd)
     x_nom = np.array([np.log(params.k_t), np.log(params.k_n)] + [0.0] * len(names))
-
-    def structure(x):
-        return apply_factors(
-            params.with_contact(float(np.exp(x[0])), float(np.exp(x[1]))),
-            {f: float(np.exp(v)) for f, v in zip(names, x[2:])},
-        )
-
-    def data_residuals(x):
-        try:
-            f, R = modal_predictions(structure(x), n)
-        except ValueError:
-            return np.full(n + (0 if R_id is None else R_id.size), 1e3)
-        r = [(f - f_id) / f_sd]
-        if R_id is not None:
-            r.append(((R - R_id) / (residue_accuracy * R_id)).ravel())
-        return np.concatenate(r)
-
-    def residuals(x, free):
-        return np.concatenate([data_residuals(x), ((x - x_nom) / sd)[free]])
-
-    def fit(free):
-        def res(z):
-            x = x_nom.copy()
-            x[free] = z
-            return residuals(x, free)
-
-        sol = least_squares(res, x_nom[free], x_scale=sd[free] * 0.1, xtol=1e-10, ftol=1e-12, max_nfev=400)
-        x = x_nom.copy()
-        x[free] = sol.x
-        return x, sol
-
+    problem = _UpdatingProblem(params, names, f_id, f_sd, R_id, residue_accuracy, sd)
     contact_only = np.array([True, True] + [False] * len(names))
-    x0, _ = fit(contact_only)  # the nominal structure with k_t, k_n refitted to the same data
-    chi2_nominal = float(np.sum(data_residuals(x0) ** 2))
+    x0, _ = problem.fit(x_nom, contact_only)  # the nominal structure with k_t, k_n refitted to the same data
+    chi2_nominal = float(np.sum(problem.data_residuals(x0) ** 2))
     free = np.ones(x_nom.size, bool)
-    x_nom_saved = x_nom.copy()
-    x_nom[:2] = x0[:2]  # start (not prior centre) of the contact parameters
-    x1, sol = fit(free)
-    x_nom = x_nom_saved
-    chi2_updated = float(np.sum(data_residuals(x1) ** 2))
+    x_start = x_nom.copy()
+    x_start[:2] = x0[:2]  # the contact parameters start (and their wide prior is centred) at the refitted k_t, k_n
+    x1, sol = problem.fit(x_start, free)
+    chi2_updated = float(np.sum(problem.data_residuals(x1) ** 2))
     from scipy.stats import chi2 as chi2_dist  # here: scipy.stats takes 0.3 s to import
 
     accepted = bool(names) and bool(chi2_nominal - chi2_updated > chi2_dist.ppf(confidence, len(names)))
-    # linearised posterior: J of the residuals (data + prior) in x
-    J = sol.jac
-    try:
-        cov = np.linalg.inv(J.T @ J)
-    except np.linalg.LinAlgError:
-        cov = np.linalg.pinv(J.T @ J)
-    post_sd = np.sqrt(np.clip(np.diag(cov), 0, None))
-    corr = cov / np.outer(post_sd, post_sd)
-    labels = ["k_t", "k_n"] + names
-    ident = {}
-    for i, name in enumerate(labels):
-        others = [j for j in range(len(labels)) if j != i]
-        j = max(others, key=lambda j: abs(corr[i, j])) if others else None
-        ratio = float(post_sd[i] / sd[i])
-        ident[name] = {
-            "posterior_sd": float(post_sd[i]),
-            "prior_sd": float(sd[i]),
-            "posterior_over_prior": ratio,
-            "bound_by_data": bool(ratio < IDENTIFIED),
-            "most_correlated_with": labels[j] if j is not None else None,
-            "correlation": float(corr[i, j]) if j is not None else None,
-        }
+    cov, ident = _posterior_identifiability(sol.jac, sd, ["k_t", "k_n"] + names)
     x = x1 if accepted else x0
-    f_best, _ = modal_predictions(structure(x), n)
+    f_best, _ = modal_predictions(problem.structure(x), n)
     return UpdatingResult(
         {f: float(np.exp(v)) for f, v in zip(names, x[2:])},
         float(np.exp(x[0])),
         float(np.exp(x[1])),
-        structure(x),
+        problem.structure(x),
         chi2_nominal,
         chi2_updated,
         accepted,

@@ -256,6 +256,120 @@ def evaluate(
 POLISH_SEARCH = contextvars.ContextVar("polish_search", default=False)
 
 
+class _CandidateRuns:
+    """The chain redone (``evaluate``) at the thetas a calibration tries, each once: called with theta, it returns
+    (gap, model with refitted friction, simulation, friction misfit, augmentation), every simulation starting from
+    the previous one's steady state; a theta the law or the simulation fails at gets an infinite gap (and is logged).
+    ``evaluations`` counts the distinct runs."""
+
+    def __init__(self, model, cand, rec, bounds, n_harmonics: int, start, base):
+        self.model, self.cand, self.rec, self.base = model, cand, rec, base
+        self.bounds, self.n_harmonics = bounds, n_harmonics
+        self.last_sim = start
+        self.evaluations = 0
+        self.cache = {}
+
+    def __call__(self, theta, polish=False):
+        polish = polish or POLISH_SEARCH.get()  # the key holds what is run: a polished search's optimum is not rerun
+        key = (*np.round(np.atleast_1d(theta), 12), polish)
+        if key not in self.cache:
+            self.evaluations += 1
+            aug = self.base.merge(self.cand.augmentation(np.atleast_1d(theta)))
+            try:
+                out = evaluate(
+                    self.model, aug, self.rec, self.bounds, self.n_harmonics, start=self.last_sim, polish=polish
+                )
+                self.last_sim = out[2]  # the next theta is a neighbour: start from here
+                if not np.isfinite(out[0]):
+                    raise FloatingPointError("the simulation diverged")
+                self.cache[key] = (*out, aug)
+            except (ValueError, FloatingPointError) as exc:  # e.g. the law is undefined there
+                log.info("%s at %s: %s", self.cand.name, theta, exc)
+                self.cache[key] = (np.inf, self.model, None, np.nan, aug)
+        return self.cache[key]
+
+
+def _per_channel_theta(run: _CandidateRuns, cand: Candidate, rec: RecordHarmonics, max_evaluations: int) -> np.ndarray:
+    """theta of a per-channel candidate (one parameter per accelerometer channel): Nelder-Mead from zero, simplex
+    steps of 10 % of the range; zero where that is no worse."""
+    from scipy.optimize import minimize
+
+    j = rec.acceleration.shape[0]
+    p = cand.parameters[0]
+    step = 0.1 * (p.high - p.low)
+    simplex = np.vstack([np.zeros(j), step * np.eye(j)])
+    res = minimize(
+        lambda x: run(np.clip(x, p.low, p.high))[0],
+        np.zeros(j),
+        method="Nelder-Mead",
+        options={
+            "initial_simplex": simplex,
+            "maxfev": 5 * max_evaluations,
+            "xatol": 1e-3 * (p.high - p.low),
+            "fatol": 1e-6,
+        },
+    )
+    theta = np.clip(res.x, p.low, p.high)
+    if run(np.zeros(j))[0] <= run(theta)[0]:
+        theta = np.zeros(j)
+    return theta
+
+
+def _scalar_theta(run: _CandidateRuns, cand: Candidate, max_evaluations: int) -> np.ndarray:
+    """theta (1,) of a one-parameter candidate: a scan of the range, the bounded search between the best point's
+    neighbours, and "off" where that is better."""
+    # a scan of the range (1/32, 1/8, 1/4, 1/2, 3/4), then the bounded search between the best point's neighbours:
+    # a search over the whole range from its middle can settle in a side basin (the blind benchmark's
+    # transducer-mass items: theta 0.35 instead of 0.22, a held-out gap four times larger)
+    # the scan also halves towards the low end twice more: an effect at a few per cent of its range (structural
+    # damping 0.0017 of 0-0.05) otherwise lies below the first point, and the search between the low end and
+    # the middle settled in a side basin (0.013; the detection ladder's items at a third of the typical value)
+    p = cand.parameters[0]
+    grid = p.low + (p.high - p.low) * np.array([0.0, 1 / 32, 1 / 8, 1 / 4, 1 / 2, 3 / 4, 1.0])
+    best = min(range(1, 6), key=lambda i: run(np.array([grid[i]]))[0])
+    res = minimize_scalar(
+        lambda x: run(np.array([x]))[0],
+        bounds=(grid[best - 1], grid[best + 1]),
+        method="bounded",
+        options={"xatol": 1e-3 * (p.high - p.low), "maxiter": max_evaluations},
+    )
+    theta = np.array([res.x]) if run(np.array([res.x]))[0] <= run(np.array([grid[best]]))[0] else np.array([grid[best]])
+    # the bounded search never tries the ends: compare with "off" (the low end or zero)
+    off = np.array([p.off])
+    if run(off)[0] < run(theta)[0]:
+        theta = off
+    return theta
+
+
+def _simplex_theta(run: _CandidateRuns, cand: Candidate, max_evaluations: int, starts) -> np.ndarray:
+    """theta of a candidate with several parameters: Nelder-Mead in the unit cube of their ranges from the best of a
+    scan of the first parameter (and of the earlier optimum and ``starts``)."""
+    from scipy.optimize import minimize
+
+    lo = np.array([p.low for p in cand.parameters])
+    hi = np.array([p.high for p in cand.parameters])
+    x0 = np.array([0.5 if p.start is None else (p.start - p.low) / (p.high - p.low) for p in cand.parameters])
+    # the first parameter scanned at the others' starts (its quarter points), Nelder-Mead from the best:
+    # a gap that jumps where the contact starts to open has more than one basin (the blind benchmark's
+    # contact-separation items: found from the middle of the range in 2 of 6)
+    scan = [np.concatenate([[q], x0[1:]]) for q in (0.125, 0.375, 0.625, 0.875)]
+    joint = all(p.start is not None for p in cand.parameters)
+    if joint:  # a joint refit: also from the earlier optimum itself, with a finer simplex (an oblique valley)
+        scan.append(x0)
+    scan += [np.clip((np.asarray(t, float) - lo) / (hi - lo), 0.0, 1.0) for t in starts]
+    x0 = min(scan, key=lambda x: run(lo + x * (hi - lo))[0])
+    size = 0.1 if joint else 0.25
+    step = np.where(x0 + size <= 1.0, size, -size)
+    simplex = np.vstack([x0, x0 + np.diag(step)])
+    res = minimize(
+        lambda x: run(lo + np.clip(x, 0, 1) * (hi - lo))[0],
+        x0,
+        method="Nelder-Mead",
+        options={"initial_simplex": simplex, "maxfev": max_evaluations * lo.size, "xatol": 1e-3, "fatol": 1e-6},
+    )
+    return lo + np.clip(res.x, 0, 1) * (hi - lo)
+
+
 def calibrate(
     model: IdentifiedModel,
     cand: Candidate,
@@ -275,100 +389,13 @@ def calibrate(
     True polishes each with the integrator, as before); the optimum is evaluated again with the integrator's
     polish, so its gap and simulation are the reference's (same optimum within 1 %, a quarter to a third less
     diagnosis time, measured on 10 benchmark items)."""
-    bounds = settings.bounds
-    n_eval = 0
-    cache = {}
-
-    last = {"sim": start}
-
-    def run(theta, polish=False):
-        nonlocal n_eval
-        polish = polish or POLISH_SEARCH.get()  # the key holds what is run: a polished search's optimum is not rerun
-        key = (*np.round(np.atleast_1d(theta), 12), polish)
-        if key not in cache:
-            n_eval += 1
-            aug = base.merge(cand.augmentation(np.atleast_1d(theta)))
-            try:
-                out = evaluate(model, aug, rec, bounds, n_harmonics, start=last["sim"], polish=polish)
-                last["sim"] = out[2]  # the next theta is a neighbour: start from here
-                if not np.isfinite(out[0]):
-                    raise FloatingPointError("the simulation diverged")
-                cache[key] = (*out, aug)
-            except (ValueError, FloatingPointError) as exc:  # e.g. the law is undefined there
-                log.info("%s at %s: %s", cand.name, theta, exc)
-                cache[key] = (np.inf, model, None, np.nan, aug)
-        return cache[key]
-
+    run = _CandidateRuns(model, cand, rec, settings.bounds, n_harmonics, start, base)
     if cand.per_channel:
-        # one parameter per accelerometer channel: Nelder-Mead from zero, simplex steps of 10 % of the range
-        from scipy.optimize import minimize
-
-        j = rec.acceleration.shape[0]
-        p = cand.parameters[0]
-        step = 0.1 * (p.high - p.low)
-        simplex = np.vstack([np.zeros(j), step * np.eye(j)])
-        res = minimize(
-            lambda x: run(np.clip(x, p.low, p.high))[0],
-            np.zeros(j),
-            method="Nelder-Mead",
-            options={
-                "initial_simplex": simplex,
-                "maxfev": 5 * max_evaluations,
-                "xatol": 1e-3 * (p.high - p.low),
-                "fatol": 1e-6,
-            },
-        )
-        theta = np.clip(res.x, p.low, p.high)
-        if run(np.zeros(j))[0] <= run(theta)[0]:
-            theta = np.zeros(j)
+        theta = _per_channel_theta(run, cand, rec, max_evaluations)
     elif len(cand.parameters) == 1:
-        # a scan of the range (1/32, 1/8, 1/4, 1/2, 3/4), then the bounded search between the best point's neighbours:
-        # a search over the whole range from its middle can settle in a side basin (the blind benchmark's
-        # transducer-mass items: theta 0.35 instead of 0.22, a held-out gap four times larger)
-        # the scan also halves towards the low end twice more: an effect at a few per cent of its range (structural
-        # damping 0.0017 of 0-0.05) otherwise lies below the first point, and the search between the low end and
-        # the middle settled in a side basin (0.013; the detection ladder's items at a third of the typical value)
-        p = cand.parameters[0]
-        grid = p.low + (p.high - p.low) * np.array([0.0, 1 / 32, 1 / 8, 1 / 4, 1 / 2, 3 / 4, 1.0])
-        best = min(range(1, 6), key=lambda i: run(np.array([grid[i]]))[0])
-        res = minimize_scalar(
-            lambda x: run(np.array([x]))[0],
-            bounds=(grid[best - 1], grid[best + 1]),
-            method="bounded",
-            options={"xatol": 1e-3 * (p.high - p.low), "maxiter": max_evaluations},
-        )
-        theta = (
-            np.array([res.x]) if run(np.array([res.x]))[0] <= run(np.array([grid[best]]))[0] else np.array([grid[best]])
-        )
-        # the bounded search never tries the ends: compare with "off" (the low end or zero)
-        off = np.array([p.off])
-        if run(off)[0] < run(theta)[0]:
-            theta = off
+        theta = _scalar_theta(run, cand, max_evaluations)
     else:
-        from scipy.optimize import minimize
-
-        lo = np.array([p.low for p in cand.parameters])
-        hi = np.array([p.high for p in cand.parameters])
-        x0 = np.array([0.5 if p.start is None else (p.start - p.low) / (p.high - p.low) for p in cand.parameters])
-        # the first parameter scanned at the others' starts (its quarter points), Nelder-Mead from the best:
-        # a gap that jumps where the contact starts to open has more than one basin (the blind benchmark's
-        # contact-separation items: found from the middle of the range in 2 of 6)
-        scan = [np.concatenate([[q], x0[1:]]) for q in (0.125, 0.375, 0.625, 0.875)]
-        joint = all(p.start is not None for p in cand.parameters)
-        if joint:  # a joint refit: also from the earlier optimum itself, with a finer simplex (an oblique valley)
-            scan.append(x0)
-        scan += [np.clip((np.asarray(t, float) - lo) / (hi - lo), 0.0, 1.0) for t in starts]
-        x0 = min(scan, key=lambda x: run(lo + x * (hi - lo))[0])
-        size = 0.1 if joint else 0.25
-        step = np.where(x0 + size <= 1.0, size, -size)
-        simplex = np.vstack([x0, x0 + np.diag(step)])
-        res = minimize(
-            lambda x: run(lo + np.clip(x, 0, 1) * (hi - lo))[0],
-            x0,
-            method="Nelder-Mead",
-            options={"initial_simplex": simplex, "maxfev": max_evaluations * lo.size, "xatol": 1e-3, "fatol": 1e-6},
-        )
-        theta = lo + np.clip(res.x, 0, 1) * (hi - lo)
+        theta = _simplex_theta(run, cand, max_evaluations, starts)
     g, m2, sim, misfit, aug = run(theta, polish=True)
     if not np.isfinite(g):  # nothing in the range could be simulated: the effect off
         theta = (
@@ -377,7 +404,7 @@ def calibrate(
         g, m2, sim, misfit, aug = run(theta, polish=True)
     theta = np.atleast_1d(theta)
     return Calibration(
-        cand.name, theta, np.asarray(m2.friction), g, m2, aug, n_eval, misfit, sim, ((cand.name, theta),)
+        cand.name, theta, np.asarray(m2.friction), g, m2, aug, run.evaluations, misfit, sim, ((cand.name, theta),)
     )
 
 
