@@ -62,20 +62,44 @@ def frf_dataset(raw: xr.Dataset, segment_length: int, overlap: float, window: st
                 ]
             )
         )
-    block_h1 = np.array(block_h1)
-    ds = xr.Dataset(
+    attrs = {
+        "n_averages": full.n_averages,
+        "segment_length": segment_length,
+        "overlap": overlap,
+        "window": window,
+        "sampling_rate_hz": fs,
+        "driving_point_sensor": str(raw["sensor"].values[0]),
+    }
+    return frf_result_dataset(
+        full.frequency_hz,
+        full.h1,
+        full.coherence,
+        np.array(block_h1),
+        raw["sensor"].values,
+        raw["position"].values,
+        attrs,
+    )
+
+
+def frf_result_dataset(frequency_hz, h1, coherence, block_h1, sensors, positions_m, attrs: Mapping) -> xr.Dataset:
+    """The FRF dataset (results/linear/frf.nc) the modal fit reads: H1 accelerance (sensor, frequency) complex in
+    m/s^2/N, ordinary coherence (1), H1 of sub-records (block, sensor, frequency; the block dimension may be
+    empty: no sub-records), frequency (Hz), sensor names and positions (m), and ``attrs``. One home of the
+    variables, units and names, for the FRF from a time record and the FRF imported from a file."""
+    block_h1 = np.asarray(block_h1, dtype=complex).reshape(-1, *np.shape(h1))
+    return xr.Dataset(
         {
             "h1_real": (
                 ("sensor", "frequency"),
-                full.h1.real,
+                np.real(h1),
                 {"units": "m/s^2/N", "long_name": "H1 accelerance, real part"},
             ),
             "h1_imag": (
                 ("sensor", "frequency"),
-                full.h1.imag,
+                np.imag(h1),
                 {"units": "m/s^2/N", "long_name": "H1 accelerance, imaginary part"},
             ),
-            "coherence": (("sensor", "frequency"), full.coherence, {"units": "1", "long_name": "ordinary coherence"}),
+            "coherence": (("sensor", "frequency"), coherence, {"units": "1", "long_name": "ordinary coherence"}),
             "block_h1_real": (
                 ("block", "sensor", "frequency"),
                 block_h1.real,
@@ -88,21 +112,21 @@ def frf_dataset(raw: xr.Dataset, segment_length: int, overlap: float, window: st
             ),
         },
         coords={
-            "frequency": ("frequency", full.frequency_hz, {"units": "Hz", "long_name": "frequency"}),
-            "sensor": raw["sensor"].values,
-            "position": ("sensor", raw["position"].values, {"units": "m", "long_name": "distance from the clamp"}),
-            "block": np.arange(blocks),
+            "frequency": (
+                "frequency",
+                np.asarray(frequency_hz, dtype=float),
+                {"units": "Hz", "long_name": "frequency"},
+            ),
+            "sensor": np.asarray(sensors),
+            "position": (
+                "sensor",
+                np.asarray(positions_m, dtype=float),
+                {"units": "m", "long_name": "distance from the clamp"},
+            ),
+            "block": np.arange(block_h1.shape[0]),
         },
-        attrs={
-            "n_averages": full.n_averages,
-            "segment_length": segment_length,
-            "overlap": overlap,
-            "window": window,
-            "sampling_rate_hz": fs,
-            "driving_point_sensor": str(raw["sensor"].values[0]),
-        },
+        attrs=dict(attrs),
     )
-    return ds
 
 
 def complex_frf(ds: xr.Dataset, prefix: str = "h1") -> np.ndarray:
