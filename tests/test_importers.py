@@ -5,6 +5,7 @@ bad files and bad records must give a RawDataError that names the file and the p
 traceback from inside numpy and never a result."""
 
 import copy
+import json
 
 import numpy as np
 import pytest
@@ -295,3 +296,237 @@ def test_samples_at_limit_counts_flat_tops():
     x = np.sin(np.linspace(0, 20 * np.pi, 4000))
     assert samples_at_limit(x) == 1
     assert samples_at_limit(np.clip(x, -0.9, 0.9)) > 100
+
+
+# ------------------------------------------------------------------------------------------
+# measured FRFs (UFF58 function type 4 with coherence, type 6) in and out (issue 17)
+# ------------------------------------------------------------------------------------------
+
+G = 9.80665
+
+
+@pytest.fixture(scope="module")
+def rig_frf(small_config):
+    """The rig's FRF dataset (results/linear/frf.nc's form) of a 3.2 s random test on the small config."""
+    from contactid.config import with_defaults
+    from contactid.linear_chain import frf_dataset
+    from contactid.rig.random_test import random_test_datasets
+
+    cfg = with_defaults(small_config)
+    cfg["random_test"]["duration_s"] = 3.2
+    raw, _ = random_test_datasets(cfg["structure"], cfg["rig"], cfg["random_test"], seed=3)
+    return frf_dataset(raw, 4096, 0.5, "hann", 2), cfg["structure"]
+
+
+def _frf_sets(path):
+    import pyuff
+
+    return pyuff.UFF(str(path)).read_sets()
+
+
+def test_rig_frfs_round_trip_through_pyuff_and_the_importer(rig_frf, tmp_path):
+    from contactid.importers.frf_uff import measured_frf_dataset, write_frf_uff58
+    from contactid.linear_chain import complex_frf
+
+    frf, structure = rig_frf
+    f, h, coh = frf["frequency"].values, complex_frf(frf), frf["coherence"].values
+    block = write_frf_uff58(tmp_path / "frf.uff", f, h, frf["sensor"].values, coh)
+    sets = _frf_sets(tmp_path / "frf.uff")  # what another modal tool reads: one FRF and one coherence per sensor
+    assert [(s["func_type"], s["id1"].strip(), s["rsp_node"], s["ref_node"]) for s in sets] == [
+        (4, "a1", 1, 1),
+        (4, "a2", 2, 1),
+        (4, "a3", 3, 1),
+        (6, "a1", 1, 1),
+        (6, "a2", 2, 1),
+        (6, "a3", 3, 1),
+    ]
+    for i, s in enumerate(sets[:3]):
+        assert s["ordinate_axis_units_lab"].strip() == "m/s^2" and s["orddenom_axis_units_lab"].strip() == "N"
+        np.testing.assert_array_equal(s["x"], f)
+        np.testing.assert_array_equal(s["data"], h[i])  # binary double precision: exact
+        np.testing.assert_array_equal(sets[3 + i]["data"], coh[i])
+    back = measured_frf_dataset(block, "random_test", structure, [20.0, 450.0])
+    assert set(back.data_vars) == set(frf.data_vars) and back["h1_real"].dims == frf["h1_real"].dims
+    for name in ("h1_real", "h1_imag", "coherence"):
+        np.testing.assert_array_equal(back[name].values, frf[name].values)
+        assert back[name].attrs["units"] == frf[name].attrs["units"]
+    np.testing.assert_array_equal(back["frequency"].values, f)
+    np.testing.assert_array_equal(back["position"].values, frf["position"].values)
+    assert back.sizes["block"] == 0 and back.attrs["frequency_resolution_hz"] == 1.25
+    assert "imported from" in back.attrs["frf_source"] and back.attrs["source_file"] == "frf.uff"
+    assert json.loads(back.attrs["coherence_given"]) == {"a1": True, "a2": True, "a3": True}
+
+
+def test_frfs_in_g_per_n_without_coherence_on_any_axis(rig_frf, tmp_path):
+    """g/N is converted (x 9.80665); a sensor without coherence gets 1 and says so; lines whose spacing the
+    header's 6 digits cannot keep are stored one by one and read back exactly."""
+    from contactid.importers.frf_uff import measured_frf_dataset, write_frf_uff58
+    from contactid.linear_chain import complex_frf
+
+    frf, structure = rig_frf
+    f = frf["frequency"].values * (1 + 1e-7)  # 1.250000125 Hz apart
+    h = complex_frf(frf)
+    path = tmp_path / "frf_g.uff"
+    coherence = [frf["coherence"].values[0], None, None]
+    write_frf_uff58(path, f, h / G, frf["sensor"].values, coherence, labels={"ordinate_axis_units_lab": "g"})
+    assert _frf_sets(path)[0]["abscissa_spacing"] == 0
+    back = measured_frf_dataset({"file": str(path)}, "random_test", structure, [20.0, 450.0])
+    np.testing.assert_array_equal(back["frequency"].values, f)
+    np.testing.assert_allclose(back["h1_real"].values, h.real, rtol=1e-15, atol=1e-15 * np.abs(h).max())
+    np.testing.assert_allclose(back["h1_imag"].values, h.imag, rtol=1e-15, atol=1e-15 * np.abs(h).max())
+    np.testing.assert_array_equal(back["coherence"].values[1:], 1.0)
+    assert json.loads(back.attrs["coherence_given"]) == {"a1": True, "a2": False, "a3": False}
+    assert '["a2", "a3"]' in back["coherence"].attrs["comment"] and "x 9.80665 (g/N)" in back.attrs["conversion"]
+
+
+def _write_frfs(path, frf, sensors=("a1", "a2", "a3"), **labels):
+    """The FRFs of ``sensors`` with the accelerance labels changed as given (a receptance file, say)."""
+    from contactid.importers.frf_uff import write_frf_uff58
+    from contactid.linear_chain import complex_frf
+
+    idx = [list(frf["sensor"].values).index(s) for s in sensors]
+    return write_frf_uff58(path, frf["frequency"].values, complex_frf(frf)[idx], sensors, labels=labels)
+
+
+def test_synthesised_frfs_are_the_lsfd_fit_of_the_identified_modes(rig_frf, tmp_path):
+    """The identified modes' FRFs (LSFD residues and residuals in the band) on every measured line, written as
+    UFF58 type 4 and read back by the importer (coherence not given) on the same lines."""
+    from contactid.frf_synthesis import identified_poles, synthesised_frf
+    from contactid.importers.frf_uff import measured_frf_dataset, write_frf_uff58
+    from contactid.linear_chain import complex_frf, modal_dataset
+    from contactid.modal_fit import lsfd_residues
+
+    frf, structure = rig_frf
+    modal = modal_dataset(frf, 3, [20.0, 450.0], 16)
+    syn = synthesised_frf(frf, modal)
+    f, h = frf["frequency"].values, complex_frf(frf)
+    band = (f >= 20.0) & (f <= 450.0)
+    _, fit = lsfd_residues(f[band], h[:, band], identified_poles(modal))
+    np.testing.assert_allclose(syn[:, band], fit, rtol=0, atol=1e-10 * np.abs(fit).max())
+    assert np.linalg.norm(syn[:, band] - h[:, band]) < 0.1 * np.linalg.norm(h[:, band])  # three modes fit the band
+    block = write_frf_uff58(tmp_path / "syn.uff", f, syn, frf["sensor"].values, description="LSFD")
+    back = measured_frf_dataset(block, "random_test", structure, [20.0, 450.0])
+    np.testing.assert_array_equal(back["frequency"].values, f)
+    np.testing.assert_array_equal(back["h1_real"].values + 1j * back["h1_imag"].values, syn)
+    assert json.loads(back.attrs["coherence_given"]) == {"a1": False, "a2": False, "a3": False}
+
+
+@pytest.mark.parametrize(
+    "sensors, labels, band, message",
+    [
+        (
+            ("a1", "a2", "a3"),
+            {"ordinate_spec_data_type": 8, "ordinate_axis_lab": "Displacement", "ordinate_axis_units_lab": "m"},
+            [20.0, 450.0],
+            r"frf\.uff: the FRF 'a1' \(node 1 dir 3\) of sensor a1 is receptance \(displacement over force\); "
+            r"the chain needs force-normalised accelerance .*export accelerance FRFs",
+        ),
+        (
+            ("a1", "a2", "a3"),
+            {"ordinate_spec_data_type": 1, "ordinate_axis_units_lab": "m/s"},
+            [20.0, 450.0],
+            r"frf\.uff: the FRF 'a1' .* is mobility \(velocity over force\)",
+        ),
+        (
+            ("a1", "a2"),
+            {},
+            [20.0, 450.0],
+            r"frf\.uff: no FRF \(dataset 58, function type 4\) for sensor a3 \(id1 'a3'\); the file has FRFs "
+            r"'a1' \(node 1 dir 3\), 'a2' \(node 2 dir 3\)\. Correct the channel map",
+        ),
+        (
+            ("a1", "a2", "a3"),
+            {"ordinate_axis_units_lab": "NONE", "orddenom_axis_units_lab": "NONE"},
+            [20.0, 450.0],
+            r"frf\.uff: the FRF 'a1' .* states no units; give units: m/s\^2/N \(or g/N\) for a1 in "
+            r"random_test\.channels\.sensors",
+        ),
+        (
+            ("a1", "a2", "a3"),
+            {},
+            [20.0, 3000.0],
+            r"frf\.uff: the FRFs cover 0-2560 Hz, which does not hold modal\.band_hz = \[20, 3000\] Hz",
+        ),
+    ],
+    ids=["receptance", "mobility", "missing_sensor", "no_units", "band_not_covered"],
+)
+def test_frf_files_that_are_not_accelerance_of_every_sensor_are_refused(
+    rig_frf, tmp_path, sensors, labels, band, message
+):
+    from contactid.importers.frf_uff import measured_frf_dataset
+
+    frf, structure = rig_frf
+    block = _write_frfs(tmp_path / "frf.uff", frf, sensors, **labels)
+    with pytest.raises(RawDataError, match=message):
+        measured_frf_dataset(block, "random_test", structure, band)
+
+
+def test_frf_channel_map_by_node_and_the_config_checks(rig_frf, tmp_path, small_config):
+    """Sensors matched by response node (the map's units where the file states none); the config's checks know
+    the format: a map that leaves out a sensor, and FRFs for a load case, are refused before any rule."""
+    from contactid.importers.frf_uff import measured_frf_dataset
+
+    frf, structure = rig_frf
+    block = _write_frfs(tmp_path / "frf.uff", frf, ("a3", "a2", "a1"), ordinate_axis_units_lab="NONE")
+    nodes = [{"name": n, "node": k, "direction": 3, "units": "m/s^2/N"} for n, k in (("a1", 3), ("a2", 2), ("a3", 1))]
+    back = measured_frf_dataset({**block, "channels": {"sensors": nodes}}, "random_test", structure, [20, 450])
+    np.testing.assert_array_equal(back["h1_real"].values, frf["h1_real"].values)
+    cfg = copy.deepcopy(small_config)
+    cfg["random_test"] = {**block, "channels": {"sensors": nodes[:2]}}
+    with pytest.raises(ConfigError, match=r"random_test: channels\.sensors does not map \['a3'\]"):
+        check_config(cfg)
+    cfg["random_test"] = block
+    check_config(cfg)
+    cfg["load_cases"]["lc1"] = dict(block)
+    with pytest.raises(ConfigError, match="load_cases.lc1.format = 'uff58_frf': FRFs replace the random test only"):
+        check_config(cfg)
+
+
+def test_frf_resolution_check_without_a_time_record(rig_frf):
+    from contactid.raw_checks import validate_frf_resolution
+
+    frf, _ = rig_frf  # lines 1.25 Hz apart
+    with pytest.raises(RawDataError, match=r"f\.uff: FRF resolution check failed: the lines are 1\.25 Hz apart"):
+        validate_frf_resolution(frf, "f.uff", {})
+    assert validate_frf_resolution(frf, "f.uff", {"max_frf_resolution_hz": 2.0}) != []
+    assert validate_frf_resolution(frf, "f.uff", {"max_frf_resolution_hz": 3.0}) == []
+
+
+@pytest.mark.workflow
+def test_chain_on_measured_frfs_identifies_the_time_records_modes(small_run, tmp_path):
+    """A project whose random test is the small run's FRFs as a UFF58 file (function types 4 and 6): `snakemake
+    results/linear/stiction.nc` runs import_uff58_frf (no rig, no time-record checks), modal and the stiffness
+    fit, and identifies the small run's natural frequencies and damping; the FRFs written back out
+    (frf_measured.uff, frf_synthesised.uff) read back with pyuff on the same lines."""
+    import xarray as xr
+
+    from contactid.importers.frf_uff import write_frf_uff58
+    from contactid.linear_chain import complex_frf
+    from workflow_projects import project_config, small_project, snakemake
+
+    frf = xr.load_dataset(small_run / "results/linear/frf.nc", engine="netcdf4")
+    proj = small_project(tmp_path)
+    (proj / "measured").mkdir()
+    block = write_frf_uff58(
+        proj / "measured/frf.uff", frf["frequency"].values, complex_frf(frf), frf["sensor"].values, frf["coherence"]
+    )
+    cfg = project_config(proj)
+    cfg["random_test"] = {**block, "file": "measured/frf.uff"}
+    (proj / "config/config.yaml").write_text(yaml.safe_dump(cfg))
+    out = ["results/linear/frf_measured.uff", "results/linear/frf_synthesised.uff"]
+    res = snakemake(proj, "results/linear/stiction.nc", *out)
+    assert res.returncode == 0, res.stderr[-3000:]
+    assert "import_uff58_frf" in res.stderr and "rig_random_test" not in res.stderr and "rule frf:" not in res.stderr
+    modal = xr.load_dataset(proj / "results/linear/modal.nc", engine="netcdf4")
+    ref = xr.load_dataset(small_run / "results/linear/modal.nc", engine="netcdf4")
+    np.testing.assert_allclose(modal["natural_frequency"].values, ref["natural_frequency"].values, rtol=1e-6)
+    np.testing.assert_allclose(modal["damping_ratio"].values, ref["damping_ratio"].values, rtol=1e-6)
+    imported = xr.load_dataset(proj / "results/linear/frf.nc", engine="netcdf4")
+    assert imported.attrs["producer_rule"] == "import_uff58_frf" and "measured/frf.uff" in imported.attrs["frf_source"]
+    assert (proj / "results/linear/stiction.nc").exists() and not (proj / "data/raw").exists()
+    measured, synthesised = (_frf_sets(proj / p) for p in out)
+    assert [s["func_type"] for s in measured] == [4, 4, 4, 6, 6, 6] and [s["func_type"] for s in synthesised] == [4] * 3
+    for i in range(3):
+        np.testing.assert_array_equal(measured[i]["data"], complex_frf(frf)[i])
+        np.testing.assert_array_equal(measured[3 + i]["data"], frf["coherence"].values[i])
+        np.testing.assert_array_equal(synthesised[i]["x"], frf["frequency"].values)

@@ -265,23 +265,41 @@ def _load_case_errors(cfg: Mapping) -> list:
 
 
 def _record_format_errors(cfg: Mapping) -> list:
-    """A measured record in another format than netCDF has a complete channel map (``importers.record_spec``); a
-    format other than netCDF is for measured records only."""
+    """A measured record in another format than netCDF has a complete channel map (``importers.record_spec``, for
+    measured FRFs ``importers.frf_uff.frf_sensor_map``); a format other than netCDF is for measured records only,
+    and FRFs (uff58_frf) are for the random test only."""
     errors = []
     for where, block in [("random_test", cfg["random_test"])] + [
         (f"load_cases.{c}", lc) for c, lc in (cfg.get("load_cases") or {}).items()
     ]:
-        if block.get("source", "rig") == "measured" and block.get("format", "netcdf") != "netcdf" and block.get("file"):
-            from .importers import record_spec
+        fmt = block.get("format", "netcdf")
+        if fmt == "uff58_frf" and where != "random_test":
+            errors.append(
+                f"{where}.format = 'uff58_frf': FRFs replace the random test only; a load case needs its dual-sine "
+                "time record (netcdf, uff58, tdms or csv)"
+            )
+        elif block.get("source", "rig") == "measured" and fmt != "netcdf" and block.get("file"):
             from .io import RawDataError
 
             try:
-                record_spec(block, where)  # the channel map (and a CSV's sidecar) is complete and consistent
+                _check_channel_map(block, where, fmt, cfg["structure"])
             except RawDataError as exc:
                 errors.append(str(exc))
-        elif block.get("format", "netcdf") != "netcdf" and block.get("source", "rig") != "measured":
+        elif fmt != "netcdf" and block.get("source", "rig") != "measured":
             errors.append(f"{where}.format = {block['format']!r} applies to measured files only; set source: measured")
     return errors
+
+
+def _check_channel_map(block: Mapping, where: str, fmt: str, structure: Mapping) -> None:
+    """The channel map (and a CSV's sidecar) of a measured record is complete and consistent; raises RawDataError."""
+    if fmt == "uff58_frf":
+        from .importers.frf_uff import frf_sensor_map
+
+        frf_sensor_map(block, where, structure)
+    else:
+        from .importers import record_spec
+
+        record_spec(block, where)
 
 
 def _rig_errors(cfg: Mapping) -> list:

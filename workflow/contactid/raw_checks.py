@@ -243,3 +243,20 @@ def validate_coherence(frf: xr.Dataset, band_hz, path: str, checks: Mapping) -> 
         if share < 0.5 * (1.0 + c["coherence_fraction"]):
             warnings.append(f"{s}: {share:.1%} of the band's lines reach coherence {c['min_coherence']}")
     return shares, warnings
+
+
+def validate_frf_resolution(frf: xr.Dataset, path: str, checks: Mapping) -> list[str]:
+    """The spacing of an FRF's lines (Hz) against raw_checks.max_frf_resolution_hz, for FRFs given as such (an FRF
+    file: no record length or segment to check); a spacing beyond half of the limit is a warning."""
+    c = check_settings(checks)
+    f = frf["frequency"].values
+    df = float((f[-1] - f[0]) / (f.size - 1))
+    if df > c["max_frf_resolution_hz"]:
+        raise RawDataError(
+            f"{path}: FRF resolution check failed: the lines are {df:.3g} Hz apart, coarser than "
+            f"raw_checks.max_frf_resolution_hz = {c['max_frf_resolution_hz']}; measure the FRFs with a finer "
+            "resolution (longer blocks, or zoom on modal.band_hz)"
+        )
+    if df > 0.5 * c["max_frf_resolution_hz"]:
+        return [f"FRF lines {df:.3g} Hz apart (raw_checks.max_frf_resolution_hz = {c['max_frf_resolution_hz']})"]
+    return []

@@ -20,9 +20,16 @@ def _is_measured(block):
 
 
 def _import_format(block):
-    """The importer a measured record needs (uff58, tdms, csv), or None (rig, or a raw netCDF file)."""
+    """The importer a measured record needs (uff58, tdms, csv), or None (rig, a raw netCDF file, or measured FRFs:
+    rule import_uff58_frf writes results/linear/frf.nc itself)."""
     fmt = (block or {}).get("format", "netcdf")
-    return fmt if _is_measured(block) and fmt != "netcdf" else None
+    return fmt if _is_measured(block) and fmt not in ("netcdf", "uff58_frf") else None
+
+
+def random_test_is_frf_file():
+    """Is the random test given as measured FRFs (random_test.format: uff58_frf) instead of a time record?"""
+    rt = config["random_test"]
+    return _is_measured(rt) and rt.get("format") == "uff58_frf"
 
 
 def record_block(record):
@@ -161,6 +168,8 @@ def all_outputs():
         "results/tables/paper_consistency.csv",
         "results/figures/fig03_frf.png",
         "results/figures/fig03_frf.pdf",
+        "results/linear/frf_measured.uff",
+        "results/linear/frf_synthesised.uff",
         *[f"results/{c}/raw_check.nc" for c in load_cases()],
         *[f"results/{c}/contact_forces.nc" for c in load_cases()],
         *[f"results/{c}/validation.nc" for c in load_cases()],

@@ -1,0 +1,509 @@
+"""Frequency response functions in universal files (datasets 58): FRFs a lab hands over read in as the linear
+chain's FRF dataset (results/linear/frf.nc), and the chain's measured and LSFD-synthesised FRFs written out.
+
+In a dataset 58 an FRF is function type 4 (complex ordinate) and a coherence function type 6 ("Coherence" in
+the dataset's description; type 9 is a power spectral density). The FRFs must be force-normalised accelerance
+(m/s^2/N, or g/N converted with 9.80665): receptance (displacement over force) and mobility (velocity over force)
+are refused, never differentiated here. Each sensor of ``structure.sensors`` is matched to one FRF by its ID line
+1 (``id1``, the sensor's name unless a channel map says otherwise) or by its response node and direction; its
+coherence is the type-6 dataset of the same response and reference node and direction. Nothing is guessed: the
+units come from the file's labels or from the map, and where both state them they must agree.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Mapping
+
+import numpy as np
+import xarray as xr
+
+from ..io import RawDataError
+
+FRF_FUNCTION, COHERENCE_FUNCTION = 4, 6
+# force-normalised accelerance, with the factor to m/s^2/N
+ACCELERANCE_UNITS = {"m/s^2/N": 1.0, "g/N": 9.80665, "mm/s^2/N": 1.0e-3}
+_UNIT_SPELLINGS = {
+    "m/s2/N": "m/s^2/N",
+    "(m/s^2)/N": "m/s^2/N",
+    "(m/s2)/N": "m/s^2/N",
+    "m/s**2/N": "m/s^2/N",
+    "m/s/s/N": "m/s^2/N",
+    "m s-2 N-1": "m/s^2/N",
+    "m/(s^2 N)": "m/s^2/N",
+    "m/N/s^2": "m/s^2/N",
+    "g0/N": "g/N",
+    "gn/N": "g/N",
+    "mm/s2/N": "mm/s^2/N",
+    "(mm/s^2)/N": "mm/s^2/N",
+}
+# other FRF kinds by unit label and by the ordinate's specific data type (8 displacement, 11 velocity)
+OTHER_KINDS = {
+    "m/N": "receptance (displacement over force)",
+    "mm/N": "receptance (displacement over force)",
+    "um/N": "receptance (displacement over force)",
+    "m/s/N": "mobility (velocity over force)",
+    "(m/s)/N": "mobility (velocity over force)",
+    "mm/s/N": "mobility (velocity over force)",
+    "N/m": "dynamic stiffness (force over displacement)",
+    "N/(m/s)": "mechanical impedance (force over velocity)",
+    "kg": "apparent mass (force over acceleration)",
+    "N/(m/s^2)": "apparent mass (force over acceleration)",
+}
+SPEC_KINDS = {8: "receptance (displacement over force)", 11: "mobility (velocity over force)"}
+FORCE_SPEC_TYPES = (0, 1, 9, 13)  # unknown, general, reaction force, excitation force
+_NO_LABEL = ("", "NONE", "none", "-")
+
+
+@dataclass(frozen=True)
+class FrfSensor:
+    """One sensor of the FRF file: its name and position (m, structure.sensors), the FRF dataset that holds it
+    (``channel`` = id1, or response ``node`` and ``direction``) and the units the map states (or None)."""
+
+    name: str
+    position_m: float
+    channel: str | None = None
+    node: int | None = None
+    direction: int | None = None
+    units: str | None = None
+
+    def describe(self) -> str:
+        if self.channel is not None:
+            return f"id1 {self.channel!r}"
+        return f"response node {self.node}" + ("" if self.direction is None else f" direction {self.direction}")
+
+
+def accelerance_unit(label) -> str | None:
+    """A unit label of an FRF in the spelling of ACCELERANCE_UNITS / OTHER_KINDS (None for no label)."""
+    if label is None or str(label).strip() in _NO_LABEL:
+        return None
+    s = " ".join(str(label).split())
+    s = s.replace(" / ", "/")
+    return _UNIT_SPELLINGS.get(s, s)
+
+
+def _map_entry(entry, i: int, names: list, positions: list, where: str) -> FrfSensor:
+    key = f"{where}: channels.sensors[{i}]"
+    if not isinstance(entry, Mapping) or not entry.get("name"):
+        raise RawDataError(f"{key}: give a mapping with the sensor's name and its channel (id1) or node")
+    name = str(entry["name"])
+    if name not in names:
+        raise RawDataError(f"{key}: sensor {name!r} is not one of structure.sensors.names {names}")
+    pos = positions[names.index(name)]
+    if entry.get("position_m") is not None and abs(float(entry["position_m"]) - pos) > 1e-3:
+        raise RawDataError(
+            f"{key}: position_m = {entry['position_m']} m but structure.sensors puts {name} at {pos} m; "
+            "make the model's sensor layout (config) match the test"
+        )
+    channel, node = entry.get("channel"), entry.get("node")
+    if (channel is None) == (node is None):
+        raise RawDataError(f"{key}: give either channel (the FRF's id1) or node (its response node), not both")
+    units = entry.get("units")
+    if units is not None and accelerance_unit(units) not in ACCELERANCE_UNITS:
+        raise RawDataError(
+            f"{key}: units = {units!r}; give force-normalised accelerance: {', '.join(ACCELERANCE_UNITS)}"
+        )
+    direction = entry.get("direction")
+    return FrfSensor(
+        name,
+        pos,
+        None if channel is None else str(channel),
+        None if node is None else int(node),
+        None if direction is None else int(direction),
+        None if units is None else accelerance_unit(units),
+    )
+
+
+def frf_sensor_map(block: Mapping, where: str, structure_cfg: Mapping) -> tuple:
+    """The FrfSensor of every structure sensor, in structure order: from ``channels.sensors`` of the config
+    block, or, without a map, the FRF whose id1 is the sensor's name."""
+    names = [str(n) for n in structure_cfg["sensors"]["names"]]
+    positions = [float(x) for x in structure_cfg["sensors"]["positions_m"]]
+    chans = block.get("channels")
+    if not chans:
+        return tuple(FrfSensor(n, p, channel=n) for n, p in zip(names, positions))
+    if not isinstance(chans, Mapping) or "force" in chans or not isinstance(chans.get("sensors"), (list, tuple)):
+        raise RawDataError(
+            f"{where}: an FRF file's channel map is channels: {{sensors: [{{name, channel or node, units}}]}} "
+            "(no force: the FRFs are already normalised by it)"
+        )
+    mapped = {}
+    for i, entry in enumerate(chans["sensors"]):
+        s = _map_entry(entry, i, names, positions, where)
+        if s.name in mapped:
+            raise RawDataError(f"{where}: channels.sensors maps {s.name} twice; give each sensor once")
+        mapped[s.name] = s
+    missing = [n for n in names if n not in mapped]
+    if missing:
+        raise RawDataError(
+            f"{where}: channels.sensors does not map {missing} of structure.sensors.names; "
+            "the modal fit needs an FRF at every sensor of the model"
+        )
+    return tuple(mapped[n] for n in names)
+
+
+def uff58_sets(path: str) -> list:
+    """Every dataset 58 of a universal file (pyuff's dicts), with errors that name the file."""
+    import pyuff
+
+    if not os.path.exists(path):
+        raise RawDataError(f"random_test: file {path!r} not found; correct 'file:'")
+    if os.path.getsize(path) == 0:
+        raise RawDataError(f"{path}: the file is empty (zero bytes)")
+    try:
+        sets = pyuff.UFF(path).read_sets()
+    except Exception as exc:
+        raise RawDataError(
+            f"{path}: cannot be read as a universal file ({type(exc).__name__}: {exc}); "
+            "write the FRFs as datasets 58 of function type 4"
+        ) from None
+    sets = [sets] if isinstance(sets, dict) else list(sets)
+    return [s for s in sets if isinstance(s, dict) and s.get("type") == 58]
+
+
+def _dof(s: Mapping) -> tuple:
+    return tuple(int(s.get(k) or 0) for k in ("rsp_node", "rsp_dir", "ref_node", "ref_dir"))
+
+
+def _label(s: Mapping) -> str:
+    return f"{str(s.get('id1', '')).strip()!r} (node {s.get('rsp_node')} dir {s.get('rsp_dir')})"
+
+
+def _matches(sensor: FrfSensor, s: Mapping) -> bool:
+    if sensor.channel is not None:
+        return str(s.get("id1", "")).strip() == sensor.channel.strip()
+    return int(s.get("rsp_node") or 0) == sensor.node and sensor.direction in (None, int(s.get("rsp_dir") or 0))
+
+
+def frf_set(sets: list, sensor: FrfSensor, path: str) -> dict:
+    """The one function-type-4 dataset of ``sensor``; a missing or doubled FRF names the file, the sensor and
+    what the file holds."""
+    frfs = [s for s in sets if s.get("func_type") == FRF_FUNCTION]
+    found = [s for s in frfs if _matches(sensor, s)]
+    if len(found) == 1:
+        return found[0]
+    if found:
+        raise RawDataError(
+            f"{path}: {len(found)} FRFs match sensor {sensor.name} ({sensor.describe()}): "
+            f"{', '.join(_label(s) for s in found)}; map each sensor to one (channels.sensors[].channel or node)"
+        )
+    others = [s for s in sets if _matches(sensor, s)]
+    if others:
+        raise RawDataError(
+            f"{path}: dataset 58 {_label(others[0])} of sensor {sensor.name} has function type "
+            f"{others[0].get('func_type')}, not 4 (frequency response function); export the FRFs"
+        )
+    held = ", ".join(_label(s) for s in frfs[:20]) or "none"
+    raise RawDataError(
+        f"{path}: no FRF (dataset 58, function type 4) for sensor {sensor.name} ({sensor.describe()}); the file "
+        f"has FRFs {held}. Correct the channel map (random_test.channels.sensors) or export that sensor's FRF"
+    )
+
+
+def coherence_set(sets: list, frf: Mapping, path: str) -> dict | None:
+    """The function-type-6 dataset of the same response and reference DOF as ``frf`` (by id1 where several
+    share it), or None when the file holds none."""
+    found = [s for s in sets if s.get("func_type") == COHERENCE_FUNCTION and _dof(s) == _dof(frf)]
+    if len(found) > 1:
+        found = [s for s in found if str(s.get("id1", "")).strip() == str(frf.get("id1", "")).strip()]
+    if len(found) > 1:
+        raise RawDataError(
+            f"{path}: {len(found)} coherences (function type 6) belong to the FRF {_label(frf)}; keep one"
+        )
+    return found[0] if found else None
+
+
+def frf_units(s: Mapping, sensor: FrfSensor, path: str) -> tuple[str, float]:
+    """(units, factor to m/s^2/N) of an FRF dataset: its unit labels (numerator over denominator) and its
+    specific data types against the map's units; refuses receptance, mobility and anything but accelerance."""
+    what = f"{path}: the FRF {_label(s)} of sensor {sensor.name}"
+    kind = SPEC_KINDS.get(int(s.get("ordinate_spec_data_type") or 0))
+    if kind is None and int(s.get("orddenom_spec_data_type") or 0) not in FORCE_SPEC_TYPES:
+        kind = "not normalised by a force (denominator specific data type " + f"{s.get('orddenom_spec_data_type')})"
+    num = accelerance_unit(s.get("ordinate_axis_units_lab"))
+    den = accelerance_unit(s.get("orddenom_axis_units_lab"))
+    label = None if num is None else accelerance_unit(num if den is None else f"{num}/{den}")
+    if kind is None and label is not None and label not in ACCELERANCE_UNITS:
+        kind = OTHER_KINDS.get(label, f"labelled {label!r}")
+    if kind is not None:
+        raise RawDataError(
+            f"{what} is {kind}; the chain needs force-normalised accelerance ({', '.join(ACCELERANCE_UNITS)}): "
+            "export accelerance FRFs from the acquisition software (H1 of acceleration over force)"
+        )
+    if label is None and sensor.units is None:
+        raise RawDataError(
+            f"{what} states no units; give units: m/s^2/N (or g/N) for {sensor.name} in "
+            "random_test.channels.sensors (units are never guessed)"
+        )
+    if label is not None and sensor.units is not None and label != sensor.units:
+        raise RawDataError(
+            f"{what} is labelled {label!r} but the channel map says units: {sensor.units}; "
+            "correct the map (or the file)"
+        )
+    units = label or sensor.units
+    return units, ACCELERANCE_UNITS[units]
+
+
+def _abscissa(s: Mapping, path: str) -> np.ndarray:
+    """The frequency lines (Hz) of one dataset 58."""
+    data, x = s.get("data"), s.get("x")
+    if data is None or x is None or len(data) < 2:
+        raise RawDataError(f"{path}: dataset 58 {_label(s)} holds fewer than two lines")
+    unit = str(s.get("abscissa_axis_units_lab") or "").strip()
+    if unit not in _NO_LABEL and unit.lower() not in ("hz", "1/s"):
+        raise RawDataError(
+            f"{path}: dataset 58 {_label(s)} has its abscissa in {unit!r}; export it over frequency in Hz"
+        )
+    return np.asarray(x, dtype=float)
+
+
+def frequency_axis(sets: list, path: str, band_hz) -> np.ndarray:
+    """The frequency lines (Hz) every FRF and coherence of the file shares: evenly spaced, increasing, and
+    covering ``band_hz`` (modal.band_hz)."""
+    f = _abscissa(sets[0], path)
+    for s in sets[1:]:
+        g = _abscissa(s, path)
+        if g.shape != f.shape or not np.allclose(g, f, rtol=1e-9, atol=0.0):
+            raise RawDataError(
+                f"{path}: dataset 58 {_label(s)} has {g.size} lines from {g[0]:g} to {g[-1]:g} Hz but "
+                f"{_label(sets[0])} has {f.size} from {f[0]:g} to {f[-1]:g} Hz; export every FRF and coherence "
+                "on one frequency axis"
+            )
+    df = (f[-1] - f[0]) / (f.size - 1)
+    steps = np.diff(f)
+    if not (df > 0 and np.all(np.abs(steps - df) <= 1e-6 * df)):
+        raise RawDataError(
+            f"{path}: the frequency lines are not evenly spaced and increasing (steps from {steps.min():.6g} to "
+            f"{steps.max():.6g} Hz); the modal fit needs evenly spaced lines: export the FRFs with an even abscissa"
+        )
+    if f[0] > band_hz[0] or f[-1] < band_hz[1]:
+        raise RawDataError(
+            f"{path}: the FRFs cover {f[0]:g}-{f[-1]:g} Hz, which does not hold modal.band_hz = "
+            f"[{band_hz[0]:g}, {band_hz[1]:g}] Hz; narrow modal.band_hz to the measured range or export the FRFs "
+            "over the whole band"
+        )
+    return f
+
+
+def _finite(values: np.ndarray, f: np.ndarray, what: str) -> np.ndarray:
+    bad = np.flatnonzero(~np.isfinite(values))
+    if bad.size:
+        raise RawDataError(f"{what}: line {int(bad[0])} ({f[bad[0]]:g} Hz) is {values[bad[0]]!r} ({bad.size} lines)")
+    return values
+
+
+def accelerance(s: Mapping, sensor: FrfSensor, f: np.ndarray, path: str) -> np.ndarray:
+    """The FRF of ``sensor`` in m/s^2/N (complex, one value per line of ``f``)."""
+    units, factor = frf_units(s, sensor, path)
+    data = np.asarray(s["data"])
+    if not np.iscomplexobj(data):
+        raise RawDataError(
+            f"{path}: the FRF {_label(s)} of sensor {sensor.name} holds real numbers; an FRF is complex "
+            "(export real and imaginary parts, ordinate data type 5 or 6)"
+        )
+    return _finite(data.astype(complex) * factor, f, f"{path}: the FRF {_label(s)} of sensor {sensor.name}")
+
+
+def coherence_values(s: Mapping, f: np.ndarray, path: str) -> np.ndarray:
+    """A coherence (1) as read: real, finite, within [0, 1] (1e-6 of rounding above 1 clipped)."""
+    data = np.asarray(s["data"])
+    what = f"{path}: the coherence {_label(s)}"
+    if np.iscomplexobj(data):
+        if np.any(data.imag != 0):
+            raise RawDataError(f"{what} holds complex numbers; a coherence is real, in [0, 1]")
+        data = data.real
+    c = _finite(data.astype(float), f, what)
+    worst = int(np.argmax(np.abs(c - np.clip(c, 0.0, 1.0))))
+    if c[worst] < 0 or c[worst] > 1 + 1e-6:
+        raise RawDataError(f"{what}: line {worst} ({f[worst]:g} Hz) is {c[worst]:g}, outside [0, 1]")
+    return np.clip(c, 0.0, 1.0)
+
+
+def _import_attrs(path: str, sensors: tuple, frfs: list, given: dict, f: np.ndarray) -> dict:
+    import json
+
+    return {
+        "n_averages": 0,
+        "segment_length": 0,
+        "overlap": float("nan"),
+        "window": "not stated (FRF imported from a file)",
+        "sampling_rate_hz": float("nan"),
+        "driving_point_sensor": sensors[0].name,
+        "frf_source": f"imported from {path} (UFF58 datasets of function type 4, accelerance)",
+        "source_format": "uff58_frf",
+        "source_file": os.path.basename(path),
+        "frequency_resolution_hz": float((f[-1] - f[0]) / (f.size - 1)),
+        "conversion": "; ".join(
+            f"{s.name} <- {_label(d)} x {frf_units(d, s, path)[1]:.9g} ({frf_units(d, s, path)[0]})"
+            for s, d in zip(sensors, frfs)
+        ),
+        "coherence_given": json.dumps(given),
+        "sub_records": "none: an FRF file holds no sub-record FRFs (the modal fit's sub-record uncertainty is NaN)",
+    }
+
+
+def measured_frf_dataset(block: Mapping, where: str, structure_cfg: Mapping, band_hz) -> xr.Dataset:
+    """The FRF dataset of results/linear/frf.nc (``linear_chain.frf_result_dataset``) from a UFF58 file of
+    accelerance FRFs (function type 4) and their coherences (type 6), one per sensor of ``structure_cfg``;
+    coherence 1 where the file gives none (the attribute ``coherence_given`` says which); no sub-records."""
+    import json
+
+    from ..linear_chain import frf_result_dataset
+
+    path = str(block.get("file") or "")
+    if not path:
+        raise RawDataError(f"{where}.file is not set; give the path of the UFF58 file of FRFs")
+    sensors = frf_sensor_map(block, where, structure_cfg)
+    sets = uff58_sets(path)
+    frfs = [frf_set(sets, s, path) for s in sensors]
+    for i, (s, d) in enumerate(zip(sensors, frfs)):
+        twin = next((o.name for o, e in zip(sensors[:i], frfs[:i]) if e is d), None)
+        if twin:
+            raise RawDataError(f"{path}: sensors {twin} and {s.name} are both mapped to the FRF {_label(d)}")
+    cohs = [coherence_set(sets, d, path) for d in frfs]
+    f = frequency_axis(frfs + [c for c in cohs if c is not None], path, band_hz)
+    h = np.array([accelerance(d, s, f, path) for s, d in zip(sensors, frfs)])
+    coh = np.array([np.ones(f.size) if c is None else coherence_values(c, f, path) for c in cohs])
+    given = {s.name: c is not None for s, c in zip(sensors, cohs)}
+    ds = frf_result_dataset(
+        f,
+        h,
+        coh,
+        np.empty((0, *h.shape), dtype=complex),
+        [s.name for s in sensors],
+        [s.position_m for s in sensors],
+        _import_attrs(path, sensors, frfs, given, f),
+    )
+    if not all(given.values()):
+        ds["coherence"].attrs["comment"] = (
+            "set to 1 for the sensors the file gives no coherence for (function type 6): "
+            + json.dumps([n for n, g in given.items() if not g])
+        )
+    return ds
+
+
+# ---- writing FRFs as datasets 58 -----------------------------------------------------------------------------
+
+_SIX_DIGITS = "%13.5e"  # how a universal file's header keeps the abscissa minimum and increment
+
+
+def _even_axis(f: np.ndarray) -> bool:
+    """Does the header's 6-digit minimum and increment give back exactly the lines ``f`` (Hz)?"""
+    inc = f[1] - f[0]
+    x0, dx = float(_SIX_DIGITS % f[0]), float(_SIX_DIGITS % inc)
+    return bool(np.array_equal(x0 + np.arange(f.size) * dx, f))
+
+
+def _dataset58(node: int, ref_node: int, f: np.ndarray, data: np.ndarray, labels: Mapping) -> dict:
+    even = _even_axis(f)
+    return {
+        "type": 58,
+        "binary": 1,
+        "id3": "",
+        "id4": "",
+        "id5": "",
+        "ver_num": 0,
+        "load_case_id": 0,
+        "rsp_ent_name": "beam",
+        "rsp_node": node,
+        "rsp_dir": 3,
+        "ref_ent_name": "beam",
+        "ref_node": ref_node,
+        "ref_dir": 3,
+        "abscissa_spacing": int(even),
+        "abscissa_inc": float(f[1] - f[0]) if even else 0.0,
+        "z_axis_value": 0.0,
+        "abscissa_spec_data_type": 18,
+        "abscissa_len_unit_exp": 0,
+        "abscissa_force_unit_exp": 0,
+        "abscissa_temp_unit_exp": 0,
+        "abscissa_axis_lab": "Frequency",
+        "abscissa_axis_units_lab": "Hz",
+        "ordinate_temp_unit_exp": 0,
+        "orddenom_temp_unit_exp": 0,
+        "z_axis_spec_data_type": 0,
+        "z_axis_len_unit_exp": 0,
+        "z_axis_force_unit_exp": 0,
+        "z_axis_temp_unit_exp": 0,
+        "z_axis_axis_lab": "NONE",
+        "z_axis_axis_units_lab": "NONE",
+        "num_pts": f.size,
+        "data": data,
+        "x": np.asarray(f, dtype=float),
+        **labels,
+    }
+
+
+ACCELERANCE_LABELS = {
+    "func_type": FRF_FUNCTION,
+    "ordinate_spec_data_type": 12,
+    "ordinate_len_unit_exp": 1,
+    "ordinate_force_unit_exp": 0,
+    "ordinate_axis_lab": "Acceleration",
+    "ordinate_axis_units_lab": "m/s^2",
+    "orddenom_spec_data_type": 13,
+    "orddenom_len_unit_exp": 0,
+    "orddenom_force_unit_exp": 1,
+    "orddenom_axis_lab": "Force",
+    "orddenom_axis_units_lab": "N",
+}
+COHERENCE_LABELS = {
+    "func_type": COHERENCE_FUNCTION,
+    "ordinate_spec_data_type": 1,
+    "ordinate_len_unit_exp": 0,
+    "ordinate_force_unit_exp": 0,
+    "ordinate_axis_lab": "Coherence",
+    "ordinate_axis_units_lab": "NONE",
+    "orddenom_spec_data_type": 0,
+    "orddenom_len_unit_exp": 0,
+    "orddenom_force_unit_exp": 0,
+    "orddenom_axis_lab": "NONE",
+    "orddenom_axis_units_lab": "NONE",
+}
+
+
+def write_frf_uff58(
+    path,
+    frequency_hz,
+    frf,
+    sensors,
+    coherence=None,
+    description: str = "contactid FRF",
+    reference: int = 0,
+    labels: Mapping | None = None,
+) -> dict:
+    """Write accelerance FRFs (complex, m/s^2/N, (sensor, frequency)) as datasets 58 of function type 4, binary
+    double precision, one per sensor (id1 = the sensor's name, response node = its number from 1, direction 3,
+    reference node = the number of sensor ``reference``, the driving point), and their coherences (1; ``coherence``
+    (sensor, frequency), or a list with None for a sensor without) as function type 6 of the same nodes. Lines
+    evenly spaced to the header's 6 digits are written as an even abscissa, any others with every line stored.
+    ``labels`` overrides fields of the FRF datasets (a file as another tool writes it: g/N, receptance...).
+    Replaces ``path`` whole; returns the random_test block that reads the file back."""
+    import pyuff
+
+    path = Path(path)
+    f = np.asarray(frequency_hz, dtype=float)
+    h = np.atleast_2d(np.asarray(frf, dtype=complex))
+    names = [str(s) for s in sensors]
+    tmp = path.with_name(path.name + ".tmp")
+    if tmp.exists():
+        tmp.unlink()
+    uff = pyuff.UFF(str(tmp))
+    for i, name in enumerate(names):
+        ids = {"id1": name, "id2": description, "func_id": i + 1}
+        uff.write_sets(
+            _dataset58(i + 1, reference + 1, f, h[i], {**ids, **ACCELERANCE_LABELS, **(labels or {})}),
+            mode="add",
+            force_double=True,
+        )
+    for i, name in enumerate(names):
+        c = None if coherence is None else coherence[i]
+        if c is not None:
+            ids = {"id1": name, "id2": f"{description}, coherence", "func_id": len(names) + i + 1}
+            labels = {**ids, **COHERENCE_LABELS}
+            c = np.asarray(c, dtype=float)
+            uff.write_sets(_dataset58(i + 1, reference + 1, f, c, labels), mode="add", force_double=True)
+    os.replace(tmp, path)
+    return {"source": "measured", "format": "uff58_frf", "file": str(path)}
