@@ -161,6 +161,8 @@ def all_outputs():
         "results/tables/paper_consistency.csv",
         "results/figures/fig03_frf.png",
         "results/figures/fig03_frf.pdf",
+        "results/figures/stability.png",
+        "results/figures/stability.pdf",
         *[f"results/{c}/raw_check.nc" for c in load_cases()],
         *[f"results/{c}/contact_forces.nc" for c in load_cases()],
         *[f"results/{c}/validation.nc" for c in load_cases()],
