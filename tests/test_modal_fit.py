@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from contactid.modal_fit import fit_modes, lsfd_residues
+from contactid.modal_fit import fit_modes, lsfd_residues, stability_poles, synthesise_frf
 from contactid.signals import h1_frf
 
 
@@ -60,3 +60,50 @@ def test_h1_of_a_known_filter():
     true = 0.5 + 0.25 * np.exp(-2j * np.pi * est.frequency_hz / 1000.0)
     assert np.max(np.abs(est.h1[0] - true)) < 0.01
     assert np.min(est.coherence[0]) > 0.99
+
+
+def _three_modes_with_noise(seed=3, noise=0.02):
+    rng = np.random.default_rng(seed)
+    f = np.arange(0, 500, 0.3125)
+    fn = np.array([54.85, 166.2, 339.25])
+    zeta = np.array([0.005, 0.004, 0.006])
+    R = np.array([[-0.02j, -0.05j, -0.1j], [-0.01j, 0.03j, -0.02j], [-0.001j, 0.004j, -0.01j]]) * 2 * np.pi
+    H = synthetic_accelerance(f, fn, zeta, R)
+    return f, H * (1 + noise * (rng.standard_normal(H.shape) + 1j * rng.standard_normal(H.shape))), fn, zeta
+
+
+def test_stability_diagram_marks_the_true_poles_stable_and_the_spurious_ones_not():
+    """Three modes with 2 % noise, orders 2-24: at the five highest orders every true mode has a pole stable in
+    frequency, damping and vector, within 0.1 % in frequency and 5 % in damping; the noise's computational poles
+    (present at those orders) are none of them stable."""
+    f, H, fn, zeta = _three_modes_with_noise()
+    sp = stability_poles(f, H, (20, 450), range(2, 25))
+    top = sp.order >= 20
+    nearest = np.argmin(np.abs(sp.frequency_hz[:, None] - fn[None, :]), axis=1)
+    true_f, true_z = fn[nearest], zeta[nearest]
+    near_true = np.abs(sp.frequency_hz / true_f - 1) <= 1e-3
+    stable = sp.stable & top
+    assert np.all(np.abs(sp.frequency_hz[stable] / true_f[stable] - 1) <= 1e-3)
+    assert np.all(np.abs(sp.damping_ratio[stable] / true_z[stable] - 1) <= 0.05)
+    for order in range(20, 25):
+        assert sorted(nearest[stable & (sp.order == order)]) == [0, 1, 2]
+    spurious = top & ~near_true
+    assert spurious.sum() >= 10
+    assert not np.any(sp.stable[spurious])
+
+
+def test_stability_tolerances_are_keywords():
+    """A frequency tolerance of 1e-9 leaves no pole stable; the defaults leave the modes stable."""
+    f, H, _, _ = _three_modes_with_noise()
+    assert not stability_poles(f, H, (20, 450), range(10, 16), tol_frequency=1e-9).stable.any()
+    assert stability_poles(f, H, (20, 450), range(10, 16)).stable.sum() >= 3 * 4
+
+
+def test_synthesised_frf_reproduces_a_noise_free_frf():
+    f = np.arange(0, 500, 0.3125)
+    fn, zeta = np.array([100.0, 300.0]), np.array([0.01, 0.02])
+    H = synthetic_accelerance(f, fn, zeta, np.array([[1 - 2j, 0.5 + 1j], [0.2j, -1.0]]))
+    fb, Hs = synthesise_frf(f, H, fn, zeta, (20, 450))
+    sel = (f >= 20) & (f <= 450)
+    assert np.array_equal(fb, f[sel])
+    assert np.max(np.abs(Hs - H[:, sel])) < 1e-8 * np.max(np.abs(H))

@@ -85,6 +85,14 @@ def lsfd_residues(frequency_hz: np.ndarray, frf: np.ndarray, poles: np.ndarray) 
     return res, fit
 
 
+def _physical_poles(s: np.ndarray, band_hz: tuple[float, float], max_damping: float) -> np.ndarray:
+    """The poles ``s`` (rad/s) that are stable, inside ``band_hz`` and with 0 < zeta < ``max_damping``."""
+    wn = np.abs(s)
+    zeta = -s.real / wn
+    keep = (zeta > 0) & (zeta < max_damping) & (wn / (2 * np.pi) >= band_hz[0]) & (wn / (2 * np.pi) <= band_hz[1])
+    return s[keep]
+
+
 def fit_modes(
     frequency_hz: np.ndarray,
     frf: np.ndarray,
@@ -110,11 +118,7 @@ def fit_modes(
         )
     fb, Hb = f[sel], np.atleast_2d(frf)[:, sel]
     Wb = None if weights is None else np.atleast_2d(weights)[:, sel]
-    s = lscf_poles(fb, Hb, order, Wb)
-    wn = np.abs(s)
-    zeta = -s.real / wn
-    keep = (zeta > 0) & (zeta < max_damping) & (wn / (2 * np.pi) >= band_hz[0]) & (wn / (2 * np.pi) <= band_hz[1])
-    s = s[keep]
+    s = _physical_poles(lscf_poles(fb, Hb, order, Wb), band_hz, max_damping)
     if len(s) < n_modes:
         raise ValueError(f"found {len(s)} physical poles in {band_hz} Hz, {n_modes} requested")
     R, _ = lsfd_residues(fb, Hb, s)
@@ -123,3 +127,99 @@ def fit_modes(
     top = np.sort(np.argsort(strength)[::-1][:n_modes])
     top = top[np.argsort(wn[top])]
     return ModalEstimate(wn[top] / (2 * np.pi), zeta[top], R[:, top], strength[top], order)
+
+
+def mode_poles(natural_frequency_hz: np.ndarray, damping_ratio: np.ndarray) -> np.ndarray:
+    """Poles s_r = -zeta w_n + i w_n sqrt(1 - zeta^2) (rad/s) of identified modes."""
+    wn = 2 * np.pi * np.asarray(natural_frequency_hz, dtype=float)
+    z = np.asarray(damping_ratio, dtype=float)
+    return -z * wn + 1j * wn * np.sqrt(1 - z**2)
+
+
+def synthesise_frf(
+    frequency_hz: np.ndarray,
+    frf: np.ndarray,
+    natural_frequency_hz: np.ndarray,
+    damping_ratio: np.ndarray,
+    band_hz: tuple[float, float],
+) -> tuple[np.ndarray, np.ndarray]:
+    """The FRF synthesised from identified modes: LSFD residues (with lower and upper residual terms) of the
+    poles of ``natural_frequency_hz``, ``damping_ratio`` fitted to ``frf`` (n_out, n_f) inside ``band_hz``.
+    Returns (the frequencies in the band (Hz), the synthesised FRF there (n_out, n_band))."""
+    f = np.asarray(frequency_hz, dtype=float)
+    sel = (f >= band_hz[0]) & (f <= band_hz[1])
+    _, fit = lsfd_residues(f[sel], np.atleast_2d(frf)[:, sel], mode_poles(natural_frequency_hz, damping_ratio))
+    return f[sel], fit
+
+
+@dataclass(frozen=True)
+class StabilityPoles:
+    """The physical poles of every model order of a stabilisation diagram, one entry per pole.
+
+    order: LSCF model order; frequency_hz, damping_ratio: the pole's; stable_frequency, stable_damping,
+    stable_vector: whether the nearest pole of the previous order lies within the frequency, damping and vector
+    (1 - MAC of the LSFD residue vectors; with one output, the residue's relative change) tolerances.
+    """
+
+    order: np.ndarray
+    frequency_hz: np.ndarray
+    damping_ratio: np.ndarray
+    stable_frequency: np.ndarray
+    stable_damping: np.ndarray
+    stable_vector: np.ndarray
+
+    @property
+    def stable(self) -> np.ndarray:
+        """Stable in frequency, damping and vector."""
+        return self.stable_frequency & self.stable_damping & self.stable_vector
+
+
+def _vector_change(a: np.ndarray, b: np.ndarray) -> float:
+    """1 - MAC of two residue vectors; for single values the relative change of the residue."""
+    if a.size == 1:
+        return float(np.abs(a[0] - b[0]) / max(np.abs(b[0]), 1e-300))
+    mac = np.abs(np.vdot(a, b)) ** 2 / max((np.vdot(a, a).real * np.vdot(b, b).real), 1e-300)
+    return float(1.0 - mac)
+
+
+def stability_poles(
+    frequency_hz: np.ndarray,
+    frf: np.ndarray,
+    band_hz: tuple[float, float],
+    orders,
+    max_damping: float = 0.2,
+    tol_frequency: float = 0.01,
+    tol_damping: float = 0.05,
+    tol_vector: float = 0.02,
+) -> StabilityPoles:
+    """The stabilisation diagram of the LSCF fit: for each model order in ``orders`` (increasing) the physical
+    poles in ``band_hz`` (as :func:`fit_modes` keeps them), each compared with the nearest pole in frequency of
+    the previous order: stable in frequency when their relative difference is within ``tol_frequency``, in
+    damping within ``tol_damping`` (relative) and in vector when 1 - MAC of their LSFD residue vectors is within
+    ``tol_vector``. Poles of the first order, or without a previous pole, are stable in nothing."""
+    f = np.asarray(frequency_hz, dtype=float)
+    sel = (f >= band_hz[0]) & (f <= band_hz[1])
+    fb, Hb = f[sel], np.atleast_2d(frf)[:, sel]
+    rows, prev = [], None
+    for order in orders:
+        s = _physical_poles(lscf_poles(fb, Hb, int(order), None), band_hz, max_damping)
+        R = lsfd_residues(fb, Hb, s)[0] if len(s) else np.zeros((Hb.shape[0], 0), dtype=complex)
+        fn, zeta = np.abs(s) / (2 * np.pi), -s.real / np.abs(s)
+        for k in range(len(s)):
+            flags = (False, False, False)
+            if prev is not None and len(prev[0]):
+                j = int(np.argmin(np.abs(prev[0] - fn[k])))
+                flags = (
+                    abs(fn[k] - prev[0][j]) <= tol_frequency * prev[0][j],
+                    abs(zeta[k] - prev[1][j]) <= tol_damping * prev[1][j],
+                    _vector_change(R[:, k], prev[2][:, j]) <= tol_vector,
+                )
+            rows.append((int(order), fn[k], zeta[k], *flags))
+        prev = (fn, zeta, R)
+    cols = list(zip(*rows)) if rows else [()] * 6
+    return StabilityPoles(
+        np.array(cols[0], dtype=int),
+        np.array(cols[1], dtype=float),
+        np.array(cols[2], dtype=float),
+        *(np.array(c, dtype=bool) for c in cols[3:]),
+    )

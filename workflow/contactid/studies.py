@@ -17,6 +17,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
+from . import print_style as ps
 from .contact_laws import stiction_shear_stiffness
 
 QUANTITIES = ("mu", "e0", "k_t")
@@ -125,17 +126,15 @@ def gather(rows: list) -> xr.Dataset:
     return ds
 
 
+@ps.print_figure
 def plot_noise_study(ds: xr.Dataset, default_noise: float, png: str, pdf: str | None = None) -> None:
     """|error| of mu, e_0 and k_t against the noise fraction: every seed as a dot, the median as a line
-    per record length; the default noise marked."""
-    import matplotlib
+    per record length; the default noise marked. Drawn at the report's text width (print_style)."""
     import matplotlib.ticker
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    plt = ps.pyplot()
     noise = ds["noise_fraction"].values
-    fig, axes = plt.subplots(1, len(QUANTITIES), figsize=(11, 3.4), sharex=True)
+    fig, axes = plt.subplots(1, len(QUANTITIES), figsize=(ps.TEXT_WIDTH_IN, 3.0), sharex=True)
     labels = {"mu": r"$\mu$", "e0": r"$e_0$ at $N_0$", "k_t": r"$k_t$"}
     for ax, q in zip(axes, QUANTITIES):
         err = 100 * np.abs(ds[f"error_{q}"].values)  # (noise, length, seed)
@@ -154,13 +153,16 @@ def plot_noise_study(ds: xr.Dataset, default_noise: float, png: str, pdf: str | 
         ax.set_title(f"|error| of {labels[q]} (%)")
     axes[0].legend(fontsize=8)
     axes[-1].text(
-        0.02, 0.02, "from the random test: the same for every record length", transform=axes[-1].transAxes, fontsize=7
+        0.97,
+        0.03,
+        "from the random test:\nthe same for every\nrecord length",
+        transform=axes[-1].transAxes,
+        ha="right",
+        fontsize=8,
+        bbox={"fc": "white", "ec": "none", "alpha": 0.8, "pad": 1.0},
     )
-    fig.tight_layout()
-    fig.savefig(png, dpi=130)
-    if pdf:
-        fig.savefig(pdf)
-    plt.close(fig)
+    fig.tight_layout(w_pad=0.5)
+    ps.save(fig, png, pdf)
 
 
 def report_section(ds: xr.Dataset | None) -> str:

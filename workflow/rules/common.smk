@@ -170,6 +170,8 @@ def all_outputs():
         "results/figures/fig03_frf.pdf",
         "results/linear/frf_measured.uff",
         "results/linear/frf_synthesised.uff",
+        "results/figures/stability.png",
+        "results/figures/stability.pdf",
         *[f"results/{c}/raw_check.nc" for c in load_cases()],
         *[f"results/{c}/contact_forces.nc" for c in load_cases()],
         *[f"results/{c}/validation.nc" for c in load_cases()],

@@ -43,7 +43,7 @@ rule linear_tables:
 
 
 rule fig03_frf:
-    """Fig. 3: the driving-point FRF and its coherence (results/figures/fig03_frf.png)."""
+    """Fig. 3: every sensor's FRF, measured and synthesised from the identified modes, phase, coherence (results/figures/fig03_frf.png)."""
     input:
         frf="results/linear/frf.nc",
         modal="results/linear/modal.nc",
@@ -58,6 +58,24 @@ rule fig03_frf:
         "logs/fig03_frf.log",
     script:
         "../scripts/fig03_frf.py"
+
+
+rule stability_diagram:
+    """The stability diagram of the modal fit: LSCF poles over model order, the chosen poles ringed, on the summed FRF (results/figures/stability.png)."""
+    input:
+        frf="results/linear/frf.nc",
+        modal="results/linear/modal.nc",
+    output:
+        png=report("results/figures/stability.png", caption="../report/stability.rst", category="Figures"),
+        pdf="results/figures/stability.pdf",
+    params:
+        code=CODE_DIGEST,
+    conda:
+        "../envs/contactid.yaml"
+    log:
+        "logs/stability_diagram.log",
+    script:
+        "../scripts/stability_diagram.py"
 
 
 rule summary:

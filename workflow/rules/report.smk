@@ -46,6 +46,7 @@ rule report:
             "results/figures/{fig}.pdf",
             fig=[
                 "fig03_frf",
+                "stability",
                 "fig04_generalized_coordinates",
                 "fig05_reconstruction",
                 "fig06_contact_forces",

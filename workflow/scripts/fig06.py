@@ -2,7 +2,7 @@
 
 from contactid.io import load_dataset
 from contactid.logs import setup_logging
-from contactid.reporting import plot_fig06
+from contactid.paper_figures import plot_fig06
 
 setup_logging(snakemake.log[0])
 forces = {c: load_dataset(p) for c, p in zip(snakemake.params.cases, snakemake.input.forces)}

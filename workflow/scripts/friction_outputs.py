@@ -4,7 +4,8 @@ from pathlib import Path
 
 from contactid.io import load_dataset
 from contactid.logs import setup_logging
-from contactid.reporting import plot_friction_figures, table4
+from contactid.paper_figures import plot_friction_figures
+from contactid.reporting import table4
 
 log = setup_logging(snakemake.log[0])
 fit = load_dataset(snakemake.input.fit)

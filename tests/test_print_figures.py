@@ -1,0 +1,182 @@
+"""Every figure the report includes is drawn at the width paper/report.tex prints it at, with no text under 8 pt
+(issue 17): the figures are drawn from small synthetic datasets and caught before they are written."""
+
+import re
+from pathlib import Path
+
+import matplotlib
+import numpy as np
+import pytest
+import xarray as xr
+
+from contactid import print_style as ps
+from contactid.modal_figures import plot_fig03, plot_stability
+from contactid.studies import QUANTITIES, plot_noise_study, report_section
+from contactid.paper_figures import plot_fig04, plot_fig05, plot_fig06, plot_friction_figures
+
+REPORT = Path(__file__).resolve().parents[1] / "paper" / "report.tex"
+FIGURES = [
+    "fig03_frf",
+    "stability",
+    "fig04_generalized_coordinates",
+    "fig05_reconstruction",
+    "fig06_contact_forces",
+    "fig07_e0",
+    "fig08_s_xi",
+    "fig09_s_xidot",
+]
+
+
+def printed_widths_in() -> dict:
+    """{figure: printed width (in)} from report.tex's \\includegraphics and its page geometry."""
+    tex = REPORT.read_text()
+    assert "a4paper" in tex
+    margin_cm = float(re.search(r"\\usepackage\[margin=([0-9.]+)cm\]\{geometry\}", tex).group(1))
+    text_width = (21.0 - 2 * margin_cm) / 2.54
+    assert text_width == pytest.approx(ps.TEXT_WIDTH_IN, rel=1e-12)
+    found = re.findall(r"\\includegraphics\[width=([0-9.]*)\\textwidth\]\{([A-Za-z0-9_]+)\.pdf\}", tex)
+    return {name: (float(frac) if frac else 1.0) * text_width for frac, name in found}
+
+
+@pytest.fixture
+def caught(monkeypatch):
+    """The figures the plotting functions would save, by file stem, drawn but not written."""
+    figures = {}
+
+    def save(fig, png, pdf=None):
+        fig.canvas.draw()
+        figures[Path(png).stem] = fig
+
+    monkeypatch.setattr(ps, "save", save)
+    yield figures
+    for fig in figures.values():
+        ps.pyplot().close(fig)
+
+
+def _frf_and_modal():
+    f = np.arange(0.0, 600.0, 0.25)
+    fn, zeta = np.array([55.0, 167.0, 338.0]), np.array([0.005, 0.005, 0.005])
+    iw = 2j * np.pi * f
+    R = np.array([[-0.1j, -0.3j, -0.6j], [-0.05j, 0.2j, -0.1j], [-0.01j, 0.03j, -0.1j]]) * 2 * np.pi
+    H = np.zeros((3, f.size), dtype=complex)
+    for r, (f0, z) in enumerate(zip(fn, zeta)):
+        s = 2 * np.pi * f0 * (-z + 1j * np.sqrt(1 - z**2))
+        H += iw**2 * (R[:, r, None] / (iw - s) + np.conj(R[:, r, None]) / (iw - np.conj(s)))
+    frf = xr.Dataset(
+        {
+            "h1_real": (("sensor", "frequency"), H.real),
+            "h1_imag": (("sensor", "frequency"), H.imag),
+            "coherence": (("sensor", "frequency"), np.ones(H.shape)),
+        },
+        coords={"sensor": ["a1", "a2", "a3"], "frequency": f},
+    )
+    modal = xr.Dataset(
+        {"natural_frequency": ("mode", fn), "damping_ratio": ("mode", zeta)},
+        coords={"mode": [1, 2, 3]},
+        attrs={"band_low_hz": 20.0, "band_high_hz": 450.0, "order": 12},
+    )
+    return frf, modal
+
+
+def _loops(truth: bool):
+    t = np.linspace(0, 2 * np.pi, 400)
+    v = {"S": 30 * np.sin(t), "xi": 1e-5 * np.cos(t), "N_dyn": 12 * np.sin(t), "eta": 5e-7 * np.sin(t + 0.1)}
+    data = {k: ("time", x) for k, x in v.items()}
+    data.update({f"{k}_paper": ("time", 8 * x) for k, x in v.items()})
+    if truth:
+        data.update({f"{k}_truth": ("time", 1.02 * x) for k, x in v.items()})
+    return {c: xr.Dataset(data, coords={"time": t}) for c in ("lc1", "lc2", "lc3")}
+
+
+def _draw_all(truth: bool = True):
+    frf, modal = _frf_and_modal()
+    plot_fig03(frf, modal, "fig03_frf.png", "fig03_frf.pdf")
+    plot_stability(frf, modal, "stability.png", "stability.pdf")
+    t = np.linspace(0, 0.06, 600)
+    gc = xr.Dataset(
+        {"p": (("mode", "time"), np.vstack([np.sin(2 * np.pi * 50 * k * t) for k in (1, 3, 5)]) * 1e-4)},
+        coords={"mode": [1, 2, 3], "time": t},
+        attrs={"excitation_frequency_hz": 54.0},
+    )
+    plot_fig04(gc, "lc3", "fig04_generalized_coordinates.png", "x.pdf")
+    s = 50 * np.sin(2 * np.pi * 54 * t)
+    nnm = xr.Dataset(
+        {"drive_measured": ("time", s), "drive_reconstructed": ("time", 1.01 * s)},
+        coords={"time": t},
+        attrs={"excitation_frequency_hz": 54.0, "reconstruction_nrmse": 0.013},
+    )
+    plot_fig05(nnm, "lc3", "fig05_reconstruction.png", "x.pdf")
+    plot_fig06(_loops(truth), "fig06_contact_forces.png", "x.pdf")
+    fit = xr.Dataset(
+        {
+            "parameter_value": ("parameter", [1e6, 0.05, 1e4, 0.5, 0.4]),
+            "ga_best": ("generation", np.geomspace(1, 0.01, 20)),
+            "ga_mean": ("generation", np.geomspace(2, 0.02, 20)),
+        },
+        coords={"parameter": ["e_f", "k_c", "e_t", "kappa", "mu"], "generation": np.arange(20)},
+        attrs={"preload_n": 70.0, "misfit_nrmse": 0.005},
+    )
+    x = np.linspace(0, 2 * np.pi, 200)
+    val = xr.Dataset(
+        {
+            "N": ("time", 70 + 10 * np.sin(x)),
+            "xi": ("time", 1e-5 * np.cos(x)),
+            "xi_dot": ("time", -1e-3 * np.sin(x)),
+            "S_identified": ("time", 30 * np.sin(x)),
+            "S_predicted": ("time", 30 * np.sin(x)),
+        },
+        attrs={"nrmse_vs_identified": 0.004},
+    )
+    names = {"fig07": "fig07_e0", "fig08": "fig08_s_xi", "fig09": "fig09_s_xidot", "convergence": "convergence"}
+    paths = {f"{k}_{ext}": f"{v}.{ext}" for k, v in names.items() for ext in ("png", "pdf")}
+    plot_friction_figures(fit, {c: val for c in ("lc1", "lc2", "lc3")}, None, paths)
+
+
+def test_every_report_figure_is_drawn_at_its_printed_width_with_8pt_text(caught):
+    widths = printed_widths_in()
+    assert set(FIGURES) <= set(widths), "report.tex includes each figure at an explicit fraction of \\textwidth"
+    _draw_all()
+    for name in FIGURES:
+        fig = caught[name]
+        assert fig.get_size_inches()[0] == pytest.approx(widths[name], abs=1e-6), name
+        small = [
+            (t.get_text(), t.get_fontsize())
+            for t in fig.findobj(matplotlib.text.Text)
+            if t.get_visible() and t.get_text().strip() and t.get_fontsize() < ps.MIN_FONT_PT
+        ]
+        assert not small, f"{name}: text under {ps.MIN_FONT_PT} pt: {small}"
+
+
+def test_fig06_limits_come_from_the_working_method_also_without_truth(caught):
+    """Without truth (measured data) the working method's loops fill their panels: the paper's chain, eight times
+    larger, has rows of its own and leaves the working method's limits alone."""
+    plot_fig06(_loops(truth=False), "fig06_contact_forces.png", "x.pdf")
+    axes = caught["fig06_contact_forces"].axes
+    assert len(axes) == 12
+    for ax, span in zip(axes[:6], (60.0, 60.0, 60.0, 24.0, 24.0, 24.0)):
+        lo, hi = ax.get_ylim()
+        assert span <= hi - lo <= 1.2 * span
+    for ax, span in zip(axes[6:], (480.0, 480.0, 480.0, 192.0, 192.0, 192.0)):
+        lo, hi = ax.get_ylim()
+        assert span <= hi - lo <= 1.2 * span
+    legend = caught["fig06_contact_forces"].legends[0]
+    assert [t.get_text() for t in legend.get_texts()] == ["working method", "paper's chain"]
+
+
+def test_the_noise_study_figure_is_drawn_at_the_width_its_section_includes_it(caught):
+    """The noise study's figure (in the report when noise_study.in_report) at the text width, text >= 8 pt."""
+    noise, lengths, seeds = np.array([0.001, 0.003, 0.01, 0.03]), np.array([4096, 16384]), np.arange(3)
+    rng = np.random.default_rng(0)
+    ds = xr.Dataset(
+        {
+            f"error_{q}": (("noise_fraction", "record_samples", "seed"), rng.normal(0, 0.01, (4, 2, 3)))
+            for q in QUANTITIES
+        },
+        coords={"noise_fraction": noise, "record_samples": lengths, "seed": seeds},
+        attrs={"default_noise_fraction": 0.003},
+    )
+    assert "\\includegraphics[width=\\textwidth]{noise_study.pdf}" in report_section(ds)
+    plot_noise_study(ds, 0.003, "noise_study.png", "noise_study.pdf")
+    fig = caught["noise_study"]
+    assert fig.get_size_inches()[0] == pytest.approx(ps.TEXT_WIDTH_IN, abs=1e-6)
+    assert min(t.get_fontsize() for t in fig.findobj(matplotlib.text.Text) if t.get_text().strip()) >= 8
