@@ -32,12 +32,12 @@ from pathlib import Path
 # one BLAS thread, as the gap_diagnosis rule runs (threads: 1); both diagnoses run under it
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
-import numpy as np
 import yaml
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "workflow"))
 
+from contactid.friction_parameters import parameter_dataset  # noqa: E402
 from contactid.gap.model import STEADY_STATE  # noqa: E402
 from contactid.gap.refit import memoised  # noqa: E402
 from contactid.io import load_dataset, read_raw  # noqa: E402
@@ -73,7 +73,6 @@ def default_data(cfg):
 
 def effect_data(cfg, effect, magnitude):
     """Rig records with one effect (cached as netCDF), identified as the workflow does."""
-    import xarray as xr
 
     from contactid.gap.pipeline import identify, rig_records
 
@@ -87,9 +86,7 @@ def effect_data(cfg, effect, magnitude):
             recs[n].to_netcdf(folder / f"{n}.nc", engine="netcdf4")
     recs = {n: load_dataset(folder / f"{n}.nc") for n in names}
     model, modes, modal, frf = identify(cfg, recs["random_test"], recs[cfg["nonlinear"]["calibration_case"]])
-    fit = xr.Dataset(
-        {"parameter_value": ("parameter", np.asarray(model.friction))}, attrs={"regularization": model.regularization}
-    )
+    fit = parameter_dataset(model.friction, model.regularization)
     return {"linear_modes": modes, "modal": modal, "frf": frf, "friction_fit": fit}, {c: recs[c] for c in cases}
 
 

@@ -10,6 +10,7 @@ import pytest
 import xarray as xr
 
 from contactid import print_style as ps
+from contactid.friction_parameters import parameter_dataset
 from contactid.modal_figures import plot_fig03, plot_stability
 from contactid.studies import QUANTITIES, plot_noise_study, report_section
 from contactid.paper_figures import plot_fig04, plot_fig05, plot_fig06, plot_friction_figures
@@ -107,15 +108,11 @@ def _draw_all(truth: bool = True):
     )
     plot_fig05(nnm, "lc3", "fig05_reconstruction.png", "x.pdf")
     plot_fig06(_loops(truth), "fig06_contact_forces.png", "x.pdf")
-    fit = xr.Dataset(
-        {
-            "parameter_value": ("parameter", [1e6, 0.05, 1e4, 0.5, 0.4]),
-            "ga_best": ("generation", np.geomspace(1, 0.01, 20)),
-            "ga_mean": ("generation", np.geomspace(2, 0.02, 20)),
-        },
-        coords={"parameter": ["e_f", "k_c", "e_t", "kappa", "mu"], "generation": np.arange(20)},
-        attrs={"preload_n": 70.0, "misfit_nrmse": 0.005},
+    fit = parameter_dataset([1e6, 0.05, 1e4, 0.5, 0.4], "none").assign(
+        ga_best=("generation", np.geomspace(1, 0.01, 20)), ga_mean=("generation", np.geomspace(2, 0.02, 20))
     )
+    fit = fit.assign_coords(parameter=["e_f", "k_c", "e_t", "kappa", "mu"], generation=np.arange(20))
+    fit.attrs.update({"preload_n": 70.0, "misfit_nrmse": 0.005})
     x = np.linspace(0, 2 * np.pi, 200)
     val = xr.Dataset(
         {

@@ -180,6 +180,33 @@ def test_outputs_for_people_exist(default_run):
     assert (default_run / "results/figures/fig03_frf.png").stat().st_size > 10000
 
 
+def test_every_units_attribute_parses_and_every_variable_has_one_unit(default_run):
+    """Every ``units`` attribute of every dataset the acceptance run wrote (data/ and results/, variables and
+    coordinates) is a unit pint reads (mass-normalised coordinates as kg^0.5 m, kg^-0.5; no "mixed" vectors: the
+    friction law's parameters, the response control's history and the force-state maps are one variable per
+    quantity)."""
+    import pint
+    import xarray as xr
+
+    ureg = pint.UnitRegistry()
+    seen = set()
+    for f in sorted([*(default_run / "data").rglob("*.nc"), *(default_run / "results").rglob("*.nc")]):
+        with xr.open_dataset(f, engine="netcdf4") as ds:
+            for name, var in {**ds.data_vars, **ds.coords}.items():
+                units = var.attrs.get("units")
+                if units is None:
+                    continue
+                seen.add(units)
+                try:
+                    ureg.parse_expression(units) if units == "1" else ureg.parse_units(units)
+                except Exception as exc:  # pint raises several kinds
+                    raise AssertionError(f"{f.relative_to(default_run)}: {name}: units {units!r}: {exc}") from exc
+    assert {"N", "m/s^2", "kg^-0.5", "N/m", "1/m"} <= seen, seen
+    fit = xr.load_dataset(default_run / "results/friction/friction_fit.nc", engine="netcdf4")
+    assert [fit[p].attrs["units"] for p in ("e_f", "k_c", "e_t", "kappa", "mu")] == ["N/m", "1/m", "N/m", "1", "1"]
+    assert list(fit["estimate"].values) == ["value", "interval_low", "interval_high"]
+
+
 def test_default_records_meet_table2(default_run):
     s = json.loads((default_run / "results" / "summary.json").read_text())
     for case, (a1, a2) in {"lc1": (14, 34), "lc2": (17.5, 42.5), "lc3": (20, 50)}.items():

@@ -29,6 +29,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from .friction_parameters import PARAMETER_NAMES
+
 REGULARIZATIONS = ("none", "slip_limit")
 SINGULAR_GUARD = 0.9  # law "none": d >= -SINGULAR_GUARD / kappa (Eq. 21's denominator >= 1 - SINGULAR_GUARD)
 STIFF_STEP = 0.5  # law "none": largest |d(dS)/dS| per (sub-)step; beyond it the step is split (Heun is stable to 2)
@@ -180,10 +182,6 @@ def valanis_step(S, xi0, xi1, n0, n1, e_f, k_c, e_t, kappa, mu, n_min, slip_limi
         kappa,
         slip_limit,
     )
-
-
-PARAMETER_NAMES = ("e_f", "k_c", "e_t", "kappa", "mu")
-PARAMETER_UNITS = ("N/m", "1/m", "N/m", "1", "1")
 
 
 def check_parameters(params: np.ndarray) -> np.ndarray:

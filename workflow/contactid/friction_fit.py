@@ -15,6 +15,7 @@ import numpy as np
 
 from .contact_laws import stiction_shear_stiffness
 from .friction import PARAMETER_NAMES, REGULARIZATIONS, valanis_friction_force
+from .friction_parameters import ESTIMATES, GRID_FIELDS, fitted_parameters, parameter_variables
 from .harmonics import periodic_grid
 from .random_streams import generator
 
@@ -422,24 +423,11 @@ def _fit_on_forces(
 
 
 def _fit_variables(res: FitResult) -> dict:
-    """The dataset's variables of the working method's fit: parameters (e_f, k_c, e_t in N/m, 1/m, N/m; kappa, mu
-    dimensionless), their intervals and bounds, correlation, the GA's misfits per generation, the grid history."""
+    """The dataset's variables of the working method's fit: one variable per parameter (e_f, k_c, e_t in N/m, 1/m,
+    N/m; kappa, mu dimensionless) with its interval, the bounds, correlation, the GA's misfits per generation and
+    the grid refinements."""
     return {
-        "parameter_value": (
-            "parameter",
-            res.params,
-            {"units": "mixed (N/m, 1/m, N/m, 1, 1)", "long_name": "fitted e_f, k_c, e_t, kappa, mu"},
-        ),
-        "interval_low": (
-            "parameter",
-            res.intervals[:, 0],
-            {"units": "mixed", "long_name": "profile-likelihood interval, lower end"},
-        ),
-        "interval_high": (
-            "parameter",
-            res.intervals[:, 1],
-            {"units": "mixed", "long_name": "profile-likelihood interval, upper end"},
-        ),
+        **parameter_variables(res.params, res.intervals),
         "bounded_below": (
             "parameter",
             res.bounded[:, 0].astype(int),
@@ -469,11 +457,14 @@ def _fit_variables(res: FitResult) -> dict:
             [m for _, _, m in res.logbook],
             {"units": "1", "long_name": "mean misfit per generation"},
         ),
-        "grid_history": (
-            ("refinement", "grid_field"),
-            np.array(res.grid_history),
-            {"units": "mixed", "long_name": "grid points, e_f, k_c, e_t, kappa, mu, misfit per refinement"},
-        ),
+        **{
+            f"refinement_{name}": (
+                "refinement",
+                np.array(res.grid_history)[:, k],
+                {"units": unit, "long_name": f"{name} per grid refinement"},
+            )
+            for k, (name, unit) in enumerate(GRID_FIELDS)
+        },
     }
 
 
@@ -522,23 +513,7 @@ def _paper_fit_outputs(paper_forces, preload: float, fit) -> tuple[dict, dict]:
     except ValueError as exc:  # e.g. the paper's N reaches zero: the law is not defined there
         log.warning("the paper's chain's forces cannot be fitted: %s", exc)
         return {}, {"paper_fit_error": str(exc)}
-    data = {
-        "paper_parameter_value": (
-            "parameter",
-            rp.params,
-            {"units": "mixed", "long_name": "fitted to the paper's chain's forces"},
-        ),
-        "paper_interval_low": (
-            "parameter",
-            rp.intervals[:, 0],
-            {"units": "mixed", "long_name": "paper's chain: interval, lower end"},
-        ),
-        "paper_interval_high": (
-            "parameter",
-            rp.intervals[:, 1],
-            {"units": "mixed", "long_name": "paper's chain: interval, upper end"},
-        ),
-    }
+    data = parameter_variables(rp.params, rp.intervals, prefix="paper_", what="fitted to the paper's chain's forces:")
     return data, {"paper_e0_at_preload_n_per_m": rp.e0_at_preload, "paper_misfit_nrmse": rp.misfit}
 
 
@@ -566,7 +541,7 @@ def friction_fit_dataset(forces, preload: float, settings: FitSettings, seed: in
             "parameter": list(PARAMETER_NAMES),
             "parameter_": list(PARAMETER_NAMES),
             "generation": np.arange(len(res.logbook)),
-            "grid_field": ["grid_points", *PARAMETER_NAMES, "misfit"],
+            "estimate": list(ESTIMATES),
         },
         attrs=attrs,
     )
@@ -589,9 +564,9 @@ def validation_dataset(forces, fit, preload: float, n_harmonics: int, truth=None
     S_id = periodic_grid(c["S"], f0, m)[0]
     xi_dot = periodic_grid(c["xi_dot"], f0, m)[0]
     reading = fit.attrs["regularization"]
-    S_pred = valanis_friction_force(xi, N, fit["parameter_value"].values[None, :], regularization=reading)[0]
+    S_pred = valanis_friction_force(xi, N, fitted_parameters(fit)[None, :], regularization=reading)[0]
     other = next(r for r in REGULARIZATIONS if r != reading)
-    S_other = valanis_friction_force(xi, N, fit["parameter_value"].values[None, :], regularization=other)[0]
+    S_other = valanis_friction_force(xi, N, fitted_parameters(fit)[None, :], regularization=other)[0]
     S_pred, S_other = S_pred - S_pred.mean(), S_other - S_other.mean()
     attrs = {
         "nrmse_vs_identified": nrmse(S_pred, S_id),

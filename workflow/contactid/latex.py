@@ -107,19 +107,61 @@ def report_values(summary: Mapping, consistency: pd.DataFrame) -> dict:
     return v
 
 
-def tabular(df: pd.DataFrame, columns: Mapping[str, str], caption: str, label: str) -> str:
-    """A booktabs table from selected columns (header text per column)."""
+_LATEX_SPECIAL = {
+    "\\": r"\textbackslash{}",
+    "&": r"\&",
+    "%": r"\%",
+    "$": r"\$",
+    "#": r"\#",
+    "_": r"\_",
+    "{": r"\{",
+    "}": r"\}",
+    "~": r"\textasciitilde{}",
+    "^": r"\textasciicircum{}",
+}
+
+
+def escape(text) -> str:
+    """Text for a LaTeX cell: every character LaTeX treats specially (\\ & % $ # _ { } ~ ^) printed as itself."""
+    return "".join(_LATEX_SPECIAL.get(ch, ch) for ch in str(text))
+
+
+def significant_digits(value: float, low: float, high: float, most: int = 6) -> int:
+    """The significant digits of ``value`` its interval [low, high] supports: the interval's half-width to two
+    significant digits fixes the last digit printed (at least 1, at most ``most``); 0 when the value is below a
+    thousandth of the half-width (printed as 0: the data do not tell it from zero)."""
+    half = 0.5 * abs(float(high) - float(low))
+    if not (math.isfinite(value) and math.isfinite(half)) or half == 0.0:
+        return 4
+    if abs(value) < 1e-3 * half:
+        return 0
+    return int(min(most, max(1, math.floor(math.log10(abs(value))) - math.floor(math.log10(half)) + 2)))
+
+
+def tabular(
+    df: pd.DataFrame,
+    columns: Mapping[str, str],
+    caption: str,
+    label: str,
+    digits: int = 3,
+    intervals: Mapping[str, tuple[str, str]] | None = None,
+) -> str:
+    """A booktabs table from selected columns (header text per column, LaTeX as given). Numbers print with
+    ``digits`` significant digits, a column named in ``intervals`` (column -> (low column, high column)) with the
+    digits its interval supports (``significant_digits``); text cells are escaped."""
     head = " & ".join(columns.values()) + r" \\"
     rows = []
     for _, r in df.iterrows():
         cells = []
         for col in columns:
             x = r[col]
-            cells.append(
-                f"${_fmt(x)}$"
-                if isinstance(x, (int, float, np.number)) and not isinstance(x, bool)
-                else str(x).replace("_", r"\_")
-            )
+            if not isinstance(x, (int, float, np.number)) or isinstance(x, (bool, np.bool_)):
+                cells.append(escape(x))
+                continue
+            n = digits
+            if intervals and col in intervals:
+                n = significant_digits(float(x), float(r[intervals[col][0]]), float(r[intervals[col][1]]))
+            cells.append("$0$" if n == 0 else f"${_fmt(x, n)}$")
         rows.append(" & ".join(cells) + r" \\")
     spec = "l" + "r" * (len(columns) - 1)
     return (
@@ -190,7 +232,7 @@ def setup_table(structure_cfg: Mapping) -> str:
     for r in rows:
         val = r["value"]
         val = f"${_fmt(val)}$" if isinstance(val, (int, float)) else f"${val}$" if "times" in str(val) else str(val)
-        lines.append(f"{r['quantity'].replace('_', chr(92) + '_')} & {val} & {r['source']} \\\\")
+        lines.append(f"{escape(r['quantity'])} & {val} & {escape(r['source'])} \\\\")
     lines += [r"\bottomrule", r"\end{tabular}", r"\end{table}"]
     return "\n".join(lines) + "\n"
 

@@ -50,19 +50,19 @@ def generalized_coordinates_dataset(raw: xr.Dataset, linear_modes: xr.Dataset, n
             "p_ddot_measured": (
                 ("mode", "time"),
                 pdd,
-                {"units": "kg^1/2 m/s^2", "long_name": "p''(t) = Phi^+ w''(t) (Eq. 15)"},
+                {"units": "kg^0.5 m/s^2", "long_name": "p''(t) = Phi^+ w''(t) (Eq. 15)"},
             ),
             "p_ddot": (
                 ("mode", "time"),
                 synthesize(coef, f0, t, 0),
-                {"units": "kg^1/2 m/s^2", "long_name": "Fourier series of p'' (Eq. 16)"},
+                {"units": "kg^0.5 m/s^2", "long_name": "Fourier series of p'' (Eq. 16)"},
             ),
             "p": (
                 ("mode", "time"),
                 synthesize(coef, f0, t, -2),
-                {"units": "kg^1/2 m", "long_name": "p(t) by analytic integration (Eq. 17)"},
+                {"units": "kg^0.5 m", "long_name": "p(t) by analytic integration (Eq. 17)"},
             ),
-            "amplitude": (("mode", "harmonic"), np.abs(coef), {"units": "kg^1/2 m/s^2", "long_name": "A_ki of Eq. 16"}),
+            "amplitude": (("mode", "harmonic"), np.abs(coef), {"units": "kg^0.5 m/s^2", "long_name": "A_ki of Eq. 16"}),
             "phase": (
                 ("mode", "harmonic"),
                 np.angle(coef),
@@ -105,16 +105,16 @@ def nonlinear_modes_dataset(
                 spread,
                 {"units": "deg", "long_name": "largest phase deviation among terms of one frequency"},
             ),
-            "shape": (("x", "nnm"), lm["phi"].values @ coef.T, {"units": "kg^-1/2", "long_name": "NNM lateral shape"}),
-            "u": ("nnm", coef @ lm["u"].values, {"units": "kg^-1/2", "long_name": "NNM axial tip motion"}),
-            "y_s": ("nnm", coef @ lm["y_s"].values, {"units": "kg^-1/2", "long_name": "NNM string stretch"}),
+            "shape": (("x", "nnm"), lm["phi"].values @ coef.T, {"units": "kg^-0.5", "long_name": "NNM lateral shape"}),
+            "u": ("nnm", coef @ lm["u"].values, {"units": "kg^-0.5", "long_name": "NNM axial tip motion"}),
+            "y_s": ("nnm", coef @ lm["y_s"].values, {"units": "kg^-0.5", "long_name": "NNM string stretch"}),
             "theta_s": (
                 "nnm",
                 coef @ lm["theta_s"].values,
-                {"units": "rad kg^-1/2", "long_name": "NNM pendulum angle"},
+                {"units": "rad kg^-0.5", "long_name": "NNM pendulum angle"},
             ),
-            "q": (("nnm", "time"), q, {"units": "kg^1/2 m", "long_name": "NNM coordinates (Eq. 19)"}),
-            "q_ddot": (("nnm", "time"), qdd, {"units": "kg^1/2 m/s^2", "long_name": "NNM accelerations"}),
+            "q": (("nnm", "time"), q, {"units": "kg^0.5 m", "long_name": "NNM coordinates (Eq. 19)"}),
+            "q_ddot": (("nnm", "time"), qdd, {"units": "kg^0.5 m/s^2", "long_name": "NNM accelerations"}),
             "drive_measured": (
                 "time",
                 measured,
@@ -164,7 +164,7 @@ def reduced_model_dataset(
             "reduced_force": (
                 "nnm",
                 g["reduced_force"],
-                {"units": "kg^-1/2", "long_name": "generalized force of a unit force at d_p"},
+                {"units": "kg^-0.5", "long_name": "generalized force of a unit force at d_p"},
             ),
             "S": (
                 "time",

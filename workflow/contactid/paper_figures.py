@@ -11,6 +11,7 @@ import xarray as xr
 from . import print_style as ps
 from .consistency import TABLE4
 from .contact_laws import stiction_shear_stiffness
+from .friction_parameters import fitted_parameters
 
 
 def _periods(t: np.ndarray, f0: float, periods: int = 3):
@@ -122,7 +123,7 @@ def _fig07(fit: xr.Dataset, validations: Mapping[str, xr.Dataset], truth_frictio
     plt = ps.pyplot()
     n0 = fit.attrs["preload_n"]
     N = np.linspace(0, 2.5 * n0, 200)
-    p = dict(zip(fit["parameter"].values, fit["parameter_value"].values))
+    p = dict(zip(fit["parameter"].values, fitted_parameters(fit)))
     fig, ax = plt.subplots(figsize=(ps.NARROW_WIDTH_IN, 3.0))
     ax.plot(N, 1e-6 * stiction_shear_stiffness(N, p["e_f"], p["k_c"]), "-", color="C0", label="identified")
     ax.plot(

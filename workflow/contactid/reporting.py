@@ -13,6 +13,7 @@ import xarray as xr
 
 from .consistency import TABLE1_HZ, TABLE3, TABLE4
 from .contact_laws import stiction_shear_stiffness
+from .friction_parameters import fitted_intervals, fitted_parameters
 
 
 def _pct(a, b):
@@ -154,10 +155,12 @@ def table4(fit: xr.Dataset, truth_friction: Mapping | None) -> pd.DataFrame:
     the paper's value and the rig truth, plus e_0 at the preload."""
     rows = []
     keys = {"e_f": "e_f_n_per_m", "k_c": "k_c_per_m", "e_t": "e_t_n_per_m", "kappa": "kappa", "mu": "mu"}
+    values, intervals = fitted_parameters(fit), fitted_intervals(fit)
+    paper = fitted_parameters(fit, "paper_") if "paper_e_f" in fit else np.full(len(values), np.nan)
     for i, name in enumerate(fit["parameter"].values):
         tr = float(truth_friction[keys[name]]) if truth_friction else np.nan
-        v = float(fit["parameter_value"].values[i])
-        lo, hi = float(fit["interval_low"].values[i]), float(fit["interval_high"].values[i])
+        v = float(values[i])
+        lo, hi = float(intervals[i, 0]), float(intervals[i, 1])
         kind = (
             "value"
             if fit["bounded_below"].values[i] and fit["bounded_above"].values[i]
@@ -174,9 +177,7 @@ def table4(fit: xr.Dataset, truth_friction: Mapping | None) -> pd.DataFrame:
                 "interval_low": lo,
                 "interval_high": hi,
                 "reported_as": kind,
-                "paper_chain_fit": float(fit["paper_parameter_value"].values[i])
-                if "paper_parameter_value" in fit
-                else np.nan,
+                "paper_chain_fit": float(paper[i]),
                 "paper_value": TABLE4[name],
                 "truth": tr,
                 "diff_vs_truth_pct": _pct(v, tr) if name != "e_t" else np.nan,
@@ -220,11 +221,8 @@ def stiction_shear_stiffness_paper(preload: float) -> float:
 
 def friction_summary(fit: xr.Dataset, validations: Mapping[str, xr.Dataset]) -> dict:
     """`friction` and `validation_nrmse` blocks of summary.json."""
-    p = dict(zip(fit["parameter"].values, (float(v) for v in fit["parameter_value"].values)))
-    intervals = {
-        n: [float(lo), float(hi)]
-        for n, lo, hi in zip(fit["parameter"].values, fit["interval_low"].values, fit["interval_high"].values)
-    }
+    p = dict(zip(fit["parameter"].values, (float(v) for v in fitted_parameters(fit))))
+    intervals = {n: [float(lo), float(hi)] for n, (lo, hi) in zip(fit["parameter"].values, fitted_intervals(fit))}
     bounded_only = [
         n
         for n, b, a in zip(fit["parameter"].values, fit["bounded_below"].values, fit["bounded_above"].values)

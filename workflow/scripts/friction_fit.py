@@ -1,6 +1,7 @@
 """Rule friction_fit: GA + polish of the modified Valanis law on the calibration case (Table 4)."""
 
 from contactid.friction_fit import friction_fit_dataset, settings_from_config
+from contactid.friction_parameters import fitted_parameters
 from contactid.io import load_dataset, provenance, write_dataset
 from contactid.logs import fmt, setup_logging
 
@@ -20,7 +21,7 @@ ds.attrs.update(
 write_dataset(ds, snakemake.output.fit)
 log.info(
     "fitted %s; e0(N0) = %.4g N/m, misfit %.4g",
-    fmt(dict(zip(ds["parameter"].values, ds["parameter_value"].values))),
+    fmt(dict(zip(ds["parameter"].values, fitted_parameters(ds)))),
     ds.attrs["e0_at_preload_n_per_m"],
     ds.attrs["misfit_nrmse"],
 )

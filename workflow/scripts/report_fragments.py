@@ -45,6 +45,7 @@ Path(out.table3).write_text(
         },
         "Contact stiffness at stiction (paper, Table 3).",
         "tab:t3",
+        intervals={"identified_n_per_m": ("interval_low_n_per_m", "interval_high_n_per_m")},
     )
 )
 Path(out.table4).write_text(
@@ -61,6 +62,7 @@ Path(out.table4).write_text(
         },
         "Friction-law parameters (paper, Table 4): working method with profile-likelihood intervals.",
         "tab:t4",
+        intervals={"identified": ("interval_low", "interval_high")},
     )
 )
 Path(out.consistency).write_text(

@@ -77,14 +77,12 @@ def force_state(ds: xr.Dataset, path: str):
     n = ds.sizes["case"]
     fig, axes = plt.subplots(2, n, figsize=(3.3 * n, 5.6), squeeze=False)
     for i, c in enumerate(ds["case"].values):
-        m = ds["force_state_map"].sel(case=c)
+        m = ds.sel(case=c)
         for row, (x, y, r, lab) in enumerate(
             (("xi", "xi_dot", "S_residual", "S"), ("eta", "eta_dot", "N_residual", "N"))
         ):
             ax = axes[row, i]
-            sc = ax.scatter(
-                1e6 * m.sel(map_field=x), 1e3 * m.sel(map_field=y), c=m.sel(map_field=r), cmap="coolwarm", s=6
-            )
+            sc = ax.scatter(1e6 * m[f"map_{x}"], 1e3 * m[f"map_{y}"], c=m[f"map_{r}"], cmap="coolwarm", s=6)
             fig.colorbar(sc, ax=ax, label=f"{lab} residual (N)")
             ax.set_xlabel(f"{x} (um)")
             ax.set_ylabel(f"{y} (mm/s)")

@@ -22,6 +22,7 @@ import numpy as np
 import xarray as xr
 
 from ..beam_model import assemble
+from ..friction_parameters import fitted_parameters
 from ..harmonics import periodic_grid, periodic_harmonics
 from ..identification import damping_by_mode
 from ..parameters import StructureParameters, structure_from_config
@@ -111,7 +112,7 @@ def identified_model(
     return IdentifiedModel(
         params,
         tuple(float(z) for z in modal["damping_ratio"].values),
-        tuple(float(x) for x in friction_fit["parameter_value"].values),
+        tuple(float(x) for x in fitted_parameters(friction_fit)),
         float(structure_cfg["preload_n"]),
         int(n_modes),
         int(oversampling),

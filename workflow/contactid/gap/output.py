@@ -11,6 +11,17 @@ import xarray as xr
 from .diagnosis import Diagnosis
 
 
+# the force-state maps, one variable per field (name, units, what): the identified motion and what the laws leave
+MAP_FIELDS = (
+    ("xi", "m", "identified tangential motion xi"),
+    ("xi_dot", "m/s", "identified tangential velocity"),
+    ("S_residual", "N", "identified S - the friction law at the identified motion"),
+    ("eta", "m", "identified normal motion eta"),
+    ("eta_dot", "m/s", "identified normal velocity"),
+    ("N_residual", "N", "identified N - the best elastic normal law"),
+)
+
+
 def _clean(x):
     if isinstance(x, dict):
         return {str(k): _clean(v) for k, v in x.items()}
@@ -63,14 +74,14 @@ def localisation_variables(a: dict) -> dict:
             a["energy_normal"],
             {"units": "J", "long_name": "energy dissipated per cycle in the normal direction"},
         ),
-        "force_state_map": (
-            ("case", "map_field", "phase"),
-            a["force_state_map"],
-            {
-                "units": "SI (m, m/s, N)",
-                "long_name": "identified motion and the residual force (identified - law) over one period",
-            },
-        ),
+        **{
+            f"map_{name}": (
+                ("case", "phase"),
+                a["force_state_map"][:, k, :],
+                {"units": unit, "long_name": f"force-state map over one period: {what}"},
+            )
+            for k, (name, unit, what) in enumerate(MAP_FIELDS)
+        },
     }
 
 
@@ -176,7 +187,6 @@ def gap_dataset(diag: Diagnosis, records: dict, n_harmonics: int) -> xr.Dataset:
             "cycle_part": ["stick", "slip", "velocity_reversal", "peak_compression"],
             "source": ["identified", "simulated"],
             "phase": np.arange(a["force_state_map"].shape[-1]),
-            "map_field": ["xi", "xi_dot", "S_residual", "eta", "eta_dot", "N_residual"],
             "effect": [r["effect"] for r in diag.ranking],
         },
         attrs={

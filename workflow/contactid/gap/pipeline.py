@@ -12,6 +12,7 @@ import xarray as xr
 
 from ..config import with_defaults
 from ..friction_fit import fit_friction_law, settings_from_config
+from ..friction_parameters import parameter_dataset
 from ..linear_chain import frf_dataset, linear_modes_dataset, modal_dataset, stiction_dataset
 from .model import identified_model
 from .records import record_harmonics
@@ -44,9 +45,7 @@ def identify(cfg: Mapping, raw_random: xr.Dataset, raw_calibration: xr.Dataset, 
     modes, modal, frf = linear_chain(cfg, raw_random, return_frf=True)
     K = int(cfg["nonlinear"]["n_harmonics"])
     settings = settings_from_config(cfg["friction"])
-    unfitted = xr.Dataset(
-        {"parameter_value": ("parameter", np.ones(5))}, attrs={"regularization": settings.regularization}
-    )
+    unfitted = parameter_dataset(np.ones(5), settings.regularization)
     model = identified_model(cfg["structure"], modes, modal, unfitted, n_modes=n_modes)
     rec = record_harmonics(raw_calibration, "calibration", K)
     forces = identified_forces(model, NONE, rec)

@@ -27,6 +27,17 @@ from .structure import channel_delays, rig_structure, true_structure_config
 log = logging.getLogger(__name__)
 
 
+# the response control's history, one variable per field (name, units, what): the forces it tried, the driving
+# point's harmonics they gave, and whether the response had settled
+CONTROL_FIELDS = (
+    ("F1", "N", "force amplitude at w"),
+    ("F3", "N", "force amplitude at 3 w"),
+    ("A1", "m/s^2", "driving-point acceleration amplitude at w"),
+    ("A3", "m/s^2", "driving-point acceleration amplitude at 3 w"),
+    ("steady", "1", "1 where the response had settled"),
+)
+
+
 def dual_sine_settings(rig_cfg: Mapping, case_cfg: Mapping, sampling_rate_hz: float) -> dict:
     """Merged settings of one load case: rig.dual_sine (at the schema's defaults where left out), overridden per
     case."""
@@ -240,18 +251,17 @@ def _truth_variables(rec: dict, sim: DualSineSimulator, ctl: ControlResult, sub:
         "reduced_coordinate": (
             ("time", "reduced_mode"),
             rec["z"][sub],
-            {"units": "kg^1/2 m", "long_name": "coordinates of the rig's reduced basis"},
+            {"units": "kg^0.5 m", "long_name": "coordinates of the rig's reduced basis"},
         ),
         "reduced_frequency": (
             "reduced_mode",
             red.omega / (2 * np.pi),
             {"units": "Hz", "long_name": "frequencies of the rig's reduced stuck basis"},
         ),
-        "control_history": (
-            ("iteration", "control_field"),
-            hist,
-            {"units": "mixed", "long_name": "response control: F1 (N), F3 (N), A1, A3 (m/s^2), steady"},
-        ),
+        **{
+            f"control_{name}": ("iteration", hist[:, k], {"units": unit, "long_name": f"response control: {what}"})
+            for k, (name, unit, what) in enumerate(CONTROL_FIELDS)
+        },
         "steady_state_change": (
             "chunk",
             np.asarray(ctl.steady_state.change or [np.nan]),
@@ -353,7 +363,6 @@ def dual_sine_test(
         coords={
             "time": ("time", time, {"units": "s", "long_name": "time"}),
             "sensor": list(sensor_names),
-            "control_field": ["F1", "F3", "A1", "A3", "steady"],
         },
         attrs=_truth_attrs(ctl, target, s, eff, sim, stationarity, energy),
     )

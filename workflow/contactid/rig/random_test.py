@@ -194,7 +194,7 @@ def random_test_datasets(structure_cfg, rig_cfg, random_test_cfg, seed: int, n_t
             "mode_shape_at_sensor": (
                 ("sensor", "mode"),
                 model.sensor_vectors @ modes.shapes,
-                {"units": "kg^-1/2", "long_name": "mass-normalised mode shape at the sensors"},
+                {"units": "kg^-0.5", "long_name": "mass-normalised mode shape at the sensors"},
             ),
             "k_t": ((), params.k_t, {"units": "N/m", "long_name": "true tangential contact stiffness at stiction"}),
             "k_n": ((), params.k_n, {"units": "N/m", "long_name": "true normal contact stiffness at the preload"}),
