@@ -1,7 +1,8 @@
 import numpy as np
 import pytest
 
-from contactid.modal_fit import fit_modes, lsfd_residues, stability_poles, synthesise_frf
+from contactid.frf_synthesis import synthesised_accelerance
+from contactid.modal_fit import fit_modes, lsfd_residues, stability_poles
 from contactid.signals import h1_frf
 
 
@@ -103,7 +104,6 @@ def test_synthesised_frf_reproduces_a_noise_free_frf():
     f = np.arange(0, 500, 0.3125)
     fn, zeta = np.array([100.0, 300.0]), np.array([0.01, 0.02])
     H = synthetic_accelerance(f, fn, zeta, np.array([[1 - 2j, 0.5 + 1j], [0.2j, -1.0]]))
-    fb, Hs = synthesise_frf(f, H, fn, zeta, (20, 450))
-    sel = (f >= 20) & (f <= 450)
-    assert np.array_equal(fb, f[sel])
-    assert np.max(np.abs(Hs - H[:, sel])) < 1e-8 * np.max(np.abs(H))
+    Hs = synthesised_accelerance(f, H, fn, zeta, (20, 450))
+    assert Hs.shape == H.shape
+    assert np.max(np.abs(Hs - H)) < 1e-8 * np.max(np.abs(H))  # in the band and beyond (no residual needed here)

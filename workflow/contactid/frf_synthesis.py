@@ -13,15 +13,12 @@ import numpy as np
 import xarray as xr
 
 from .linear_chain import complex_frf
-from .modal_fit import lsfd_residues
+from .modal_fit import lsfd_residues, mode_poles
 
 
 def identified_poles(modal: xr.Dataset) -> np.ndarray:
-    """Poles s_r = -zeta_r w_r + i w_r sqrt(1 - zeta_r^2) (rad/s) of the identified modes (w_r = 2 pi f_r, the
-    undamped natural frequency |s_r|)."""
-    w = 2 * np.pi * modal["natural_frequency"].values
-    z = modal["damping_ratio"].values
-    return -z * w + 1j * w * np.sqrt(1.0 - z**2)
+    """Poles s_r (rad/s) of the identified modes in modal.nc (``modal_fit.mode_poles``)."""
+    return mode_poles(modal["natural_frequency"].values, modal["damping_ratio"].values)
 
 
 def modal_terms(frequency_hz: np.ndarray, poles: np.ndarray, residues: np.ndarray) -> np.ndarray:
@@ -33,14 +30,21 @@ def modal_terms(frequency_hz: np.ndarray, poles: np.ndarray, residues: np.ndarra
     return residues @ a + np.conj(residues) @ b
 
 
-def synthesised_frf(frf: xr.Dataset, modal: xr.Dataset) -> np.ndarray:
-    """(sensor, frequency) complex accelerance (m/s^2/N) synthesised from the identified modes on the lines of
-    ``frf``: residues and the real lower and upper residuals (LR + UR w^2) fitted by least squares to the measured
-    H1 in the modal fit's band (modal.attrs band_low_hz, band_high_hz), as modal_fit.lsfd_residues fits them."""
-    f = frf["frequency"].values
-    h = complex_frf(frf)
-    band = (f >= float(modal.attrs["band_low_hz"])) & (f <= float(modal.attrs["band_high_hz"]))
-    poles = identified_poles(modal)
+def synthesised_accelerance(
+    frequency_hz: np.ndarray,
+    frf: np.ndarray,
+    natural_frequency_hz: np.ndarray,
+    damping_ratio: np.ndarray,
+    band_hz: tuple[float, float],
+) -> np.ndarray:
+    """(n_out, n_f) complex accelerance (m/s^2/N) synthesised from modes of ``natural_frequency_hz`` (Hz) and
+    ``damping_ratio`` on every line of ``frequency_hz``: their residues and the real lower and upper residuals
+    (LR + UR w^2) fitted by least squares to ``frf`` (n_out, n_f; m/s^2/N) inside ``band_hz``, as
+    modal_fit.lsfd_residues fits them (outside the band the residual terms extrapolate)."""
+    f = np.asarray(frequency_hz, dtype=float)
+    h = np.atleast_2d(frf)
+    band = (f >= band_hz[0]) & (f <= band_hz[1])
+    poles = mode_poles(natural_frequency_hz, damping_ratio)
     residues, _ = lsfd_residues(f[band], h[:, band], poles)
     modes = modal_terms(f, poles, residues)
     w2 = (2 * np.pi * f) ** 2
@@ -49,3 +53,16 @@ def synthesised_frf(frf: xr.Dataset, modal: xr.Dataset) -> np.ndarray:
     A = np.vstack([basis, np.zeros_like(basis)])
     residual = np.array([np.linalg.lstsq(A, np.concatenate([r.real, r.imag]), rcond=None)[0] for r in rest])
     return modes + residual[:, :1] + residual[:, 1:] * w2[None, :]
+
+
+def synthesised_frf(frf: xr.Dataset, modal: xr.Dataset) -> np.ndarray:
+    """(sensor, frequency) complex accelerance (m/s^2/N) synthesised from the identified modes (modal.nc) on the
+    lines of ``frf`` (frf.nc), fitted in the modal fit's band (modal.attrs band_low_hz, band_high_hz)."""
+    band = (float(modal.attrs["band_low_hz"]), float(modal.attrs["band_high_hz"]))
+    return synthesised_accelerance(
+        frf["frequency"].values,
+        complex_frf(frf),
+        modal["natural_frequency"].values,
+        modal["damping_ratio"].values,
+        band,
+    )

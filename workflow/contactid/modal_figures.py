@@ -8,7 +8,8 @@ import xarray as xr
 
 from . import print_style as ps
 from .linear_chain import complex_frf
-from .modal_fit import StabilityPoles, stability_poles, synthesise_frf
+from .frf_synthesis import synthesised_accelerance
+from .modal_fit import StabilityPoles, stability_poles
 
 
 def _plain_log_ticks(ax) -> None:
@@ -65,7 +66,11 @@ def plot_fig03(frf: xr.Dataset, modal: xr.Dataset, png: str, pdf: str, f_max_hz:
     sel = (f > 0) & (f <= f_max_hz)
     H = complex_frf(frf)
     band = _band(modal)
-    fb, Hs = synthesise_frf(f, H, modal["natural_frequency"].values, modal["damping_ratio"].values, band)
+    in_band = (f >= band[0]) & (f <= band[1])
+    fb = f[in_band]
+    Hs = synthesised_accelerance(f, H, modal["natural_frequency"].values, modal["damping_ratio"].values, band)[
+        :, in_band
+    ]
     fig, (ax, axp, axc) = plt.subplots(
         3, 1, figsize=(ps.TEXT_WIDTH_IN, 5.6), sharex=True, gridspec_kw={"height_ratios": [3, 1.5, 1.1]}
     )

@@ -136,22 +136,6 @@ def mode_poles(natural_frequency_hz: np.ndarray, damping_ratio: np.ndarray) -> n
     return -z * wn + 1j * wn * np.sqrt(1 - z**2)
 
 
-def synthesise_frf(
-    frequency_hz: np.ndarray,
-    frf: np.ndarray,
-    natural_frequency_hz: np.ndarray,
-    damping_ratio: np.ndarray,
-    band_hz: tuple[float, float],
-) -> tuple[np.ndarray, np.ndarray]:
-    """The FRF synthesised from identified modes: LSFD residues (with lower and upper residual terms) of the
-    poles of ``natural_frequency_hz``, ``damping_ratio`` fitted to ``frf`` (n_out, n_f) inside ``band_hz``.
-    Returns (the frequencies in the band (Hz), the synthesised FRF there (n_out, n_band))."""
-    f = np.asarray(frequency_hz, dtype=float)
-    sel = (f >= band_hz[0]) & (f <= band_hz[1])
-    _, fit = lsfd_residues(f[sel], np.atleast_2d(frf)[:, sel], mode_poles(natural_frequency_hz, damping_ratio))
-    return f[sel], fit
-
-
 @dataclass(frozen=True)
 class StabilityPoles:
     """The physical poles of every model order of a stabilisation diagram, one entry per pole.
