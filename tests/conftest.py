@@ -28,6 +28,7 @@ SHARED_RUNS = {
     "other_seed_run": (wp.prepare_other_seed_run, "small_run", 10),
     "rig_run": (wp.prepare_rig_run, "small_run", 10),
     "noise_sweep_run": (wp.prepare_noise_sweep_run, "small_run", 10),
+    "frf_file_run": (lambda d: wp.prepare_frf_file_run(d, _runs["small_run"].proj), "small_run", 10),
     "lower_confidence_run": (lambda d: wp.prepare_lower_confidence_run(d, _runs["default_run"].proj), "default_run", 0),
 }
 _runs: dict = {}
@@ -112,6 +113,14 @@ def lower_confidence_run(pytestconfig):
     (workflow_projects.prepare_lower_confidence_run). Returns (project, snakemake's output)."""
     proj = _wait(pytestconfig, "lower_confidence_run")
     return proj, _runs["lower_confidence_run"].output()
+
+
+@pytest.fixture(scope="session")
+def frf_file_run(pytestconfig):
+    """The small config's linear chain from the small run's FRFs as a UFF58 file (workflow_projects.
+    prepare_frf_file_run). Returns (project, snakemake's output)."""
+    proj = _wait(pytestconfig, "frf_file_run")
+    return proj, _runs["frf_file_run"].output()
 
 
 @pytest.fixture(scope="session")

@@ -365,3 +365,34 @@ def test_changed_package_code_reruns_what_it_computed(default_run, tmp_path):
     # with the code restored, nothing is planned again
     assert "rig_random_test" not in again.stdout and "contact_forces" not in again.stdout
     assert "report_fragments" not in again.stdout
+
+
+def test_chain_on_measured_frfs_identifies_the_time_records_modes(small_run, frf_file_run):
+    """A project whose random test is the small run's FRFs as a UFF58 file (function types 4 and 6;
+    workflow_projects.prepare_frf_file_run): `snakemake results/linear/stiction.nc` runs import_uff58_frf (no rig,
+    no time-record checks), modal and the stiffness fit, and identifies the small run's natural frequencies and
+    damping; the FRFs written back out (frf_measured.uff, frf_synthesised.uff) read back with pyuff on the same
+    lines."""
+    import xarray as xr
+
+    from contactid.linear_chain import complex_frf
+    from test_importers import _frf_sets
+    from workflow_projects import FRF_FILE_TARGETS
+
+    proj, log = frf_file_run
+    out = FRF_FILE_TARGETS[1:]
+    frf = xr.load_dataset(small_run / "results/linear/frf.nc", engine="netcdf4")
+    assert "import_uff58_frf" in log and "rig_random_test" not in log and "rule frf:" not in log
+    modal = xr.load_dataset(proj / "results/linear/modal.nc", engine="netcdf4")
+    ref = xr.load_dataset(small_run / "results/linear/modal.nc", engine="netcdf4")
+    np.testing.assert_allclose(modal["natural_frequency"].values, ref["natural_frequency"].values, rtol=1e-6)
+    np.testing.assert_allclose(modal["damping_ratio"].values, ref["damping_ratio"].values, rtol=1e-6)
+    imported = xr.load_dataset(proj / "results/linear/frf.nc", engine="netcdf4")
+    assert imported.attrs["producer_rule"] == "import_uff58_frf" and "measured/frf.uff" in imported.attrs["frf_source"]
+    assert (proj / "results/linear/stiction.nc").exists() and not (proj / "data/raw").exists()
+    measured, synthesised = (_frf_sets(proj / p) for p in out)
+    assert [s["func_type"] for s in measured] == [4, 4, 4, 6, 6, 6] and [s["func_type"] for s in synthesised] == [4] * 3
+    for i in range(3):
+        np.testing.assert_array_equal(measured[i]["data"], complex_frf(frf)[i])
+        np.testing.assert_array_equal(measured[3 + i]["data"], frf["coherence"].values[i])
+        np.testing.assert_array_equal(synthesised[i]["x"], frf["frequency"].values)

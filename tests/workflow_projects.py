@@ -296,6 +296,33 @@ def prepare_noise_sweep_run(d: Path):
     return small_project(d, SWEEP), ("noise_study",)
 
 
+FRF_FILE_TARGETS = (
+    "results/linear/stiction.nc",
+    "results/linear/frf_measured.uff",
+    "results/linear/frf_synthesised.uff",
+)
+
+
+def prepare_frf_file_run(d: Path, small_run: Path):
+    """A project on the small config whose random test is the small run's FRFs as a UFF58 file (function types 4
+    and 6, measured/frf.uff): the linear chain from the file, and the FRFs written back out."""
+    import xarray as xr
+
+    from contactid.importers.frf_uff import write_frf_uff58
+    from contactid.linear_chain import complex_frf
+
+    frf = xr.load_dataset(small_run / "results/linear/frf.nc", engine="netcdf4")
+    proj = small_project(d)
+    (proj / "measured").mkdir()
+    block = write_frf_uff58(
+        proj / "measured/frf.uff", frf["frequency"].values, complex_frf(frf), frf["sensor"].values, frf["coherence"]
+    )
+    cfg = project_config(proj)
+    cfg["random_test"] = {**block, "file": "measured/frf.uff"}
+    (proj / "config/config.yaml").write_text(yaml.safe_dump(cfg))
+    return proj, FRF_FILE_TARGETS
+
+
 NUMBERS = "results/report/numbers.tex"  # the numbers the PDF prints (\\input by paper/report.tex)
 
 
