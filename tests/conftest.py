@@ -28,7 +28,6 @@ SHARED_RUNS = {
     "other_seed_run": (wp.prepare_other_seed_run, "small_run", 10),
     "rig_run": (wp.prepare_rig_run, "small_run", 10),
     "noise_sweep_run": (wp.prepare_noise_sweep_run, "small_run", 10),
-    "frf_file_run": (lambda d: wp.prepare_frf_file_run(d, _runs["small_run"].proj), "small_run", 10),
     "lower_confidence_run": (lambda d: wp.prepare_lower_confidence_run(d, _runs["default_run"].proj), "default_run", 0),
 }
 _runs: dict = {}
@@ -89,8 +88,9 @@ def small_run(pytestconfig):
 
 @pytest.fixture(scope="session")
 def measured_run(pytestconfig, small_run):
-    """Every record a measured file (UFF58, TDMS, CSV, netCDF): the gap target and the contact forces
-    (workflow_projects.prepare_measured_run). Returns (project, snakemake's output)."""
+    """Every record a measured file (the random test as FRFs in a UFF58 file; the load cases as UFF58, TDMS, CSV):
+    the gap target, the contact forces and the FRFs written back out (workflow_projects.prepare_measured_run).
+    Returns (project, snakemake's output)."""
     proj = _wait(pytestconfig, "measured_run")
     return proj, _runs["measured_run"].output()
 
@@ -113,14 +113,6 @@ def lower_confidence_run(pytestconfig):
     (workflow_projects.prepare_lower_confidence_run). Returns (project, snakemake's output)."""
     proj = _wait(pytestconfig, "lower_confidence_run")
     return proj, _runs["lower_confidence_run"].output()
-
-
-@pytest.fixture(scope="session")
-def frf_file_run(pytestconfig):
-    """The small config's linear chain from the small run's FRFs as a UFF58 file (workflow_projects.
-    prepare_frf_file_run). Returns (project, snakemake's output)."""
-    proj = _wait(pytestconfig, "frf_file_run")
-    return proj, _runs["frf_file_run"].output()
 
 
 @pytest.fixture(scope="session")

@@ -131,7 +131,7 @@ def test_gap_runs_on_a_directory_of_raw_files_alone(measured_run):
 def test_imported_uff58_tdms_csv_give_the_same_contact_forces(small_run, measured_run):
     """Each load case's rig record, written as a UFF58 file (accelerations in g), a TDMS file (voltages
     with sensitivities) or a CSV + sidecar YAML and imported by its rule, identifies the same S(t) as the
-    netCDF original (the linear chain redone from the same random test)."""
+    netCDF original (the linear chain redone from the same random test's FRFs, imported from a UFF58 file)."""
     import xarray as xr
 
     proj, out = measured_run
@@ -367,19 +367,18 @@ def test_changed_package_code_reruns_what_it_computed(default_run, tmp_path):
     assert "report_fragments" not in again.stdout
 
 
-def test_chain_on_measured_frfs_identifies_the_time_records_modes(small_run, frf_file_run):
-    """A project whose random test is the small run's FRFs as a UFF58 file (function types 4 and 6;
-    workflow_projects.prepare_frf_file_run): `snakemake results/linear/stiction.nc` runs import_uff58_frf (no rig,
-    no time-record checks), modal and the stiffness fit, and identifies the small run's natural frequencies and
-    damping; the FRFs written back out (frf_measured.uff, frf_synthesised.uff) read back with pyuff on the same
-    lines."""
+def test_chain_on_measured_frfs_identifies_the_time_records_modes(small_run, measured_run):
+    """The measured run's random test is the small run's FRFs as a UFF58 file (function types 4 and 6;
+    workflow_projects.prepare_measured_run): import_uff58_frf (no rig, no time-record checks), modal and the
+    stiffness fit identify the small run's natural frequencies and damping; the FRFs written back out
+    (frf_measured.uff, frf_synthesised.uff) read back with pyuff on the same lines."""
     import xarray as xr
 
     from contactid.linear_chain import complex_frf
     from test_importers import _frf_sets
     from workflow_projects import FRF_FILE_TARGETS
 
-    proj, log = frf_file_run
+    proj, log = measured_run
     out = FRF_FILE_TARGETS[1:]
     frf = xr.load_dataset(small_run / "results/linear/frf.nc", engine="netcdf4")
     assert "import_uff58_frf" in log and "rig_random_test" not in log and "rule frf:" not in log
@@ -396,3 +395,36 @@ def test_chain_on_measured_frfs_identifies_the_time_records_modes(small_run, frf
         np.testing.assert_array_equal(measured[i]["data"], complex_frf(frf)[i])
         np.testing.assert_array_equal(measured[3 + i]["data"], frf["coherence"].values[i])
         np.testing.assert_array_equal(synthesised[i]["x"], frf["frequency"].values)
+
+
+def test_no_table_cell_prints_more_digits_than_its_interval_supports(default_run):
+    """Tables 3 and 4 of the acceptance run's report: each identified value prints at most the significant digits
+    its interval supports (contactid.latex.significant_digits; 0 where the value is lost in its interval)."""
+    import re
+
+    import pandas as pd
+
+    from contactid.latex import significant_digits
+
+    def digits(cell: str) -> int:
+        mantissa = re.match(r"\$(-?[0-9.]+)", cell).group(1).lstrip("-")
+        return len(mantissa.replace(".", "").lstrip("0").rstrip("0" if "." not in mantissa else "")) or 0
+
+    for table, value, low, high in (
+        ("table3", "identified_n_per_m", "interval_low_n_per_m", "interval_high_n_per_m"),
+        ("table4", "identified", "interval_low", "interval_high"),
+    ):
+        csv = pd.read_csv(default_run / f"results/tables/{table}.csv").set_index("parameter")
+        rows = [
+            line.split(" & ")
+            for line in (default_run / f"results/report/{table}.tex").read_text().splitlines()
+            if line.count(" & ") >= 3 and "$" in line
+        ]
+        assert len(rows) == len(csv), table
+        for cells in rows:
+            name = cells[0].replace("\\_", "_")
+            r = csv.loc[name]
+            allowed = significant_digits(float(r[value]), float(r[low]), float(r[high]))
+            assert digits(cells[1]) <= max(allowed, 1), f"{table} {name}: {cells[1]} ({allowed} digits supported)"
+            if allowed == 0:
+                assert cells[1] == "$0$", f"{table} {name}: {cells[1]} is lost in its interval"

@@ -303,26 +303,6 @@ FRF_FILE_TARGETS = (
 )
 
 
-def prepare_frf_file_run(d: Path, small_run: Path):
-    """A project on the small config whose random test is the small run's FRFs as a UFF58 file (function types 4
-    and 6, measured/frf.uff): the linear chain from the file, and the FRFs written back out."""
-    import xarray as xr
-
-    from contactid.importers.frf_uff import write_frf_uff58
-    from contactid.linear_chain import complex_frf
-
-    frf = xr.load_dataset(small_run / "results/linear/frf.nc", engine="netcdf4")
-    proj = small_project(d)
-    (proj / "measured").mkdir()
-    block = write_frf_uff58(
-        proj / "measured/frf.uff", frf["frequency"].values, complex_frf(frf), frf["sensor"].values, frf["coherence"]
-    )
-    cfg = project_config(proj)
-    cfg["random_test"] = {**block, "file": "measured/frf.uff"}
-    (proj / "config/config.yaml").write_text(yaml.safe_dump(cfg))
-    return proj, FRF_FILE_TARGETS
-
-
 NUMBERS = "results/report/numbers.tex"  # the numbers the PDF prints (\\input by paper/report.tex)
 
 
@@ -346,19 +326,25 @@ MEASURED_FORMATS = {
 
 
 def prepare_measured_run(d: Path, small_run: Path):
-    """A project whose every record is a measured file, none from the rig: the small run's random test (netCDF)
-    and its three load cases' records written as a UFF58 file (lc1, accelerations in g), a TDMS file (lc2,
-    voltages with sensitivities) and a CSV + sidecar YAML (lc3); the gap target (one candidate) and every
-    case's contact forces, from these files alone."""
+    """A project whose every record is a measured file, none from the rig: the small run's random test as its FRFs
+    in a UFF58 file (function types 4 and 6, as labs hand them over), and its three load cases' records written as
+    a UFF58 file (lc1, accelerations in g), a TDMS file (lc2, voltages with sensitivities) and a CSV + sidecar YAML
+    (lc3); the gap target (one candidate), every case's contact forces and the FRFs written back out
+    (frf_measured.uff, frf_synthesised.uff), from these files alone."""
     import xarray as xr
 
     from contactid.importers.export import export_record
+    from contactid.importers.frf_uff import write_frf_uff58
+    from contactid.linear_chain import complex_frf
 
     proj = small_project(d, {"gap.candidates": ["viscous_friction"]})
     (proj / "measured").mkdir()
-    shutil.copy2(small_run / "data/raw/random_test.nc", proj / "measured/random_test.nc")
+    frf = xr.load_dataset(small_run / "results/linear/frf.nc", engine="netcdf4")
+    block = write_frf_uff58(
+        proj / "measured/frf.uff", frf["frequency"].values, complex_frf(frf), frf["sensor"].values, frf["coherence"]
+    )
     cfg = project_config(proj)
-    cfg["random_test"] = {**cfg["random_test"], "source": "measured", "file": "measured/random_test.nc"}
+    cfg["random_test"] = {**block, "file": "measured/frf.uff"}
     cfg["load_cases"] = {}
     for case, (fmt, storage) in MEASURED_FORMATS.items():
         raw = xr.load_dataset(small_run / f"data/raw/{case}.nc", engine="netcdf4")
@@ -366,4 +352,4 @@ def prepare_measured_run(d: Path, small_run: Path):
         block["file"] = f"measured/{case}.{fmt}"
         cfg["load_cases"][case] = block
     (proj / "config" / "config.yaml").write_text(yaml.safe_dump(cfg))
-    return proj, ("gap", *[f"results/{c}/contact_forces.nc" for c in MEASURED_FORMATS])
+    return proj, ("gap", *[f"results/{c}/contact_forces.nc" for c in MEASURED_FORMATS], *FRF_FILE_TARGETS[1:])

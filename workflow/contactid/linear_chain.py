@@ -236,8 +236,9 @@ def stiction_dataset(modal: xr.Dataset, structure_cfg: Mapping, stiction_cfg: Ma
     """k_t and k_n of Eq. (13) fitted to the identified frequencies, with
     confidence intervals and the profile misfits."""
     f_id = modal["natural_frequency"].values
-    stat = np.nan_to_num(modal["natural_frequency_std"].values, nan=0.0)
-    sigma = frequency_sigma(f_id, stat, float(stiction_cfg["frequency_uncertainty_floor"]))
+    sigma = frequency_sigma(
+        f_id, modal["natural_frequency_std"].values, float(stiction_cfg["frequency_uncertainty_floor"])
+    )
     params = structure_from_config(structure_cfg, 1e7, 1e8)
     fit = stiction_stiffness(
         params,

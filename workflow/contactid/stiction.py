@@ -48,8 +48,10 @@ class StiffnessFit:
 
 def frequency_sigma(freqs_hz: np.ndarray, stat_sigma_hz: np.ndarray, relative_floor: float) -> np.ndarray:
     """Standard uncertainty of each identified frequency (Hz): the statistical
-    part combined with a relative floor for model and estimator bias."""
-    return np.sqrt(np.asarray(stat_sigma_hz) ** 2 + (relative_floor * np.asarray(freqs_hz)) ** 2)
+    part combined with a relative floor for model and estimator bias. A frequency without a statistical
+    estimate (NaN: an imported FRF has no sub-records to compare) has the floor alone."""
+    stat = np.nan_to_num(np.asarray(stat_sigma_hz, dtype=float), nan=0.0)
+    return np.sqrt(stat**2 + (relative_floor * np.asarray(freqs_hz)) ** 2)
 
 
 def _residuals(fmap: ContactFrequencyMap, f_id, sigma, log_kt, log_kn):
