@@ -2,12 +2,10 @@
 
 import json
 
-from contactid.friction_fit import settings_from_config
 from contactid.gap.diagnosis import GapSettings
-from contactid.gap.pipeline import diagnosed_model
-from contactid.gap.records import record_harmonics
+from contactid.gap.pipeline import workflow_models
 from contactid.gap.uncertainty import friction_uncertainty
-from contactid.io import load_dataset, read_raw, write_text
+from contactid.io import write_text
 from contactid.logs import setup_logging
 
 log = setup_logging(snakemake.log[0])
@@ -15,21 +13,8 @@ p = snakemake.params
 inp = snakemake.input
 K = int(p.n_harmonics)
 settings = GapSettings.from_config(p.gap, int(p.seed), K)
-modal = load_dataset(inp.modal)
-records = {c: record_harmonics(read_raw(path, dual_sine=True), c, K) for c, path in zip(p.cases, inp.raw)}
-fit_settings = settings_from_config(p.friction)
-with open(inp.updating) as fh:
-    upd_summary = json.load(fh)
-_, model, upd = diagnosed_model(
-    p.structure,
-    load_dataset(inp.modes),
-    modal,
-    load_dataset(inp.fit),
-    records[p.calibration_case],
-    upd_summary,
-    fit_settings,
-    settings,
-    int(p.seed),
+records, fit_settings, modal, _, model, upd = workflow_models(
+    p.structure, inp, p.cases, p.calibration_case, K, p.friction, settings, int(p.seed)
 )
 unc = friction_uncertainty(
     model, records, p.calibration_case, fit_settings, int(p.seed), upd.posterior_structures() if upd is not None else ()

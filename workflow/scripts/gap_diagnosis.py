@@ -1,15 +1,12 @@
 """Rule gap_diagnosis: the identified model against every load case's raw record (issue 7)."""
 
-import json
 import time
 
-from contactid.friction_fit import settings_from_config
 from contactid.gap.candidates import load_plugins
 from contactid.gap.diagnosis import GapSettings, diagnose, linear_stage, prepare_workers
-from contactid.gap.pipeline import diagnosed_model
+from contactid.gap.pipeline import workflow_models
 from contactid.gap.output import diagnosis_json, gap_dataset
-from contactid.gap.records import record_harmonics
-from contactid.io import load_dataset, provenance, read_raw, write_dataset, write_text
+from contactid.io import load_dataset, provenance, write_dataset, write_text
 from contactid.logs import setup_logging
 
 log = setup_logging(snakemake.log[0])
@@ -21,21 +18,8 @@ K = int(p.n_harmonics)
 settings = GapSettings.from_config(p.gap, int(p.seed), K)
 workers = int(snakemake.resources.workers)
 prepare_workers(workers)  # before the friction fit after updating starts numba's threads
-modal = load_dataset(inp.modal)
-records = {c: record_harmonics(read_raw(path, dual_sine=True), c, K) for c, path in zip(p.cases, inp.raw)}
-fit_settings = settings_from_config(p.friction)
-with open(inp.updating) as fh:
-    upd_summary = json.load(fh)
-chain_model, model, updating = diagnosed_model(
-    p.structure,
-    load_dataset(inp.modes),
-    modal,
-    load_dataset(inp.fit),
-    records[p.calibration_case],
-    upd_summary,
-    fit_settings,
-    settings,
-    int(p.seed),
+records, fit_settings, modal, chain_model, model, updating = workflow_models(
+    p.structure, inp, p.cases, p.calibration_case, K, p.friction, settings, int(p.seed)
 )
 linear = linear_stage(model, load_dataset(inp.frf), modal)
 diag = diagnose(

@@ -109,6 +109,45 @@ def structure_update(structure, modal: xr.Dataset, settings):
     )
 
 
+def workflow_models(
+    structure_cfg: Mapping,
+    inputs,
+    cases,
+    calibration_case: str,
+    n_harmonics: int,
+    friction_cfg: Mapping,
+    settings,
+    seed: int,
+):
+    """What the gap's rules (gap_diagnosis, friction_intervals) read from the workflow's files: ``inputs`` names
+    modes, modal, fit, updating (model_updating.json) and raw (the load cases' records, in the order of
+    ``cases``). Returns (the records' harmonics (``n_harmonics``) by case, the friction fit's settings, modal.nc,
+    and ``diagnosed_model``'s chain model, model to diagnose and UpdatingResult or None)."""
+    import json
+
+    from ..io import load_dataset, read_raw
+
+    modal = load_dataset(inputs.modal)
+    records = {
+        c: record_harmonics(read_raw(path, dual_sine=True), c, n_harmonics) for c, path in zip(cases, inputs.raw)
+    }
+    fit_settings = settings_from_config(friction_cfg)
+    with open(inputs.updating) as fh:
+        upd_summary = json.load(fh)
+    chain, model, upd = diagnosed_model(
+        structure_cfg,
+        load_dataset(inputs.modes),
+        modal,
+        load_dataset(inputs.fit),
+        records[calibration_case],
+        upd_summary,
+        fit_settings,
+        settings,
+        seed,
+    )
+    return records, fit_settings, modal, chain, model, upd
+
+
 def diagnosed_model(
     structure_cfg: Mapping,
     modes: xr.Dataset,
