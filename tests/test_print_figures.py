@@ -2,9 +2,9 @@
 (issue 17): the figures are drawn from small synthetic datasets and caught before they are written."""
 
 import re
+import warnings
 from pathlib import Path
 
-import matplotlib
 import numpy as np
 import pytest
 import xarray as xr
@@ -129,19 +129,44 @@ def _draw_all(truth: bool = True):
     plot_friction_figures(fit, {c: val for c in ("lc1", "lc2", "lc3")}, None, paths)
 
 
-def test_every_report_figure_is_drawn_at_its_printed_width_with_8pt_text(caught):
+def assert_print_rule(fig, name: str, width_in: float) -> None:
+    """``fig`` is drawn at ``width_in`` and no text renders under MIN_FONT_PT on paper: mathtext sub- and
+    superscripts (70 % of the font size) count at their rendered size (print_style.rendered_sizes_pt)."""
+    assert fig.get_size_inches()[0] == pytest.approx(width_in, abs=1e-6), name
+    small = [(text, size) for size, text in ps.rendered_sizes_pt(fig) if size < ps.MIN_FONT_PT]
+    assert not small, f"{name}: text rendered under {ps.MIN_FONT_PT} pt: {small}"
+
+
+@pytest.fixture
+def no_missing_glyphs():
+    """Fails the test when the font lacks a glyph the figures draw (the Unicode sub- and superscripts)."""
+    with warnings.catch_warnings(record=True) as caught_warnings:
+        warnings.simplefilter("always")
+        yield
+    missing = [str(w.message) for w in caught_warnings if "missing from" in str(w.message)]
+    assert not missing, missing
+
+
+def test_every_report_figure_is_drawn_at_its_printed_width_with_8pt_text(caught, no_missing_glyphs):
     widths = printed_widths_in()
     assert set(FIGURES) <= set(widths), "report.tex includes each figure at an explicit fraction of \\textwidth"
     _draw_all()
     for name in FIGURES:
-        fig = caught[name]
-        assert fig.get_size_inches()[0] == pytest.approx(widths[name], abs=1e-6), name
-        small = [
-            (t.get_text(), t.get_fontsize())
-            for t in fig.findobj(matplotlib.text.Text)
-            if t.get_visible() and t.get_text().strip() and t.get_fontsize() < ps.MIN_FONT_PT
-        ]
-        assert not small, f"{name}: text under {ps.MIN_FONT_PT} pt: {small}"
+        assert_print_rule(caught[name], name, widths[name])
+
+
+def test_the_rendered_size_counts_mathtext_subscripts_at_70_percent():
+    """The check above would catch a label like the old Fig. 5's 'd$_p$ (m s$^{-2}$)': 5.6 pt at 8 pt."""
+    plt = ps.pyplot()
+    with plt.rc_context(ps.STYLE):
+        fig, ax = plt.subplots(figsize=(ps.TEXT_WIDTH_IN, 2))
+        ax.set_ylabel("acceleration at d$_p$ (m s$^{-2}$)")
+        ax.set_xlabel("acceleration at " + "d" + ps.sub("p") + " (m s" + ps.sup("-2") + ")")
+        fig.canvas.draw()
+    sizes = dict((text, size) for size, text in ps.rendered_sizes_pt(fig))
+    plt.close(fig)
+    assert sizes["acceleration at d$_p$ (m s$^{-2}$)"] == pytest.approx(5.6)
+    assert sizes["acceleration at dₚ (m s⁻²)"] == 8.0
 
 
 def test_fig06_limits_come_from_the_working_method_also_without_truth(caught):
@@ -160,7 +185,7 @@ def test_fig06_limits_come_from_the_working_method_also_without_truth(caught):
     assert [t.get_text() for t in legend.get_texts()] == ["working method", "paper's chain"]
 
 
-def test_the_noise_study_figure_is_drawn_at_the_width_its_section_includes_it(caught):
+def test_the_noise_study_figure_is_drawn_at_the_width_its_section_includes_it(caught, no_missing_glyphs):
     """The noise study's figure (in the report when noise_study.in_report) at the text width, text >= 8 pt."""
     noise, lengths, seeds = np.array([0.001, 0.003, 0.01, 0.03]), np.array([4096, 16384]), np.arange(3)
     rng = np.random.default_rng(0)
@@ -174,6 +199,4 @@ def test_the_noise_study_figure_is_drawn_at_the_width_its_section_includes_it(ca
     )
     assert "\\includegraphics[width=\\textwidth]{noise_study.pdf}" in report_section(ds)
     plot_noise_study(ds, 0.003, "noise_study.png", "noise_study.pdf")
-    fig = caught["noise_study"]
-    assert fig.get_size_inches()[0] == pytest.approx(ps.TEXT_WIDTH_IN, abs=1e-6)
-    assert min(t.get_fontsize() for t in fig.findobj(matplotlib.text.Text) if t.get_text().strip()) >= 8
+    assert_print_rule(caught["noise_study"], "noise_study", ps.TEXT_WIDTH_IN)
