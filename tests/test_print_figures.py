@@ -200,3 +200,123 @@ def test_the_noise_study_figure_is_drawn_at_the_width_its_section_includes_it(ca
     assert "\\includegraphics[width=\\textwidth]{noise_study.pdf}" in report_section(ds)
     plot_noise_study(ds, 0.003, "noise_study.png", "noise_study.pdf")
     assert_print_rule(caught["noise_study"], "noise_study", ps.TEXT_WIDTH_IN)
+
+
+def _gap_diagnosis() -> dict:
+    """A diagnosis with a candidate that shrinks the gap, two that do not move it (one ends above 'before', as
+    zero-effect refits do by the bootstrap's noise), one diverged, and a zero stage value."""
+    row = {"n_parameters": 1, "heldout_gap_before": 0.0025, "score": 1.0, "reduction": None, "parameters": {}}
+    rows = [
+        {
+            **row,
+            "effect": "contact_separation",
+            "heldout_gap_after": 0.00175,
+            "heldout_gap_after_interval": [0.0017, 0.0018],
+        },
+        {
+            **row,
+            "effect": "structural_damping",
+            "heldout_gap_after": 0.00256,
+            "heldout_gap_after_interval": [0.0025, 0.0026],
+        },
+        {
+            **row,
+            "effect": "viscous_friction",
+            "heldout_gap_after": 0.0025,
+            "heldout_gap_after_interval": [0.0025, 0.0025],
+        },
+        {**row, "effect": "preload_drift", "heldout_gap_after": None, "heldout_gap_after_interval": [None, None]},
+    ]
+    stage = {"accelerations": 0.0023, "identification_residual": 2.8e-5, "open_fraction": 0.0, "contact_force_N": 0.1}
+    by_case = {
+        c: {"before": 0.0025, "before_interval": [0.0024, 0.0026], "after": 0.0018, "after_interval": [0.0017, 0.0019]}
+        for c in ("lc2", "lc3")
+    }
+    harm = {"before": [0.001, 1e-4, 0.001], "after": [0.0009, 1e-4, 0.0008]}
+    return {
+        "verdict": "none",
+        "ranking": rows,
+        "where": {
+            "stage": stage,
+            "heldout_gap_before": 0.0025,
+            "record_scatter": 2.9e-5,
+            "identification_noise": {"lc1": 9e-6, "lc2": 8e-6, "lc3": 6e-6},
+            "place": "contact",
+        },
+        "explanation": [],
+        "remaining_gap": {"heldout_gap": 0.0025, "share": 1.0, "floor": 0.006, "at_floor": True, "place": "contact"},
+        "shrink": {
+            "winner": {"effect": "contact_separation", "by_case": by_case, "by_harmonic": harm},
+            "runner_up": {"effect": "structural_damping", "by_case": by_case, "by_harmonic": harm},
+        },
+    }
+
+
+def test_the_gap_figures_the_report_includes_meet_the_print_rule(caught, no_missing_glyphs):
+    """The gap section includes its four figures as PDFs at the text width they are drawn at, text >= 8 pt."""
+    from contactid.gap import figures
+    from contactid.gap.report import gap_section
+
+    diag = _gap_diagnosis()
+    tex = gap_section({**diag, "calibration_case": "lc1", "reason": "r"} | {"where": _where_for_text(diag)}, None)
+    found = dict(
+        (name, frac)
+        for frac, name in re.findall(r"\\includegraphics\[width=([0-9.]*)\\textwidth\]\{(gap_\w+)\.pdf\}", tex)
+    )
+    assert set(found) == {f"gap_{v}" for v in figures.IN_REPORT} and set(found.values()) == {""}
+    assert not re.search(r"\\includegraphics\[[^]]*\]\{[^}]*\.png\}", tex)  # no PNG scaled into the page
+    for view in figures.IN_REPORT:
+        getattr(figures, view)(diag, f"gap_{view}.png", f"gap_{view}.pdf")
+        assert_print_rule(caught[f"gap_{view}"], view, ps.TEXT_WIDTH_IN)
+
+
+def _where_for_text(diag: dict) -> dict:
+    """The 'where' block with what the section's text reads besides the figures."""
+    stage = {k: 0.001 for k in ("generalized_coordinates", "contact_force_S", "energy_tangential")}
+    return {
+        **diag["where"],
+        "stage": {**stage, **diag["where"]["stage"]},
+        "heldout_gap_before_interval": [0.0024, 0.0026],
+        "by_harmonic": {1: 0.001},
+        "worst_sensor": "a1",
+        "worst_harmonic": 1,
+        "even_share": 0.1,
+        "worst_cycle_part": "slip",
+        "place_reason": "eta not observable",
+    }
+
+
+def test_the_ranking_clips_a_candidate_without_effect_at_before_and_draws_min_gap_and_the_scatter(caught):
+    """Read back from the Axes: a candidate whose held-out gap after is at or above before ends at before,
+    labelled no effect; the effective one ends at its own gap; the lines sit at the diagnosis' values (%)."""
+    from matplotlib.patches import Rectangle
+
+    from contactid.gap import figures
+
+    figures.ranking(_gap_diagnosis(), "gap_ranking.png")
+    ax = caught["gap_ranking"].axes[0]
+    ends = {r.get_gid()[4:]: r.get_width() for r in ax.findobj(Rectangle) if (r.get_gid() or "").startswith("bar:")}
+    assert ends == pytest.approx({"contact_separation": 0.175, "structural_damping": 0.25, "viscous_friction": 0.25})
+    marked = {t.get_gid()[10:] for t in ax.texts if t.get_text() == "no effect"}
+    assert marked == {"structural_damping", "viscous_friction"}
+    assert any(t.get_text() == "prediction diverged" for t in ax.texts)
+    lines = {line.get_label().split(":")[0]: line.get_xdata()[0] for line in ax.get_lines()}
+    assert lines["before (identified model)"] == pytest.approx(0.25)
+    assert lines["gap.min_gap"] == pytest.approx(0.6)
+    assert lines["records' scatter"] == pytest.approx(0.0029)
+    assert ax.get_xlim()[1] >= 0.6  # min_gap in view, which explains the verdict none
+
+
+def test_the_stage_figure_has_readable_labels_thresholds_and_a_visible_zero(caught):
+    from contactid.gap import figures
+
+    figures.stages(_gap_diagnosis(), "gap_stages.png")
+    ax = caught["gap_stages"].axes[0]
+    labels = [t.get_text() for t in ax.get_yticklabels()]
+    assert "contact force N (elastic normal law)" in labels and not any("_" in lab for lab in labels)
+    marks = {line.get_gid(): line.get_xdata()[0] for line in ax.get_lines() if line.get_gid()}
+    assert marks == pytest.approx(
+        {"threshold:heldout": 0.6, "threshold:contact_force_N": 25.0, "threshold:identification_residual": 20 * 8e-4}
+    )
+    assert [t.get_gid() for t in ax.texts if t.get_text() == "0" and t.get_gid()] == ["zero:open_fraction"]
+    assert [t.get_text() for t in ax.texts if t.get_text().startswith("10 %")] == ["10 %  (normal_limit: 25 %)"]
