@@ -345,7 +345,7 @@ def test_every_figure_and_the_report_section_for_any_diagnosis(tmp_path, steps, 
         getattr(figures, view)(diag, str(path))
         assert path.stat().st_size > 1000
     text = gap_section(diag, None)
-    assert "Step by step" in text and "gap_explanation.png" in text
+    assert "Step by step" in text and "{gap_explanation.pdf}" in text
     if steps:
         assert (
             "normal\\_contact\\_damping" in text

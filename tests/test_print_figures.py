@@ -2,9 +2,9 @@
 (issue 17): the figures are drawn from small synthetic datasets and caught before they are written."""
 
 import re
+import warnings
 from pathlib import Path
 
-import matplotlib
 import numpy as np
 import pytest
 import xarray as xr
@@ -129,19 +129,44 @@ def _draw_all(truth: bool = True):
     plot_friction_figures(fit, {c: val for c in ("lc1", "lc2", "lc3")}, None, paths)
 
 
-def test_every_report_figure_is_drawn_at_its_printed_width_with_8pt_text(caught):
+def assert_print_rule(fig, name: str, width_in: float) -> None:
+    """``fig`` is drawn at ``width_in`` and no text renders under MIN_FONT_PT on paper: mathtext sub- and
+    superscripts (70 % of the font size) count at their rendered size (print_style.rendered_sizes_pt)."""
+    assert fig.get_size_inches()[0] == pytest.approx(width_in, abs=1e-6), name
+    small = [(text, size) for size, text in ps.rendered_sizes_pt(fig) if size < ps.MIN_FONT_PT]
+    assert not small, f"{name}: text rendered under {ps.MIN_FONT_PT} pt: {small}"
+
+
+@pytest.fixture
+def no_missing_glyphs():
+    """Fails the test when the font lacks a glyph the figures draw (the Unicode sub- and superscripts)."""
+    with warnings.catch_warnings(record=True) as caught_warnings:
+        warnings.simplefilter("always")
+        yield
+    missing = [str(w.message) for w in caught_warnings if "missing from" in str(w.message)]
+    assert not missing, missing
+
+
+def test_every_report_figure_is_drawn_at_its_printed_width_with_8pt_text(caught, no_missing_glyphs):
     widths = printed_widths_in()
     assert set(FIGURES) <= set(widths), "report.tex includes each figure at an explicit fraction of \\textwidth"
     _draw_all()
     for name in FIGURES:
-        fig = caught[name]
-        assert fig.get_size_inches()[0] == pytest.approx(widths[name], abs=1e-6), name
-        small = [
-            (t.get_text(), t.get_fontsize())
-            for t in fig.findobj(matplotlib.text.Text)
-            if t.get_visible() and t.get_text().strip() and t.get_fontsize() < ps.MIN_FONT_PT
-        ]
-        assert not small, f"{name}: text under {ps.MIN_FONT_PT} pt: {small}"
+        assert_print_rule(caught[name], name, widths[name])
+
+
+def test_the_rendered_size_counts_mathtext_subscripts_at_70_percent():
+    """The check above would catch a label like the old Fig. 5's 'd$_p$ (m s$^{-2}$)': 5.6 pt at 8 pt."""
+    plt = ps.pyplot()
+    with plt.rc_context(ps.STYLE):
+        fig, ax = plt.subplots(figsize=(ps.TEXT_WIDTH_IN, 2))
+        ax.set_ylabel("acceleration at d$_p$ (m s$^{-2}$)")
+        ax.set_xlabel("acceleration at " + "d" + ps.sub("p") + " (m s" + ps.sup("-2") + ")")
+        fig.canvas.draw()
+    sizes = dict((text, size) for size, text in ps.rendered_sizes_pt(fig))
+    plt.close(fig)
+    assert sizes["acceleration at d$_p$ (m s$^{-2}$)"] == pytest.approx(5.6)
+    assert sizes["acceleration at dₚ (m s⁻²)"] == 8.0
 
 
 def test_fig06_limits_come_from_the_working_method_also_without_truth(caught):
@@ -160,7 +185,7 @@ def test_fig06_limits_come_from_the_working_method_also_without_truth(caught):
     assert [t.get_text() for t in legend.get_texts()] == ["working method", "paper's chain"]
 
 
-def test_the_noise_study_figure_is_drawn_at_the_width_its_section_includes_it(caught):
+def test_the_noise_study_figure_is_drawn_at_the_width_its_section_includes_it(caught, no_missing_glyphs):
     """The noise study's figure (in the report when noise_study.in_report) at the text width, text >= 8 pt."""
     noise, lengths, seeds = np.array([0.001, 0.003, 0.01, 0.03]), np.array([4096, 16384]), np.arange(3)
     rng = np.random.default_rng(0)
@@ -174,6 +199,124 @@ def test_the_noise_study_figure_is_drawn_at_the_width_its_section_includes_it(ca
     )
     assert "\\includegraphics[width=\\textwidth]{noise_study.pdf}" in report_section(ds)
     plot_noise_study(ds, 0.003, "noise_study.png", "noise_study.pdf")
-    fig = caught["noise_study"]
-    assert fig.get_size_inches()[0] == pytest.approx(ps.TEXT_WIDTH_IN, abs=1e-6)
-    assert min(t.get_fontsize() for t in fig.findobj(matplotlib.text.Text) if t.get_text().strip()) >= 8
+    assert_print_rule(caught["noise_study"], "noise_study", ps.TEXT_WIDTH_IN)
+
+
+def _gap_diagnosis() -> dict:
+    """A diagnosis with a candidate that shrinks the gap, two that do not move it (one ends above 'before', as
+    zero-effect refits do by the bootstrap's noise), one diverged, and a zero stage value."""
+    row = {"n_parameters": 1, "heldout_gap_before": 0.0025, "score": 1.0, "reduction": None, "parameters": {}}
+    rows = [
+        {
+            **row,
+            "effect": "contact_separation",
+            "heldout_gap_after": 0.00175,
+            "heldout_gap_after_interval": [0.0017, 0.0018],
+        },
+        {
+            **row,
+            "effect": "structural_damping",
+            "heldout_gap_after": 0.00256,
+            "heldout_gap_after_interval": [0.0025, 0.0026],
+        },
+        {
+            **row,
+            "effect": "viscous_friction",
+            "heldout_gap_after": 0.0025,
+            "heldout_gap_after_interval": [0.0025, 0.0025],
+        },
+        {**row, "effect": "preload_drift", "heldout_gap_after": None, "heldout_gap_after_interval": [None, None]},
+    ]
+    stage = {"accelerations": 0.0023, "identification_residual": 2.8e-5, "open_fraction": 0.0, "contact_force_N": 0.1}
+    by_case = {
+        c: {"before": 0.0025, "before_interval": [0.0024, 0.0026], "after": 0.0018, "after_interval": [0.0017, 0.0019]}
+        for c in ("lc2", "lc3")
+    }
+    harm = {"before": [0.001, 1e-4, 0.001], "after": [0.0009, 1e-4, 0.0008]}
+    return {
+        "verdict": "none",
+        "ranking": rows,
+        "where": {
+            "stage": stage,
+            "heldout_gap_before": 0.0025,
+            "record_scatter": 2.9e-5,
+            "identification_noise": {"lc1": 9e-6, "lc2": 8e-6, "lc3": 6e-6},
+            "place": "contact",
+        },
+        "explanation": [],
+        "remaining_gap": {"heldout_gap": 0.0025, "share": 1.0, "floor": 0.006, "at_floor": True, "place": "contact"},
+        "shrink": {
+            "winner": {"effect": "contact_separation", "by_case": by_case, "by_harmonic": harm},
+            "runner_up": {"effect": "structural_damping", "by_case": by_case, "by_harmonic": harm},
+        },
+    }
+
+
+def test_the_gap_figures_the_report_includes_meet_the_print_rule(caught, no_missing_glyphs):
+    """The gap section includes its four figures as PDFs at the text width they are drawn at, text >= 8 pt."""
+    from contactid.gap import figures
+    from contactid.gap.report import gap_section
+
+    diag = _gap_diagnosis()
+    tex = gap_section({**diag, "calibration_case": "lc1", "reason": "r"} | {"where": _where_for_text(diag)}, None)
+    found = dict(
+        (name, frac)
+        for frac, name in re.findall(r"\\includegraphics\[width=([0-9.]*)\\textwidth\]\{(gap_\w+)\.pdf\}", tex)
+    )
+    assert set(found) == {f"gap_{v}" for v in figures.IN_REPORT} and set(found.values()) == {""}
+    assert not re.search(r"\\includegraphics\[[^]]*\]\{[^}]*\.png\}", tex)  # no PNG scaled into the page
+    for view in figures.IN_REPORT:
+        getattr(figures, view)(diag, f"gap_{view}.png", f"gap_{view}.pdf")
+        assert_print_rule(caught[f"gap_{view}"], view, ps.TEXT_WIDTH_IN)
+
+
+def _where_for_text(diag: dict) -> dict:
+    """The 'where' block with what the section's text reads besides the figures."""
+    stage = {k: 0.001 for k in ("generalized_coordinates", "contact_force_S", "energy_tangential")}
+    return {
+        **diag["where"],
+        "stage": {**stage, **diag["where"]["stage"]},
+        "heldout_gap_before_interval": [0.0024, 0.0026],
+        "by_harmonic": {1: 0.001},
+        "worst_sensor": "a1",
+        "worst_harmonic": 1,
+        "even_share": 0.1,
+        "worst_cycle_part": "slip",
+        "place_reason": "eta not observable",
+    }
+
+
+def test_the_ranking_clips_a_candidate_without_effect_at_before_and_draws_min_gap_and_the_scatter(caught):
+    """Read back from the Axes: a candidate whose held-out gap after is at or above before ends at before,
+    labelled no effect; the effective one ends at its own gap; the lines sit at the diagnosis' values (%)."""
+    from matplotlib.patches import Rectangle
+
+    from contactid.gap import figures
+
+    figures.ranking(_gap_diagnosis(), "gap_ranking.png")
+    ax = caught["gap_ranking"].axes[0]
+    ends = {r.get_gid()[4:]: r.get_width() for r in ax.findobj(Rectangle) if (r.get_gid() or "").startswith("bar:")}
+    assert ends == pytest.approx({"contact_separation": 0.175, "structural_damping": 0.25, "viscous_friction": 0.25})
+    marked = {t.get_gid()[10:] for t in ax.texts if t.get_text() == "no effect"}
+    assert marked == {"structural_damping", "viscous_friction"}
+    assert any(t.get_text() == "prediction diverged" for t in ax.texts)
+    lines = {line.get_label().split(":")[0]: line.get_xdata()[0] for line in ax.get_lines()}
+    assert lines["before (identified model)"] == pytest.approx(0.25)
+    assert lines["gap.min_gap"] == pytest.approx(0.6)
+    assert lines["records' scatter"] == pytest.approx(0.0029)
+    assert ax.get_xlim()[1] >= 0.6  # min_gap in view, which explains the verdict none
+
+
+def test_the_stage_figure_has_readable_labels_thresholds_and_a_visible_zero(caught):
+    from contactid.gap import figures
+
+    figures.stages(_gap_diagnosis(), "gap_stages.png")
+    ax = caught["gap_stages"].axes[0]
+    labels = [t.get_text() for t in ax.get_yticklabels()]
+    assert "contact force N (elastic normal law)" in labels and not any("_" in lab for lab in labels)
+    marks = {line.get_gid(): line.get_xdata()[0] for line in ax.get_lines() if line.get_gid()}
+    assert marks == pytest.approx(
+        {"threshold:heldout": 0.6, "threshold:contact_force_N": 25.0, "threshold:identification_residual": 20 * 8e-4}
+    )
+    assert [t.get_gid() for t in ax.texts if t.get_text() == "0" and t.get_gid()] == ["zero:open_fraction"]
+    assert [t.get_text() for t in ax.texts if t.get_text().startswith("10 %")] == ["10 %  (normal_limit: 25 %)"]

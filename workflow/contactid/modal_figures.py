@@ -12,14 +12,6 @@ from .frf_synthesis import synthesised_accelerance
 from .modal_fit import StabilityPoles, stability_poles
 
 
-def _plain_log_ticks(ax) -> None:
-    """Log-axis tick labels as plain numbers (0.01, 1, 100) at full size, not powers of ten with small exponents."""
-    from matplotlib.ticker import FuncFormatter, NullFormatter
-
-    ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
-    ax.yaxis.set_minor_formatter(NullFormatter())
-
-
 def _band(modal: xr.Dataset) -> tuple[float, float]:
     return float(modal.attrs["band_low_hz"]), float(modal.attrs["band_high_hz"])
 
@@ -86,8 +78,8 @@ def plot_fig03(frf: xr.Dataset, modal: xr.Dataset, png: str, pdf: str, f_max_hz:
     _mode_labels(ax, modal)
     lo, hi = ax.get_ylim()
     ax.set_ylim(lo, hi * 30)  # room for the mode labels above the peaks
-    _plain_log_ticks(ax)
-    ax.set_ylabel("|accelerance| (m s$^{-2}$/N)")
+    ps.plain_log_ticks(ax.yaxis)
+    ax.set_ylabel("|accelerance| (m s⁻²/N)")
     ax.legend(loc="lower right", ncol=3)
     axp.set_ylim(-180, 180)
     axp.set_yticks([-180, -90, 0, 90, 180])
@@ -139,8 +131,8 @@ def plot_stability(frf: xr.Dataset, modal: xr.Dataset, png: str, pdf: str, min_o
     axh = ax.twinx()
     sel = (f >= band[0]) & (f <= band[1])
     axh.semilogy(f[sel], np.abs(H[:, sel]).sum(axis=0), color="0.6", lw=0.7, label="summed |H| (right axis)")
-    _plain_log_ticks(axh)
-    axh.set_ylabel("summed |accelerance| (m s$^{-2}$/N)")
+    ps.plain_log_ticks(axh.yaxis)
+    axh.set_ylabel("summed |accelerance| (m s⁻²/N)")
     ax.set_zorder(axh.get_zorder() + 1)
     ax.patch.set_visible(False)
     for mask, marker, colour, size, label in _categories(sp):

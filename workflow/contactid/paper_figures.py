@@ -26,9 +26,9 @@ def plot_fig04(gc: xr.Dataset, case: str, png: str, pdf: str) -> None:
     sel = _periods(t, gc.attrs["excitation_frequency_hz"])
     fig, ax = plt.subplots(figsize=(ps.NARROW_WIDTH_IN, 2.9))
     for i, m in enumerate(gc["mode"].values):
-        ax.plot(1e3 * t[sel], 1e3 * gc["p"].values[i, sel], lw=1.0, label=f"p$_{m}$")
+        ax.plot(1e3 * t[sel], 1e3 * gc["p"].values[i, sel], lw=1.0, label=f"p{ps.sub(m)}")
     ax.set_xlabel("time (ms)")
-    ax.set_ylabel("p$_i$ (10$^{-3}$ kg$^{1/2}$ m)")
+    ax.set_ylabel("pᵢ (10⁻³ kg¹ᐟ² m)")
     ax.set_title(f"Generalized coordinates of the linear modes, {case}")
     ax.legend(ncol=3, loc="upper right")
     lo, hi = ax.get_ylim()
@@ -57,7 +57,7 @@ def plot_fig05(nnm: xr.Dataset, case: str, png: str, pdf: str) -> None:
         label=f"from the NNMs (NRMSE {100 * nnm.attrs['reconstruction_nrmse']:.1f} %)",
     )
     ax.set_xlabel("time (ms)")
-    ax.set_ylabel("acceleration at d$_p$ (m s$^{-2}$)")
+    ax.set_ylabel("acceleration at dₚ (m s⁻²)")
     ax.set_title(f"Driving-point acceleration, {case}")
     lo, hi = ax.get_ylim()
     ax.set_ylim(lo, hi + 0.35 * (hi - lo))  # room for the legend above the signal
@@ -68,7 +68,7 @@ def plot_fig05(nnm: xr.Dataset, case: str, png: str, pdf: str) -> None:
 
 
 # Fig. 6's loops: force, motion, x label, y label
-_LOOPS = (("S", "xi", r"$\xi$ ($\mu$m)", "S (N)"), ("N_dyn", "eta", r"$\eta$ ($\mu$m)", r"N $-$ N$_0$ (N)"))
+_LOOPS = (("S", "xi", r"$\xi$ ($\mu$m)", "S (N)"), ("N_dyn", "eta", r"$\eta$ ($\mu$m)", "N − N₀ (N)"))
 
 
 def _limits(values: np.ndarray, pad: float = 0.08) -> tuple[float, float]:
@@ -135,7 +135,7 @@ def _fig07(fit: xr.Dataset, validations: Mapping[str, xr.Dataset], truth_frictio
     for k, (case, v) in enumerate(validations.items()):
         ax.axvspan(v["N"].values.min(), v["N"].values.max(), color=f"C{k + 2}", alpha=0.15, label=f"N range, {case}")
     ax.set_xlabel("normal force N (N)")
-    ax.set_ylabel("e$_0$ (10$^6$ N/m)")
+    ax.set_ylabel("e₀ (10⁶ N/m)")
     ax.set_title("Contact shear stiffness at stiction, Eq. 22")
     ax.legend()
     ax.grid(alpha=0.3)
@@ -171,6 +171,7 @@ def _convergence(fit: xr.Dataset, png: str) -> None:
     fig, ax = plt.subplots(figsize=(ps.NARROW_WIDTH_IN, 2.8))
     ax.semilogy(fit["generation"].values, fit["ga_best"].values, label="best")
     ax.semilogy(fit["generation"].values, fit["ga_mean"].values, label="mean")
+    ps.plain_log_ticks(ax.yaxis)
     ax.axhline(fit.attrs["misfit_nrmse"], color="0.4", ls="--", label="after polish")
     ax.set_xlabel("generation")
     ax.set_ylabel("misfit (NRMSE of S)")

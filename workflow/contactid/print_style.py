@@ -9,6 +9,7 @@ either at the text width or at ``NARROW_FRACTION`` of it, and report.tex include
 from __future__ import annotations
 
 import functools
+import math
 
 TEXT_WIDTH_IN = (210.0 - 2 * 22.0) / 25.4  # 6.535 in: A4 less the report's 2.2 cm margins
 NARROW_FRACTION = 0.65
@@ -58,3 +59,62 @@ def save(fig, png: str, pdf: str | None = None) -> None:
     if pdf:
         fig.savefig(pdf)
     pyplot().close(fig)
+
+
+# Sub- and superscripts as Unicode characters drawn at the text's full size: mathtext draws ``$^{-2}$`` and
+# ``$_0$`` at 70 % of it (8 pt -> 5.6 pt). DejaVu Sans, matplotlib's default font, has every glyph below.
+_SUPERSCRIPT = str.maketrans("0123456789-+/in", "⁰¹²³⁴⁵⁶⁷⁸⁹⁻⁺ᐟⁱⁿ")
+_SUBSCRIPT = str.maketrans("0123456789inpt", "₀₁₂₃₄₅₆₇₈₉ᵢₙₚₜ")
+
+
+def sup(text: str) -> str:
+    """``text`` as Unicode superscript characters: sup("-2") = "⁻²", sup("1/2") = "¹ᐟ²"."""
+    return str(text).translate(_SUPERSCRIPT)
+
+
+def sub(text: str) -> str:
+    """``text`` as Unicode subscript characters: sub("0") = "₀", sub("p") = "ₚ"."""
+    return str(text).translate(_SUBSCRIPT)
+
+
+def _tick_text(value: float) -> str:
+    """A log axis' tick: a plain number from 1e-4 to 1e5 (0.001, 20), else a power of ten as 10⁻⁶."""
+    if value <= 0:
+        return ""
+    if 1e-4 <= value < 1e5:
+        return f"{value:g}"
+    exponent = int(round(math.log10(value)))
+    mantissa = value / 10.0**exponent
+    head = "" if abs(mantissa - 1) < 1e-9 else f"{mantissa:g}×"
+    return f"{head}10{sup(str(exponent))}".replace("-", "−")
+
+
+def plain_log_ticks(axis) -> None:
+    """Label a log ``axis`` (ax.xaxis or ax.yaxis) at full size: plain numbers or 10⁻⁶, no mathtext exponents;
+    minor ticks unlabelled."""
+    from matplotlib.ticker import FuncFormatter, NullFormatter
+
+    axis.set_major_formatter(FuncFormatter(lambda v, _: _tick_text(v)))
+    axis.set_minor_formatter(NullFormatter())
+
+
+def rendered_sizes_pt(fig) -> list[tuple[float, str]]:
+    """(smallest rendered size in pt, text) of every visible, non-empty text of a drawn ``fig``: its font size,
+    or for mathtext the smallest glyph's (sub- and superscripts at 70 %). With the figure drawn at its printed
+    width these are sizes on paper."""
+    import matplotlib.text
+    from matplotlib.mathtext import MathTextParser
+
+    parser = MathTextParser("path")
+    out = []
+    for t in fig.findobj(matplotlib.text.Text):
+        s = t.get_text()
+        if not (t.get_visible() and s.strip()):
+            continue
+        s, ismath = t._preprocess_math(s)
+        size = t.get_fontsize()
+        if ismath:
+            glyphs = parser.parse(s, dpi=72, prop=t.get_fontproperties()).glyphs
+            size = min((g[1] for g in glyphs), default=size)
+        out.append((float(size), t.get_text()))
+    return out

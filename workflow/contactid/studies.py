@@ -135,7 +135,7 @@ def plot_noise_study(ds: xr.Dataset, default_noise: float, png: str, pdf: str | 
     plt = ps.pyplot()
     noise = ds["noise_fraction"].values
     fig, axes = plt.subplots(1, len(QUANTITIES), figsize=(ps.TEXT_WIDTH_IN, 3.0), sharex=True)
-    labels = {"mu": r"$\mu$", "e0": r"$e_0$ at $N_0$", "k_t": r"$k_t$"}
+    labels = {"mu": r"$\mu$", "e0": "e₀ at N₀", "k_t": "kₜ"}
     for ax, q in zip(axes, QUANTITIES):
         err = 100 * np.abs(ds[f"error_{q}"].values)  # (noise, length, seed)
         for j, n in enumerate(ds["record_samples"].values):
@@ -146,6 +146,7 @@ def plot_noise_study(ds: xr.Dataset, default_noise: float, png: str, pdf: str | 
         ax.text(default_noise, 0.97, " default", transform=ax.get_xaxis_transform(), va="top", fontsize=8)
         ax.set_xscale("log")
         ax.set_yscale("log")
+        ps.plain_log_ticks(ax.yaxis)
         ax.set_xticks(noise)
         ax.set_xticklabels([f"{x:g}" for x in noise], rotation=45, fontsize=8)
         ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())

@@ -93,7 +93,7 @@ rule gap_diagnosis:
 
 
 rule gap_figures:
-    """The gap diagnosis' figures: the gap by stage, the ranked candidates and the diagnostic views (results/gap/*.png)."""
+    """The gap diagnosis' figures, one per question: the gap by stage, the candidates ranked, before and after per held-out case and the explanation (PNG, and PDF at the report's text width), and the diagnostic views by harmonic and sensor, by part of the cycle and the force-state maps (results/gap/*.png)."""
     input:
         diagnosis="results/gap/diagnosis.json",
         dataset="results/gap/gap.nc",
@@ -105,8 +105,13 @@ rule gap_figures:
         ranking=report("results/gap/gap_ranking.png", caption="../report/gap.rst", category="Gap diagnosis"),
         shrink=report("results/gap/gap_shrink.png", caption="../report/gap.rst", category="Gap diagnosis"),
         explanation=report("results/gap/gap_explanation.png", caption="../report/gap.rst", category="Gap diagnosis"),
+        stages_pdf="results/gap/gap_stages.pdf",
+        ranking_pdf="results/gap/gap_ranking.pdf",
+        shrink_pdf="results/gap/gap_shrink.pdf",
+        explanation_pdf="results/gap/gap_explanation.pdf",
     params:
         code=CODE_DIGEST,
+        place=config["gap"].get("place"),
     conda:
         "../envs/contactid.yaml"
     log:

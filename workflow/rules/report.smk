@@ -37,10 +37,7 @@ rule report:
         gap="results/report/gap.tex",
         noise="results/report/noise.tex",
         noise_figure=["results/figures/noise_study.pdf"] if noise_study_in_report() else [],
-        gap_figures=[
-            f"results/gap/gap_{v}.png"
-            for v in ("stages", "harmonics", "cycle", "ranking", "shrink", "force_state", "explanation")
-        ],
+        gap_figures=[f"results/gap/gap_{v}.pdf" for v in ("stages", "ranking", "shrink", "explanation")],
         benchmark_figure=(["results/gap_benchmark/confusion.png"] if gap_benchmark_in_report() else []),
         figures=expand(
             "results/figures/{fig}.pdf",

@@ -1,21 +1,14 @@
-"""Rule gap_figures: one figure per view of the diagnosis."""
+"""Rule gap_figures: one figure per question of the diagnosis (PDF too for those the report includes)."""
 
 from contactid.gap.figures import all_figures
+from contactid.gap.verdict import PlaceThresholds
 from contactid.logs import setup_logging
 
 log = setup_logging(snakemake.log[0])
-o = snakemake.output
 all_figures(
     snakemake.input.diagnosis,
     snakemake.input.dataset,
-    {
-        "stages": o.stages,
-        "harmonics": o.harmonics,
-        "cycle": o.cycle,
-        "force_state": o.force_state,
-        "ranking": o.ranking,
-        "shrink": o.shrink,
-        "explanation": o.explanation,
-    },
+    dict(snakemake.output.items()),
+    PlaceThresholds.from_config(snakemake.params.place),
 )
 log.info("gap figures written")

@@ -1,15 +1,35 @@
-"""Figures of the diagnosis (results/gap/*.png): one per view."""
+"""Figures of the diagnosis (results/gap/): one per question, drawn at the report's text width with text of at
+least 8 pt (:mod:`contactid.print_style`). The report includes the gap by stage, the candidates ranked, before and
+after per held-out case and the step-by-step explanation (PDF at ``\\textwidth``); the diagnostic views (by
+harmonic and sensor, by part of the cycle, the force-state maps) are figures of their own in results/gap/."""
 
 from __future__ import annotations
 
 import json
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
 import numpy as np
 import xarray as xr
+
+from .. import print_style as ps
+from .verdict import DEFAULT_PLACE, PlaceThresholds
+
+W = ps.TEXT_WIDTH_IN
+XI_UM, XI_DOT, ETA_UM, ETA_DOT = r"$\xi$ ($\mu$m)", r"d$\xi$/dt (mm/s)", r"$\eta$ ($\mu$m)", r"d$\eta$/dt (mm/s)"
+
+# the stages' readable labels (diagnosis.json where.stage keys)
+STAGE_LABELS = {
+    "accelerations": "sensor accelerations, all cases",
+    "generalized_coordinates": "generalized coordinates",
+    "identification_residual": "identification misfit at ω and 3ω",
+    "contact_force_S": "contact force S (friction law)",
+    "contact_force_N": "contact force N (elastic normal law)",
+    "energy_tangential": "energy, tangential direction",
+    "energy_normal": "energy, normal direction",
+    "frf_frequency": "random test: natural frequencies",
+    "frf_peak_amplitude": "random test: FRF peaks",
+    "open_fraction": "contact open (share of the cycle)",
+}
+HELDOUT = "heldout"
 
 
 def _num(x) -> float:
@@ -17,168 +37,284 @@ def _num(x) -> float:
     return float("nan") if x is None else float(x)
 
 
-def _save(fig, path):
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+def _name(effect: str) -> str:
+    """A candidate's name as words: contact_separation -> contact separation."""
+    return str(effect).replace("_", " ")
 
 
-def stages(diag: dict, path: str):
-    st = diag["where"]["stage"]
-    fig, ax = plt.subplots(figsize=(6.5, 3.2))
-    keys = list(st)
-    ax.barh(keys, [100 * st[k] for k in keys], color="tab:red")
+def min_gap(diag: dict, default: float = 0.006) -> float:
+    """gap.min_gap of the diagnosis (its remaining gap's floor)."""
+    return float((diag.get("remaining_gap") or {}).get("floor", default))
+
+
+def stage_rows(diag: dict, thresholds: PlaceThresholds = DEFAULT_PLACE) -> list[tuple[str, str, float, tuple]]:
+    """The stage figure's rows: (key, label, value, (threshold, its name) or ()). The held-out gap first (compared
+    with gap.min_gap), then each stage; the localisation's thresholds where a stage is compared with one."""
+    w = diag["where"]
+    rows = [(HELDOUT, "held-out gap (accelerations)", _num(w["heldout_gap_before"]), (min_gap(diag), "gap.min_gap"))]
+    noise = list((w.get("identification_noise") or {}).values())
+    limits = {"contact_force_N": (thresholds.normal_limit, "normal_limit")}
+    if noise:
+        limits["identification_residual"] = (
+            thresholds.residual_factor * float(np.median(noise)),
+            f"{thresholds.residual_factor:g} × its scatter",
+        )
+    for key, value in w["stage"].items():
+        rows.append((key, STAGE_LABELS.get(key, _name(key)), _num(value), limits.get(key, ())))
+    return rows
+
+
+def _stage_value_text(v: float, limit: tuple) -> str:
+    """The stage figure's right-hand column: the value (%), and the threshold it is compared with."""
+    text = "0" if v == 0 else ("n/a" if not np.isfinite(v) else f"{v:.2g} %")
+    return text + (f"  ({limit[1]}: {100 * limit[0]:.2g} %)" if limit else "")
+
+
+@ps.print_figure
+def stages(diag: dict, png: str, pdf: str | None = None, thresholds: PlaceThresholds = DEFAULT_PLACE):
+    """The gap at each stage of the chain (%, log axis; a zero value written as 0, its bar absent), with the
+    threshold each is compared with (black mark, and in the right-hand column): gap.min_gap for the held-out gap,
+    the localisation's (gap.place) for the stages it tests."""
+    plt = ps.pyplot()
+    rows = stage_rows(diag, thresholds)
+    values = np.array([100 * v for _, _, v, _ in rows])
+    limits = [100 * t[0] for *_, t in rows if t]
+    positive = values[np.isfinite(values) & (values > 0)]
+    lo = 10 ** np.floor(np.log10(min(positive.min() if positive.size else 1e-3, *limits)))
+    hi = 10 ** np.ceil(np.log10(max(positive.max() if positive.size else 1.0, *limits)) + 0.2)
+    fig, ax = plt.subplots(figsize=(W, 0.24 * len(rows) + 1.1))
+    y = np.arange(len(rows))
+    ax.barh(y, np.where(values > 0, values - lo, 0), left=lo, height=0.6, color="tab:red", alpha=0.8)
+    for yi, v, (key, _, _, limit) in zip(y, values, rows):
+        ax.text(1.02, yi, _stage_value_text(v, limit), transform=ax.get_yaxis_transform(), va="center")
+        if v == 0:
+            ax.text(lo * 1.1, yi, "0", va="center", gid=f"zero:{key}")
+        if limit:
+            ax.plot([100 * limit[0]] * 2, [yi - 0.45, yi + 0.45], color="k", lw=1.8, gid=f"threshold:{key}")
+    ax.plot([], [], color="k", lw=1.8, label="threshold the value is compared with (value in brackets)")
     ax.set_xscale("log")
-    ax.set_xlabel("relative disagreement (%)")
-    ax.set_title("Gap by stage of the chain (identified model vs records)")
-    _save(fig, path)
+    ax.set_xlim(lo, hi)
+    ps.plain_log_ticks(ax.xaxis)
+    ax.set_yticks(y, [label for _, label, _, _ in rows])
+    ax.set_ylim(len(rows) - 0.5, -0.5)
+    ax.set_xlabel("relative disagreement, identified model against the records (%)")
+    ax.set_title("The gap at each stage of the chain")
+    fig.legend(loc="lower center", frameon=False)
+    ax.grid(axis="x", alpha=0.3)
+    fig.tight_layout(rect=(0, 0.3 / fig.get_size_inches()[1], 1, 1))
+    ps.save(fig, png, pdf)
 
 
-def harmonics(ds: xr.Dataset, path: str):
-    fig, axes = plt.subplots(1, 2, figsize=(9, 3.3))
+@ps.print_figure
+def harmonics(ds: xr.Dataset, png: str, pdf: str | None = None):
+    """The gap by harmonic (log) and by sensor, per load case."""
+    plt = ps.pyplot()
+    fig, axes = plt.subplots(1, 2, figsize=(W, 2.9))
     for c in ds["case"].values:
-        axes[0].semilogy(ds["harmonic"], 100 * ds["gap_by_harmonic"].sel(case=c), "o-", label=str(c))
+        axes[0].semilogy(ds["harmonic"], 100 * ds["gap_by_harmonic"].sel(case=c), "o-", ms=3, label=str(c))
+    ps.plain_log_ticks(axes[0].yaxis)
+    axes[0].set_xticks(ds["harmonic"].values)
     axes[0].set_xlabel("harmonic of the test frequency")
     axes[0].set_ylabel("residual / |A| (%)")
-    axes[0].set_title("by harmonic (odd: driven; even: asymmetry)")
+    axes[0].set_title("By harmonic (odd: driven; even: asymmetry)")
     axes[0].legend()
     x = np.arange(ds.sizes["sensor"])
+    n = ds.sizes["case"]
     for i, c in enumerate(ds["case"].values):
-        axes[1].bar(x + 0.25 * i, 100 * ds["gap_by_sensor"].sel(case=c), 0.25, label=str(c))
-    axes[1].set_xticks(x + 0.25, [str(s) for s in ds["sensor"].values])
+        axes[1].bar(x + (i - (n - 1) / 2) / (n + 1), 100 * ds["gap_by_sensor"].sel(case=c), 1 / (n + 1), label=str(c))
+    axes[1].set_xticks(x, [str(s) for s in ds["sensor"].values])
+    axes[1].set_xlabel("sensor")
     axes[1].set_ylabel("gap (%)")
-    axes[1].set_title("by sensor and load case")
-    _save(fig, path)
+    axes[1].set_title("By sensor and load case")
+    for ax in axes:
+        ax.grid(alpha=0.3)
+    fig.tight_layout()
+    ps.save(fig, png, pdf)
 
 
-def cycle(ds: xr.Dataset, path: str):
-    fig, axes = plt.subplots(1, 2, figsize=(9, 3.3))
+@ps.print_figure
+def cycle(ds: xr.Dataset, png: str, pdf: str | None = None):
+    """The gap by part of the cycle and the energy dissipated per cycle in each direction, per load case."""
+    plt = ps.pyplot()
+    fig, axes = plt.subplots(1, 2, figsize=(W, 3.0))
     x = np.arange(ds.sizes["cycle_part"])
+    n = ds.sizes["case"]
     for i, c in enumerate(ds["case"].values):
-        axes[0].bar(x + 0.25 * i, 100 * ds["gap_by_cycle_part"].sel(case=c), 0.25, label=str(c))
-    axes[0].set_xticks(x + 0.25, [p.replace("_", "\n") for p in ds["cycle_part"].values])
+        axes[0].bar(x + (i - (n - 1) / 2) / (n + 1), 100 * ds["gap_by_cycle_part"].sel(case=c), 1 / (n + 1), label=c)
+    axes[0].set_xticks(x, [p.replace("_", "\n") for p in ds["cycle_part"].values])
     axes[0].set_ylabel("rms residual / rms acceleration (%)")
-    axes[0].set_title("by part of the cycle (driving point)")
+    axes[0].set_title("By part of the cycle (driving point)")
     axes[0].legend()
     et, en = ds["energy_tangential"].values, ds["energy_normal"].values
-    x = np.arange(ds.sizes["case"])
-    axes[1].bar(x - 0.3, 1e3 * et[:, 0], 0.2, label="tangential, identified")
-    axes[1].bar(x - 0.1, 1e3 * et[:, 1], 0.2, label="tangential, model")
-    axes[1].bar(x + 0.1, 1e3 * en[:, 0], 0.2, label="normal, identified")
-    axes[1].bar(x + 0.3, 1e3 * en[:, 1], 0.2, label="normal, model")
+    x = np.arange(n)
+    for k, (e, d, j) in enumerate(((et, "tangential", 0), (et, "tangential", 1), (en, "normal", 0), (en, "normal", 1))):
+        who = ("identified", "model")[j]
+        axes[1].bar(x + 0.2 * k - 0.3, 1e3 * e[:, j], 0.2, label=f"{d}, {who}", color=f"C{k}")
     axes[1].set_xticks(x, [str(c) for c in ds["case"].values])
     axes[1].set_ylabel("energy per cycle (mJ)")
-    axes[1].set_title("dissipation in each direction")
-    axes[1].legend(fontsize=7)
-    _save(fig, path)
+    axes[1].set_title("Dissipation in each direction")
+    axes[1].legend()
+    for ax in axes:
+        ax.grid(axis="y", alpha=0.3)
+    fig.tight_layout()
+    ps.save(fig, png, pdf)
 
 
-def force_state(ds: xr.Dataset, path: str):
+@ps.print_figure
+def force_state(ds: xr.Dataset, png: str, pdf: str | None = None):
+    """The residual force-state maps over one period: S identified - friction law over (xi, dxi/dt), N identified
+    - the best elastic normal law over (eta, deta/dt); one colour scale per row, centred on zero."""
+    plt = ps.pyplot()
     n = ds.sizes["case"]
-    fig, axes = plt.subplots(2, n, figsize=(3.3 * n, 5.6), squeeze=False)
-    for i, c in enumerate(ds["case"].values):
-        m = ds.sel(case=c)
-        for row, (x, y, r, lab) in enumerate(
-            (("xi", "xi_dot", "S_residual", "S"), ("eta", "eta_dot", "N_residual", "N"))
-        ):
-            ax = axes[row, i]
-            sc = ax.scatter(1e6 * m[f"map_{x}"], 1e3 * m[f"map_{y}"], c=m[f"map_{r}"], cmap="coolwarm", s=6)
-            fig.colorbar(sc, ax=ax, label=f"{lab} residual (N)")
-            ax.set_xlabel(f"{x} (um)")
-            ax.set_ylabel(f"{y} (mm/s)")
-            ax.set_title(f"{c}: {lab} identified - law")
-    _save(fig, path)
+    fig, axes = plt.subplots(2, n, figsize=(W, 5.0), squeeze=False, layout="constrained")
+    specs = (("xi", "xi_dot", "S_residual", "S", XI_UM, XI_DOT), ("eta", "eta_dot", "N_residual", "N", ETA_UM, ETA_DOT))
+    for row, (x, y, r, force, xl, yl) in enumerate(specs):
+        vmax = float(np.nanmax(np.abs(ds[f"map_{r}"].values))) or 1.0
+        for i, c in enumerate(ds["case"].values):
+            m, ax = ds.sel(case=c), axes[row, i]
+            sc = ax.scatter(1e6 * m[f"map_{x}"], 1e3 * m[f"map_{y}"], c=m[f"map_{r}"], cmap="coolwarm", s=5)
+            sc.set_clim(-vmax, vmax)
+            ax.set_xlabel(xl)
+            if i == 0:
+                ax.set_ylabel(yl)
+            ax.set_title(f"{c}: {force} identified − law", fontsize=8.5)
+            ax.grid(alpha=0.3)
+        fig.colorbar(sc, ax=list(axes[row]), label=f"{force} residual (N)", pad=0.02)
+    ps.save(fig, png, pdf)
 
 
-def ranking(diag: dict, path: str):
-    rows = diag["ranking"]
-    fig, ax = plt.subplots(figsize=(7, 3.6))
-    names = [r["effect"] for r in rows]
-    after = np.array([100 * _num(r["heldout_gap_after"]) for r in rows])
-    lo = np.array([100 * _num(r["heldout_gap_after_interval"][0]) for r in rows])
-    hi = np.array([100 * _num(r["heldout_gap_after_interval"][1]) for r in rows])
-    y = np.arange(len(rows))
-    ax.barh(
-        y, after, xerr=[np.maximum(after - lo, 0), np.maximum(hi - after, 0)], color="tab:blue", label="with the effect"
-    )
-    if rows:
-        ax.axvline(100 * rows[0]["heldout_gap_before"], color="k", ls="--", label="identified model (before)")
-    ax.set_yticks(y, names)
-    ax.invert_yaxis()
-    finite = hi[np.isfinite(hi)]
-    ax.set_xlim(
-        0, 1.15 * max(finite.max() if finite.size else 1.0, 100 * rows[0]["heldout_gap_before"] if rows else 1.0)
-    )
-    ax.set_xlabel("held-out gap (%)")
-    ax.set_title(f"Candidates ranked; verdict: {diag['verdict']}")
-    ax.legend(fontsize=7)
-    _save(fig, path)
+def ranking_bars(diag: dict) -> list[dict]:
+    """The ranking figure's bars: per candidate its held-out gap after (%) and bootstrap interval; a candidate
+    that does not lower the held-out gap (after >= before) is clipped at before and marked no effect."""
+    out = []
+    for r in diag["ranking"]:
+        before, after = 100 * _num(r["heldout_gap_before"]), 100 * _num(r["heldout_gap_after"])
+        lo, hi = (100 * _num(v) for v in r["heldout_gap_after_interval"])
+        no_effect = bool(np.isfinite(after) and after >= before)
+        out.append(
+            {
+                "effect": r["effect"],
+                "end": before if no_effect else after,
+                "low": lo,
+                "high": hi,
+                "no_effect": no_effect,
+                "diverged": not np.isfinite(after),
+                "reduction": 1 - after / before if before > 0 else float("nan"),
+            }
+        )
+    return out
 
 
-def shrink(diag: dict, path: str):
-    """Held-out gap before and after for the winner and the runner-up, per load case and per harmonic."""
-    fig, axes = plt.subplots(1, 2, figsize=(9, 3.4))
-    sh = diag.get("shrink", {})
-    cases = list(next(iter(sh.values()))["by_case"]) if sh else []
+@ps.print_figure
+def ranking(diag: dict, png: str, pdf: str | None = None):
+    """The candidates ranked: each one's held-out gap after (bar, 95 % bootstrap interval), the gap before, the
+    identification's floor gap.min_gap (below it the verdict is none) and the records' scatter as lines; a
+    candidate with no effect ends at before, marked."""
+    plt = ps.pyplot()
+    bars, w = ranking_bars(diag), diag["where"]
+    before, floor, scatter = 100 * _num(w["heldout_gap_before"]), 100 * min_gap(diag), 100 * _num(w["record_scatter"])
+    fig, ax = plt.subplots(figsize=(W, 0.3 * len(bars) + 1.5))
+    ends = [before, floor] + [b["high"] for b in bars if np.isfinite(b["high"]) and not b["no_effect"]]
+    right = 1.12 * max(ends)
+    for y, b in enumerate(bars):
+        if b["diverged"]:
+            ax.text(0.01 * right, y, "prediction diverged", va="center", fontsize=8)
+            continue
+        if b["no_effect"]:
+            ax.barh(y, b["end"], 0.6, color="0.85", edgecolor="0.5", hatch="//", lw=0.5, gid=f"bar:{b['effect']}")
+            ax.text(0.02 * right, y, "no effect", va="center", fontsize=8, gid=f"no_effect:{b['effect']}")
+            continue
+        err = [[max(b["end"] - b["low"], 0)], [max(b["high"] - b["end"], 0)]]
+        ax.barh(y, b["end"], 0.6, xerr=err, color="tab:blue", capsize=2, gid=f"bar:{b['effect']}")
+        ax.text(0.02 * right, y, f"−{100 * b['reduction']:.0f} %", va="center", color="white", fontsize=8)
+    ax.axvline(before, color="k", ls="--", lw=1.2, label=f"before (identified model): {before:.2g} %")
+    ax.axvline(floor, color="tab:red", ls=":", lw=1.5, label=f"gap.min_gap: {floor:.2g} %")
+    ax.axvline(scatter, color="0.4", ls="-.", lw=1.0, label=f"records' scatter: {scatter:.1g} %")
+    ax.set_yticks(range(len(bars)), [_name(b["effect"]) for b in bars])
+    ax.set_ylim(len(bars) - 0.4, -0.6)
+    ax.set_xlim(0, right)
+    ax.set_xlabel("held-out gap with the candidate added (%), 95 % bootstrap interval")
+    ax.set_title(f"Candidates ranked; verdict: {_name(diag['verdict'])}")
+    fig.legend(loc="lower center", ncol=3, frameon=False)
+    fig.tight_layout(rect=(0, 0.3 / fig.get_size_inches()[1], 1, 1))
+    ps.save(fig, png, pdf)
+
+
+def _shrink_by_case(ax, sh: dict, floor: float) -> None:
+    """Before (grey) and after each of the winner and the runner-up, per held-out case, 95 % bootstrap."""
+    cases = list(next(iter(sh.values()))["by_case"])
     x = np.arange(len(cases))
-    first = True
-    for i, (label, v) in enumerate(sh.items()):
+    width = 0.8 / (len(sh) + 1)
+
+    def bar(k, values, intervals, **kw):
+        v = 100 * np.array(values)
+        lo, hi = (100 * np.array([i[j] for i in intervals]) for j in (0, 1))
+        ax.bar(x + (k - len(sh) / 2) * width, v, width, yerr=[np.maximum(v - lo, 0), np.maximum(hi - v, 0)], **kw)
+
+    bc = next(iter(sh.values()))["by_case"]
+    bar(0, [bc[c]["before"] for c in cases], [bc[c]["before_interval"] for c in cases], color="0.6", label="before")
+    for k, (role, v) in enumerate(sh.items(), start=1):
         bc = v["by_case"]
-        if first:
-            b = np.array([100 * bc[c]["before"] for c in cases])
-            axes[0].bar(x - 0.27, b, 0.27, color="0.6", label="identified model")
-            first = False
-        a = np.array([100 * bc[c]["after"] for c in cases])
-        lo = np.array([100 * bc[c]["after_interval"][0] for c in cases])
-        hi = np.array([100 * bc[c]["after_interval"][1] for c in cases])
-        axes[0].bar(
-            x + 0.27 * i,
-            a,
-            0.27,
-            yerr=[np.maximum(a - lo, 0), np.maximum(hi - a, 0)],
-            label=f"+ {v['effect']} ({label.replace('_', '-')})",
+        label = f"+ {_name(v['effect'])} ({role.replace('_', '-')})"
+        bar(
+            k, [bc[c]["after"] for c in cases], [bc[c]["after_interval"] for c in cases], color=f"C{k - 1}", label=label
         )
-        axes[1].semilogy(
-            np.arange(1, len(v["by_harmonic"]["after"]) + 1),
-            100 * np.array(v["by_harmonic"]["after"]),
-            "o-",
-            label=f"+ {v['effect']}",
-        )
-    if sh:
-        v = next(iter(sh.values()))
-        axes[1].semilogy(
-            np.arange(1, len(v["by_harmonic"]["before"]) + 1),
-            100 * np.array(v["by_harmonic"]["before"]),
-            "s--",
-            color="0.4",
-            label="identified model",
-        )
-    axes[0].set_xticks(x, cases)
-    axes[0].set_ylabel("held-out gap (%)")
-    axes[0].set_title("before and after, per held-out case (95 % bootstrap)")
-    axes[0].legend(fontsize=7)
-    axes[1].set_xlabel("harmonic")
+    ax.axhline(100 * floor, color="tab:red", ls=":", lw=1.5, label="gap.min_gap")
+    ax.set_xticks(x, cases)
+    ax.set_xlabel("held-out load case")
+    ax.set_ylabel("held-out gap (%)")
+    ax.set_title("Per held-out case (95 % bootstrap)")
+
+
+@ps.print_figure
+def shrink(diag: dict, png: str, pdf: str | None = None):
+    """Held-out gap before and after for the winner and the runner-up, per held-out case and per harmonic."""
+    plt = ps.pyplot()
+    fig, axes = plt.subplots(1, 2, figsize=(W, 3.3))
+    sh = diag.get("shrink") or {}
+    if not sh:
+        for ax in axes:
+            ax.set_axis_off()
+        axes[0].text(0, 0.5, "No candidate was refitted: nothing to compare.", transform=axes[0].transAxes)
+        ps.save(fig, png, pdf)
+        return
+    _shrink_by_case(axes[0], sh, min_gap(diag))
+    v = next(iter(sh.values()))
+    h = np.arange(1, len(v["by_harmonic"]["before"]) + 1)
+    axes[1].semilogy(h, 100 * np.array(v["by_harmonic"]["before"]), "s--", ms=3, color="0.4", label="before")
+    for k, (role, v) in enumerate(sh.items()):
+        axes[1].semilogy(h, 100 * np.array(v["by_harmonic"]["after"]), "o-", ms=3, color=f"C{k}", label=role)
+    ps.plain_log_ticks(axes[1].yaxis)
+    axes[1].set_xticks(h)
+    axes[1].set_xlabel("harmonic of the test frequency")
     axes[1].set_ylabel("residual / |A| (%)")
-    axes[1].set_title("per harmonic (held-out cases)")
-    axes[1].legend(fontsize=7)
-    _save(fig, path)
+    axes[1].set_title("Per harmonic (held-out cases)")
+    for ax in axes:
+        ax.grid(alpha=0.3)
+    handles, labels = axes[0].get_legend_handles_labels()
+    order = sorted(range(len(labels)), key=lambda i: labels[i] == "gap.min_gap")  # the bars first
+    fig.legend([handles[i] for i in order], [labels[i] for i in order], loc="upper center", ncol=2, frameon=False)
+    fig.tight_layout(rect=(0, 0, 1, 0.84))
+    ps.save(fig, png, pdf)
 
 
-def explanation(diag: dict, path: str):
+@ps.print_figure
+def explanation(diag: dict, png: str, pdf: str | None = None):
     """The additive explanation as a waterfall: the identified model's held-out gap, what each added effect
     removes (its share of the gap's power), what remains; the identification's floor (gap.min_gap) drawn."""
+    plt = ps.pyplot()
     steps = diag.get("explanation") or []
     left = diag.get("remaining_gap") or {}
     before = diag["where"]["heldout_gap_before"]
-    fig, ax = plt.subplots(figsize=(6.5, 3.4))
+    fig, ax = plt.subplots(figsize=(W, 3.0))
     labels, bottoms, heights, colors = ["identified model"], [0.0], [100 * before], ["0.5"]
     for s in steps:
-        labels.append(f"+ {s['effect']}\n({100 * s['share']:.0f} % of the power)")
+        labels.append(f"+ {_name(s['effect'])}\n({100 * s['share']:.0f} % of the power)")
         bottoms.append(100 * s["heldout_gap_after"])
         heights.append(100 * (s["heldout_gap_before"] - s["heldout_gap_after"]))
         colors.append("tab:green")
     remaining = left.get("heldout_gap", before)
-    labels.append(f"remaining\n({left.get('place', diag['where'].get('place', '?'))})")
+    labels.append(f"remaining\n({_name(left.get('place', diag['where'].get('place', '?')))})")
     bottoms.append(0.0)
     heights.append(100 * remaining)
     colors.append("tab:red" if not left.get("at_floor") else "tab:blue")
@@ -186,25 +322,31 @@ def explanation(diag: dict, path: str):
     ax.bar(x, heights, bottom=bottoms, color=colors, width=0.6)
     if left.get("floor") is not None:
         ax.axhline(
-            100 * left["floor"], color="k", ls=":", lw=1, label=f"floor gap.min_gap = {100 * left['floor']:.2g} %"
+            100 * left["floor"], color="tab:red", ls=":", lw=1.5, label=f"gap.min_gap = {100 * left['floor']:.2g} %"
         )
-        ax.legend(fontsize=8, loc="upper right")
-    ax.set_xticks(x, labels, fontsize=8)
+        fig.legend(loc="lower center", frameon=False)
+    ax.set_xticks(x, labels)
     ax.set_ylabel("held-out gap (%)")
     ax.set_title(
         "The held-out gap explained step by step" if steps else "No effect explains the held-out gap materially"
     )
-    _save(fig, path)
+    ax.grid(axis="y", alpha=0.3)
+    fig.tight_layout(rect=(0, 0.3 / fig.get_size_inches()[1], 1, 1))
+    ps.save(fig, png, pdf)
 
 
-def all_figures(diagnosis_path: str, gap_path: str, out: dict):
-    diag = json.load(open(diagnosis_path))
-    ds = xr.open_dataset(gap_path, engine="netcdf4")
-    stages(diag, out["stages"])
-    harmonics(ds, out["harmonics"])
-    cycle(ds, out["cycle"])
-    force_state(ds, out["force_state"])
-    ranking(diag, out["ranking"])
-    shrink(diag, out["shrink"])
-    explanation(diag, out["explanation"])
-    ds.close()
+# the views of the diagnosis; the report includes the first four (PDF), the others are results/gap/*.png only
+IN_REPORT = ("stages", "ranking", "shrink", "explanation")
+DIAGNOSTIC = ("harmonics", "cycle", "force_state")
+
+
+def all_figures(diagnosis_path: str, gap_path: str, out: dict, thresholds: PlaceThresholds = DEFAULT_PLACE):
+    """Every figure: ``out`` maps a view to its PNG path, and ``<view>_pdf`` to its PDF where there is one."""
+    with open(diagnosis_path) as f:
+        diag = json.load(f)
+    stages(diag, out["stages"], out.get("stages_pdf"), thresholds)
+    for view in IN_REPORT[1:]:
+        globals()[view](diag, out[view], out.get(f"{view}_pdf"))
+    with xr.open_dataset(gap_path, engine="netcdf4") as ds:
+        for view in DIAGNOSTIC:
+            globals()[view](ds, out[view], out.get(f"{view}_pdf"))

@@ -202,7 +202,8 @@ def where_paragraph(diag: dict) -> str:
         + r" of the residual), worst part of the cycle: "
         + _t(w["worst_cycle_part"])
         + r". "
-        r"The localisation places the gap in: \emph{" + _t(w["place"]) + r"} (" + _t(w["place_reason"]) + ")."
+        r"The localisation places the gap in: \emph{" + _t(w["place"]) + r"} (" + _t(w["place_reason"]) + r"); "
+        r"Fig.~\ref{fig:gap_stages}."
     )
 
 
@@ -260,20 +261,41 @@ def candidates_table(diag: dict) -> str:
     )
 
 
-# the diagnosis' figures (results/gap/*.png) and the additive explanation's
+def _figure(name: str, caption: str) -> str:
+    """A gap figure at the report's text width, the width it is drawn at (print_style): text >= 8 pt on paper."""
+    return (
+        "\\begin{figure}[H]\\centering\\includegraphics[width=\\textwidth]{" + name + ".pdf}"
+        "\\caption{" + caption + "}\\label{fig:" + name + "}\\end{figure}\n"
+    )
+
+
+# the diagnosis' figures the report includes (results/gap/*.pdf); the diagnostic views stay in results/gap/
 GAP_FIGURES = (
-    "\\begin{figure}[H]\\centering\\includegraphics[width=0.49\\textwidth]{gap_stages.png}"
-    "\\includegraphics[width=0.49\\textwidth]{gap_ranking.png}\n"
-    "\\includegraphics[width=0.49\\textwidth]{gap_harmonics.png}"
-    "\\includegraphics[width=0.49\\textwidth]{gap_cycle.png}\n"
-    "\\includegraphics[width=0.49\\textwidth]{gap_shrink.png}"
-    "\\includegraphics[width=0.49\\textwidth]{gap_force_state.png}\n"
-    "\\caption{The gap by stage, the candidates ranked, by harmonic and sensor, by part of the cycle and "
-    "dissipation in each direction, the held-out gap before and after the two best candidates, and the residual "
-    "force-state maps.}\\label{fig:gap}\\end{figure}\n"
-    "\\begin{figure}[H]\\centering\\includegraphics[width=0.7\\textwidth]{gap_explanation.png}"
-    "\\caption{The held-out gap explained step by step: the identified model, what each added effect removes, "
-    "what remains (dotted: the identification's floor).}\\label{fig:gap_explanation}\\end{figure}\n"
+    _figure(
+        "gap_stages",
+        "The gap at each stage of the chain, identified model against the records (log axis; a zero value is "
+        "written as 0), and the threshold each value is compared with: gap.min\\_gap for the held-out gap, the "
+        "localisation's (gap.place) for the identification misfit and the normal law.",
+    )
+    + _figure(
+        "gap_ranking",
+        "The candidates ranked: held-out gap with each candidate added (95\\,\\% bootstrap interval) against the "
+        "gap before, the identification's floor gap.min\\_gap (below it the verdict is none) and the records' "
+        "scatter. A candidate that does not lower the gap ends at `before', marked no effect.",
+    )
+    + _figure(
+        "gap_shrink",
+        "Held-out gap before and after the winner and the runner-up, per held-out load case (95\\,\\% bootstrap "
+        "intervals) and per harmonic.",
+    )
+    + _figure(
+        "gap_explanation",
+        "The held-out gap explained step by step: the identified model, what each added effect removes, what "
+        "remains (dotted: the identification's floor gap.min\\_gap).",
+    )
+    + "The diagnostic views are figures of their own in \\texttt{results/gap/}: the gap by harmonic and by sensor "
+    "(\\texttt{gap\\_harmonics.png}), by part of the cycle with the dissipation in each direction "
+    "(\\texttt{gap\\_cycle.png}) and the residual force-state maps (\\texttt{gap\\_force\\_state.png}).\n"
 )
 
 NO_BENCHMARK = (
