@@ -33,3 +33,14 @@ def test_digits_follow_the_interval_and_a_value_lost_in_it_prints_as_zero():
     assert r"e\_t & $0$ & $0$ & $16000$ \\" in lines
     assert r"mu & $0.3957$ & $0.394$ & $0.397$ \\" in lines
     assert r"e\_f & $3.8\times10^{7}$ & $2.94\times10^{7}$ & $5.85\times10^{7}$ \\" in lines
+
+
+def test_a_plain_number_with_more_integer_digits_than_asked_is_rounded_to_them():
+    # the model-form table's e_t interval bound 15875 N/m at 3 digits (it printed all five)
+    from contactid.latex import _fmt
+
+    assert _fmt(15875.000000002, 3) == "15900"
+    assert _fmt(1968.9, 3) == "1970"
+    assert _fmt(338.22, 3) == "338"
+    assert _fmt(54.79, 4) == "54.79"
+    assert _fmt(2.185776e5, 3) == r"2.19\times10^{5}"

@@ -398,7 +398,7 @@ def test_chain_on_measured_frfs_identifies_the_time_records_modes(small_run, mea
 
 
 def test_no_table_cell_prints_more_digits_than_its_interval_supports(default_run):
-    """Tables 3 and 4 of the acceptance run's report: each identified value prints at most the significant digits
+    """Tables 3, 4 and 8 of the acceptance run's report: each identified value prints at most the significant digits
     its interval supports (contactid.latex.significant_digits; 0 where the value is lost in its interval)."""
     import re
 
@@ -428,3 +428,16 @@ def test_no_table_cell_prints_more_digits_than_its_interval_supports(default_run
             assert digits(cells[1]) <= max(allowed, 1), f"{table} {name}: {cells[1]} ({allowed} digits supported)"
             if allowed == 0:
                 assert cells[1] == "$0$", f"{table} {name}: {cells[1]} is lost in its interval"
+    # Table 8 (gap.tex): the friction law's values against their intervals with the model-form term
+    intervals = json.loads((default_run / "results/gap/friction_intervals.json").read_text())["parameters"]
+    tex = (default_run / "results/report/gap.tex").read_text()
+    body = tex[tex.index("tab:intervals") :].split(r"\midrule")[1].split(r"\bottomrule")[0]
+    rows = [line.split(" & ") for line in body.strip().splitlines()]
+    names = ["e_f", "k_c", "e_t", "kappa", "mu", "e0"]
+    assert len(rows) == len(names)
+    for name, cells in zip(names, rows):
+        v = intervals[name]
+        allowed = significant_digits(v["value"], *v["interval"])
+        assert digits(cells[1]) <= max(allowed, 1), f"Table 8 {name}: {cells[1]} ({allowed} digits supported)"
+        if allowed == 0:
+            assert cells[1] == "$0$", f"Table 8 {name}: {cells[1]} is lost in its interval"

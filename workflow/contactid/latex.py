@@ -25,8 +25,8 @@ def _fmt(v, digits: int = 4) -> str:
     if v == 0:
         return "0"
     e = int(math.floor(math.log10(abs(v))))
-    if -3 <= e < 5:
-        return f"{v:.{max(digits - 1 - e, 0)}f}" if e < digits else f"{v:.0f}"
+    if -3 <= e < 5:  # plain notation; a value with more integer digits than ``digits`` is rounded to them
+        return f"{v:.{max(digits - 1 - e, 0)}f}" if e < digits else f"{round(v, digits - 1 - e):.0f}"
     m = v / 10**e
     return f"{m:.{digits - 1}f}\\times10^{{{e}}}"
 

@@ -144,8 +144,10 @@ def intervals_text(intervals: dict | None) -> str:
                 "hi": "high",
             },
             "Friction law: profile-likelihood interval and the 95\\,\\% interval with the "
-            "model-form term (spreads over load cases and structures).",
+            "model-form term (spreads over load cases and structures); each value printed to the digits that "
+            "interval supports.",
             "tab:intervals",
+            intervals={"value": ("lo", "hi")},
         )
     )
 
