@@ -116,7 +116,7 @@ rule harmonic_study:
     params:
         code=CODE_DIGEST,
         structure=config["structure"],
-        counts=config["nonlinear"].get("harmonic_study", [5, 10, 15, 20, 25, 30]),
+        counts=config["nonlinear"]["harmonic_study"],
     conda:
         "../envs/contactid.yaml"
     log:
