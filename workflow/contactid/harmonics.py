@@ -11,7 +11,8 @@ import numpy as np
 
 def harmonic_amplitudes(signal: np.ndarray, t: np.ndarray, w: float, harmonics) -> np.ndarray:
     """Complex amplitudes c_h of signal ~ mean + sum_h Im(c_h exp(i h w t)) by least squares
-    (t in s, w in rad/s; valid on any window, whole number of periods or not)."""
+    (t in s, w in rad/s; valid on any window, whole number of periods or not). ``signal`` (n,) or (n, k): k
+    signals sampled at the same times, solved together (c of shape (H, k))."""
     harmonics = list(harmonics)
     cols = [np.ones_like(t)]
     for h in harmonics:

@@ -48,7 +48,8 @@ def _aligned(force_coef: np.ndarray, coefs: np.ndarray) -> tuple[np.ndarray, np.
 
 
 def _harmonics(x: np.ndarray, t: np.ndarray, w: float, H: int) -> np.ndarray:
-    return np.array([harmonic_amplitudes(row, t, w, range(1, H + 1)) for row in np.atleast_2d(x)])
+    """Harmonics 1..H of every row of x, one least-squares solve for all rows (one design matrix)."""
+    return harmonic_amplitudes(np.atleast_2d(x).T, t, w, range(1, H + 1)).T
 
 
 def record_harmonics(raw: xr.Dataset, case: str, n_harmonics: int, n_blocks: int = 8) -> RecordHarmonics:

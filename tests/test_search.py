@@ -1,0 +1,48 @@
+"""The residual-vector searches of the gap's calibration (contactid.gap.search): known minima, few evaluations."""
+
+import numpy as np
+import pytest
+
+from contactid.gap.search import quadratic_model_minimum, residual_line_search
+
+
+def test_a_quadratic_residual_is_minimised_exactly_by_its_model():
+    # r(t) = (t - 0.3, 2 (t - 0.3) + 0.5 (t - 0.3)^2, 0.1): ||r||^2 has its only minimum at t = 0.3
+    def r(t):
+        return np.array([t - 0.3, 2 * (t - 0.3) + 0.5 * (t - 0.3) ** 2, 0.1])
+
+    ts = [0.0, 0.5, 1.0]
+    assert quadratic_model_minimum(ts, [r(t) for t in ts], 0.0, 1.0) == pytest.approx(0.3, abs=1e-12)
+    # complex entries count by their real and imaginary parts; a minimum outside the interval lands on its end
+    rc = [np.array([1j * (t - 2.0)]) for t in ts]
+    assert quadratic_model_minimum(ts, rc, 0.0, 1.0) == pytest.approx(1.0)
+    with pytest.raises(ValueError, match="three distinct"):
+        quadratic_model_minimum([0.0, 0.0, 1.0], [r(0.0)] * 3, 0.0, 1.0)
+
+
+def test_the_line_search_lands_within_its_tolerance_in_a_few_evaluations():
+    # a smooth non-quadratic residual: ||r||^2 = (sin t - 0.3)^2 + (t^2 - 0.1)^2 + 0.01, minimum found on a fine grid
+    calls = []
+
+    def r(t):
+        calls.append(t)
+        return np.array([np.sin(t) - 0.3, t * t - 0.1, 0.1 + 0j])
+
+    fine = np.linspace(0.0, 1.0, 20001)
+    truth = fine[np.argmin([np.linalg.norm(r(t)) for t in fine])]
+    calls.clear()
+    points = {t: r(t) for t in (0.0, 0.5, 1.0)}
+    calls.clear()
+    best = residual_line_search(r, points, 0.0, 1.0, xatol=1e-3, max_evaluations=12)
+    assert abs(best - truth) <= 1e-3
+    assert len(calls) <= 4  # Brent's bounded search needs 8-12 for the same tolerance
+    assert set(calls) <= set(points)
+
+
+def test_an_unsimulable_point_is_never_chosen():
+    def r(t):
+        return None if t > 0.6 else np.array([t - 0.5])
+
+    points = {0.0: r(0.0), 0.4: r(0.4), 0.55: r(0.55), 0.9: None}
+    best = residual_line_search(r, points, 0.0, 1.0, xatol=1e-4, max_evaluations=6)
+    assert best == pytest.approx(0.5, abs=1e-4)

@@ -1,0 +1,86 @@
+"""Searches over a candidate's parameters that use the gap's residual vector, not only its norm.
+
+The calibration gap is the norm of a residual vector r(theta) (the sensors' harmonics, ``refit.gap_residual``),
+smooth in theta wherever the contact stays closed. A one-parameter search that models r itself by a quadratic
+through three evaluated points, and minimises the norm of that model (a quartic), lands within the search's
+tolerance in two to four evaluations where a bounded Brent search on the norm alone needs eight to twelve to certify
+the same tolerance (measured on the default data and three one-effect data sets, ``benchmarks/gap_diagnosis.py``).
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+
+
+def _stacked(r: np.ndarray) -> np.ndarray:
+    r = np.asarray(r).ravel()
+    return np.concatenate([r.real, r.imag]) if np.iscomplexobj(r) else r.astype(float)
+
+
+def quadratic_model_minimum(thetas, residuals, low: float, high: float) -> float:
+    """theta in [low, high] minimising ||q(theta)||, q the vector quadratic through three points (theta_i, r_i)
+    (Lagrange form, per residual entry; complex entries as real and imaginary parts)."""
+    t = np.asarray(thetas, dtype=float)
+    if t.size != 3 or len(set(t.tolist())) != 3:
+        raise ValueError("quadratic_model_minimum: give three distinct thetas")
+    R = np.array([_stacked(r) for r in residuals])
+    s0 = t[1]
+    s = t - s0
+    # q(s) = a + b s + c s^2 through (s_i, R_i)
+    V = np.vstack([np.ones(3), s, s**2]).T
+    a, b, c = np.linalg.solve(V, R)
+    # ||q||^2 = aa + 2ab s + (bb + 2ac) s^2 + 2bc s^3 + cc s^4; its derivative's real roots in the interval
+    deriv = [4 * c @ c, 6 * b @ c, 2 * (b @ b + 2 * a @ c), 2 * a @ b]
+    lo, hi = low - s0, high - s0
+    cand = [lo, hi]
+    if np.any(np.abs(deriv) > 0):
+        for z in np.roots(np.trim_zeros(np.array(deriv), "f")):
+            if abs(z.imag) <= 1e-12 * max(1.0, abs(z.real)) and lo <= z.real <= hi:
+                cand.append(float(z.real))
+    cand = np.array(cand)
+    f = [np.sum((a + b * x + c * x * x) ** 2) for x in cand]
+    return float(s0 + cand[int(np.argmin(f))])
+
+
+def residual_line_search(
+    residual: Callable[[float], np.ndarray | None],
+    points: dict,
+    low: float,
+    high: float,
+    xatol: float,
+    max_evaluations: int,
+) -> float:
+    """The theta in [low, high] with the smallest ||residual(theta)||, by successive vector-quadratic models.
+
+    points: {theta: residual vector} already evaluated (at least three in [low, high]; residual None where the
+    model could not be simulated). Each step fits the quadratic through the best point and its nearest evaluated
+    neighbours on either side (or the two nearest), moves to its minimum within the neighbours' bracket, and stops
+    when that minimum lies within ``xatol`` of an evaluated point or after ``max_evaluations`` new evaluations.
+    Returns the best evaluated theta (of ``points`` and the new ones; ``points`` is updated)."""
+
+    def norm(th):
+        r = points[th]
+        return np.inf if r is None else float(np.linalg.norm(r))
+
+    for _ in range(max_evaluations + 1):
+        ok = sorted(th for th in points if low <= th <= high and points[th] is not None)
+        if len(ok) < 3:
+            break
+        best = min(ok, key=norm)
+        i = ok.index(best)
+        lo_b = ok[i - 1] if i > 0 else low
+        hi_b = ok[i + 1] if i + 1 < len(ok) else high
+        trio = ok[max(0, min(i - 1, len(ok) - 3)) :][:3]
+        try:
+            nxt = quadratic_model_minimum(trio, [points[th] for th in trio], lo_b, hi_b)
+        except np.linalg.LinAlgError:
+            break
+        if min(abs(nxt - th) for th in points) <= xatol:
+            break
+        if _ == max_evaluations:
+            break
+        points[nxt] = residual(nxt)
+    ok = [th for th in points if low <= th <= high]
+    return min(ok, key=norm)
