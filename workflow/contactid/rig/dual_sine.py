@@ -55,8 +55,11 @@ def dual_sine_settings(rig_cfg: Mapping, case_cfg: Mapping, sampling_rate_hz: fl
 
 
 def contact_parameters(structure_cfg: Mapping, rig_cfg: Mapping) -> ContactParameters:
-    """The rig's true contact laws with the configured effects."""
-    truth = rig_cfg["truth"]
+    """The rig's true contact laws with the configured effects (keys of ``rig.truth`` left out: the schema's
+    defaults, for a config not validated by the Snakefile)."""
+    from ..config import with_defaults
+
+    truth = with_defaults({"rig": {"truth": rig_cfg["truth"]}})["rig"]["truth"]
     fr = ValanisParameters.from_config(truth["friction"])
     n0 = float(true_structure_config(structure_cfg, rig_cfg)["preload_n"])
     law = NormalLaw(n0, float(truth["normal"]["stiffness_at_preload_n_per_m"]), float(truth["normal"]["exponent"]))
@@ -70,8 +73,8 @@ def contact_parameters(structure_cfg: Mapping, rig_cfg: Mapping) -> ContactParam
         viscous=eff["viscous_friction"],
         iwan_share=eff["multi_asperity_friction"],
         preload_drift=eff["preload_drift"],
-        regularization=str(truth["friction"].get("regularization", "none")),
-        cubic=float(truth["normal"].get("cubic_n_per_m3", 0.0)),  # the schema's default: no cubic term
+        regularization=str(truth["friction"]["regularization"]),
+        cubic=float(truth["normal"]["cubic_n_per_m3"]),
     )
 
 
