@@ -21,6 +21,7 @@ import numpy as np
 import xarray as xr
 
 from ..io import RawDataError
+from .readers import datasets58
 
 FRF_FUNCTION, COHERENCE_FUNCTION = 4, 6
 # force-normalised accelerance, with the factor to m/s^2/N
@@ -146,21 +147,11 @@ def frf_sensor_map(block: Mapping, where: str, structure_cfg: Mapping) -> tuple:
 
 def uff58_sets(path: str) -> list:
     """Every dataset 58 of a universal file (pyuff's dicts), with errors that name the file."""
-    import pyuff
-
     if not os.path.exists(path):
         raise RawDataError(f"random_test: file {path!r} not found; correct 'file:'")
     if os.path.getsize(path) == 0:
         raise RawDataError(f"{path}: the file is empty (zero bytes)")
-    try:
-        sets = pyuff.UFF(path).read_sets()
-    except Exception as exc:
-        raise RawDataError(
-            f"{path}: cannot be read as a universal file ({type(exc).__name__}: {exc}); "
-            "write the FRFs as datasets 58 of function type 4"
-        ) from None
-    sets = [sets] if isinstance(sets, dict) else list(sets)
-    return [s for s in sets if isinstance(s, dict) and s.get("type") == 58]
+    return datasets58(path, "write the FRFs as datasets 58 of function type 4")
 
 
 def _dof(s: Mapping) -> tuple:

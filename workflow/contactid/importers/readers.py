@@ -37,25 +37,26 @@ def _missing(path, what, channel, available):
     return RawDataError(f"{path}: {what} {channel!r} not found; the file has {avail}. Correct the channel map")
 
 
-def read_uff58(spec: ImportSpec) -> dict:
-    """Time histories from a universal file (datasets 58, function type 1 = time response,
-    even abscissa), each channel selected by its ID line 1 (``id1``)."""
+def datasets58(path: str, fix: str) -> list:
+    """Every dataset 58 of a universal file (pyuff's dicts); a file pyuff cannot read is refused with an error that
+    names it and ends with ``fix`` (what to write instead)."""
     import pyuff
 
-    path = spec.file
     try:
         sets = pyuff.UFF(path).read_sets()
     except Exception as exc:
-        raise RawDataError(
-            f"{path}: cannot be read as a universal file ({type(exc).__name__}: {exc}); "
-            "write the time histories as datasets 58"
-        ) from None
-    if isinstance(sets, dict):
-        sets = [sets]
+        raise RawDataError(f"{path}: cannot be read as a universal file ({type(exc).__name__}: {exc}); {fix}") from None
+    sets = [sets] if isinstance(sets, dict) else list(sets)
+    return [s for s in sets if isinstance(s, dict) and s.get("type") == 58]
+
+
+def read_uff58(spec: ImportSpec) -> dict:
+    """Time histories from a universal file (datasets 58, function type 1 = time response,
+    even abscissa), each channel selected by its ID line 1 (``id1``)."""
+    path = spec.file
     by_id = {}
-    for s in sets:
-        if isinstance(s, dict) and s.get("type") == 58:
-            by_id.setdefault(str(s.get("id1", "")).strip(), s)
+    for s in datasets58(path, "write the time histories as datasets 58"):
+        by_id.setdefault(str(s.get("id1", "")).strip(), s)
     out = {}
     for ch in spec.channels:
         s = by_id.get(ch.channel.strip())
