@@ -28,7 +28,7 @@ from ..rig.nonlinear import iwan_slip_weights
 from .candidates import Candidate
 from .model import NONE, Augmentation, IdentifiedModel, SimResult, fe_model, simulate
 from .records import RecordHarmonics
-from .search import residual_line_search
+from .search import residual_line_search, stacked
 
 log = logging.getLogger(__name__)
 
@@ -295,42 +295,30 @@ class _CandidateRuns:
         return gap_residual(sim, self.rec, self.n_harmonics) if sim is not None and np.isfinite(g) else None
 
 
-# "residual": the searches model the gap's residual vector (a one-parameter candidate by quadratics,
-# ``search.residual_line_search``; a per-channel one by least squares), the default; "gap": the searches see the gap
-# alone (Brent's bounded search, Nelder-Mead; the plain reference of the benchmarks)
+# "residual": a one-parameter candidate's search models the gap's residual vector by quadratics
+# (``search.residual_line_search``) and a joint refit takes least-squares steps on it, the default; "gap": the searches
+# see the gap alone (Brent's bounded search, Nelder-Mead; the plain reference of the benchmarks)
 SEARCH = contextvars.ContextVar("search", default="residual")
 
 
-# Per-channel delays by least squares (False: Nelder-Mead on the gap, the default). Least squares found the delays a
-# skew leaves more exactly (2.6-3.3e-5 s for 3.4-4.0e-5 s, where Nelder-Mead stopped at 1.5e-5 s), but also a common
-# delay on every channel (-28 us) that stands in for a normal dashpot's dissipation: the blind benchmark's
-# compound-13-s2 then named the channel skew instead of the dashpot (e722a0b).
-PER_CHANNEL_LEAST_SQUARES = False
-
-
 def _per_channel_theta(run: _CandidateRuns, cand: Candidate, rec: RecordHarmonics, max_evaluations: int) -> np.ndarray:
-    """theta of a per-channel candidate (one parameter per accelerometer channel), from zero: by Nelder-Mead on the
-    gap (simplex steps of 10 % of the range), or by least squares on the residual vector where
-    ``PER_CHANNEL_LEAST_SQUARES`` (trust-region reflective within the range, finite-difference steps of 1e-3 of the
-    range); zero where that is no worse."""
+    """theta of a per-channel candidate (one parameter per accelerometer channel): Nelder-Mead on the gap from zero,
+    simplex steps of 10 % of the range; zero where that is no worse. (Least squares on the residual vector found a
+    skew's delays more exactly, but also a common delay on every channel, -28 us, that stood in for a normal dashpot's
+    dissipation: the blind benchmark's compound-13-s2 named the channel skew instead of the dashpot; e722a0b.)"""
     from scipy.optimize import minimize
 
     j = rec.acceleration.shape[0]
     p = cand.parameters[0]
     span = p.high - p.low
-    if SEARCH.get() == "residual" and PER_CHANNEL_LEAST_SQUARES and run.residual(np.zeros(j)) is not None:
-        lo, hi = np.full(j, p.low), np.full(j, p.high)
-        theta = lo + _least_squares_unit(run, lo, hi, (0.0 - lo) / (hi - lo), max_evaluations) * (hi - lo)
-    else:
-        step = 0.1 * span
-        simplex = np.vstack([np.zeros(j), step * np.eye(j)])
-        res = minimize(
-            lambda x: run(np.clip(x, p.low, p.high))[0],
-            np.zeros(j),
-            method="Nelder-Mead",
-            options={"initial_simplex": simplex, "maxfev": 5 * max_evaluations, "xatol": 1e-3 * span, "fatol": 1e-6},
-        )
-        theta = np.clip(res.x, p.low, p.high)
+    simplex = np.vstack([np.zeros(j), 0.1 * span * np.eye(j)])
+    res = minimize(
+        lambda x: run(np.clip(x, p.low, p.high))[0],
+        np.zeros(j),
+        method="Nelder-Mead",
+        options={"initial_simplex": simplex, "maxfev": 5 * max_evaluations, "xatol": 1e-3 * span, "fatol": 1e-6},
+    )
+    theta = np.clip(res.x, p.low, p.high)
     if run(np.zeros(j))[0] <= run(theta)[0]:
         theta = np.zeros(j)
     return theta
@@ -345,11 +333,11 @@ def _least_squares_unit(
     residual)."""
     from scipy.optimize import least_squares
 
-    size = 2 * run.residual(lo + x0 * (hi - lo)).size
+    size = stacked(run.residual(lo + x0 * (hi - lo))).size
 
     def residual(x):
         r = run.residual(lo + np.clip(x, 0.0, 1.0) * (hi - lo))
-        return np.full(size, 1e3) if r is None else np.concatenate([r.real, r.imag])
+        return np.full(size, 1e3) if r is None else stacked(r)
 
     res = least_squares(
         residual,
@@ -365,8 +353,8 @@ def _least_squares_unit(
 
 
 def _scalar_theta(run: _CandidateRuns, cand: Candidate, max_evaluations: int) -> np.ndarray:
-    """theta (1,) of a one-parameter candidate: a scan of the range, the bounded search between the best point's
-    neighbours, and "off" where that is better."""
+    """theta (1,) of a one-parameter candidate: a scan of the range, the search between the best point's neighbours
+    (``SEARCH``), and "off" where that is better."""
     # a scan of the range (1/32, 1/8, 1/4, 1/2, 3/4), then the bounded search between the best point's neighbours:
     # a search over the whole range from its middle can settle in a side basin (the blind benchmark's
     # transducer-mass items: theta 0.35 instead of 0.22, a held-out gap four times larger)

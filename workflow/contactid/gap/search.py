@@ -14,7 +14,8 @@ from typing import Callable
 import numpy as np
 
 
-def _stacked(r: np.ndarray) -> np.ndarray:
+def stacked(r: np.ndarray) -> np.ndarray:
+    """A residual vector as real numbers: complex entries as their real parts, then their imaginary parts."""
     r = np.asarray(r).ravel()
     return np.concatenate([r.real, r.imag]) if np.iscomplexobj(r) else r.astype(float)
 
@@ -25,7 +26,7 @@ def quadratic_model_minimum(thetas, residuals, low: float, high: float) -> float
     t = np.asarray(thetas, dtype=float)
     if t.size != 3 or len(set(t.tolist())) != 3:
         raise ValueError("quadratic_model_minimum: give three distinct thetas")
-    R = np.array([_stacked(r) for r in residuals])
+    R = np.array([stacked(r) for r in residuals])
     s0 = t[1]
     s = t - s0
     # q(s) = a + b s + c s^2 through (s_i, R_i)
@@ -64,7 +65,7 @@ def residual_line_search(
         r = points[th]
         return np.inf if r is None else float(np.linalg.norm(r))
 
-    for _ in range(max_evaluations + 1):
+    for k in range(max_evaluations + 1):
         ok = sorted(th for th in points if low <= th <= high and points[th] is not None)
         if len(ok) < 3:
             break
@@ -79,7 +80,7 @@ def residual_line_search(
             break
         if min(abs(nxt - th) for th in points) <= xatol:
             break
-        if _ == max_evaluations:
+        if k == max_evaluations:
             break
         points[nxt] = residual(nxt)
     ok = [th for th in points if low <= th <= high]
