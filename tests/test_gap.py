@@ -9,7 +9,7 @@ import pytest
 from contactid.gap.candidates import LIBRARY, Candidate, Parameter, register
 from contactid.gap.diagnosis import GapSettings, diagnose, linear_stage
 from contactid.gap.model import Augmentation
-from contactid.harmonics import periodic_harmonics
+from contactid.harmonics import harmonic_amplitudes, periodic_grid, periodic_harmonics
 from contactid.gap.pipeline import identify, rig_records
 from contactid.gap.records import record_harmonics
 from contactid.io import raw_dataset
@@ -51,6 +51,32 @@ def test_periodic_harmonics_exact_from_any_start():
     t = 0.0123 + np.arange(5 * n_per) * (2 * np.pi / w / n_per)
     x = 0.7 + np.imag(c @ np.exp(1j * np.outer(np.arange(1, H + 1) * w, t)))
     assert periodic_harmonics(x, t[0], w, n_per, H)[0] == pytest.approx(c, abs=1e-12)
+
+
+@pytest.mark.parametrize("K, m", [(25, 200), (9, 512), (10, 21), (10, 20), (40, 32)])
+@pytest.mark.parametrize("derivative", [0, 1, -2])
+def test_period_grid_synthesis_equals_the_series_at_those_times(K, m, derivative):
+    # the inverse real FFT (m > 2 K) and the matrix product (otherwise) against the series summed term by term
+    f0 = 54.375
+    c = np.random.default_rng(K * m).normal(size=(3, K)) + 1j * np.random.default_rng(m).normal(size=(3, K))
+    t = np.arange(m) / (m * f0)
+    h = np.arange(1, K + 1)
+    series = sum(
+        np.imag(np.outer(c[:, k] * (1j * h[k] * 2 * np.pi * f0) ** derivative, np.exp(1j * h[k] * 2 * np.pi * f0 * t)))
+        for k in range(K)
+    )
+    assert periodic_grid(c, f0, m, derivative) == pytest.approx(series, abs=1e-11 * np.abs(series).max())
+
+
+def test_whole_period_harmonics_equal_the_least_squares_ones():
+    # the steady-state test of the gap's simulator takes whole periods by FFT; the rig's (no whole steps per
+    # period) by least squares: on whole periods both give the same harmonics
+    w, n_per = 2 * np.pi * 54.375, 760
+    t = 3.7 + np.arange(8 * n_per) * (2 * np.pi / w / n_per)
+    x = 0.3 + 2 * np.sin(w * t + 0.2) + 0.5 * np.cos(3 * w * t) + 0.1 * np.sin(5 * w * t)
+    x = x + 0.01 * np.random.default_rng(0).normal(size=t.size)
+    lsq = harmonic_amplitudes(x, t, w, (1, 3))
+    assert periodic_harmonics(x, t[0], w, n_per, 3)[0, [0, 2]] == pytest.approx(lsq, abs=1e-12)
 
 
 def test_register_refuses_taken_names_and_bad_ranges():

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .beam_model import FEModel, all_modes, shortening_matrix
-from .harmonics import fourier_series, synthesize
+from .harmonics import fourier_series, periodic_grid, synthesize
 
 
 class IdentificationError(ValueError):
@@ -211,7 +211,6 @@ def inverse_harmonics(
     G = shortening_matrix(model)
     n_dof = phi.shape[0]
     M = 8 * K  # one-period grid for the nonlinear term
-    t_grid = np.arange(M) / (M * f0)
     geo_coef = np.zeros((n_dof, K), dtype=complex)  # harmonics of G q S (generalized force)
     W = np.arange(1, K + 1) * w0
     g = 1.0 / (wn[:, None] ** 2 - W[None, :] ** 2 + 2j * zeta[:, None] * wn[:, None] * W[None, :])  # (modes, K)
@@ -228,15 +227,15 @@ def inverse_harmonics(
         residual = np.linalg.norm(misfit, axis=0) / np.maximum(np.linalg.norm(disp, axis=0), 1e-300)
         if n_iterations <= 1:
             break
-        qg = synthesize(q_coef, f0, t_grid, 0)
-        S_g = synthesize(r_coef[:1], f0, t_grid, 0)[0] + p.k_t * (model.xi_vector @ qg)
+        qg = periodic_grid(q_coef, f0, M)
+        S_g = periodic_grid(r_coef[:1], f0, M)[0] + p.k_t * (model.xi_vector @ qg)
         new = period_coefficients((G @ qg) * S_g, K)
         change = np.linalg.norm(new - geo_coef) / max(np.linalg.norm(new), 1e-300)
         geo_coef = new
         if change < 1e-8:
             break
-    qg = synthesize(q_coef, f0, t_grid, 0)
-    qdg = synthesize(q_coef, f0, t_grid, 1)
+    qg = periodic_grid(q_coef, f0, M)
+    qdg = periodic_grid(q_coef, f0, M, 1)
     xi_lin = model.xi_vector @ q_coef
     xi = xi_lin - 0.5 * period_coefficients(_column_forms(qg, G, qg), K)
     xi_dot = period_coefficients(model.xi_vector @ qdg - _column_forms(qg, G, qdg), K)
