@@ -68,6 +68,18 @@ def test_period_grid_synthesis_equals_the_series_at_those_times(K, m, derivative
     assert periodic_grid(c, f0, m, derivative) == pytest.approx(series, abs=1e-11 * np.abs(series).max())
 
 
+@pytest.mark.parametrize("periods", [0.6, 1.5, 2.0, 37.3])
+def test_harmonic_amplitudes_recover_known_ones_on_any_window(periods):
+    # below two periods by least squares (SVD), from two on by the normal equations: both exact on noise-free data
+    w = 2 * np.pi * 54.375
+    c = {1: 1.0 - 2.0j, 3: 0.3 + 0.1j, 7: 0.05j}
+    t = 0.41 + np.arange(int(periods * 5120 / 54.375)) / 5120
+    x = 0.7 + sum(np.imag(ch * np.exp(1j * h * w * t)) for h, ch in c.items())
+    got = harmonic_amplitudes(np.column_stack([x, 2 * x]), t, w, (1, 2, 3, 7))
+    want = np.array([c[1], 0.0, c[3], c[7]])
+    assert got[:, 0] == pytest.approx(want, abs=1e-10) and got[:, 1] == pytest.approx(2 * want, abs=1e-10)
+
+
 def test_whole_period_harmonics_equal_the_least_squares_ones():
     # the steady-state test of the gap's simulator takes whole periods by FFT; the rig's (no whole steps per
     # period) by least squares: on whole periods both give the same harmonics

@@ -13,11 +13,28 @@ def harmonic_amplitudes(signal: np.ndarray, t: np.ndarray, w: float, harmonics) 
     """Complex amplitudes c_h of signal ~ mean + sum_h Im(c_h exp(i h w t)) by least squares
     (t in s, w in rad/s; valid on any window, whole number of periods or not). ``signal`` (n,) or (n, k): k
     signals sampled at the same times, solved together (c of shape (H, k))."""
-    harmonics = list(harmonics)
-    cols = [np.ones_like(t)]
-    for h in harmonics:
-        cols += [np.sin(h * w * t), np.cos(h * w * t)]
-    coef = np.linalg.lstsq(np.column_stack(cols), signal, rcond=None)[0]
+    harmonics = [int(h) for h in harmonics]
+    t = np.asarray(t, dtype=float)
+    # e^{i h w t} by powers of e^{i w t} (about h machine epsilons of error, a tenth of the cost of sin and cos)
+    z = np.exp(1j * w * t)
+    powers = {}
+    zh = np.ones_like(z)
+    for h in range(1, max(harmonics) + 1):
+        zh = zh * z
+        powers[h] = zh
+    X = np.empty((t.size, 1 + 2 * len(harmonics)))
+    X[:, 0] = 1.0
+    for k, h in enumerate(harmonics):
+        X[:, 1 + 2 * k], X[:, 2 + 2 * k] = powers[h].imag, powers[h].real
+    periods = (t[-1] - t[0]) * w / (2 * np.pi) if t.size > 1 else 0.0
+    if periods >= 2.0 and t.size > 4 * X.shape[1]:
+        # two periods or more: the columns are near orthogonal (condition about 1.4), so the normal equations
+        # are as accurate as an SVD (1e-16) at a third of its cost
+        import scipy.linalg
+
+        coef = scipy.linalg.solve(X.T @ X, X.T @ signal, assume_a="pos", check_finite=False)
+    else:
+        coef = np.linalg.lstsq(X, signal, rcond=None)[0]
     # Im(c e^{i h w t}) = Re(c) sin + Im(c) cos
     return coef[1::2] + 1j * coef[2::2]
 
