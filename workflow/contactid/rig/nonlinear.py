@@ -139,7 +139,10 @@ def iwan_slip_weights(n: int, spread: float = 0.8) -> np.ndarray:
 
 
 @njit(cache=True)
-def _contact_state(z, v, xi_v, eta_v, G):
+def _contact_state(z, v, xi_v, eta_v, G, dxi_dq):
+    """xi_lin, xi (with the shortening z G z / 2), eta, their rates; dxi/dq = xi_v - G z is written into ``dxi_dq``
+    (n_r,), a buffer the caller keeps: no array is made per step (the matrix products as loops, equal to them to
+    rounding)."""
     n = z.size
     xi_lin = 0.0
     eta = 0.0
@@ -148,11 +151,16 @@ def _contact_state(z, v, xi_v, eta_v, G):
         xi_lin += xi_v[i] * z[i]
         eta += eta_v[i] * z[i]
         deta += eta_v[i] * v[i]
-    gz = G @ z
-    short = 0.5 * (z @ gz)
-    dxi_dq = xi_v - gz
-    dxi = dxi_dq @ v
-    return xi_lin, xi_lin - short, dxi_dq, eta, deta, dxi
+    short = 0.0
+    dxi = 0.0
+    for i in range(n):
+        gz = 0.0
+        for j in range(n):
+            gz += G[i, j] * z[j]
+        short += z[i] * gz
+        dxi_dq[i] = xi_v[i] - gz
+        dxi += dxi_dq[i] * v[i]
+    return xi_lin, xi_lin - 0.5 * short, eta, deta, dxi
 
 
 @njit(cache=True)
@@ -368,7 +376,8 @@ def integrate(z, v, state, x_sl, t0, n_steps, dt, model, contact, drive, store_f
     c = 2.0 * zeta * omega
     om2 = omega * omega
     S_val = state[0]
-    xi_lin, xi, dxi_dq, eta, deta, dxi = _contact_state(z, v, xi_v, eta_v, G)
+    dxi_dq = np.empty(z.size)
+    xi_lin, xi, eta, deta, dxi = _contact_state(z, v, xi_v, eta_v, G, dxi_dq)
     N = _normal_force(eta, deta, n0, delta0, p, hc, unilateral, cubic)
     P = n0
     a = np.empty(n)
@@ -388,7 +397,7 @@ def integrate(z, v, state, x_sl, t0, n_steps, dt, model, contact, drive, store_f
         t = t0 + (step + 1) * dt
         xi_old = xi
         N_old = N
-        xi_lin, xi, dxi_dq, eta, deta, dxi = _contact_state(z, v, xi_v, eta_v, G)
+        xi_lin, xi, eta, deta, dxi = _contact_state(z, v, xi_v, eta_v, G, dxi_dq)
         N = _normal_force(eta, deta, n0, delta0, p, hc, unilateral, cubic)  # explicit estimate for the friction law
         S_val = valanis_step(S_val, xi_old, xi, N_old, N, e_f, k_c, e_t, kappa, mu, 1e-6, slip_limit)
         S_tot = _friction_force(S_val, xi, dxi, N, x_sl, contact, no_flags)
@@ -604,6 +613,21 @@ def _log_unsteady_stop(it: int, F: np.ndarray, A: np.ndarray, unsteady: int) -> 
     )
 
 
+def _log_scatter_stop(it: int, F: np.ndarray, A: np.ndarray, scatter: float) -> None:
+    """Log that the control stops at iteration ``it`` (from 0) with an unsteady response on target within its
+    scatter (relative)."""
+    progress.info(
+        "response control %d: F1 = %.4g N, F3 = %.4g N -> A1 = %.4g, A3 = %.4g m/s^2 (mean of 10 chunks): the motion "
+        "does not settle, but is on target within twice its scatter (%.2g %%); the control stops here",
+        it + 1,
+        F[0],
+        F[1],
+        A[0],
+        A[1],
+        100 * scatter,
+    )
+
+
 def _log_iteration(it: int, F: np.ndarray, A: np.ndarray, target: np.ndarray, ok: bool) -> None:
     """Log iteration ``it`` (from 0) of the control: force (N), response and targets (m/s^2), steady or not."""
     progress.info(
@@ -665,6 +689,8 @@ def control_response(
     tol: float = 1e-3,
     max_iter: int = 40,
     max_unsteady: int = 12,
+    max_chunks: int = 60,
+    max_scatter_tolerance: float = 0.02,
 ) -> ControlResult:
     """Tune F1, F3 until the driving-point acceleration harmonics at w and 3w
     equal the targets within ``tol`` (relative): Broyden's method on
@@ -673,7 +699,15 @@ def control_response(
     force that gave a finite response, from that force's state. A response that has not settled for
     ``max_unsteady`` iterations in a row (impacts that keep the motion from becoming periodic) ends the control
     there, unconverged, as a test engineer would stop (the blind benchmark's contact-separation items ran all 40
-    iterations on lc3, 22 s each, without settling)."""
+    iterations on lc3, 22 s each, without settling).
+
+    Each iteration lets the response settle for at most ``max_chunks`` chunks of 8 periods (a settling response
+    took at most 24 on the default load cases, with and without effects). One that does not settle is measured
+    as a test engineer's controller would: its amplitudes averaged over the last ten chunks, and their scatter
+    (relative standard deviation). The control then stops, unconverged, once that average is on target within
+    twice the scatter (at most ``max_scatter_tolerance``): closer than its own scatter it cannot be told apart.
+    Before, such a response ran 200 chunks an iteration until ``max_unsteady``, 14-23 s for the small config's
+    separating lc1, with a path (and a cost) that changed with the last digit of the arithmetic."""
     h1, h3 = abs(sim.linear_frf(w)), abs(sim.linear_frf(3 * w))
     target = np.array([target_a1, target_a3])
     F = target / np.array([h1, h3])
@@ -685,8 +719,12 @@ def control_response(
     good = None  # (F, simulator state) of the last finite response
     unsteady = 0
     for it in range(max_iter):
-        c, log, ok = sim.settle(F[0], F[1], w)
-        A = np.abs(c)
+        c, log, ok = sim.settle(F[0], F[1], w, max_chunks=max_chunks)
+        A, scatter = np.abs(c), 0.0
+        if not ok and len(log.a1) >= 10:
+            chunks = np.array([log.a1[-10:], log.a3[-10:]])
+            A = chunks.mean(axis=1)
+            scatter = float(np.max(chunks.std(axis=1) / A))
         history.append((float(F[0]), float(F[1]), float(A[0]), float(A[1]), bool(ok)))
         unsteady = 0 if ok else unsteady + 1
         if unsteady >= max_unsteady and np.all(np.isfinite(A)):
@@ -700,6 +738,9 @@ def control_response(
         _log_iteration(it, F, A, target, ok)
         if ok and np.max(np.abs(r) / target) < tol:
             return ControlResult(float(F[0]), float(F[1]), float(A[0]), float(A[1]), True, history, log)
+        if not ok and np.max(np.abs(r) / target) < max(tol, min(2.0 * scatter, max_scatter_tolerance)):
+            _log_scatter_stop(it, F, A, scatter)
+            return ControlResult(float(F[0]), float(F[1]), float(A[0]), float(A[1]), False, history, log)
         if prev is not None:
             J = _broyden_jacobian(J, F - prev[0], A - prev[1])
         prev = (F.copy(), A.copy())
