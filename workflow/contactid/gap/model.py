@@ -380,7 +380,7 @@ def _marched_result(
             sim.drift_rate = aug.preload_drift / (n_rec * sim.dt)
         else:
             n_rec = int(record_periods) * n_per
-        out = sim.run(coef, None, w, n_rec, store_from=0)
+        out = sim.run(coef, None, w, n_rec, store_from=0, state=False)
     acc = (out["a"] @ sim.red.sensors.T).T
     t1 = out["t"][0]
     if aug.preload_drift:
