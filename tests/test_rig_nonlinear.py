@@ -105,7 +105,11 @@ def test_effects_off_are_bit_identical_and_on_change_the_response(default_config
     assert np.array_equal(raw_off["acceleration"].values, raw0["acceleration"].values)
     assert np.array_equal(raw_off["force"].values, raw0["force"].values)
     s = small_config
-    df = effect_study(s["structure"], s["rig"], s["load_cases"]["lc1"], FS).set_index("effect")
+    # contact separation at 7.1x rather than its typical 7.2x: the small config's lc1 separates there too, and
+    # settles, where at 7.2x the impacts keep it from settling (a response control of 14-23 s)
+    df = effect_study(
+        s["structure"], s["rig"], s["load_cases"]["lc1"], FS, magnitudes={"contact_separation": 7.1}
+    ).set_index("effect")
     assert set(df.index) == set(EFFECTS)
     changed = df[["F1_change_pct", "F3_change_pct", "drive_acceleration_nrmse_pct"]].abs().max(axis=1)
     assert (changed > 0.5).all(), changed
