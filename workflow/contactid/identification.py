@@ -218,6 +218,7 @@ def inverse_harmonics(
     Amat = np.stack([-(sens @ (g * b_xi[:, None])), sens @ (g * b_eta[:, None])], axis=-1).transpose(1, 0, 2)
     Apinv = np.linalg.pinv(Amat)  # (K, 2, j): the least-squares solution of each harmonic's 2 unknowns
     disp = A_coef / (-(W**2))  # sensor displacements (j, K)
+    qg = None  # q on the period grid, of the latest q_coef
     for it in range(max(1, n_iterations)):
         known = g * (b_f[:, None] * F_coef[None, :K] + phi.T @ geo_coef)  # modal (modes, K)
         rhs = disp - sens @ known
@@ -234,7 +235,8 @@ def inverse_harmonics(
         geo_coef = new
         if change < 1e-8:
             break
-    qg = periodic_grid(q_coef, f0, M)
+    if qg is None:  # a single pass: the loop stopped before the grid
+        qg = periodic_grid(q_coef, f0, M)
     qdg = periodic_grid(q_coef, f0, M, 1)
     xi_lin = model.xi_vector @ q_coef
     xi = xi_lin - 0.5 * period_coefficients(_column_forms(qg, G, qg), K)
