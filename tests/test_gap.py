@@ -80,6 +80,17 @@ def test_harmonic_amplitudes_recover_known_ones_on_any_window(periods):
     assert got[:, 0] == pytest.approx(want, abs=1e-10) and got[:, 1] == pytest.approx(2 * want, abs=1e-10)
 
 
+def test_harmonic_amplitudes_of_a_repeated_or_nyquist_harmonic_are_the_least_squares_ones():
+    # a design the normal equations cannot take (a harmonic twice, or one at Nyquist) gets the SVD's
+    # minimum-norm solution, over many periods too
+    w = 2 * np.pi * 54.375
+    t = np.arange(4000) / 5120
+    twice = harmonic_amplitudes(np.sin(3 * w * t), t, w, (3, 1, 3))
+    assert twice == pytest.approx([0.5, 0.0, 0.5], abs=1e-12)
+    nyquist = harmonic_amplitudes(np.cos(np.pi * 5120 * t), t, 2 * np.pi * 256.0, (1, 10))
+    assert np.abs(nyquist) == pytest.approx([0.0, 1.0], abs=1e-12)
+
+
 def test_whole_period_harmonics_equal_the_least_squares_ones():
     # the steady-state test of the gap's simulator takes whole periods by FFT; the rig's (no whole steps per
     # period) by least squares: on whole periods both give the same harmonics

@@ -16,20 +16,22 @@ def harmonic_amplitudes(signal: np.ndarray, t: np.ndarray, w: float, harmonics) 
     harmonics = [int(h) for h in harmonics]
     t = np.asarray(t, dtype=float)
     # e^{i h w t} by powers of e^{i w t} (about h machine epsilons of error, a tenth of the cost of sin and cos)
-    z = np.exp(1j * w * t)
-    powers = {}
-    zh = np.ones_like(z)
-    for h in range(1, max(harmonics) + 1):
-        zh = zh * z
-        powers[h] = zh
     X = np.empty((t.size, 1 + 2 * len(harmonics)))
     X[:, 0] = 1.0
-    for k, h in enumerate(harmonics):
-        X[:, 1 + 2 * k], X[:, 2 + 2 * k] = powers[h].imag, powers[h].real
-    periods = (t[-1] - t[0]) * w / (2 * np.pi) if t.size > 1 else 0.0
-    if periods >= 2.0 and t.size > 4 * X.shape[1]:
-        # two periods or more: the columns are near orthogonal (condition about 1.4), so the normal equations
-        # are as accurate as an SVD (1e-16) at a third of its cost
+    z = np.exp(1j * w * t)
+    zh = np.ones_like(z)
+    for h in range(1, max(harmonics, default=0) + 1):
+        zh = zh * z
+        for k in (k for k, hk in enumerate(harmonics) if hk == h):
+            X[:, 1 + 2 * k], X[:, 2 + 2 * k] = zh.imag, zh.real
+    span = t[-1] - t[0] if t.size > 1 else 0.0
+    periods = span * w / (2 * np.pi)
+    # the highest harmonic's phase advance per sample, against pi (Nyquist: its sine column would vanish)
+    top = max(harmonics, default=0) * w * span / max(t.size - 1, 1)
+    if periods >= 2.0 and t.size > 4 * X.shape[1] and len(set(harmonics)) == len(harmonics) and top < 0.9 * np.pi:
+        # two periods or more of distinct harmonics below Nyquist: the columns are near orthogonal (condition about
+        # 1.4), so the normal equations are as accurate as an SVD (1e-16) at a third of its cost; otherwise the
+        # SVD least squares (a repeated or aliased harmonic: the minimum-norm solution, as before)
         import scipy.linalg
 
         coef = scipy.linalg.solve(X.T @ X, X.T @ signal, assume_a="pos", check_finite=False)
