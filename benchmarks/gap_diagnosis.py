@@ -94,12 +94,23 @@ def effect_data(cfg, effect, magnitude):
     return {"linear_modes": modes, "modal": modal, "frf": frf, "friction_fit": fit}, {c: recs[c] for c in cases}
 
 
+def _reference_fit(fit):
+    """The friction fit as REFERENCE reads it: one variable ``parameter_value`` over the parameters (today's dataset
+    has a variable per parameter, ``contactid.friction_parameters``)."""
+    import xarray as xr
+
+    from contactid.friction_parameters import PARAMETER_NAMES, fitted_parameters
+
+    return xr.Dataset({"parameter_value": ("parameter", fitted_parameters(fit))}, coords={"parameter": list(PARAMETER_NAMES)})
+
+
 def run(pkg, method, memo, ds, raw, cfg, warm_up=False, workers=1, search="residual"):
     """One diagnosis with package ``pkg`` (contactid or contactid_ref) on the datasets and raw records: steady states
     by ``method``, memos on or off, the calibration searches on the residual vector or the gap alone (``search``)."""
     gm = importlib.import_module(f"{pkg}.gap.model")
     gd = importlib.import_module(f"{pkg}.gap.diagnosis")
-    model = gm.identified_model(cfg["structure"], ds["linear_modes"], ds["modal"], ds["friction_fit"])
+    fit = ds["friction_fit"] if pkg == "contactid" else _reference_fit(ds["friction_fit"])
+    model = gm.identified_model(cfg["structure"], ds["linear_modes"], ds["modal"], fit)
     K = cfg["nonlinear"]["n_harmonics"]
     records = {c: importlib.import_module(f"{pkg}.gap.records").record_harmonics(r, c, K) for c, r in raw.items()}
     lin = gd.linear_stage(model, ds["frf"], ds["modal"])
