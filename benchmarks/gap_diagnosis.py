@@ -101,7 +101,9 @@ def _reference_fit(fit):
 
     from contactid.friction_parameters import PARAMETER_NAMES, fitted_parameters
 
-    return xr.Dataset({"parameter_value": ("parameter", fitted_parameters(fit))}, coords={"parameter": list(PARAMETER_NAMES)})
+    return xr.Dataset(
+        {"parameter_value": ("parameter", fitted_parameters(fit))}, coords={"parameter": list(PARAMETER_NAMES)}
+    )
 
 
 def run(pkg, method, memo, ds, raw, cfg, warm_up=False, workers=1, search="residual"):

@@ -550,3 +550,31 @@ def test_a_pair_that_together_shrinks_the_gap_materially_is_added():
     # nor where what is left is within 3 x min_gap (0.018): model form, mostly
     steps, _, tried = _explain({"normal_contact_damping": 0.012}, [second], before=0.017, settings=on)
     assert steps == [] and tried == []
+
+
+def test_contact_opens_tells_a_separating_law_from_a_stiffer_closed_one():
+    from types import SimpleNamespace
+
+    from contactid.gap.diagnosis import contact_opens
+    from contactid.gap.report import explanation_text
+
+    def sim(n_min):
+        return SimpleNamespace(grid={"N": 70.0 + (70.0 - n_min) * np.cos(np.linspace(0, 2 * np.pi, 64))})
+
+    cal = SimpleNamespace(model=SimpleNamespace(preload=70.0), simulation=sim(40.0))
+    assert contact_opens(cal, {"lc2": sim(35.0), "lc3": sim(20.0)}, 0.02) is False
+    # 1.4 N = 0.02 x 70 N is open; one scored case reaching it is enough
+    assert contact_opens(cal, {"lc2": sim(35.0), "lc3": sim(1.3)}, 0.02) is True
+    assert contact_opens(cal, {"lc2": sim(35.0), "lc3": sim(1.5)}, 0.02) is False
+    assert contact_opens(SimpleNamespace(candidate="x"), {"lc2": 0.01}, 0.02) is None  # nothing to tell from
+    step = {
+        "effect": "contact_separation",
+        "parameters": {"exponent": 1.0, "stiffness_factor": 2.3},
+        "heldout_gap_before": 0.03,
+        "heldout_gap_after": 0.004,
+        "share": 0.98,
+    }
+    left = {"heldout_gap": 0.004, "share": 0.02, "at_floor": True, "floor": 0.006}
+    closed = explanation_text({"explanation": [{**step, "contact_opens": False}], "remaining_gap": left})
+    opened = explanation_text({"explanation": [{**step, "contact_opens": True}], "remaining_gap": left})
+    assert "never opens" in closed and "never opens" not in opened

@@ -641,6 +641,19 @@ def _parameter_values(name: str, cal=None, theta=None) -> dict:
     }
 
 
+def contact_opens(cal, sims: Mapping, open_limit: float) -> bool | None:
+    """Whether a calibrated candidate's model opens the contact anywhere: its N falls to ``open_limit`` x the
+    preload or below over the period, in the calibration case's simulation or a scored case's (None: no simulation
+    to tell). A normal law that may open (contact_separation) but never does in these simulations acts as a stiffer
+    or harder normal law than Eq. 13's spring: model form, not separation (the compound benchmark's hardening rigs,
+    docs/gap.md)."""
+    runs = [getattr(cal, "simulation", None), *sims.values()]
+    grids = [sim.grid["N"] for sim in runs if isinstance(getattr(sim, "grid", None), dict) and "N" in sim.grid]
+    if not grids or getattr(cal, "model", None) is None:
+        return None
+    return any(bool(np.min(N) <= open_limit * cal.model.preload) for N in grids)
+
+
 def explain(
     first: dict,
     names: list,
@@ -706,6 +719,7 @@ def explain(
                     "parameters": _parameter_values(name, cal),
                     "heldout_gap_before": gap,
                     "heldout_gap_after": after,
+                    "contact_opens": contact_opens(cal, sims, getattr(settings, "place", DEFAULT_PLACE).open_limit),
                 }
             )
             if len(cal.steps) > 1:  # the earlier steps' parameters as refitted with this one (gap.joint_refit)

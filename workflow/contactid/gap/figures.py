@@ -309,7 +309,8 @@ def explanation(diag: dict, png: str, pdf: str | None = None):
     fig, ax = plt.subplots(figsize=(W, 3.0))
     labels, bottoms, heights, colors = ["identified model"], [0.0], [100 * before], ["0.5"]
     for s in steps:
-        labels.append(f"+ {_name(s['effect'])}\n({100 * s['share']:.0f} % of the power)")
+        law = " (never opens)" if s["effect"] == "contact_separation" and s.get("contact_opens") is False else ""
+        labels.append(f"+ {_name(s['effect'])}{law}\n({100 * s['share']:.0f} % of the power)")
         bottoms.append(100 * s["heldout_gap_after"])
         heights.append(100 * (s["heldout_gap_before"] - s["heldout_gap_after"]))
         colors.append("tab:green")

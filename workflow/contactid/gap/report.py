@@ -48,6 +48,16 @@ def _pct(x) -> str:
     return "--" if x is None else f"${_fmt(100 * float(x), 3)}$\\,\\%"
 
 
+def _law_note(step: dict) -> str:
+    """For a contact-separation step whose law never opens the contact: what it stands for instead."""
+    if step.get("effect") == "contact_separation" and step.get("contact_opens") is False:
+        return (
+            r" (its law never opens the contact here: it stands for a stiffer or harder normal law than "
+            r"Eq.~13's spring, model form rather than separation)"
+        )
+    return ""
+
+
 def explanation_text(diag: dict) -> str:
     """The additive explanation in words (Fig. gap_explanation)."""
     steps, left = diag.get("explanation") or [], diag.get("remaining_gap") or {}
@@ -61,6 +71,7 @@ def explanation_text(diag: dict) -> str:
     else:
         parts = [
             _t(s["effect"])
+            + _law_note(s)
             + r" (refitted: "
             + ", ".join(f"{_t(k)} $= {_fmt(v, 3)}$" for k, v in s["parameters"].items())
             + r") takes the held-out gap from "
