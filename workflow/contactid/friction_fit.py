@@ -170,8 +170,9 @@ def _ga(problem: _Problem, settings: FitSettings, seed: int, label: str = "frict
         random.setstate(state)
 
 
-def _polish(problem: _Problem, u0, fixed: dict | None = None):
-    """Least-squares polish in the unit cube; ``fixed`` {index: unit value} holds parameters."""
+def _polish(problem: _Problem, u0, fixed: dict | None = None, xtol: float = 1e-10, ftol: float = 1e-12):
+    """Least-squares polish in the unit cube; ``fixed`` {index: unit value} holds parameters; ``xtol``, ``ftol``:
+    scipy's least_squares tolerances (the chain's fit and its intervals keep the tight defaults)."""
     fixed = fixed or {}
     free = [i for i in range(5) if i not in fixed]
 
@@ -202,9 +203,7 @@ def _polish(problem: _Problem, u0, fixed: dict | None = None):
     threads = numba.get_num_threads()
     numba.set_num_threads(1)  # a handful of sets per call: parallel threads cost more than they give
     try:
-        r = least_squares(
-            fun, np.clip(u0[free], 0, 1), jac=jac, bounds=(0.0, 1.0), x_scale=0.05, xtol=1e-10, ftol=1e-12
-        )
+        r = least_squares(fun, np.clip(u0[free], 0, 1), jac=jac, bounds=(0.0, 1.0), x_scale=0.05, xtol=xtol, ftol=ftol)
     finally:
         numba.set_num_threads(threads)
     return full(r.x), float(np.sum(r.fun**2)), r
