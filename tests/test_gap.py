@@ -381,6 +381,20 @@ def _synthetic_diagnosis(steps, verdict="none", after=None):
             "transducer_mass_error",
             0.01,
         ),
+        (  # a contact-separation law that never opens (a stiffer normal law): said in words and on the waterfall
+            [
+                {
+                    "effect": "contact_separation",
+                    "parameters": {"exponent": 1.0, "stiffness_factor": 2.3},
+                    "heldout_gap_before": 0.04,
+                    "heldout_gap_after": 0.005,
+                    "share": 0.98,
+                    "contact_opens": False,
+                }
+            ],
+            "none",
+            0.005,
+        ),
     ],
 )
 def test_every_figure_and_the_report_section_for_any_diagnosis(tmp_path, steps, verdict, after):
@@ -395,7 +409,9 @@ def test_every_figure_and_the_report_section_for_any_diagnosis(tmp_path, steps, 
         assert path.stat().st_size > 1000
     text = gap_section(diag, None)
     assert "Step by step" in text and "{gap_explanation.pdf}" in text
-    if steps:
+    if steps and steps[0].get("contact_opens") is False:
+        assert "never opens the contact here" in text
+    elif steps:
         assert (
             "normal\\_contact\\_damping" in text
             and "mass\\_error $= -0.300$" in text
