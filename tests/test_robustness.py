@@ -54,15 +54,25 @@ def _job_running(proj: Path, rule: str) -> bool:
     return False
 
 
-def _interrupt_during(p: subprocess.Popen, proj: Path, rule: str, sig, timeout=600) -> str:
-    """Send ``sig`` to the whole run (snakemake and its job) while ``rule``'s script is running; its output."""
+def _interrupt_during(p: subprocess.Popen, proj: Path, rule: str, sig, timeout=600, started: str | None = None) -> str:
+    """Send ``sig`` to the whole run (snakemake and its job) while ``rule``'s script is running; its output.
+    ``started``: a line of the job's log (logs/<rule>.log) that shows its computation under way; the signal follows
+    it at once (a fixed second after the script's start came, on a busy machine, when a 2-s job was nearly done and
+    its output written). Without it, the signal comes one second after the script starts."""
     t0 = time.time()
     while not _job_running(proj, rule):
         assert p.poll() is None, "the run ended before the job to interrupt started"
         assert time.time() - t0 < timeout, f"{rule} never started"
         time.sleep(0.05)
-    time.sleep(1.0)  # inside the job's computation
-    assert _job_running(proj, rule), f"{rule} ended within a second; nothing was interrupted"
+    if started is None:
+        time.sleep(1.0)  # inside the job's computation
+    else:
+        log = proj / "logs" / f"{rule}.log"
+        while not (log.exists() and started in log.read_text(errors="replace")):
+            assert _job_running(proj, rule), f"{rule} ended before its log showed {started!r}"
+            assert time.time() - t0 < timeout, f"{rule}'s log never showed {started!r}"
+            time.sleep(0.01)
+    assert _job_running(proj, rule), f"{rule} ended before the signal; nothing was interrupted"
     os.killpg(p.pid, sig)
     out, _ = p.communicate(timeout=120)
     return out
@@ -94,8 +104,9 @@ def test_killed_runs_resume_to_bit_identical_results(small_run, tmp_path):
         xr.load_dataset(f, engine="netcdf4")
     _finish(_start(run, "--unlock"))
     # 2. resume, then SIGINT in the middle of the friction fit
+    (run / "logs" / "friction_fit.log").unlink(missing_ok=True)  # the copy's log shows the earlier run's GA
     second = _start(run, "--rerun-incomplete", TARGET)
-    out = _interrupt_during(second, run, "friction_fit", signal.SIGINT)
+    out = _interrupt_during(second, run, "friction_fit", signal.SIGINT, started="GA, ")
     assert not (run / TARGET).exists(), out[-3000:]  # the interrupted job left no output
     # 3. resume to the end: then nothing is left to do
     _finish(_start(run, "--rerun-incomplete", TARGET))
