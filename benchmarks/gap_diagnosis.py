@@ -128,6 +128,8 @@ def run(pkg, method, memo, ds, raw, cfg, warm_up=False, workers=1, search="resid
         with memoised(memo if pkg == "contactid" else True):
             t0 = time.perf_counter()
             kw = {"workers": workers} if workers > 1 else {}
+            if pkg == "contactid":
+                kw["channel_delays"] = gd.random_test_delays(ds["frf"], ds["modal"])
             d = gd.diagnose(model, records, cfg["nonlinear"]["calibration_case"], settings, fit_settings, lin, **kw)
             return d, time.perf_counter() - t0
     finally:

@@ -46,3 +46,35 @@ def test_an_unsimulable_point_is_never_chosen():
     points = {0.0: r(0.0), 0.4: r(0.4), 0.55: r(0.55), 0.9: None}
     best = residual_line_search(r, points, 0.0, 1.0, xatol=1e-4, max_evaluations=6)
     assert best == pytest.approx(0.5, abs=1e-4)
+
+
+def test_a_channel_delay_search_holds_the_random_tests_common_delay():
+    """The calibration gap cannot tell a delay common to every channel (the identified forces take it up): with the
+    random test's delays given, the search keeps their mean and finds the channels' differences; without, it starts
+    from zero and ends wherever along the common direction."""
+    from types import SimpleNamespace
+
+    from contactid.gap.candidates import LIBRARY
+    from contactid.gap.refit import _per_channel_theta
+
+    truth = np.array([6.7e-6, 13.3e-6, 20.0e-6])
+    P = np.eye(3) - np.ones((3, 3)) / 3  # the gap sees only the differences between channels
+
+    class Run:
+        def __init__(self):
+            self.n = 0
+
+        def __call__(self, theta):
+            self.n += 1
+            return (float(np.linalg.norm(P @ (theta - truth)) / 1e-5) + 1e-3,)
+
+    rec = SimpleNamespace(acceleration=np.zeros((3, 9)))
+    run = Run()
+    common = truth + np.array([0.4e-6, -0.3e-6, -0.5e-6])  # the random test's estimate, within 1 us
+    theta = _per_channel_theta(run, LIBRARY["channel_time_skew"], rec, 10, common)
+    assert np.mean(theta) == pytest.approx(np.mean(common), abs=1e-12)
+    np.testing.assert_allclose(P @ theta, P @ truth, atol=2e-7)
+    assert run.n <= 3 * 10 + 2
+    # where zero is no worse, zero
+    flat = _per_channel_theta(lambda th: (1.0,), LIBRARY["channel_time_skew"], rec, 10, common)
+    assert np.all(flat == 0.0)

@@ -3,7 +3,7 @@
 import time
 
 from contactid.gap.candidates import load_plugins
-from contactid.gap.diagnosis import GapSettings, diagnose, linear_stage, prepare_workers
+from contactid.gap.diagnosis import GapSettings, diagnose, linear_stage, prepare_workers, random_test_delays
 from contactid.gap.pipeline import workflow_models
 from contactid.gap.output import diagnosis_json, gap_dataset
 from contactid.io import load_dataset, provenance, write_dataset, write_text
@@ -21,7 +21,8 @@ prepare_workers(workers)  # before the friction fit after updating starts numba'
 records, fit_settings, modal, chain_model, model, updating = workflow_models(
     p.structure, inp, p.cases, p.calibration_case, K, p.friction, settings, int(p.seed)
 )
-linear = linear_stage(model, load_dataset(inp.frf), modal)
+frf = load_dataset(inp.frf)
+linear = linear_stage(model, frf, modal)
 diag = diagnose(
     model,
     records,
@@ -32,6 +33,7 @@ diag = diagnose(
     workers=workers,
     identified=chain_model,
     updating=updating,
+    channel_delays=random_test_delays(frf, modal),
 )
 seconds = time.perf_counter() - t0
 prov = provenance(

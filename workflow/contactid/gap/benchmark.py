@@ -207,7 +207,7 @@ def diagnose_item(spec: Mapping, cfg: Mapping, recs: Mapping, cases: list, t0: f
     """Identify the model from an item's rig records ``recs`` (the chain, then model updating) and diagnose it with
     the item's library; ``t0`` the item's start (``time.perf_counter``, s), ``t_rig`` the rig's time (s)."""
     from ..friction_fit import settings_from_config
-    from .diagnosis import GapSettings, diagnose, linear_stage
+    from .diagnosis import GapSettings, diagnose, linear_stage, random_test_delays
     from .pipeline import identify, updated_model
     from .records import record_harmonics
 
@@ -238,6 +238,7 @@ def diagnose_item(spec: Mapping, cfg: Mapping, recs: Mapping, cases: list, t0: f
         linear_stage(model, frf, modal),
         identified=chain_model,
         updating=updating,
+        channel_delays=random_test_delays(frf, modal),
     )
     t_diag = time.perf_counter() - t1
     return ItemDiagnosis(diag, model, chain_model, updating, records, fit_settings, t_id, t1, t_diag)

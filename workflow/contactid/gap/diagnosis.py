@@ -402,6 +402,26 @@ def eta_model_spread(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmo
 # unit-tested in tests/test_verdict.py)
 
 
+def random_test_delays(frf: xr.Dataset, modal: xr.Dataset) -> np.ndarray | None:
+    """Each accelerometer channel's delay on the force (s) from the random test's residue phases at its highest
+    identified mode (``modal_fit.residue_phase_delays``), None where the FRF or the modes do not allow it (logged)."""
+    from ..modal_fit import residue_phase_delays
+
+    try:
+        H = frf["h1_real"].values + 1j * frf["h1_imag"].values
+        band = (float(modal.attrs["band_low_hz"]), float(modal.attrs["band_high_hz"]))
+        tau = residue_phase_delays(
+            frf["frequency"].values, H, modal["natural_frequency"].values, modal["damping_ratio"].values, band
+        )
+    except (KeyError, ValueError, np.linalg.LinAlgError) as exc:
+        log.info("random test: no channel delays from the residue phases (%s)", exc)
+        return None
+    if not np.all(np.isfinite(tau)):
+        return None
+    log.info("random test: channel delays from the residue phases %s us", ", ".join(f"{1e6 * t:.2f}" for t in tau))
+    return tau
+
+
 def linear_stage(model: IdentifiedModel, frf: xr.Dataset, modal: xr.Dataset) -> dict:
     """The random test's FRF against the identified model: natural frequencies (relative error) and
     the driving-point |H1| at the identified peaks (relative error of the model's accelerance)."""
@@ -511,14 +531,15 @@ def _candidate(
     base_steps: tuple = (),
     joint: bool = True,
     alone: dict | None = None,
+    channel_delays=None,
 ):
     """One candidate added to the explanation's earlier steps ``base_steps`` ((name, theta), ...): calibrated on
     the calibration case (with ``joint``, together with the earlier steps' parameters, ``joint_candidate``;
     otherwise with them held), predicted on the scored cases (each simulation warm-started from the baseline's).
     ``alone``: {name: theta} of the first pass (each candidate alone); a joint refit also starts between the
     earlier steps' optimum and this candidate's own (two effects that can stand in for each other, viscous friction
-    and a normal dashpot, leave a ridge between the one-effect optimum and the truth). Returns (calibration, sims,
-    residuals) by case."""
+    and a normal dashpot, leave a ridge between the one-effect optimum and the truth). ``channel_delays``: the random
+    test's per-channel delays (``refit.calibrate``). Returns (calibration, sims, residuals) by case."""
     rec = records[calibration_case]
     # per-channel effects (channel delays) trade off with no contact effect and would add a dimension per channel:
     # they are held, and a per-channel candidate is refitted on the earlier steps held
@@ -555,7 +576,15 @@ def _candidate(
     else:
         base = merged_augmentation((LIBRARY[n], th) for n, th in base_steps)
         cal = calibrate(
-            model, LIBRARY[name], rec, fit_settings, H, max_evaluations, start=base_sims[calibration_case], base=base
+            model,
+            LIBRARY[name],
+            rec,
+            fit_settings,
+            H,
+            max_evaluations,
+            start=base_sims[calibration_case],
+            base=base,
+            channel_delays=channel_delays,
         )
         cal = dataclasses.replace(cal, steps=tuple(base_steps) + ((name, cal.theta),))
     sims = {calibration_case: None}
@@ -899,6 +928,7 @@ class _DiagnosisRun:
     workers: int
     base_sims: dict
     boot: dict = field(default_factory=dict)
+    channel_delays: np.ndarray | None = None  # the random test's per-channel delays (s), where known
 
     @property
     def H(self) -> int:
@@ -918,6 +948,7 @@ class _DiagnosisRun:
             fit_settings=self.fit_settings,
             H=self.H,
             max_evaluations=self.settings.max_evaluations,
+            channel_delays=self.channel_delays,
             **extra,
         )
 
@@ -997,18 +1028,28 @@ def diagnose(
     workers: int = 1,
     identified: IdentifiedModel | None = None,
     updating=None,
+    channel_delays=None,
 ) -> Diagnosis:
     """Run the whole diagnosis on the load cases' records (``calibration_case`` for the refits,
     the others held out); the candidates in ``workers`` processes (see ``_candidates``). ``identified``: the
     chain's own model when ``model`` is its update (``gap.pipeline.updated_model``; ``updating`` its
-    UpdatingResult): the explanation then starts with the update's step."""
+    UpdatingResult): the explanation then starts with the update's step. ``channel_delays``: each accelerometer
+    channel's delay on the force (s) as the random test shows it (``random_test_delays``), held in common by the
+    channel-delay candidate's refit; None: that refit searches every channel's delay from zero."""
     H = settings.n_harmonics
     if calibration_case not in records:
         raise ValueError(f"gap: the calibration case {calibration_case!r} is not among the load cases {list(records)}")
     held = [c for c in records if c != calibration_case]
     base_sims = {c: baseline(model, records[c], H)[1] for c in records}
     run = _DiagnosisRun(
-        records, calibration_case, held or [calibration_case], settings, fit_settings, workers, base_sims
+        records,
+        calibration_case,
+        held or [calibration_case],
+        settings,
+        fit_settings,
+        workers,
+        base_sims,
+        channel_delays=None if channel_delays is None else np.asarray(channel_delays, dtype=float),
     )
     # candidates: calibrate, predict the held-out cases (forked before the localisation runs numba's
     # parallel friction kernel in this process)

@@ -303,24 +303,56 @@ class _CandidateRuns:
 SEARCH = contextvars.ContextVar("search", default="residual")
 
 
-def _per_channel_theta(run: _CandidateRuns, cand: Candidate, rec: RecordHarmonics, max_evaluations: int) -> np.ndarray:
-    """theta of a per-channel candidate (one parameter per accelerometer channel): Nelder-Mead on the gap from zero,
-    simplex steps of 10 % of the range; zero where that is no worse. (Least squares on the residual vector found a
-    skew's delays more exactly, but also a common delay on every channel, -28 us, that stood in for a normal dashpot's
-    dissipation: the blind benchmark's compound-13-s2 named the channel skew instead of the dashpot; e722a0b.)"""
+def _per_channel_theta(
+    run: _CandidateRuns, cand: Candidate, rec: RecordHarmonics, max_evaluations: int, common=None
+) -> np.ndarray:
+    """theta of a per-channel candidate (one parameter per accelerometer channel); zero where that is no worse.
+
+    ``common`` (j,): per-channel values measured elsewhere (channel delays: the random test's residue phases,
+    ``modal_fit.residue_phase_delays``). Their mean is held and Nelder-Mead searches the channels' differences from
+    them (j - 1 parameters; simplex steps of 2.5 % of the range, at most 3 x max_evaluations simulations). The
+    calibration gap does not bind a delay common to every channel: the forces identified from the record and the
+    refitted friction law take it up. From zero, the search put the ladder's skews of 20 us at 12.5-15.6 us and of
+    6.7 us at 12 us (a common shift of about -5 us); from the random test's delays, at 19.8-20.0 us and 6.4 us, with
+    the same calibration gap and 30 simulations instead of 50 (docs/measurements.md).
+
+    Without ``common``: Nelder-Mead on the gap from zero, simplex steps of 10 % of the range. (Least squares on the
+    residual vector found a skew's delays more exactly, but also a common delay on every channel, -28 us, that stood
+    in for a normal dashpot's dissipation: the blind benchmark's compound-13-s2 named the channel skew instead of the
+    dashpot; e722a0b.)"""
     from scipy.optimize import minimize
 
     j = rec.acceleration.shape[0]
     p = cand.parameters[0]
     span = p.high - p.low
-    simplex = np.vstack([np.zeros(j), 0.1 * span * np.eye(j)])
-    res = minimize(
-        lambda x: run(np.clip(x, p.low, p.high))[0],
-        np.zeros(j),
-        method="Nelder-Mead",
-        options={"initial_simplex": simplex, "maxfev": 5 * max_evaluations, "xatol": 1e-3 * span, "fatol": 1e-6},
-    )
-    theta = np.clip(res.x, p.low, p.high)
+    opts = {"xatol": 1e-3 * span, "fatol": 1e-6}
+    if common is not None and np.size(common) == j and j > 1 and np.all(np.isfinite(common)):
+        x0 = np.clip(np.asarray(common, dtype=float), p.low, p.high)
+        # an orthonormal basis of the channels' differences (the plane where the values sum to zero)
+        B = np.linalg.qr(np.vstack([np.ones(j), np.eye(j)[: j - 1]]).T)[0][:, 1:]
+        res = minimize(
+            lambda y: run(np.clip(x0 + B @ y, p.low, p.high))[0],
+            np.zeros(j - 1),
+            method="Nelder-Mead",
+            options={
+                "initial_simplex": np.vstack([np.zeros(j - 1), 0.025 * span * np.eye(j - 1)]),
+                "maxfev": 3 * max_evaluations,
+                **opts,
+            },
+        )
+        theta = np.clip(x0 + B @ res.x, p.low, p.high)
+    else:
+        res = minimize(
+            lambda x: run(np.clip(x, p.low, p.high))[0],
+            np.zeros(j),
+            method="Nelder-Mead",
+            options={
+                "initial_simplex": np.vstack([np.zeros(j), 0.1 * span * np.eye(j)]),
+                "maxfev": 5 * max_evaluations,
+                **opts,
+            },
+        )
+        theta = np.clip(res.x, p.low, p.high)
     if run(np.zeros(j))[0] <= run(theta)[0]:
         theta = np.zeros(j)
     return theta
@@ -431,18 +463,23 @@ def calibrate(
     start: SimResult | None = None,
     base: Augmentation = NONE,
     starts=(),
+    channel_delays=None,
 ) -> Calibration:
     """theta of ``cand`` minimising the calibration case's gap (friction law refitted at each theta);
     each simulation starts from the previous one's steady state (``start``: the model's own). ``base``:
     effects already added (the additive explanation's earlier steps); the candidate's are added to them. ``starts``:
     more points (theta) a search over several parameters starts from if they are better than its scan's best.
+    ``channel_delays``: the random test's per-channel delays (s), where known; a per-channel candidate that sets
+    delays holds their common part (``_per_channel_theta``).
     The search compares harmonic-balance states (within 1e-3 of the integrator's orbit; ``POLISH_SEARCH`` set to
     True polishes each with the integrator, as before); the optimum is evaluated again with the integrator's
     polish, so its gap and simulation are the reference's (same optimum within 1 %, a quarter to a third less
     diagnosis time, measured on 10 benchmark items)."""
     run = _CandidateRuns(model, cand, rec, settings.bounds, n_harmonics, start, base)
     if cand.per_channel:
-        theta = _per_channel_theta(run, cand, rec, max_evaluations)
+        j = rec.acceleration.shape[0]
+        sets_delays = channel_delays is not None and bool(cand.augmentation(np.ones(j)).delays)
+        theta = _per_channel_theta(run, cand, rec, max_evaluations, channel_delays if sets_delays else None)
     elif len(cand.parameters) == 1:
         theta = _scalar_theta(run, cand, max_evaluations)
     else:
