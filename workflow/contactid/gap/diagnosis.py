@@ -1085,6 +1085,9 @@ def diagnose(
     where["heldout_gap_before"] = before
     where["heldout_gap_before_interval"] = [float(np.percentile(before_b, 2.5)), float(np.percentile(before_b, 97.5))]
     where["record_scatter"] = scatter
+    if run.channel_delays is not None:  # what the channel-delay refit holds in common (audit)
+        sensors = list(getattr(records[calibration_case], "sensors", range(len(run.channel_delays))))
+        where["random_test_channel_delays_s"] = {str(k): float(t) for k, t in zip(sensors, run.channel_delays)}
     later = retried({n: r[0].theta for n, r in results.items()}, LIBRARY, settings)
     steps, left, last = explain(
         results, names, before, scatter, settings, run.heldout_gap, run.next_pass(results), later
