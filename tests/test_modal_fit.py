@@ -109,8 +109,9 @@ def test_synthesised_frf_reproduces_a_noise_free_frf():
     assert np.max(np.abs(Hs - H)) < 1e-8 * np.max(np.abs(H))  # in the band and beyond (no residual needed here)
 
 
+@pytest.mark.parametrize("node", [False, True])
 @pytest.mark.parametrize("delays_us", [(0.0, 0.0, 0.0), (6.7, 13.3, 20.0), (-3.0, 0.0, 2.0)])
-def test_residue_phases_give_each_channels_delay(delays_us):
+def test_residue_phases_give_each_channels_delay(delays_us, node):
     """Proportional modes (real shapes) seen through channels late by tau: the highest mode's residue phases give
     tau back, though the lower modes' residues are turned less (and would carry any structural complexity)."""
     from contactid.modal_fit import residue_phase_delays
@@ -120,6 +121,8 @@ def test_residue_phases_give_each_channels_delay(delays_us):
     fn, zeta = np.array([55.0, 167.0, 338.0]), np.array([0.005, 0.005, 0.005])
     wn = 2 * np.pi * fn
     shapes = np.array([[1.0, 0.8, -0.6], [0.7, -0.5, 0.9], [0.4, -0.9, -0.7]])  # channel x mode; force at channel 0
+    if node:  # channel 2 at a node of the highest mode: it reads the second
+        shapes[2, 2] = 0.0
     tau = 1e-6 * np.asarray(delays_us)
     H = np.array(
         [

@@ -224,8 +224,9 @@ def residue_phase_delays(
     residues carry the structure's own complexity (measured on the default rig without a delay: up to 8 degrees at
     the first mode, within 0.07 degrees at the third). On rig records the estimate was within 0.9 us of the rig's
     per-channel delays (2-37 us) and of zero without them (the default data: 0.83, -0.21, -0.71 us), also on rigs
-    whose structure, damping form and normal law differ from the model's (docs/measurements.md). frf: (n_out, n_f)
-    complex accelerance."""
+    whose structure, damping form and normal law differ from the model's (docs/measurements.md). A channel near a
+    node of the highest mode (its residue below a tenth of that mode's largest) reads the highest mode where it is
+    not; nan where there is none. frf: (n_out, n_f) complex accelerance."""
     f = np.asarray(frequency_hz, dtype=float)
     H = np.atleast_2d(frf)
     sel = (f >= band_hz[0]) & (f <= band_hz[1])
@@ -234,6 +235,14 @@ def residue_phase_delays(
     wn = 2 * np.pi * fn
     poles = -z * wn + 1j * wn * np.sqrt(1 - z**2)
     R, _ = lsfd_residues(f[sel], H[:, sel], poles)
-    r = int(np.argmax(fn))
-    deviation = np.angle(R[:, r] / (1j * np.where(R[:, r].imag >= 0, 1.0, -1.0)))
-    return -deviation / wn[r]
+    # a channel near a node of the highest mode (its residue below a tenth of that mode's largest) reads the next
+    # mode down where it is not; nan where it is at a node of every mode
+    strong = np.abs(R) >= 0.1 * np.abs(R).max(axis=0, keepdims=True)
+    tau = np.full(R.shape[0], np.nan)
+    for o in range(R.shape[0]):
+        usable = [r for r in np.argsort(fn)[::-1] if strong[o, r]]
+        if usable:
+            r = int(usable[0])
+            deviation = np.angle(R[o, r] / (1j * (1.0 if R[o, r].imag >= 0 else -1.0)))
+            tau[o] = -deviation / wn[r]
+    return tau
