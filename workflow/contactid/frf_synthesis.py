@@ -13,7 +13,7 @@ import numpy as np
 import xarray as xr
 
 from .linear_chain import complex_frf
-from .modal_fit import lsfd_residues, mode_poles
+from .modal_fit import band_residues, mode_poles
 
 
 def identified_poles(modal: xr.Dataset) -> np.ndarray:
@@ -44,8 +44,7 @@ def synthesised_accelerance(
     f = np.asarray(frequency_hz, dtype=float)
     h = np.atleast_2d(frf)
     band = (f >= band_hz[0]) & (f <= band_hz[1])
-    poles = mode_poles(natural_frequency_hz, damping_ratio)
-    residues, _ = lsfd_residues(f[band], h[:, band], poles)
+    poles, residues = band_residues(f, h, natural_frequency_hz, damping_ratio, band_hz)
     modes = modal_terms(f, poles, residues)
     w2 = (2 * np.pi * f) ** 2
     basis = np.array([np.ones(band.sum()), w2[band]]).T  # real LR, UR: fitted to the real and imaginary parts

@@ -209,6 +209,22 @@ def stability_poles(
     )
 
 
+def band_residues(
+    frequency_hz: np.ndarray,
+    frf: np.ndarray,
+    natural_frequency_hz: np.ndarray,
+    damping_ratio: np.ndarray,
+    band_hz: tuple[float, float],
+) -> tuple[np.ndarray, np.ndarray]:
+    """(poles (n_modes,) rad/s, residues (n_out, n_modes)) of identified modes: ``mode_poles`` and the LSFD residues
+    fitted to ``frf`` (n_out, n_f; complex accelerance) on the lines of ``frequency_hz`` inside ``band_hz``."""
+    f = np.asarray(frequency_hz, dtype=float)
+    H = np.atleast_2d(frf)
+    band = (f >= band_hz[0]) & (f <= band_hz[1])
+    poles = mode_poles(natural_frequency_hz, damping_ratio)
+    return poles, lsfd_residues(f[band], H[:, band], poles)[0]
+
+
 def residue_phase_delays(
     frequency_hz: np.ndarray,
     frf: np.ndarray,
@@ -227,14 +243,9 @@ def residue_phase_delays(
     whose structure, damping form and normal law differ from the model's (docs/measurements.md). A channel near a
     node of the highest mode (its residue below a tenth of that mode's largest) reads the highest mode where it is
     not; nan where there is none. frf: (n_out, n_f) complex accelerance."""
-    f = np.asarray(frequency_hz, dtype=float)
-    H = np.atleast_2d(frf)
-    sel = (f >= band_hz[0]) & (f <= band_hz[1])
     fn = np.asarray(natural_frequency_hz, dtype=float)
-    z = np.asarray(damping_ratio, dtype=float)
     wn = 2 * np.pi * fn
-    poles = -z * wn + 1j * wn * np.sqrt(1 - z**2)
-    R, _ = lsfd_residues(f[sel], H[:, sel], poles)
+    _, R = band_residues(frequency_hz, frf, natural_frequency_hz, damping_ratio, band_hz)
     # a channel near a node of the highest mode (its residue below a tenth of that mode's largest) reads the next
     # mode down where it is not; nan where it is at a node of every mode
     strong = np.abs(R) >= 0.1 * np.abs(R).max(axis=0, keepdims=True)

@@ -405,10 +405,11 @@ def eta_model_spread(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmo
 def random_test_delays(frf: xr.Dataset, modal: xr.Dataset) -> np.ndarray | None:
     """Each accelerometer channel's delay on the force (s) from the random test's residue phases at its highest
     identified mode (``modal_fit.residue_phase_delays``), None where the FRF or the modes do not allow it (logged)."""
+    from ..linear_chain import complex_frf
     from ..modal_fit import residue_phase_delays
 
     try:
-        H = frf["h1_real"].values + 1j * frf["h1_imag"].values
+        H = complex_frf(frf)
         band = (float(modal.attrs["band_low_hz"]), float(modal.attrs["band_high_hz"]))
         tau = residue_phase_delays(
             frf["frequency"].values, H, modal["natural_frequency"].values, modal["damping_ratio"].values, band

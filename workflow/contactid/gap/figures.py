@@ -11,7 +11,7 @@ import numpy as np
 import xarray as xr
 
 from .. import print_style as ps
-from .verdict import DEFAULT_PLACE, PlaceThresholds
+from .verdict import DEFAULT_PLACE, PlaceThresholds, never_opens
 
 W = ps.TEXT_WIDTH_IN
 XI_UM, XI_DOT, ETA_UM, ETA_DOT = r"$\xi$ ($\mu$m)", r"d$\xi$/dt (mm/s)", r"$\eta$ ($\mu$m)", r"d$\eta$/dt (mm/s)"
@@ -309,7 +309,7 @@ def explanation(diag: dict, png: str, pdf: str | None = None):
     fig, ax = plt.subplots(figsize=(W, 3.0))
     labels, bottoms, heights, colors = ["identified model"], [0.0], [100 * before], ["0.5"]
     for s in steps:
-        law = " (never opens)" if s["effect"] == "contact_separation" and s.get("contact_opens") is False else ""
+        law = " (never opens)" if never_opens(s) else ""
         labels.append(f"+ {_name(s['effect'])}{law}\n({100 * s['share']:.0f} % of the power)")
         bottoms.append(100 * s["heldout_gap_after"])
         heights.append(100 * (s["heldout_gap_before"] - s["heldout_gap_after"]))

@@ -325,34 +325,26 @@ def _per_channel_theta(
     j = rec.acceleration.shape[0]
     p = cand.parameters[0]
     span = p.high - p.low
-    opts = {"xatol": 1e-3 * span, "fatol": 1e-6}
     if common is not None and np.size(common) == j and j > 1 and np.all(np.isfinite(common)):
         x0 = np.clip(np.asarray(common, dtype=float), p.low, p.high)
         # an orthonormal basis of the channels' differences (the plane where the values sum to zero)
         B = np.linalg.qr(np.vstack([np.ones(j), np.eye(j)[: j - 1]]).T)[0][:, 1:]
-        res = minimize(
-            lambda y: run(np.clip(x0 + B @ y, p.low, p.high))[0],
-            np.zeros(j - 1),
-            method="Nelder-Mead",
-            options={
-                "initial_simplex": np.vstack([np.zeros(j - 1), 0.025 * span * np.eye(j - 1)]),
-                "maxfev": 3 * max_evaluations,
-                **opts,
-            },
-        )
-        theta = np.clip(x0 + B @ res.x, p.low, p.high)
-    else:
-        res = minimize(
-            lambda x: run(np.clip(x, p.low, p.high))[0],
-            np.zeros(j),
-            method="Nelder-Mead",
-            options={
-                "initial_simplex": np.vstack([np.zeros(j), 0.1 * span * np.eye(j)]),
-                "maxfev": 5 * max_evaluations,
-                **opts,
-            },
-        )
-        theta = np.clip(res.x, p.low, p.high)
+        step, maxfev = 0.025, 3 * max_evaluations
+    else:  # every channel's value, from zero
+        x0, B, step, maxfev = np.zeros(j), np.eye(j), 0.1, 5 * max_evaluations
+    n = B.shape[1]
+    res = minimize(
+        lambda y: run(np.clip(x0 + B @ y, p.low, p.high))[0],
+        np.zeros(n),
+        method="Nelder-Mead",
+        options={
+            "initial_simplex": np.vstack([np.zeros(n), step * span * np.eye(n)]),
+            "maxfev": maxfev,
+            "xatol": 1e-3 * span,
+            "fatol": 1e-6,
+        },
+    )
+    theta = np.clip(x0 + B @ res.x, p.low, p.high)
     if run(np.zeros(j))[0] <= run(theta)[0]:
         theta = np.zeros(j)
     return theta

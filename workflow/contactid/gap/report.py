@@ -6,6 +6,7 @@ from __future__ import annotations
 import pandas as pd
 
 from ..latex import _fmt, plain_text as _t, tabular
+from .verdict import never_opens
 
 
 def _bound_text(c: dict) -> str:
@@ -50,7 +51,7 @@ def _pct(x) -> str:
 
 def _law_note(step: dict) -> str:
     """For a contact-separation step whose law never opens the contact: what it stands for instead."""
-    if step.get("effect") == "contact_separation" and step.get("contact_opens") is False:
+    if never_opens(step):
         return (
             r" (its law never opens the contact here: it stands for a stiffer or harder normal law than "
             r"Eq.~13's spring, model form rather than separation)"

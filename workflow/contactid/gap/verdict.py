@@ -41,6 +41,12 @@ def open_fraction(normal_force, preload: float, open_limit: float = DEFAULT_PLAC
     return float(np.mean(np.asarray(normal_force) <= open_limit * preload))
 
 
+def never_opens(step: Mapping) -> bool:
+    """Whether an explanation step is a contact-separation law that never opened the contact in its simulations
+    (``explanation[k].contact_opens`` false): it stands for a stiffer or harder normal law, model form."""
+    return step.get("effect") == "contact_separation" and step.get("contact_opens") is False
+
+
 def acts_where(acts_on: str, place: str) -> bool:
     """Whether a candidate acting on ``acts_on`` acts where the gap lies: the same place, "any", or either
     contact direction when the place is "contact" (the normal motion not observable)."""
