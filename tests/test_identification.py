@@ -98,3 +98,33 @@ def test_structural_modes_used_by_the_chain_are_reproducible():
     a = structural_modes(m, 3).shapes
     b = structural_modes(assemble(P), 3).shapes
     assert np.array_equal(a, b)
+
+
+def test_damping_above_the_identified_modes_grows_as_the_identified_ratios_do():
+    """The identified model's damping of the modes the random test does not measure (higher beam modes, the static
+    contact shapes) against the rig's own damping forms (rig.damping): a stiffness-proportional structure's
+    ratios grow as f, and the model extrapolates them from three identified modes to every higher mode of the
+    rig's reduced model within 1 % (the ceiling at 2 included); a modal one keeps the last ratio (bit for bit the
+    former rule), and a mass-proportional one, whose ratios fall with frequency, too."""
+    from contactid.identification import damping_by_mode, damping_exponent
+    from contactid.rig.damping import damping_ratios
+
+    model = assemble(P)
+    red = reduced_model(model, 8)
+    f = red.omega / (2 * np.pi)
+    beam = np.flatnonzero(red.beam_mode)
+    assert f[beam[-1]] > 5 * f[beam[2]]  # the static contact shapes lie far above the third mode
+    for form, exact in (("stiffness_proportional", True), ("modal", True), ("mass_proportional", False)):
+        truth = damping_ratios(f, 0.005, form, reference_hz=f[beam[0]])
+        zeta = damping_by_mode(red.beam_mode, truth[beam[:3]], f)
+        gamma = damping_exponent(f[beam[:3]], truth[beam[:3]])
+        if exact:
+            assert np.allclose(zeta[beam], truth[beam], rtol=0.01), form
+        else:  # falling ratios are not extrapolated: the last identified one above
+            assert gamma == 0.0 and np.all(zeta[beam[3:]] == truth[beam[2]])
+        assert np.array_equal(damping_by_mode(red.beam_mode, truth[beam[:3]])[beam[:3]], truth[beam[:3]])
+    assert damping_exponent(f[beam[:3]], 0.005 * f[beam[:3]] / f[beam[0]]) == pytest.approx(1.0)
+    assert damping_exponent(f[beam[:1]], [0.005]) == 0.0  # one mode tells no trend
+    # the ceiling: ratios that would exceed 2 stay at 2
+    steep = damping_by_mode(red.beam_mode, 0.2 * f[beam[:3]] / f[beam[0]], f)
+    assert steep.max() == pytest.approx(2.0) and np.all(steep <= 2.0)

@@ -158,7 +158,7 @@ def simulator(model: IdentifiedModel, aug: Augmentation, fs: float, f0: float | 
     """The reduced identified model with the augmentation, ready to integrate (step as the rig's,
     shortened to a whole number of steps per period of ``f0`` when given)."""
     red = _reduced(model.structure_with(aug), model.n_modes)[1]
-    zeta = damping_by_mode(red.beam_mode, model.damping)
+    zeta = damping_by_mode(red.beam_mode, model.damping, red.omega / (2 * np.pi))
     zeta[red.beam_mode] += aug.extra_damping
     k_n = red.k_n * aug.normal_stiffness_factor
     p = aug.unilateral_exponent if aug.unilateral_exponent >= 1.0 else 1.0
