@@ -102,10 +102,11 @@ def test_structural_modes_used_by_the_chain_are_reproducible():
 
 def test_damping_above_the_identified_modes_grows_as_the_identified_ratios_do():
     """The identified model's damping of the modes the random test does not measure (higher beam modes, the static
-    contact shapes) against the rig's own damping forms (rig.damping): a stiffness-proportional structure's
-    ratios grow as f, and the model extrapolates them from three identified modes to every higher mode of the
-    rig's reduced model within 1 % (the ceiling at 2 included); a modal one keeps the last ratio (bit for bit the
-    former rule), and a mass-proportional one, whose ratios fall with frequency, too."""
+    contact shapes) against the rig's own damping forms (rig.damping) and Rayleigh damping: a
+    stiffness-proportional or Rayleigh-damped structure's ratios grow with f, and the model extrapolates them from
+    three identified modes to every higher mode of the rig's reduced model within 1 % (the ceiling at 2
+    included); a modal one keeps the last ratio (bit for bit the former rule), and a mass-proportional one, whose
+    ratios fall with frequency, too."""
     from contactid.identification import damping_by_mode, damping_exponent
     from contactid.rig.damping import damping_ratios
 
@@ -123,6 +124,16 @@ def test_damping_above_the_identified_modes_grows_as_the_identified_ratios_do():
         else:  # falling ratios are not extrapolated: the last identified one above
             assert gamma == 0.0 and np.all(zeta[beam[3:]] == truth[beam[2]])
         assert np.array_equal(damping_by_mode(red.beam_mode, truth[beam[:3]])[beam[:3]], truth[beam[:3]])
+    # Rayleigh damping (alpha M + beta K, as many FE simulators damp): the mass term dominates the first mode, the
+    # stiffness term the third; the fitted Rayleigh trend carries on within 1 %, where the power law alone (its
+    # slope over the identified modes under 1) would damp the static contact shapes several times too little
+    w = red.omega
+    alpha, beta = 2 * 0.004 * w[beam[0]], 2 * 0.004 / w[beam[2]]
+    truth = alpha / (2 * w) + beta * w / 2
+    zeta = damping_by_mode(red.beam_mode, truth[beam[:3]], f)
+    assert np.allclose(zeta[beam], np.minimum(truth[beam], 2.0), rtol=0.01)
+    power_law = truth[beam[2]] * (f[beam[-1]] / f[beam[2]]) ** damping_exponent(f[beam[:3]], truth[beam[:3]])
+    assert power_law < 0.5 * truth[beam[-1]]
     assert damping_exponent(f[beam[:3]], 0.005 * f[beam[:3]] / f[beam[0]]) == pytest.approx(1.0)
     assert damping_exponent(f[beam[:1]], [0.005]) == 0.0  # one mode tells no trend
     # the ceiling: ratios that would exceed 2 stay at 2

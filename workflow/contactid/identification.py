@@ -159,12 +159,55 @@ def damping_exponent(frequencies_hz, zeta) -> float:
     """gamma (1) of zeta ~ f^gamma fitted to identified modes (least squares on log zeta against log f), kept in
     [0, 1]: 0 where the ratios do not grow with frequency (modal damping, the identified model's form), 1 for
     stiffness-proportional damping (zeta_i = beta omega_i / 2). Needs two modes or more (else 0)."""
+    f, z = _positive(frequencies_hz, zeta)
+    if f.size < 2 or np.ptp(np.log(f)) < 1e-6:
+        return 0.0
+    gamma = np.polyfit(np.log(f), np.log(z), 1)[0]
+    return float(np.clip(gamma, 0.0, 1.0))
+
+
+def rayleigh_coefficients(frequencies_hz, zeta) -> tuple[float, float]:
+    """(alpha (1/s), beta (s)) >= 0 of Rayleigh damping C = alpha M + beta K, zeta_i = alpha / (2 omega_i) +
+    beta omega_i / 2, fitted to identified modes (non-negative least squares on the relative misfit)."""
+    from scipy.optimize import nnls
+
+    f, z = _positive(frequencies_hz, zeta)
+    if f.size < 2:
+        return 0.0, 0.0
+    w = 2 * np.pi * f
+    coef, _ = nnls(np.column_stack([0.5 / w, 0.5 * w]) / z[:, None], np.ones(f.size))
+    return float(coef[0]), float(coef[1])
+
+
+def _positive(frequencies_hz, zeta):
     f, z = np.asarray(frequencies_hz, dtype=float), np.asarray(zeta, dtype=float)
     ok = (f > 0) & (z > 0) & np.isfinite(f) & np.isfinite(z)
-    if ok.sum() < 2 or np.ptp(np.log(f[ok])) < 1e-6:
-        return 0.0
-    gamma = np.polyfit(np.log(f[ok]), np.log(z[ok]), 1)[0]
-    return float(np.clip(gamma, 0.0, 1.0))
+    return f[ok], z[ok]
+
+
+def extrapolated_damping(frequencies_hz, zeta, f_above) -> np.ndarray:
+    """Damping ratios at frequencies ``f_above`` (Hz) above identified modes (``frequencies_hz``, ``zeta``): the
+    trend of the identified ratios carried on, never below the last identified ratio, at most
+    MAX_EXTRAPOLATED_ZETA. The trend is the power law zeta_last (f / f_last)^gamma (``damping_exponent``: modal
+    gamma = 0, stiffness-proportional 1), or Rayleigh damping (``rayleigh_coefficients``) where its relative rms
+    misfit is at most half the power law's and its stiffness term carries half the last ratio or more: its ratios
+    grow as beta omega / 2 once the mass term has faded (a structure with both terms, as many FE simulators damp
+    theirs, shows a slope under 1 over the identified modes and would be damped too little above them by the power
+    law)."""
+    f, z = np.asarray(frequencies_hz, dtype=float), np.asarray(zeta, dtype=float)
+    f_above = np.asarray(f_above, dtype=float)
+    last = float(z[-1])
+    gamma = damping_exponent(f, z)
+    power = lambda x: last * (x / f[-1]) ** gamma  # noqa: E731
+    alpha, beta = rayleigh_coefficients(f, z)
+    rayleigh = lambda x: alpha / (4 * np.pi * x) + beta * np.pi * x  # noqa: E731
+    misfit = lambda model: float(np.sqrt(np.mean((model(f) / z - 1.0) ** 2)))  # noqa: E731
+    # Rayleigh where it fits clearly better and its stiffness term already carries half the last ratio: ratios that
+    # fall over the band and then level off (mass-proportional damping with a floor) are not grown from a trace of
+    # beta
+    grows = beta * np.pi * f[-1] >= 0.5 * last
+    best = rayleigh if grows and misfit(rayleigh) < 0.5 * misfit(power) else power
+    return np.minimum(np.maximum(best(f_above), last), MAX_EXTRAPOLATED_ZETA)
 
 
 def damping_by_mode(structural: np.ndarray, identified_zeta, frequencies_hz=None) -> np.ndarray:
@@ -172,11 +215,10 @@ def damping_by_mode(structural: np.ndarray, identified_zeta, frequencies_hz=None
     beam's: the identified ratios for the structural modes in order, and the first for the other modes (the
     block's suspension). Above the identified modes (the higher beam modes and the static contact shapes, which
     the random test does not measure): the last identified ratio, grown with frequency as the identified ratios
-    grow (``damping_exponent`` gamma over the structural modes' ``frequencies_hz``, Hz, when given):
-    zeta_i = zeta_last (f_i / f_last)^gamma, at most MAX_EXTRAPOLATED_ZETA. A modally damped structure
-    (gamma = 0) keeps the last ratio; a stiffness-proportionally damped one damps its static contact shapes as
-    strongly as it does, which shapes the identified contact forces' phase (kappa was 17-38 % low on such
-    rigs of the compound benchmark, docs/gap.md)."""
+    grow (``extrapolated_damping`` over the structural modes' ``frequencies_hz``, Hz, when given). A modally
+    damped structure keeps the last ratio; a stiffness-proportionally or Rayleigh-damped one damps its static
+    contact shapes as strongly as it does, which shapes the identified contact forces' phase (kappa was 17-38 %
+    low on stiffness-proportional rigs of the compound benchmark, docs/identification.md)."""
     zeta = np.full(np.size(structural), float(identified_zeta[0]))
     beam = np.flatnonzero(structural)
     n_id = len(identified_zeta)
@@ -184,11 +226,7 @@ def damping_by_mode(structural: np.ndarray, identified_zeta, frequencies_hz=None
         zeta[idx] = identified_zeta[min(k, n_id - 1)]
     if frequencies_hz is not None and beam.size > n_id >= 2:
         f = np.asarray(frequencies_hz, dtype=float)
-        gamma = damping_exponent(f[beam[:n_id]], identified_zeta)
-        if gamma > 0.0:
-            above = beam[n_id:]
-            grown = float(identified_zeta[-1]) * (f[above] / f[beam[n_id - 1]]) ** gamma
-            zeta[above] = np.minimum(np.maximum(grown, float(identified_zeta[-1])), MAX_EXTRAPOLATED_ZETA)
+        zeta[beam[n_id:]] = extrapolated_damping(f[beam[:n_id]], identified_zeta, f[beam[n_id:]])
     return zeta
 
 
