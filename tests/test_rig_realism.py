@@ -87,8 +87,13 @@ def test_damping_forms():
     assert damping_ratios(f, 0.005, "modal") == pytest.approx([0.005] * 3)
     assert damping_ratios(f, 0.005, "stiffness_proportional", 50.0) == pytest.approx([0.005, 0.015, 0.3])
     assert damping_ratios(f, 0.005, "mass_proportional", 50.0) == pytest.approx([0.005, 0.005 / 3, 0.001])  # floored
+    # Rayleigh, both terms equal at f_ref: 0.005 there, (1/3 + 3) / 2 x 0.005 at 150 Hz, capped at 2 far above
+    assert damping_ratios(f, 0.005, "rayleigh", 50.0) == pytest.approx(
+        [0.005, 0.005 * (1 / 3 + 3) / 2, 0.0025 * (1 / 60 + 60)]
+    )
+    assert damping_ratios([5.0e5], 0.005, "rayleigh", 50.0) == pytest.approx([2.0])
     with pytest.raises(ValueError, match="rig.true_damping.form"):
-        damping_ratios(f, 0.005, "rayleigh")
+        damping_ratios(f, 0.005, "hysteretic")
 
 
 @pytest.mark.slow  # one random test and one dual-sine test of a perturbed rig (small config's records)

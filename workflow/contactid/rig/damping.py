@@ -6,7 +6,9 @@
 - ``modal``: every mode the same ratio (the identified model's form);
 - ``stiffness_proportional``: C = beta K, zeta_i = zeta_ref f_i / f_ref (grows with frequency, so the
   static contact shapes, high in frequency, are damped most);
-- ``mass_proportional``: C = alpha M, zeta_i = zeta_ref f_ref / f_i.
+- ``mass_proportional``: C = alpha M, zeta_i = zeta_ref f_ref / f_i;
+- ``rayleigh``: C = alpha M + beta K with both terms equal at f_ref, zeta_i = zeta_ref (f_ref / f_i + f_i / f_ref) / 2
+  (as FE simulators often damp: least at f_ref, growing as f above it).
 
 Ratios are kept within [MIN_FRACTION zeta_ref, MAX_RATIO].
 """
@@ -17,7 +19,7 @@ from typing import Mapping
 
 import numpy as np
 
-FORMS = ("modal", "stiffness_proportional", "mass_proportional")
+FORMS = ("modal", "stiffness_proportional", "mass_proportional", "rayleigh")
 MAX_RATIO = 2.0  # ratios are capped (an overdamped static shape stays overdamped)
 MIN_FRACTION = 0.2  # ... and floored at this fraction of the reference ratio: mass-proportional damping alone
 # leaves the kHz static normal shape with zeta ~ 1e-4, and with a hardening normal law the explicit integrator's
@@ -34,6 +36,9 @@ def damping_ratios(frequencies_hz, ratio: float, form: str = "modal", reference_
         z = float(ratio) * f / float(reference_hz)
     elif form == "mass_proportional":
         z = float(ratio) * float(reference_hz) / np.maximum(f, 1e-9)
+    elif form == "rayleigh":
+        x = np.maximum(f, 1e-9) / float(reference_hz)
+        z = 0.5 * float(ratio) * (1.0 / x + x)
     else:
         raise ValueError(f"rig.true_damping.form = {form!r} is not one of {FORMS}")
     return np.clip(z, MIN_FRACTION * float(ratio), MAX_RATIO)
