@@ -228,6 +228,13 @@ def main():
         f"time marching with the same searches: {'same' if solver_ok else 'NOT the same'} verdicts and rankings, "
         f"held-out gaps within {max(r['solver']['max_rel_gap_difference'] for r in rows):.2%}"
     )
+    if with_reference:
+        ref1 = min(r["seconds_reference"] / r["seconds_now"] for r in rows)
+        ref2 = min(r["seconds_reference"] / r["seconds_two_workers"] for r in rows)
+        print(
+            f"against {REFERENCE} (the package when issue 14 was taken up, its slip-limit friction kernel): smallest "
+            f"ratio x{ref1:.1f} in one process, x{ref2:.1f} with two workers (as the gap_diagnosis rule runs it)"
+        )
     CACHE.mkdir(parents=True, exist_ok=True)
     (CACHE / "gap_diagnosis.json").write_text(json.dumps(rows, indent=2, default=str))
 
