@@ -34,6 +34,9 @@ def test_masses_and_stiffness_off_are_found_and_the_lever_arm_is_stated_unbound(
     assert ident["tangential_lever_arm_scale"]["most_correlated_with"] == "k_t"
     assert ident["k_t"]["correlation"] < -0.8
     assert np.allclose(upd.model_frequencies_hz, f, rtol=2e-3)
+    # each factor's profile: holding the masses at nominal costs the posterior more than 2^2, the lever arm not 1
+    assert ident["transducer_mass_scale"]["profile_chi2_increase"] > 4  # moved (UPDATING_Z = 2)
+    assert ident["tangential_lever_arm_scale"]["profile_chi2_increase"] < 1
     # the summary rebuilds the same structure
     again = UpdatingResult.from_summary(upd.summary(), nominal)
     assert again.structure == upd.structure

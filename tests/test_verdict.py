@@ -417,6 +417,18 @@ def test_an_update_that_moves_only_the_transducer_masses_is_the_transducer_mass_
     )
     # the stiffness alone moved: model form without an effect of its own
     assert V.updating_effect({"stiffness_scale": 1.2, "mass_scale": 1.0, "transducer_mass_scale": 1.0}, ident) is None
+    # with profiles, they decide: masses at 1.194 whose linearised sd (0.108) says 1.8 sd, but holding them at nominal
+    # raises the posterior misfit by 4.6 (> 2^2): the effect; E and the density 0.14 % off (profiles 0.03-0.04): not
+    profiled = {
+        "stiffness_scale": {"posterior_sd": 0.0008, "profile_chi2_increase": 0.03},
+        "mass_scale": {"posterior_sd": 0.0008, "profile_chi2_increase": 0.04},
+        "transducer_mass_scale": {"posterior_sd": 0.108, "profile_chi2_increase": 4.6},
+    }
+    factors = {"stiffness_scale": 1.0014, "mass_scale": 1.0013, "transducer_mass_scale": 1.194}
+    assert V.updating_effect(factors, profiled) == "transducer_mass_error"
+    assert V.updating_effect(factors, {k: {"posterior_sd": v["posterior_sd"]} for k, v in profiled.items()}) is None
+    held = {**profiled, "transducer_mass_scale": {"posterior_sd": 0.05, "profile_chi2_increase": 3.0}}
+    assert V.updating_effect(factors, held) is None
 
 
 def test_a_joint_refit_step_reports_the_earlier_steps_refitted_parameters():

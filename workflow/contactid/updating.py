@@ -216,9 +216,9 @@ class _UpdatingProblem:
             r.append(((R - R_id) / (self.residue_accuracy * R_id)).ravel())
         return np.concatenate(r)
 
-    def fit(self, x_centre, free):
+    def fit(self, x_centre, free, start=None):
         """(x, least-squares result) of the maximum a posteriori fit of the ``free`` entries of x, the others held at
-        ``x_centre``, which is both the start and the centre of the prior."""
+        ``x_centre``, which is the centre of the prior and the start (or ``start``'s free entries)."""
         sd = self.sd
 
         def res(z):
@@ -226,7 +226,8 @@ class _UpdatingProblem:
             x[free] = z
             return np.concatenate([self.data_residuals(x), ((x - x_centre) / sd)[free]])
 
-        sol = least_squares(res, x_centre[free], x_scale=sd[free] * 0.1, xtol=1e-10, ftol=1e-12, max_nfev=400)
+        z0 = (x_centre if start is None else np.asarray(start, float))[free]
+        sol = least_squares(res, z0, x_scale=sd[free] * 0.1, xtol=1e-10, ftol=1e-12, max_nfev=400)
         x = x_centre.copy()
         x[free] = sol.x
         return x, sol
@@ -298,6 +299,12 @@ def update_structure(
 
     accepted = bool(names) and bool(chi2_nominal - chi2_updated > chi2_dist.ppf(confidence, len(names)))
     cov, ident = _posterior_identifiability(sol.jac, sd, ["k_t", "k_n"] + names)
+    if accepted:  # each factor's profile: the posterior misfit's rise when it is held at its nominal value
+        for i, name in enumerate(names):
+            hold = free.copy()
+            hold[2 + i] = False
+            _, sol_i = problem.fit(x_start, hold, start=x1)  # from the update: the others are near their optimum
+            ident[name]["profile_chi2_increase"] = float(max(2.0 * (sol_i.cost - sol.cost), 0.0))
     x = x1 if accepted else x0
     f_best, _ = modal_predictions(problem.structure(x), n)
     return UpdatingResult(
