@@ -4,7 +4,7 @@ the measured frequency axis (outside the band the residual terms extrapolate).
 
     H_o(w) = sum_r (iw)^2 [R_or / (iw - s_r) + conj(R_or) / (iw - conj(s_r))] + LR_o + UR_o w^2 + i UI_o w^3   (m/s^2/N)
 
-as ``modal_fit.lsfd_residues`` fits it, with the identified modes' poles only.
+as ``modal_fit.lsfd_fit`` fits it, with the identified modes' poles only.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ import numpy as np
 import xarray as xr
 
 from .linear_chain import complex_frf
-from .modal_fit import band_residues, mode_poles
+from .modal_fit import lsfd_fit, mode_poles, residual_terms
 
 
 def identified_poles(modal: xr.Dataset) -> np.ndarray:
@@ -40,20 +40,13 @@ def synthesised_accelerance(
     """(n_out, n_f) complex accelerance (m/s^2/N) synthesised from modes of ``natural_frequency_hz`` (Hz) and
     ``damping_ratio`` on every line of ``frequency_hz``: their residues and the lower and upper residuals
     (LR + UR w^2 + i UI w^3, LR, UR, UI real) fitted by least squares to ``frf`` (n_out, n_f; m/s^2/N) inside
-    ``band_hz``, as modal_fit.lsfd_residues fits them (outside the band the residual terms extrapolate)."""
+    ``band_hz``, as modal_fit.lsfd_fit fits them (outside the band the residual terms extrapolate)."""
     f = np.asarray(frequency_hz, dtype=float)
     h = np.atleast_2d(frf)
     band = (f >= band_hz[0]) & (f <= band_hz[1])
-    poles, residues = band_residues(f, h, natural_frequency_hz, damping_ratio, band_hz)
-    modes = modal_terms(f, poles, residues)
-    w = 2 * np.pi * f
-    wb = w[band]
-    zero = np.zeros_like(wb)
-    # real LR, UR, UI: LR + UR w^2 in the real part, UI w^3 in the imaginary part
-    A = np.vstack([np.array([np.ones_like(wb), wb**2, zero]).T, np.array([zero, zero, wb**3]).T])
-    rest = h[:, band] - modes[:, band]
-    c = np.array([np.linalg.lstsq(A, np.concatenate([r.real, r.imag]), rcond=None)[0] for r in rest])
-    return modes + c[:, :1] + c[:, 1:2] * w[None, :] ** 2 + 1j * c[:, 2:3] * w[None, :] ** 3
+    poles = mode_poles(natural_frequency_hz, damping_ratio)
+    residues, coef, _ = lsfd_fit(f[band], h[:, band], poles)
+    return modal_terms(f, poles, residues) + coef @ residual_terms(f)
 
 
 def synthesised_frf(frf: xr.Dataset, modal: xr.Dataset) -> np.ndarray:

@@ -58,15 +58,22 @@ def lscf_poles(frequency_hz: np.ndarray, frf: np.ndarray, order: int, weights: n
     return s[s.imag > 0]
 
 
-def lsfd_residues(frequency_hz: np.ndarray, frf: np.ndarray, poles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def residual_terms(frequency_hz: np.ndarray) -> np.ndarray:
+    """(3, n_f) the LSFD's residual terms per unit coefficient on the lines of ``frequency_hz``: 1, w^2 and i w^3
+    (``lsfd_fit``); the terms of output o are ``coef[o] @ residual_terms(f)``."""
+    w = 2 * np.pi * np.asarray(frequency_hz, dtype=float)
+    return np.array([np.ones_like(w), w**2, 1j * w**3])
+
+
+def lsfd_fit(frequency_hz: np.ndarray, frf: np.ndarray, poles: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Accelerance residues R_or for fixed poles, with lower (constant) and upper residual terms:
         H_o(w) = sum_r (iw)^2 [R_or / (iw - s_r) + conj(R_or) / (iw - conj(s_r))] + LR_o + UR_o w^2 + i UI_o w^3
-    (LR, UR, UI real). UR w^2 is the mass line of the modes above the band; i UI w^3 is their damping's trace
-    in the band (a mode far above, -w^2 phi phi / (w_n^2 - w^2 + 2 i zeta w_n w), adds 2 i zeta phi phi w^3 / w_n^3).
-    Without it, a structure that damps its high modes strongly (stiffness-proportional: zeta 0.2-2 above 2 kHz)
-    left that trace in the residues: 0.5-0.75 % off, and the model updating fitted to them moved k_t 7 % and the
-    lever arm 3 % away from the truth (docs/measurements.md). Returns (residues (n_out, n_poles), fitted FRF
-    (n_out, n_f)).
+    (LR, UR, UI real; ``residual_terms``). UR w^2 is the mass line of the modes above the band; i UI w^3 is their
+    damping's trace in the band (a mode far above, -w^2 phi phi / (w_n^2 - w^2 + 2 i zeta w_n w), adds
+    2 i zeta phi phi w^3 / w_n^3). Without it, a structure that damps its high modes strongly (stiffness-proportional:
+    zeta 0.2-2 above 2 kHz) left that trace in the residues: 0.5-0.75 % off, and the model updating fitted to them
+    moved k_t 7 % and the lever arm 3 % away from the truth (docs/measurements.md). Returns (residues
+    (n_out, n_poles), residual coefficients (n_out, 3) real: LR, UR, UI, fitted FRF (n_out, n_f)).
     """
     w = 2 * np.pi * np.asarray(frequency_hz, dtype=float)
     iw = 1j * w
@@ -75,17 +82,25 @@ def lsfd_residues(frequency_hz: np.ndarray, frf: np.ndarray, poles: np.ndarray) 
         a = iw**2 / (iw - s)
         b = iw**2 / (iw - np.conj(s))
         cols += [a + b, 1j * (a - b)]  # Re R and Im R
-    cols += [np.ones_like(w), w**2, 1j * w**3]
-    A = np.array(cols).T
+    A = np.vstack([np.array(cols).reshape(-1, w.size), residual_terms(frequency_hz)]).T
     Areal = np.vstack([A.real, A.imag])
     H = np.atleast_2d(frf)
+    n = 2 * len(poles)
     res = np.empty((H.shape[0], len(poles)), dtype=complex)
+    coef = np.empty((H.shape[0], 3))
     fit = np.empty_like(H)
     for o in range(H.shape[0]):
         b = np.concatenate([H[o].real, H[o].imag])
         c = np.linalg.lstsq(Areal, b, rcond=None)[0]
-        res[o] = c[0 : 2 * len(poles) : 2] + 1j * c[1 : 2 * len(poles) : 2]
+        res[o] = c[0:n:2] + 1j * c[1:n:2]
+        coef[o] = c[n:]
         fit[o] = A @ c
+    return res, coef, fit
+
+
+def lsfd_residues(frequency_hz: np.ndarray, frf: np.ndarray, poles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(residues (n_out, n_poles), fitted FRF (n_out, n_f)) of ``lsfd_fit``."""
+    res, _, fit = lsfd_fit(frequency_hz, frf, poles)
     return res, fit
 
 

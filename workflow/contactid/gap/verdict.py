@@ -239,11 +239,11 @@ def updating_effect(factors: Mapping[str, float], identifiability: Mapping[str, 
     does: the blind benchmark's transducer masses +20 % were found at 1.194-1.197 in two runs, at 2.7 and 1.8
     linearised sd (k_n 2.34e7 and 2.23e7 N/m), and called "none" the second time."""
 
-    def moved(f, v):
+    def has_moved(f, v):
         d = identifiability[f]
         if "profile_chi2_increase" in d:
             return d["profile_chi2_increase"] > UPDATING_Z**2
         return abs(np.log(v)) > UPDATING_Z * max(d["posterior_sd"], 1e-12)
 
-    moved = [f for f, v in factors.items() if moved(f, v)]
+    moved = [f for f, v in factors.items() if has_moved(f, v)]
     return UPDATING_EFFECTS.get(moved[0]) if len(moved) == 1 else None
