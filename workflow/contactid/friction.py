@@ -164,12 +164,17 @@ def valanis_step(S, xi0, xi1, n0, n1, e_f, k_c, e_t, kappa, mu, n_min, slip_limi
     """Friction force S (N) after xi moves from xi0 to xi1 (m) while N moves from n0 to n1 (N),
     Eqs. 21-22 (Heun's method in xi; N linear over the step). slip_limit: the ``slip_limit``
     reading (True) or Eq. 21 as printed (False)."""
-    if n1 <= n_min:
-        return 0.0
-    if n0 <= n_min:  # re-contact: the contact sticks where it lands
+    if n1 <= n_min or n0 <= n_min:  # open, or re-contact: the contact sticks where it lands
         return 0.0
     e0a = initial_stiffness(n0, e_f, k_c)
     e0b = initial_stiffness(n1, e_f, k_c)
+    return valanis_step_at(S, xi0, xi1, n0, n1, e0a, e0b, e_t, kappa, mu, slip_limit)
+
+
+@njit(cache=True)
+def valanis_step_at(S, xi0, xi1, n0, n1, e0a, e0b, e_t, kappa, mu, slip_limit):
+    """``valanis_step`` with Eq. 22's e_0 at both ends given (e0a at n0, e0b at n1, N/m; a time stepper that
+    carries one step's e0b over as the next step's e0a saves an exponential a step); both forces above n_min."""
     return _step_terms(
         S,
         xi0,
