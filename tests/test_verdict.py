@@ -356,6 +356,25 @@ def test_compound_items_are_seeded_and_balanced():
         assert abs(p["tangential_lever_arm"]) <= 0.08
 
 
+def test_long_benchmark_items_are_scheduled_first():
+    """The scheduler's order (gap_benchmark_item's priority): compound items with a drifting preload, then items whose
+    contact opens, then the other compound items, the leave-outs, and the single effects last."""
+    from contactid.gap.benchmark import benchmark_items, expected_seconds, ladder_items
+
+    items = {**benchmark_items({}, 20260101), **ladder_items({}, 20260101)}
+    cost = {name: expected_seconds(spec) for name, spec in items.items()}
+    drift = [n for n, s in items.items() if s["kind"] == "compound" and "preload_drift" in s["effects"]]
+    opening = [n for n, s in items.items() if s["kind"] == "blind" and s["effect"] == "contact_separation"]
+    compound = [n for n, s in items.items() if s["kind"] == "compound" and n not in drift]
+    single = [n for n, s in items.items() if s["kind"] == "blind" and n not in opening]
+    assert drift and opening and compound and single
+    assert min(cost[n] for n in drift) > max(cost[n] for n in opening) > max(cost[n] for n in compound)
+    assert min(cost[n] for n in compound) > max(cost[n] for n in single)
+    # a ladder's contact opens only near the typical magnitude (its tenth and third stay closed)
+    ladder = {s["fraction"]: cost[n] for n, s in items.items() if n.startswith("ladder_contact_separation")}
+    assert ladder[max(ladder)] > ladder[min(ladder)]
+
+
 def test_compound_score_counts_named_effects_against_the_truth():
     from contactid.gap.benchmark import compound_score
 

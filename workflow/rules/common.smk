@@ -245,6 +245,14 @@ def ladder_items():
     return items(config["gap_benchmark"], int(config["seed"]))
 
 
+def benchmark_item_priority(item):
+    """A benchmark or ladder item's scheduling priority: its expected run time in seconds
+    (contactid.gap.benchmark.expected_seconds), so that the long items start first."""
+    from contactid.gap.benchmark import expected_seconds
+
+    return expected_seconds({**benchmark_items(), **ladder_items()}[item])
+
+
 def gap_report_inputs(wildcards):
     """The report's gap section: the diagnosis, and the blind benchmark when gap_benchmark.in_report."""
     inputs = {"diagnosis": "results/gap/diagnosis.json", "intervals": "results/gap/friction_intervals.json"}

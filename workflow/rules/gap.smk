@@ -131,6 +131,8 @@ rule gap_benchmark_item:
     wildcard_constraints:
         item=r"[a-z_]+-[0-9]+-s[0-9]+",
     threads: 1
+    # the long items first (longest-processing-time order): none is left to run alone at the end
+    priority: lambda wc: benchmark_item_priority(wc.item)
     resources:
         runtime=20,
         mem_mb=2000,

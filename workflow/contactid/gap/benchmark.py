@@ -85,6 +85,22 @@ def benchmark_items(cfg: Mapping, seed: int) -> dict:
     return items
 
 
+def expected_seconds(spec: Mapping) -> int:
+    """A benchmark item's expected run time (s, on one core of the 2-core reference machine; the blind benchmark
+    at 4e9292c), for the workflow's scheduler to start the long items first so that no core idles at the end
+    waiting for one of them (``gap_benchmark_item``'s priority). The rig's truth sets it: a preload drift in a
+    compound item (its later passes march whole records: 30-75 s) and a contact that opens (every simulation
+    marched from the linear state: 31-38 s) are the long ones; most items take 10-20 s."""
+    effects = dict(spec.get("effects") or {})
+    if spec.get("effect"):
+        effects[spec["effect"]] = spec.get("magnitude", 0.0)
+    if spec.get("kind") == "compound":
+        return 35 if "preload_drift" in effects else 20
+    if "contact_separation" in effects and spec.get("kind") != "leave_out":
+        return 33 if spec.get("fraction", 1.0) > 0.5 else 12
+    return 18 if spec.get("kind") == "leave_out" else 11
+
+
 def ladder_typical(effect: str, ranges: Mapping = RANGES) -> float:
     """An effect's typical magnitude (``rig.effects``' typical value), kept inside its benchmark range's upper
     end (contact separation's typical 7.2 makes lc3's impacts keep the motion from settling)."""
