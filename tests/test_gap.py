@@ -422,6 +422,44 @@ def test_every_figure_and_the_report_section_for_any_diagnosis(tmp_path, steps, 
 
 
 @pytest.mark.slow
+def test_polish_searches_setting_polishes_every_searched_state(hc_data, monkeypatch):
+    """gap.polish_searches reaches the candidate's search (as an argument of the task, so that a worker process sees
+    it too): every state compared is polished; by default only the optimum is."""
+    from contactid.gap import refit
+    from contactid.gap.diagnosis import GapSettings, _candidate
+    from contactid.gap.refit import POLISH_SEARCH, baseline
+
+    cfg, model, records, _ = hc_data
+    fit = settings_from_config(cfg["friction"])
+    settings = GapSettings.from_config({**cfg["gap"], "polish_searches": True}, 0, 25)
+    assert settings.polish_searches and not GapSettings.from_config(cfg["gap"], 0, 25).polish_searches
+    base = {c: baseline(model, records[c], 9)[1] for c in records}
+    seen = []
+    evaluate = refit.evaluate
+
+    def spy(*args, polish=True, **kw):
+        seen.append(polish)
+        return evaluate(*args, polish=polish, **kw)
+
+    monkeypatch.setattr(refit, "evaluate", spy)
+    common = dict(
+        model=model,
+        records=records,
+        calibration_case="lc1",
+        score_cases=["lc2", "lc3"],
+        base_sims=base,
+        fit_settings=fit,
+        H=9,
+        max_evaluations=4,
+    )
+    _candidate("viscous_friction", **common, polish_searches=True)
+    assert len(seen) > 3 and all(seen) and not POLISH_SEARCH.get()
+    seen.clear()
+    _candidate("viscous_friction", **common)
+    assert len(seen) > 3 and seen.count(True) == 1  # the optimum alone
+
+
+@pytest.mark.slow
 def test_search_finds_the_time_marching_searchs_optimum(hc_data):
     """The calibration search on harmonic-balance states (within 5e-4 of the integrator's orbit) finds the optimum of
     a search on time-marched states within 1 % and reports the integrator's gap there; with every state polished by

@@ -29,6 +29,7 @@ from .candidates import LIBRARY, joint_candidate, merged_augmentation
 from .model import NONE, Augmentation, IdentifiedModel, fe_model
 from .records import RecordHarmonics
 from .refit import (
+    POLISH_SEARCH,
     baseline,
     calibrate,
     contact_grids,
@@ -93,6 +94,7 @@ class GapSettings:
     updating_confidence: float = 0.95
     updating_prior_sd: tuple = ()  # ((factor, sd of its ln), ...) replacing contactid.updating.FACTORS' priors
     joint_refit: bool = True  # the explanation's later steps refit the earlier steps' parameters with theirs
+    polish_searches: bool = False  # every searched state polished by the integrator (refit.POLISH_SEARCH)
     pair_lookahead: float = 3.0  # where no candidate shrinks a gap above this many min_gap materially, try a pair
     retry_unmoved: bool = False  # later passes also try the candidates whose refit alone left them off
     place: PlaceThresholds = DEFAULT_PLACE  # the localisation's thresholds (gap.place)
@@ -121,6 +123,7 @@ class GapSettings:
             max_evaluations=int(g["max_evaluations"]),
             eta_observability_limit=float(g["eta_observability_limit"]),
             joint_refit=bool(g["joint_refit"]),
+            polish_searches=bool(g["polish_searches"]),
             pair_lookahead=float(g["pair_lookahead"]),
             retry_unmoved=bool(g["retry_unmoved"]),
             place=PlaceThresholds.from_config(g.get("place")),
@@ -533,6 +536,7 @@ def _candidate(
     joint: bool = True,
     alone: dict | None = None,
     channel_delays=None,
+    polish_searches: bool = False,
 ):
     """One candidate added to the explanation's earlier steps ``base_steps`` ((name, theta), ...): calibrated on
     the calibration case (with ``joint``, together with the earlier steps' parameters, ``joint_candidate``;
@@ -540,7 +544,29 @@ def _candidate(
     ``alone``: {name: theta} of the first pass (each candidate alone); a joint refit also starts between the
     earlier steps' optimum and this candidate's own (two effects that can stand in for each other, viscous friction
     and a normal dashpot, leave a ridge between the one-effect optimum and the truth). ``channel_delays``: the random
-    test's per-channel delays (``refit.calibrate``). Returns (calibration, sims, residuals) by case."""
+    test's per-channel delays (``refit.calibrate``). ``polish_searches``: every searched state polished by the
+    integrator (``refit.POLISH_SEARCH``, set here: a worker process does not inherit the caller's context).
+    Returns (calibration, sims, residuals) by case."""
+    if polish_searches and not POLISH_SEARCH.get():
+        token = POLISH_SEARCH.set(True)
+        try:
+            return _candidate(
+                name,
+                model,
+                records,
+                calibration_case,
+                score_cases,
+                base_sims,
+                fit_settings,
+                H,
+                max_evaluations,
+                base_steps,
+                joint,
+                alone,
+                channel_delays,
+            )
+        finally:
+            POLISH_SEARCH.reset(token)
     rec = records[calibration_case]
     # per-channel effects (channel delays) trade off with no contact effect and would add a dimension per channel:
     # they are held, and a per-channel candidate is refitted on the earlier steps held
@@ -950,6 +976,7 @@ class _DiagnosisRun:
             H=self.H,
             max_evaluations=self.settings.max_evaluations,
             channel_delays=self.channel_delays,
+            polish_searches=self.settings.polish_searches,
             **extra,
         )
 
