@@ -212,7 +212,13 @@ class HarmonicBalance:
     solution is the integrator's periodic orbit up to the harmonics above H, and it shares the
     integrator's (and the rig's) discretisation instead of differing from it by it."""
 
-    _last_lu: dict = {}
+    _last_lu: dict = {}  # the last factorised Jacobian, {(n, H, M): factor}: the next solve's chord (``forget``)
+
+    @classmethod
+    def forget(cls) -> None:
+        """Drop the factorised Jacobian kept for the next solve's chord steps, so that what follows does not depend
+        on what was solved before in this process (Newton's path, and so its state within its tolerance)."""
+        cls._last_lu = {}
 
     def __init__(self, red: ReducedModel, contact: ContactParameters, zeta: np.ndarray, w: float, H: int, M: int):
         if contact.preload_drift:
