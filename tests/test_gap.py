@@ -189,7 +189,9 @@ def test_a_diagnosis_does_not_depend_on_what_ran_before_it(hc_data, hc_diagnosis
     assert [r["heldout_gap_after"] for r in again.ranking] == [r["heldout_gap_after"] for r in hc_diagnosis.ranking]
     assert [r["calibration_gap"] for r in again.ranking] == [r["calibration_gap"] for r in hc_diagnosis.ranking]
     polished_again = _diagnose(hc_data, TWO, polish_searches=True)
-    assert [r["heldout_gap_after"] for r in polished_again.ranking] == [r["heldout_gap_after"] for r in polished.ranking]
+    assert [r["heldout_gap_after"] for r in polished_again.ranking] == [
+        r["heldout_gap_after"] for r in polished.ranking
+    ]
 
 
 @pytest.mark.slow
