@@ -441,7 +441,7 @@ def test_polish_searches_setting_polishes_every_searched_state(hc_data, monkeypa
     """gap.polish_searches reaches the candidate's search (as an argument of the task, so that a worker process sees
     it too): every state compared is polished; by default only the optimum is."""
     from contactid.gap import refit
-    from contactid.gap.diagnosis import GapSettings, _candidate
+    from contactid.gap.diagnosis import GapSettings, _candidate_task
     from contactid.gap.refit import POLISH_SEARCH, baseline
 
     cfg, model, records, _ = hc_data
@@ -467,10 +467,10 @@ def test_polish_searches_setting_polishes_every_searched_state(hc_data, monkeypa
         H=9,
         max_evaluations=4,
     )
-    _candidate("viscous_friction", **common, polish_searches=True)
+    _candidate_task(("viscous_friction", {**common, "polish_searches": True}))
     assert len(seen) > 3 and all(seen) and not POLISH_SEARCH.get()
     seen.clear()
-    _candidate("viscous_friction", **common)
+    _candidate_task(("viscous_friction", common))
     assert len(seen) > 3 and seen.count(True) == 1  # the optimum alone
 
 

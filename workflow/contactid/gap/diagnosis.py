@@ -30,7 +30,6 @@ from .candidates import LIBRARY, joint_candidate, merged_augmentation
 from .model import NONE, Augmentation, IdentifiedModel, fe_model
 from .records import RecordHarmonics
 from .refit import (
-    POLISH_SEARCH,
     baseline,
     calibrate,
     contact_grids,
@@ -39,6 +38,7 @@ from .refit import (
     gap_value,
     identified_forces,
     law_friction_force,
+    polished_searches,
 )
 from .verdict import DEFAULT_PLACE, UPDATING_Z, PlaceThresholds
 from .verdict import (
@@ -537,7 +537,6 @@ def _candidate(
     joint: bool = True,
     alone: dict | None = None,
     channel_delays=None,
-    polish_searches: bool = False,
 ):
     """One candidate added to the explanation's earlier steps ``base_steps`` ((name, theta), ...): calibrated on
     the calibration case (with ``joint``, together with the earlier steps' parameters, ``joint_candidate``;
@@ -545,29 +544,7 @@ def _candidate(
     ``alone``: {name: theta} of the first pass (each candidate alone); a joint refit also starts between the
     earlier steps' optimum and this candidate's own (two effects that can stand in for each other, viscous friction
     and a normal dashpot, leave a ridge between the one-effect optimum and the truth). ``channel_delays``: the random
-    test's per-channel delays (``refit.calibrate``). ``polish_searches``: every searched state polished by the
-    integrator (``refit.POLISH_SEARCH``, set here: a worker process does not inherit the caller's context).
-    Returns (calibration, sims, residuals) by case."""
-    if polish_searches and not POLISH_SEARCH.get():
-        token = POLISH_SEARCH.set(True)
-        try:
-            return _candidate(
-                name,
-                model,
-                records,
-                calibration_case,
-                score_cases,
-                base_sims,
-                fit_settings,
-                H,
-                max_evaluations,
-                base_steps,
-                joint,
-                alone,
-                channel_delays,
-            )
-        finally:
-            POLISH_SEARCH.reset(token)
+    test's per-channel delays (``refit.calibrate``). Returns (calibration, sims, residuals) by case."""
     rec = records[calibration_case]
     # per-channel effects (channel delays) trade off with no contact effect and would add a dimension per channel:
     # they are held, and a per-channel candidate is refitted on the earlier steps held
@@ -632,8 +609,13 @@ def _candidate(
 
 
 def _candidate_task(task):
+    """(name, common): ``_candidate(name, **common)``, every searched state polished by the integrator where
+    ``common["polish_searches"]`` says so (``refit.polished_searches``: set here, in the process that runs the
+    candidate, since a worker does not inherit the caller's context)."""
     name, common = task
-    return _candidate(name, **common)
+    common = dict(common)
+    with polished_searches(common.pop("polish_searches", False)):
+        return _candidate(name, **common)
 
 
 def fork_safe() -> bool:
@@ -682,7 +664,7 @@ def _candidates(names, workers: int, **common):
             "gap candidates: numba's parallel threads already run in this process; one process instead of %d", workers
         )
     if pool is None:
-        return lambda: {name: _candidate(name, **common) for name in names}
+        return lambda: {name: _candidate_task((name, common)) for name in names}
     pending = pool.map_async(_candidate_task, [(name, common) for name in names], chunksize=1)
     return lambda: dict(zip(names, pending.get()))
 

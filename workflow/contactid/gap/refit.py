@@ -264,6 +264,18 @@ def evaluate(
 POLISH_SEARCH = contextvars.ContextVar("polish_search", default=False)
 
 
+@contextlib.contextmanager
+def polished_searches(enabled: bool = True):
+    """Within the block, every state a calibration search compares is polished by the integrator (``POLISH_SEARCH``)
+    where ``enabled``; otherwise the search compares what the caller's context says."""
+    token = POLISH_SEARCH.set(True) if enabled else None
+    try:
+        yield
+    finally:
+        if token is not None:
+            POLISH_SEARCH.reset(token)
+
+
 class _CandidateRuns:
     """The chain redone (``evaluate``) at the thetas a calibration tries, each once: called with theta, it returns
     (gap, model with refitted friction, simulation, friction misfit, augmentation), every simulation starting from

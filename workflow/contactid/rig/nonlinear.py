@@ -270,11 +270,9 @@ def _friction_force(S_val, xi, dxi, N, x_sl, contact, no_flags):
     """The total tangential force after a step, S = (1 - s) S_valanis + s S_iwan + sigma_2 dxi/dt (N), with s the
     Iwan share; zero once the contact opens (N <= 0), and the Iwan sliders' anchors (m) then follow xi."""
     if N > 0.0:
-        if contact.iw_share <= 0.0:
-            return S_val + contact.visc * dxi
         fr = contact.fr
         e0 = initial_stiffness(N, fr[0], fr[1])
-        s_iw = iwan_force(xi, x_sl, contact.iw_w, e0, fr[4] * N, no_flags)
+        s_iw = iwan_force(xi, x_sl, contact.iw_w, e0, fr[4] * N, no_flags) if contact.iw_share > 0.0 else 0.0
         return (1.0 - contact.iw_share) * S_val + contact.iw_share * s_iw + contact.visc * dxi
     for k in range(x_sl.size):
         x_sl[k] = xi
@@ -419,7 +417,7 @@ def integrate(z, v, state, x_sl, t0, n_steps, dt, model, contact, drive, store_f
             S_val = valanis_step_at(S_val, xi_old, xi, N_old, N, e0_from, e0_to, e_t, kappa, mu, slip_limit)
         if contact.iw_share > 0.0 or N <= 0.0:
             S_tot = _friction_force(S_val, xi, dxi, N, x_sl, contact, no_flags)
-        else:  # _friction_force's closed contact without the Iwan share, inline (a tenth of the step's time)
+        else:  # a closed contact without the Iwan share, inline: no Eq. 22 exponential, 40 of 460 ns a step
             S_tot = S_val + contact.visc * dxi
         P = _static_preload(t, n0, drive)
         f = _excitation(f_sin, f_cos, w, t)
