@@ -659,8 +659,9 @@ def _candidates(names, workers: int, **common):
     """Start the candidates (see ``_candidate``) and return a function that gives {name: (calibration, sims,
     residuals)} in library order. With ``workers`` > 1 they run at once in forked worker processes while this
     process goes on (the results equal the serial ones to the last digit: each candidate starts without Newton
-    history, ``_candidate_task``); serially, when the function is called. A pool can only be forked before numba's parallel threads start in this process (in
-    a rule script: before the localisation runs the friction kernel); later calls reuse it."""
+    history, ``_candidate_task``); serially, when the function is called. A pool can only be forked before numba's
+    parallel threads start in this process (in a rule script: before the localisation runs the friction kernel);
+    later calls reuse it."""
     workers = max(1, min(int(workers), len(names)))
     pool = _pool(workers) if workers > 1 else None
     if workers > 1 and pool is None:
