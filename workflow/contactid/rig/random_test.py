@@ -106,9 +106,12 @@ def simulate_random_test(model: FEModel, settings: RandomTestSettings, seed: int
         model, lambda f: damping_ratios(f, s.modal_damping_ratio, s.damping_form, s.damping_reference_hz), 1.0 / fs_sim
     )
     acc_sim = np.zeros((sens.shape[0], n_sim))
+    term = np.empty(n_sim)
     for (num, den), part in zip(filters, sens.T):
         qdd = scipy.signal.lfilter(num, den, f_sim)
-        acc_sim += np.outer(part, qdd)
+        for channel, weight in enumerate(part):  # acc += part qdd, row by row: no (channels, n) temporary
+            np.multiply(qdd, weight, out=term)
+            acc_sim[channel] += term
 
     if s.channel_delays_s is not None:
         acc_sim = delay_channels(acc_sim, s.channel_delays_s, fs_sim)
