@@ -172,3 +172,23 @@ def test_with_every_mode_in_the_balance_the_orbit_is_the_integrators(model):
     amplitude = np.linalg.norm(A_ref, axis=1, keepdims=True)
     assert periodic.extra["method"] == "harmonic_balance" and H > 2 * 9
     assert np.max(np.abs(A - A_ref) / amplitude) < 1e-5
+
+
+def test_the_settling_tolerance_is_a_setting_of_the_context(model):
+    """``SETTLING_TOL`` sets the integrator's settling test where ``simulate`` is given none
+    (benchmarks/gap_diagnosis.py --reference-scatter runs the reference at half and double it); an explicit ``tol``
+    wins. A looser test stops earlier: other harmonics, close to the default's."""
+    from contactid.gap.model import SETTLING_TOL
+
+    rec, aug = record("lc1"), EFFECTS["none"]
+    default = simulate(model, aug, rec, method="time_marching").acceleration
+    token = SETTLING_TOL.set(1e-2)
+    try:
+        loose = simulate(model, aug, rec, method="time_marching").acceleration
+        explicit = simulate(model, aug, rec, method="time_marching", tol=2e-5).acceleration
+    finally:
+        SETTLING_TOL.reset(token)
+    assert SETTLING_TOL.get() == 2e-5
+    assert np.array_equal(explicit, default)
+    rel = np.abs(loose - default).max() / np.abs(default).max()
+    assert 0.0 < rel < 0.05

@@ -211,6 +211,9 @@ def _delay(coef: np.ndarray, delays, w: float) -> np.ndarray:
 STEADY_STATE = contextvars.ContextVar("steady_state", default="harmonic_balance")
 # a contact that may open, unpolished (a calibration search): its periodic state where it stays closed
 CLOSED_CONTACT_HB = contextvars.ContextVar("closed_contact_hb", default=True)
+# the integrator's settling test (relative change of the harmonics between 8-period chunks) where ``simulate`` is not
+# given one; benchmarks/gap_diagnosis.py --reference-scatter halves and doubles it to show the reference's own scatter
+SETTLING_TOL = contextvars.ContextVar("settling_tol", default=2e-5)
 
 
 def simulate(
@@ -219,7 +222,7 @@ def simulate(
     rec: RecordHarmonics,
     record_periods: int = 16,
     force_harmonics: int = 5,
-    tol: float = 2e-5,
+    tol: float | None = None,
     grid: int = 256,
     start: "SimResult | None" = None,
     method: str | None = None,
@@ -237,8 +240,8 @@ def simulate(
     own periodic orbit (the harmonics it leaves out); with ``polish`` (the default; in the calibration searches
     with ``refit.POLISH_SEARCH``) the integrator runs from
     that state until its harmonics settle by the reference's own test (8-period chunks changing by less than
-    ``tol``, two chunks at least) and records the last settled chunk (``record_periods`` periods, or the
-    record's length, where it does not settle), so the result is the
+    ``tol``, by default ``SETTLING_TOL``'s 2e-5, two chunks at least) and records the last settled chunk
+    (``record_periods`` periods, or the record's length, where it does not settle), so the result is the
     reference's to its tolerance at a fraction of its cost. Where Newton does not converge (a response
     that does not settle), and for a contact that may open, the integrator starts from the linear state
     instead; unpolished, a contact that may open is given its periodic state where that
@@ -247,6 +250,7 @@ def simulate(
     preload drift the whole record's length is integrated, as measured, from the settled state at the
     record's start (in a search, unpolished: from the periodic state itself, 0.17 -> 0.13 s a simulation)."""
     method = method or STEADY_STATE.get()
+    tol = SETTLING_TOL.get() if tol is None else float(tol)
     if method not in ("harmonic_balance", "time_marching"):
         raise ValueError(f"simulate: method {method!r}; give 'harmonic_balance' or 'time_marching'")
     sim = simulator(model, aug, rec.fs, rec.f0)
