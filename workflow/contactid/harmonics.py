@@ -65,6 +65,24 @@ def periodic_harmonics(x: np.ndarray, t_first: float, w: float, n_per: int, H: i
     return 2j * X / n_per * np.exp(-1j * h * w * t_first)
 
 
+def aperiodic_share(x: np.ndarray, fs: float, f0: float, band: float = 0.45) -> np.ndarray:
+    """Share of each row's rms (about its mean) that is not periodic at f0: what is left once the mean and every
+    harmonic of f0 below ``band`` x fs are fitted (least squares over the whole periods of the record, x sampled at
+    fs from t = 0). A periodic response leaves the sensors' noise alone (the noise fraction, 0.005 on the rig); a
+    motion that does not settle (impacts, chaos) leaves far more (0.2-0.5 on a separating contact's record)."""
+    x = np.atleast_2d(np.asarray(x, dtype=float))
+    periods = int(np.floor(x.shape[1] * f0 / fs + 1e-9))
+    n = min(x.shape[1], int(round(periods * fs / f0))) if periods >= 2 else x.shape[1]
+    x = x[:, :n]
+    t = np.arange(n) / fs
+    H = max(1, int(band * fs / f0))
+    c = harmonic_amplitudes(x.T, t, 2 * np.pi * f0, range(1, H + 1)).T
+    centred = x - x.mean(axis=1, keepdims=True)
+    left = centred - synthesize(c, f0, t)
+    left -= left.mean(axis=1, keepdims=True)
+    return np.sqrt(np.mean(left**2, axis=1) / np.maximum(np.mean(centred**2, axis=1), 1e-300))
+
+
 def synthesize(coef: np.ndarray, f0: float, t: np.ndarray, derivative: int = 0) -> np.ndarray:
     """Time signals sum_h Im(c_h (i h w)^d e^{i h w t}) of coefficients (rows, K); d = -2 integrates
     twice analytically (Eq. 17)."""

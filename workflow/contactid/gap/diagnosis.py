@@ -273,8 +273,8 @@ def localise(
     thresholds: PlaceThresholds = DEFAULT_PLACE,
 ) -> tuple[dict, dict]:
     """The gap by stage, sensor, harmonic, part of the cycle and load level (the identified model
-    as the chain left it, or with the effects ``aug`` added). Returns (summary for diagnosis.json, arrays for
-    gap.nc)."""
+    as the chain left it, or with the effects ``aug`` added), the records' drift and whether each settled
+    (``record_periodicity``). Returns (summary for diagnosis.json, arrays for gap.nc)."""
     H = n_harmonics
     cases = list(records)
     resp = _response_gaps(fe_model(model, aug), records, sims, H)
@@ -304,6 +304,7 @@ def localise(
     }
     summary = {"stage": stage, **_gap_patterns(stage, arrays, records, resp["accelerations"], thresholds)}
     summary["drift"] = {c: dict(zip(("change", "z"), record_drift(records[c], H))) for c in cases}
+    summary["periodicity"] = record_periodicity(records, thresholds.aperiodic_limit)
     summary["identification_residual"] = dict(zip(cases, per_case["identification_residual"]))
     summary["identification_noise"] = dict(zip(cases, per_case["identification_noise"]))
     spread = {c: eta_model_spread(model, aug, records[c], structures) for c in cases}
@@ -371,6 +372,26 @@ def record_drift(rec: RecordHarmonics, H: int) -> tuple[float, float]:
     sigma = np.sqrt(np.mean(np.sum(np.abs(resid) ** 2, axis=1)) * A.shape[0] / max(A.shape[0] - 2, 1))
     change = float(np.linalg.norm(slope) * (A.shape[0] - 1) / np.linalg.norm(rec.acceleration[:, :H]))
     return change, float(np.linalg.norm(slope) * np.sqrt(b @ b) / max(sigma, 1e-300))
+
+
+def record_periodicity(records: dict, limit: float) -> dict:
+    """Per load case: the share of the response that is not periodic at the drive (``RecordHarmonics.aperiodic``,
+    the worst accelerometer and each one) and whether the record settled (that share at most ``limit``). A record
+    that does not settle (impacts, chaos) has harmonics that are averages of a motion that never repeats: the gap
+    compares those averages, and a candidate, compared on harmonics, cannot be expected to explain it."""
+    out = {}
+    for c, rec in records.items():
+        a = getattr(rec, "aperiodic", None)
+        if a is None or not np.size(a):
+            continue
+        sensors = list(getattr(rec, "sensors", range(np.size(a))))
+        worst = float(np.max(a))
+        out[c] = {
+            "aperiodic_share": worst,
+            "by_sensor": {str(s): float(v) for s, v in zip(sensors, np.atleast_1d(a))},
+            "settled": bool(worst <= limit),
+        }
+    return out
 
 
 def identification_noise(model: IdentifiedModel, rec: RecordHarmonics) -> float:

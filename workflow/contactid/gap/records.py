@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
-from ..harmonics import harmonic_amplitudes
+from ..harmonics import aperiodic_share, harmonic_amplitudes
 
 
 @dataclass(frozen=True)
@@ -24,7 +24,9 @@ class RecordHarmonics:
 
     force: (H,) complex; acceleration: (j, H) complex; block_force (B, H) and block_acceleration
     (B, j, H): the same per block of whole periods; first/last: (j, H) of the first and last thirds;
-    f0 (Hz), fs (Hz), periods (whole periods in the record), sensors (names)."""
+    f0 (Hz), fs (Hz), periods (whole periods in the record), sensors (names); aperiodic (j,): each accelerometer's
+    share of its rms that is not periodic at f0 (``harmonics.aperiodic_share``: the noise alone where the response
+    settles; None where not computed)."""
 
     case: str
     f0: float
@@ -38,6 +40,7 @@ class RecordHarmonics:
     last: np.ndarray
     sensors: tuple
     sensor_positions: np.ndarray
+    aperiodic: np.ndarray | None = None
 
 
 def _aligned(force_coef: np.ndarray, coefs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -96,4 +99,5 @@ def record_harmonics(raw: xr.Dataset, case: str, n_harmonics: int, n_blocks: int
         thirds[1],
         tuple(str(s) for s in raw["sensor"].values),
         np.asarray(raw["sensor_position"].values if "sensor_position" in raw else [], dtype=float),
+        aperiodic_share(acc[:, :n_use], fs, f0),
     )

@@ -175,6 +175,36 @@ def comparison_lines(diag: dict) -> list[str]:
     ]
 
 
+def periodicity_text(w: dict) -> str:
+    """Whether each record settled (``where.periodicity``): one sentence, empty where the diagnosis has none."""
+    per = w.get("periodicity") or {}
+    if not per:
+        return ""
+    unsettled = {c: p for c, p in per.items() if not p.get("settled", True)}
+    if not unsettled:
+        worst = max(_num(p["aperiodic_share"]) for p in per.values())
+        return (
+            r" Every record settled: at most "
+            + _pct(worst)
+            + r" of an accelerometer's response is not periodic at the drive frequency (a settled response leaves "
+            r"its noise alone)."
+        )
+    parts = []
+    for c, p in unsettled.items():
+        by = p.get("by_sensor") or {}
+        sensor = max(by, key=lambda k: _num(by[k])) if by else None
+        parts.append(_t(c) + " (" + _pct(p["aperiodic_share"]) + (" at " + _t(sensor) if sensor else "") + ")")
+    return (
+        " "
+        + ", ".join(parts)
+        + r" did not settle: that share of the response is not periodic at the drive frequency (impacts, or a motion "
+        r"that never repeats). "
+        + ("Their" if len(parts) > 1 else "Its")
+        + r" harmonics are averages of that motion, and no candidate compared on harmonics can be expected to "
+        r"explain a gap there."
+    )
+
+
 def where_paragraph(diag: dict) -> str:
     """The paragraph 'Where the gap lies': the held-out gap (%), by stage, the worst sensor, harmonic and part of
     the cycle, and the place the localisation names."""
@@ -215,7 +245,9 @@ def where_paragraph(diag: dict) -> str:
         + _pct(w["even_share"])
         + r" of the residual), worst part of the cycle: "
         + _t(w["worst_cycle_part"])
-        + r". "
+        + r"."
+        + periodicity_text(w)
+        + r" "
         r"The localisation places the gap in: \emph{" + _t(w["place"]) + r"} (" + _t(w["place_reason"]) + r"); "
         r"Fig.~\ref{fig:gap_stages}."
     )

@@ -20,12 +20,15 @@ class PlaceThresholds:
     ``drift_z`` standard errors; the structure and sensor model disagrees with the records when the inverse
     identification's sensor misfit exceeds ``residual_factor`` times its scatter; the normal contact is not
     elastic when the best elastic normal law leaves more than ``normal_limit`` of N; the contact is open where
-    the identified N is at or below ``open_limit`` times the preload N0."""
+    the identified N is at or below ``open_limit`` times the preload N0. A record whose response is more than
+    ``aperiodic_limit`` not periodic at the drive (``harmonics.aperiodic_share``, the worst accelerometer) does not
+    settle: the localisation reports it (``where.periodicity``), the place does not use it."""
 
     drift_z: float = 8.0
     residual_factor: float = 20.0
     normal_limit: float = 0.25
     open_limit: float = 0.02
+    aperiodic_limit: float = 0.1
 
     @classmethod
     def from_config(cls, block: Mapping | None) -> "PlaceThresholds":
