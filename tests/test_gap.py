@@ -559,3 +559,53 @@ def test_search_finds_the_time_marching_searchs_optimum(hc_data):
     assert polished.gap == pytest.approx(marched.gap, rel=1e-3)
     # the reported gap is the integrator's at the optimum, not the search's periodic state
     assert fast.gap == pytest.approx(evaluate(model, fast.augmentation, rec, fit.bounds, 9)[0], rel=1e-4)
+
+
+def test_a_step_whose_model_settles_unlike_the_records_is_flagged_and_said():
+    """model_periodicity: a candidate's model that impacts (aperiodic) on a record that settled, or settles on one
+    that did not, is listed (per case, judged by gap.place.aperiodic_limit); a drifting record's simulation is left
+    out; the report's explanation says it beside the step."""
+    from types import SimpleNamespace as NS
+
+    from contactid.gap.diagnosis import model_periodicity
+    from contactid.gap.report import explanation_text
+
+    records = {c: NS(aperiodic=np.array(a)) for c, a in (("lc1", [0.005, 0.006]), ("lc2", [0.3, 0.1]), ("lc3", [0.4]))}
+    cal = NS(simulation=NS(first=None, extra={"aperiodic": np.array([0.36, 0.58])}))  # lc1: impacts, the record not
+    sims = {"lc2": NS(first=None, extra={"method": "harmonic_balance"}), "lc3": NS(first=np.zeros(1), extra={})}
+    out = model_periodicity(cal, sims, records, "lc1", 0.1)
+    assert out["aperiodic_by_case"] == {"lc1": 0.58, "lc2": 0.0}  # lc3 drifts: left out
+    assert out["settles_unlike_records"] == ["lc1", "lc2"]
+    assert model_periodicity(NS(simulation=None), {}, records, "lc1", 0.1)["settles_unlike_records"] == []
+    step = {
+        "effect": "contact_separation",
+        "parameters": {"exponent": 1.69},
+        "heldout_gap_before": 0.3,
+        "heldout_gap_after": 0.25,
+        "share": 0.3,
+        **out,
+    }
+    diag = {
+        "explanation": [step],
+        "where": {"periodicity": {"lc1": {"settled": True}, "lc2": {"settled": False}, "lc3": {"settled": False}}},
+    }
+    text = explanation_text(diag)
+    assert "does not settle on lc1" in text and "settles on lc2, where the record does not" in text
+    step.update(settles_unlike_records=[])
+    assert "settle" not in explanation_text(diag)
+    # the candidates' table marks such a candidate and says what the mark means
+    from contactid.gap.report import candidates_table
+
+    row = {
+        "effect": "contact_separation",
+        "n_parameters": 2,
+        "heldout_gap_before": 0.3,
+        "heldout_gap_after": 0.25,
+        "heldout_gap_after_interval": [0.24, 0.26],
+        "reduction": 0.17,
+        "score": -10.0,
+        "settles_unlike_records": ["lc1"],
+    }
+    table = candidates_table({"ranking": [row]})
+    assert "contact\\_separation*" in table and "does not settle on a record that did" in table
+    assert "*" not in candidates_table({"ranking": [{**row, "settles_unlike_records": []}]})

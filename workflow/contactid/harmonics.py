@@ -74,6 +74,8 @@ def aperiodic_share(x: np.ndarray, fs: float, f0: float, band: float = 0.45) -> 
     periods = int(np.floor(x.shape[1] * f0 / fs + 1e-9))
     n = min(x.shape[1], int(round(periods * fs / f0))) if periods >= 2 else x.shape[1]
     x = x[:, :n]
+    scale = np.max(np.abs(x), axis=1, keepdims=True)  # the share is scale-free: no overflow on a diverging response
+    x = x / np.where(scale > 0, scale, 1.0)
     t = np.arange(n) / fs
     H = max(1, int(band * fs / f0))
     c = harmonic_amplitudes(x.T, t, 2 * np.pi * f0, range(1, H + 1)).T

@@ -719,6 +719,28 @@ def contact_opens(cal, sims: Mapping, open_limit: float) -> bool | None:
     return any(bool(np.min(N) <= open_limit * cal.model.preload) for N in grids)
 
 
+def model_periodicity(cal, sims: Mapping, records: Mapping, calibration_case: str, limit: float) -> dict:
+    """Whether a calibrated candidate's model settles where the records do: per case (the calibration case's
+    simulation ``cal.simulation`` and the scored ones ``sims``), the largest share of the model's sensor response
+    that is not periodic (0 for a periodic state or a settled march; a drifting record's is left out), and the cases
+    where the model settles and the record does not, or the other way round (each judged by ``limit``,
+    ``gap.place.aperiodic_limit``). A law whose model impacts on a record that settled (or settles on one that did
+    not) is wrong in form, whatever its harmonic gap: the harmonics of a response that never repeats are averages."""
+    runs = {}
+    for c in records:
+        sim = getattr(cal, "simulation", None) if c == calibration_case else sims.get(c)
+        if sim is None or getattr(sim, "first", None) is not None:  # no simulation, or a drifting record's
+            continue
+        a = (getattr(sim, "extra", None) or {}).get("aperiodic")
+        runs[c] = float(np.max(a)) if a is not None and np.size(a) else 0.0
+    unlike = []
+    for c, share in runs.items():
+        rec = getattr(records[c], "aperiodic", None)
+        if rec is not None and np.size(rec) and (share > limit) != (float(np.max(rec)) > limit):
+            unlike.append(c)
+    return {"aperiodic_by_case": runs, "settles_unlike_records": unlike}
+
+
 def explain(
     first: dict,
     names: list,
@@ -728,6 +750,7 @@ def explain(
     heldout_gap,
     next_pass,
     later: list | None = None,
+    periodicity=None,
 ) -> tuple[list, float, tuple | None]:
     """The additive explanation of the held-out gap: add the candidate that leaves the smallest held-out gap
     (its refit included), then try the remaining candidates on top of it (``next_pass(remaining, calibration)``
@@ -739,7 +762,8 @@ def explain(
     pair is added when together they shrink it materially and the second shrinks it further beyond the scatter.
 
     first: {name: (calibration, sims, residuals)} of the first pass; heldout_gap(sims) the held-out gap of a
-    model's simulations; later: the candidates tried after the first pass (``verdict.retried``; None: all).
+    model's simulations; later: the candidates tried after the first pass (``verdict.retried``; None: all);
+    periodicity(cal, sims): a step's ``model_periodicity`` (None: not reported).
     Returns (steps [{effect, parameters, heldout_gap_before, heldout_gap_after, share}], the gap left,
     (calibration, sims) of the last step or None). share: the part of the held-out gap's power (its square) the step
     removes; the shares and the remaining share sum to 1."""
@@ -787,6 +811,8 @@ def explain(
                     "contact_opens": contact_opens(cal, sims, getattr(settings, "place", DEFAULT_PLACE).open_limit),
                 }
             )
+            if periodicity is not None:
+                steps[-1].update(periodicity(cal, sims))
             if len(cal.steps) > 1:  # the earlier steps' parameters as refitted with this one (gap.joint_refit)
                 steps[-1]["earlier_refitted"] = {n: _parameter_values(n, theta=th) for n, th in cal.steps[:-1]}
             log.info("explanation step %d: %s leaves a held-out gap of %.4g (from %.4g)", len(steps), name, after, gap)
@@ -870,9 +896,12 @@ def _ranking_row(
     }
 
 
-def _ranking(results, heldout_gap, n_bootstrap, before, before_b, n_data, records, calibration_case, where):
+def _ranking(
+    results, heldout_gap, n_bootstrap, before, before_b, n_data, records, calibration_case, where, aperiodic_limit=0.1
+):
     """The candidates' ranking rows, sorted by score (scores equal to 3 decimals are a tie, the same model solved
-    from other starts: library order), and each candidate's bootstrap held-out gaps."""
+    from other starts: library order), and each candidate's bootstrap held-out gaps. Each row also says where the
+    candidate's model settles unlike the records (``model_periodicity`` with ``aperiodic_limit``)."""
     rows, boots = [], {}
     for name, (cal, sims, res) in results.items():
         after = heldout_gap(sims)
@@ -883,6 +912,7 @@ def _ranking(results, heldout_gap, n_bootstrap, before, before_b, n_data, record
         rows.append(
             _ranking_row(name, cal, res, after, after_b, before, before_b, n_data, records, calibration_case, where)
         )
+        rows[-1].update(model_periodicity(cal, sims, records, calibration_case, aperiodic_limit))
     rows.sort(key=lambda r: round(r["score"], 3) if np.isfinite(r["score"]) else np.inf)
     return rows, boots
 
@@ -1113,7 +1143,16 @@ def diagnose(
     before, before_b = run.heldout_gaps(base_sims)
     n_data = 2 * sum(gap_residual(base_sims[c], records[c], H).size for c in run.score_cases)
     rows, boots = _ranking(
-        results, run.heldout_gap, settings.n_bootstrap, before, before_b, n_data, records, calibration_case, where
+        results,
+        run.heldout_gap,
+        settings.n_bootstrap,
+        before,
+        before_b,
+        n_data,
+        records,
+        calibration_case,
+        where,
+        settings.place.aperiodic_limit,
     )
     scatter = float(np.std(before_b))
     verdict, reason = _verdict(rows, before, scatter, where["place"], settings, boots)
@@ -1132,7 +1171,15 @@ def diagnose(
         where["random_test_channel_delays_s"] = {str(k): float(t) for k, t in zip(sensors, run.channel_delays)}
     later = retried({n: r[0].theta for n, r in results.items()}, LIBRARY, settings)
     steps, left, last = explain(
-        results, names, before, scatter, settings, run.heldout_gap, run.next_pass(results), later
+        results,
+        names,
+        before,
+        scatter,
+        settings,
+        run.heldout_gap,
+        run.next_pass(results),
+        later,
+        lambda cal, sims: model_periodicity(cal, sims, records, calibration_case, settings.place.aperiodic_limit),
     )
     first_before = before
     if updating is not None:

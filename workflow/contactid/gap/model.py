@@ -23,7 +23,7 @@ import xarray as xr
 
 from ..beam_model import assemble
 from ..friction_parameters import fitted_parameters
-from ..harmonics import periodic_grid, periodic_harmonics
+from ..harmonics import aperiodic_share, periodic_grid, periodic_harmonics
 from ..identification import damping_by_mode
 from ..parameters import StructureParameters, structure_from_config
 from ..rig.nonlinear import ContactParameters, DualSineSimulator, reduced_model
@@ -189,7 +189,9 @@ class SimResult:
     acceleration (j, H); contact signals S, N (total), xi, eta (H,) complex and their means;
     one period of each on ``grid`` points (for force-state maps and cycle energies); the energy
     dissipated per cycle by friction (tangential) and by the normal contact (J); whether the
-    response settled; the first- and last-third accelerations for a drifting record."""
+    response settled; the first- and last-third accelerations for a drifting record; ``extra``: the method, and for
+    a response that does not settle (not drifting) ``aperiodic``, each sensor's share of its response that is not
+    periodic (``harmonics.aperiodic_share``, at the record's rate)."""
 
     acceleration: np.ndarray
     contact: dict
@@ -405,6 +407,11 @@ def _marched_result(
         "eta_dot": out["deta"],
     }
     contact, means = _contact_harmonics(sig, t1, w, n_per, H)
+    extra = {"means": means, "method": "time_marching"}
+    if not settled and not aug.preload_drift and np.all(np.isfinite(acc)):
+        # a response that does not settle: the share of it that is not periodic, as the records' (at their rate)
+        q = max(1, int(round(1.0 / (sim.dt * rec.fs))))
+        extra["aperiodic"] = aperiodic_share(acc[:, ::q], 1.0 / (q * sim.dt), rec.f0)
     cyc = slice(n_rec - n_per, n_rec)  # the last period for the cycle energies
     e_t = float(np.sum(out["S"][cyc] * out["dxi"][cyc]) * sim.dt)
     e_n = float(-np.sum((out["N"][cyc] - model.preload) * out["deta"][cyc]) * sim.dt)
@@ -416,5 +423,5 @@ def _marched_result(
         bool(settled),
         first,
         last,
-        {"means": means, "method": "time_marching"},
+        extra,
     )

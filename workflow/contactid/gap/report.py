@@ -59,6 +59,26 @@ def _law_note(step: dict) -> str:
     return ""
 
 
+def _periodicity_note(step: dict, periodicity: dict) -> str:
+    """For a step whose model settles unlike the records (``settles_unlike_records``): where, and which way."""
+    unlike = step.get("settles_unlike_records") or []
+    if not unlike:
+        return ""
+    by = step.get("aperiodic_by_case") or {}
+    settled = [c for c in unlike if (periodicity.get(c) or {}).get("settled", True)]
+    moving = [c for c in unlike if c not in settled]
+    parts = []
+    if settled:
+        parts.append(
+            r"its model does not settle on "
+            + ", ".join(_t(c) + " (" + _pct(by.get(c)) + " not periodic)" for c in settled)
+            + r", where the record does"
+        )
+    if moving:
+        parts.append(r"its model settles on " + ", ".join(_t(c) for c in moving) + r", where the record does not")
+    return r" (" + "; ".join(parts) + r": the law is wrong in form there, whatever its harmonic gap)"
+
+
 def explanation_text(diag: dict) -> str:
     """The additive explanation in words (Fig. gap_explanation)."""
     steps, left = diag.get("explanation") or [], diag.get("remaining_gap") or {}
@@ -70,9 +90,11 @@ def explanation_text(diag: dict) -> str:
             r"nothing is added to the identified model. "
         )
     else:
+        periodicity = (diag.get("where") or {}).get("periodicity") or {}
         parts = [
             _t(s["effect"])
             + _law_note(s)
+            + _periodicity_note(s, periodicity)
             + r" (refitted: "
             + ", ".join(f"{_t(k)} $= {_fmt(v, 3)}$" for k, v in s["parameters"].items())
             + r") takes the held-out gap from "
@@ -275,7 +297,7 @@ def candidates_table(diag: dict) -> str:
     rows = pd.DataFrame(
         [
             {
-                "effect": r["effect"],
+                "effect": r["effect"] + ("*" if r.get("settles_unlike_records") else ""),
                 "k": r["n_parameters"],
                 "before": 100 * _num(r["heldout_gap_before"]),
                 "after": 100 * _num(r["heldout_gap_after"]),
@@ -302,7 +324,13 @@ def candidates_table(diag: dict) -> str:
             "score": "score",
         },
         "Candidate effects refitted on the calibration case and scored on the held-out cases "
-        "(held-out gap before and after, bootstrap interval of after, score $n\\ln(g_a^2/g_b^2)+2k$).",
+        "(held-out gap before and after, bootstrap interval of after, score $n\\ln(g_a^2/g_b^2)+2k$)."
+        + (
+            " *: its model does not settle on a record that did, or settles on one that did not (the law is wrong in "
+            "form there, whatever its harmonic gap)."
+            if any(r.get("settles_unlike_records") for r in diag["ranking"])
+            else ""
+        ),
         "tab:gap",
     )
 
