@@ -25,8 +25,8 @@ class RecordHarmonics:
     force: (H,) complex; acceleration: (j, H) complex; block_force (B, H) and block_acceleration
     (B, j, H): the same per block of whole periods; first/last: (j, H) of the first and last thirds;
     f0 (Hz), fs (Hz), periods (whole periods in the record), sensors (names); aperiodic (j,): each accelerometer's
-    share of its rms that is not periodic at f0 (``harmonics.aperiodic_share``: the noise alone where the response
-    settles; None where not computed)."""
+    share of its rms that is not periodic at the drive frequency (``harmonics.aperiodic_share`` at the frequency the
+    force record shows: the noise alone where the response settles; None where not computed)."""
 
     case: str
     f0: float
@@ -99,5 +99,17 @@ def record_harmonics(raw: xr.Dataset, case: str, n_harmonics: int, n_blocks: int
         thirds[1],
         tuple(str(s) for s in raw["sensor"].values),
         np.asarray(raw["sensor_position"].values if "sensor_position" in raw else [], dtype=float),
-        aperiodic_share(acc[:, :n_use], fs, f0),
+        aperiodic_share(acc[:, :n_use], fs, _drive_frequency(force, fs, f0)),
     )
+
+
+def _drive_frequency(force: np.ndarray, fs: float, declared_hz: float) -> float:
+    """The drive's frequency as the force record shows it (``raw_checks.recovered_frequency``), for the share of
+    the response that is not periodic: a declared frequency off by the raw checks' tolerance (0.02 cycles over the
+    record) would leave 4 % of the fundamental and more of each higher harmonic unfitted, a settled record read as
+    one that does not settle. The declared one where the record's strongest line is not one of its first three
+    harmonics."""
+    from ..raw_checks import recovered_frequency
+
+    f, h = recovered_frequency(np.asarray(force, dtype=float), fs, declared_hz)
+    return f if h in (1, 2, 3) and abs(f / declared_hz - 1.0) < 0.01 else declared_hz
