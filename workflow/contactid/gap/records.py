@@ -5,7 +5,8 @@ x ~ mean + sum_h Im(c_h e^{i h w t}) (as in Eq. 16), estimated over whole period
 moved to the force's fundamental's zero crossing (phase of c_1 of the force = 0), so records
 and simulations share one time origin; a common delay of all channels (anti-alias filter)
 drops out. Block estimates (the record cut into whole-period blocks) give the spread for the
-bootstrap, and the first and last thirds show drift.
+bootstrap, and the first and last thirds show drift. The share of each accelerometer's response that no harmonic
+of the drive explains shows whether the record settled (its noise alone) or not (impacts, chaos).
 """
 
 from __future__ import annotations
