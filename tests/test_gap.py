@@ -104,6 +104,8 @@ def test_the_report_says_which_records_did_not_settle():
     assert "Every record settled" in periodicity_text({"periodicity": {"lc1": settled, "lc2": settled}})
     text = periodicity_text({"periodicity": {"lc1": settled, "lc3": moving}})
     assert "lc3" in text and "lc1" not in text and "41" in text and "a1" in text and "did not settle" in text
+    drifting = periodicity_text({"periodicity": {"lc1": moving}, "place": "non_stationary"})
+    assert "drift" in drifting and "averages" not in drifting
 
 
 def test_periodic_harmonics_exact_from_any_start():

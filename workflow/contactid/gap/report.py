@@ -219,11 +219,16 @@ def periodicity_text(w: dict) -> str:
     return (
         " "
         + ", ".join(parts)
-        + r" did not settle: that share of the response is not periodic at the drive frequency (impacts, or a motion "
-        r"that never repeats). "
-        + ("Their" if len(parts) > 1 else "Its")
-        + r" harmonics are averages of that motion, and no candidate compared on harmonics can be expected to "
-        r"explain a gap there."
+        + r" did not settle: that share of the response is not periodic at the drive frequency (impacts, a motion "
+        r"that never repeats, or a test that drifts). "
+        + (
+            r"The records drift (the place is non\_stationary): a drift alone leaves a record that much "
+            r"from periodic."
+            if w.get("place") == "non_stationary"
+            else ("Their" if len(parts) > 1 else "Its")
+            + r" harmonics are averages of that motion, and no candidate compared on harmonics can be expected to "
+            r"explain a gap there."
+        )
     )
 
 
