@@ -28,7 +28,8 @@ def _libm_sincos_address() -> int | None:
     return None
 
 
-HAS_LIBM_SINCOS = _libm_sincos_address() is not None
+_SINCOS_ADDRESS = _libm_sincos_address()
+HAS_LIBM_SINCOS = _SINCOS_ADDRESS is not None
 
 if HAS_LIBM_SINCOS:
     import llvmlite.binding as llvm
@@ -37,7 +38,7 @@ if HAS_LIBM_SINCOS:
     from numba.core import cgutils
     from numba.extending import intrinsic
 
-    llvm.add_symbol("sincos", _libm_sincos_address())  # the kernels' machine code (cached too) calls it by name
+    llvm.add_symbol("sincos", _SINCOS_ADDRESS)  # the kernels' machine code (cached too) calls it by name
 
     @intrinsic
     def _sincos(typingctx, x):
