@@ -14,6 +14,9 @@ found it, on today's models and candidate library. Printed beside it:
 - with ``--reference-scatter``, the time-marching diagnosis itself at half and at double its settling tolerance
   (``gap.model.SETTLING_TOL``, 2e-5): how far the reference's own held-out gaps move within its tolerance, the
   scale the 0.1 % above is to be read against;
+- with ``--tight-tolerance TOL``, the time-marching diagnosis and the one with every searched state polished, both
+  at the settling tolerance TOL (5e-7, say): as the reference converges, the fast diagnosis's held-out gaps converge
+  on its (docs/measurements.md);
 - with ``--with-reference``, the package at REFERENCE (the last commit before harmonic balance, imported
   from git as ``contactid_ref``); its friction kernel is the old slip-limit one, so only its time and
   verdict are printed.
@@ -24,6 +27,7 @@ each).
 
 Needs the default workflow's results (`.venv/bin/snakemake -c2` first; `CONTACTID_RESULTS=DIR` reads another project's).
 Usage: .venv/bin/python benchmarks/gap_diagnosis.py [--only default|EFFECT] [--with-reference] [--reference-scatter]
+       [--tight-tolerance TOL]
 """
 
 import importlib
@@ -173,12 +177,13 @@ def _agreement(a, b) -> dict:
     }
 
 
-def compare(label, ds, raw, cfg, with_reference=False, scatter=False) -> dict:
+def compare(label, ds, raw, cfg, with_reference=False, scatter=False, tight=None) -> dict:
     """The diagnosis now (harmonic balance, memos, residual searches) in one process and with two workers, against
     the plain diagnosis in the same process: every steady state by time marching, no memos, the searches on the gap
     alone (the diagnosis as issue 14 found it, on today's models and library). Also the same plain run with the
     residual searches (what the solver alone changes: verdict, ranking, held-out gaps); with ``scatter``, that run at
-    half and at double its settling tolerance (the reference's own scatter); with ``with_reference``, the package at
+    half and at double its settling tolerance (the reference's own scatter); with ``tight`` (a settling tolerance),
+    that run and the polished-search diagnosis both at it; with ``with_reference``, the package at
     REFERENCE (its friction kernel is the old slip-limit one: its gaps do not compare)."""
     run("contactid", "harmonic_balance", True, ds, raw, cfg, warm_up=True)  # compile or load every kernel once
     # ... in the two worker processes too: their first candidates otherwise load every kernel and import what the
@@ -211,6 +216,15 @@ def compare(label, ds, raw, cfg, with_reference=False, scatter=False) -> dict:
             "half_tolerance": _agreement(marched, half),
             "double_tolerance": _agreement(marched, double),
         }
+    if tight is not None:
+        ref_t, t_ref_t = run("contactid", "time_marching", False, ds, raw, cfg, settle_tol=tight)
+        pol_t, t_pol_t = run("contactid", "harmonic_balance", True, ds, raw, cfg, polish_search=True, settle_tol=tight)
+        row["tight_tolerance"] = {
+            "tolerance": tight,
+            "seconds_time_marching": t_ref_t,
+            "seconds_polished_searches": t_pol_t,
+            "polished_searches": _agreement(ref_t, pol_t),
+        }
     if with_reference:
         run("contactid_ref", None, None, ds, raw, cfg, warm_up=True)
         old, t_old = run("contactid_ref", None, None, ds, raw, cfg)
@@ -240,6 +254,16 @@ def compare(label, ds, raw, cfg, with_reference=False, scatter=False) -> dict:
             f", verdict {'same' if all(a['same_verdict'] for a in rs.values()) else 'DIFFERENT'}",
             flush=True,
         )
+    if tight is not None:
+        tt = row["tight_tolerance"]
+        a = tt["polished_searches"]
+        print(
+            f"  at the settling tolerance {tight:g}: time marching {tt['seconds_time_marching']:.1f} s, every searched "
+            f"state polished {tt['seconds_polished_searches']:.1f} s: verdict "
+            f"{'same' if a['same_verdict'] else 'DIFFERENT'}, ranking {'same' if a['same_ranking'] else 'DIFFERENT'}"
+            f", held-out gaps within {a['max_rel_gap_difference']:.3%}",
+            flush=True,
+        )
     for name, a in (("solver", sv), ("searches", se)):
         if not a["same_ranking"]:
             print(f"  {name}: plain {a['rankings'][0]}\n  {' ' * len(name)}  now   {a['rankings'][1]}")
@@ -253,16 +277,24 @@ def main():
     cfg = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
     with_reference = "--with-reference" in sys.argv
     scatter = "--reference-scatter" in sys.argv
+    tight = float(sys.argv[sys.argv.index("--tight-tolerance") + 1]) if "--tight-tolerance" in sys.argv else None
     if with_reference:
         reference_package()
     only = sys.argv[sys.argv.index("--only") + 1] if "--only" in sys.argv else None
     rows = []
     if only in (None, "default"):
-        rows.append(compare("default (effect-free)", *default_data(cfg), cfg, with_reference, scatter))
+        rows.append(compare("default (effect-free)", *default_data(cfg), cfg, with_reference, scatter, tight))
     for effect, magnitude in EFFECTS.items():
         if only in (None, effect):
             rows.append(
-                compare(f"{effect} {magnitude:g}", *effect_data(cfg, effect, magnitude), cfg, with_reference, scatter)
+                compare(
+                    f"{effect} {magnitude:g}",
+                    *effect_data(cfg, effect, magnitude),
+                    cfg,
+                    with_reference,
+                    scatter,
+                    tight,
+                )
             )
     worst = max(r["seconds_now"] for r in rows)
     ratio = min(r["ratio"] for r in rows)
@@ -282,6 +314,18 @@ def main():
         print(
             f"the time-marching reference's own held-out gaps move by up to {own:.2%} between half and double its "
             "settling tolerance: agreement with it can be asked only to that scale"
+        )
+    if tight is not None:
+        worst_t = max(r["tight_tolerance"]["polished_searches"]["max_rel_gap_difference"] for r in rows)
+        same_t = all(
+            r["tight_tolerance"]["polished_searches"]["same_verdict"]
+            and r["tight_tolerance"]["polished_searches"]["same_ranking"]
+            for r in rows
+        )
+        print(
+            f"at the settling tolerance {tight:g}, every searched state polished against time marching: "
+            f"{'same' if same_t else 'NOT the same'} verdicts and rankings, held-out gaps within {worst_t:.3%} "
+            f"(goal 0.1 %: {'met' if worst_t <= 1e-3 else 'NOT met'})"
         )
     if with_reference:
         ref1 = min(r["seconds_reference"] / r["seconds_now"] for r in rows)
