@@ -2,7 +2,7 @@
 
 import pandas as pd
 
-from contactid.latex import escape, significant_digits, tabular
+from contactid.latex import contact_fragment, escape, macros, significant_digits, tabular
 
 
 def test_every_special_character_of_a_cell_prints_as_itself():
@@ -44,3 +44,29 @@ def test_a_plain_number_with_more_integer_digits_than_asked_is_rounded_to_them()
     assert _fmt(338.22, 3) == "338"
     assert _fmt(54.79, 4) == "54.79"
     assert _fmt(2.185776e5, 3) == r"2.19\times10^{5}"
+
+
+def test_a_boolean_is_a_tex_switch_and_a_number_a_macro():
+    text = macros({"rigtruth": False, "freq1": 54.8})
+    assert "\\newif\\ifrigtruth\\rigtruthfalse" in text
+    assert "\\newcommand{\\freqone}{\\ensuremath{54.80}}" in text
+    assert "\\rigtruthtrue" in macros({"rigtruth": True})
+
+
+def test_a_truth_column_without_any_value_is_left_out_and_one_with_values_kept():
+    df = pd.DataFrame({"mode": [1, 2], "identified_hz": [54.8, 166.9], "truth_hz": [float("nan")] * 2})
+    cols = {"mode": "mode", "identified_hz": "identified (Hz)", "truth_hz": "rig truth (Hz)"}
+    assert "rig truth" not in tabular(df, cols, "c", "tab:x")
+    df["truth_hz"] = [54.9, float("nan")]
+    out = tabular(df, cols, "c", "tab:x")
+    assert "rig truth" in out and "$54.9$" in out and "--" in out
+
+
+def test_contact_forces_without_truth_get_a_paragraph_not_a_table_of_dashes():
+    nan = float("nan")
+    rows = [{"case": "lc1", **{f"{m}_{q}": nan for m in "wp" for q in ("S", "N", "xi", "eta")}}]
+    text = contact_fragment(pd.DataFrame(rows))
+    assert "no truth is known" in text and "tabular" not in text
+    rows[0]["w_S"] = 0.7
+    table = contact_fragment(pd.DataFrame(rows))
+    assert "\\begin{tabular}" in table and "$0.700$" in table and "tab:contact" in table

@@ -128,6 +128,18 @@ def test_gap_runs_on_a_directory_of_raw_files_alone(measured_run):
     assert d["verdict"] == "none" and [r["effect"] for r in d["ranking"]] == ["viscous_friction"]
 
 
+def test_report_of_measured_records_says_no_truth_is_known(measured_run):
+    """Every record measured: the report compiles, says there is no truth, and prints no empty truth column."""
+    proj, _ = measured_run
+    report = proj / "results" / "report"
+    assert (report / "report.pdf").stat().st_size > 50_000
+    numbers = (report / "numbers.tex").read_text()
+    assert "\\rigtruthfalse" in numbers and "truefreq" not in numbers
+    for table in ("table1.tex", "table3.tex", "table4.tex"):
+        assert "truth" not in (report / table).read_text(), table
+    assert "no truth is known" in (report / "contact.tex").read_text()
+
+
 def test_imported_uff58_tdms_csv_give_the_same_contact_forces(small_run, measured_run):
     """Each load case's rig record, written as a UFF58 file (accelerations in g), a TDMS file (voltages
     with sensitivities) or a CSV + sidecar YAML and imported by its rule, identifies the same S(t) as the

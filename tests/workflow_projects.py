@@ -329,15 +329,21 @@ def prepare_measured_run(d: Path, small_run: Path):
     """A project whose every record is a measured file, none from the rig: the small run's random test as its FRFs
     in a UFF58 file (function types 4 and 6, as labs hand them over), and its three load cases' records written as
     a UFF58 file (lc1, accelerations in g), a TDMS file (lc2, voltages with sensitivities) and a CSV + sidecar YAML
-    (lc3); the gap target (one candidate), every case's contact forces and the FRFs written back out
-    (frf_measured.uff, frf_synthesised.uff), from these files alone. The files are written in a process of their
-    own (``write_measured_files``): this runs in a background thread of the pytest process, and HDF5 (netCDF4) is
-    not thread-safe while the tests read and write netCDF files (a Bus error, seen once)."""
+    (lc3); the gap target (one candidate), every case's contact forces, the FRFs written back out
+    (frf_measured.uff, frf_synthesised.uff) and the report (no truth anywhere), from these files alone. The files
+    are written in a process of their own (``write_measured_files``): this runs in a background thread of the pytest
+    process, and HDF5 (netCDF4) is not thread-safe while the tests read and write netCDF files (a Bus error, seen
+    once)."""
     proj = small_project(d, {"gap.candidates": ["viscous_friction"]})
     code = "import sys, pathlib, workflow_projects as wp; wp.write_measured_files(*map(pathlib.Path, sys.argv[1:]))"
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT / "workflow"), str(ROOT / "tests")])}
     subprocess.run([sys.executable, "-c", code, str(proj), str(small_run)], check=True, env=env)
-    return proj, ("gap", *[f"results/{c}/contact_forces.nc" for c in MEASURED_FORMATS], *FRF_FILE_TARGETS[1:])
+    return proj, (
+        "gap",
+        *[f"results/{c}/contact_forces.nc" for c in MEASURED_FORMATS],
+        *FRF_FILE_TARGETS[1:],
+        "results/report/report.pdf",
+    )
 
 
 def write_measured_files(proj: Path, small_run: Path) -> None:

@@ -5,10 +5,12 @@ from pathlib import Path
 
 import pandas as pd
 
-from contactid.latex import data_checks_text, macros, report_values, setup_table, tabular
+from contactid.latex import contact_fragment, data_checks_text, macros, report_values, setup_table, tabular
 from contactid.logs import setup_logging
 
 setup_logging(snakemake.log[0])
+
+
 inp, out = snakemake.input, snakemake.output
 summary = json.loads(Path(inp.summary).read_text())
 cons = pd.read_csv(inp.consistency)
@@ -90,22 +92,4 @@ for case, w in summary.get("contact_forces", {}).items():
             **{f"p_{q}": 100 * p.get(f"{q}_nrmse", float("nan")) for q in ("S", "N", "xi", "eta")},
         }
     )
-Path(out.contact).write_text(
-    tabular(
-        pd.DataFrame(rows),
-        {
-            "case": "case",
-            "w_S": "$S$",
-            "w_N": "$N$",
-            "w_xi": "$\\xi$",
-            "w_eta": "$\\eta$",
-            "p_S": "$S$ (paper)",
-            "p_N": "$N$ (paper)",
-            "p_xi": "$\\xi$ (paper)",
-            "p_eta": "$\\eta$ (paper)",
-        },
-        "NRMSE (\\%) of the identified contact forces and motions against the rig truth: "
-        "working method and the paper's chain.",
-        "tab:contact",
-    )
-)
+Path(out.contact).write_text(contact_fragment(pd.DataFrame(rows)))
