@@ -105,3 +105,20 @@ def test_stiffer_tangential_contact_raises_frequencies():
     f_stiff = natural_frequencies(p.with_contact(1e8, 2.37e7))
     assert np.all(f_stiff > f_soft)
     assert math.isclose(p.axial_stiffness, p.youngs_modulus * p.area / p.length)
+
+
+def test_the_shortening_scales_with_the_structures_shortening_scale():
+    """G (int w'^2 dx = q^T G q) times shortening_scale: 0 gives linear kinematics, and a shape's shortening is
+    the analytic one (w = x^2: int_0^L 4 x^2 dx = 4 L^3 / 3, held exactly by the cubic elements)."""
+    from contactid.beam_model import shortening_matrix
+
+    p = configured_structure()
+    m = assemble(p)
+    q = np.zeros(m.n_dof)
+    x = m.nodes
+    q[m.w_dof[m.w_dof >= 0]] = (x**2)[m.w_dof >= 0]
+    q[m.theta_dof[m.theta_dof >= 0]] = (2 * x)[m.theta_dof >= 0]
+    assert q @ shortening_matrix(m) @ q == pytest.approx(4 * p.length**3 / 3, rel=1e-12)
+    half = assemble(p.replace(shortening_scale=0.5))
+    assert np.array_equal(shortening_matrix(half), 0.5 * shortening_matrix(m))
+    assert not np.any(shortening_matrix(assemble(p.replace(shortening_scale=0.0))))

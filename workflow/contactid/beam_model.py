@@ -140,7 +140,8 @@ def _element_shortening(le: float):
 
 
 def shortening_matrix(model: "FEModel") -> np.ndarray:
-    """G with int_0^L w'^2 dx = q^T G q, so the beam shortening of Eq. (9) is -q^T G q / 2 (1/m)."""
+    """G with int_0^L w'^2 dx = q^T G q, so the beam shortening of Eq. (9) is -q^T G q / 2 (1/m), times the
+    structure's ``shortening_scale`` (1: Eq. 9 as printed; 0: linear kinematics, G = 0)."""
     G = np.zeros((model.n_dof, model.n_dof))
     nodes = model.nodes
     for e in range(len(nodes) - 1):
@@ -150,7 +151,7 @@ def shortening_matrix(model: "FEModel") -> np.ndarray:
             for b, db in enumerate(dofs):
                 if da >= 0 and db >= 0:
                     G[da, db] += ge[a, b]
-    return G
+    return G * model.params.shortening_scale
 
 
 def _node_index(nodes: np.ndarray, x: float) -> int:

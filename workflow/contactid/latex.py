@@ -230,6 +230,7 @@ def contact_fragment(contact: pd.DataFrame) -> str:
 
 
 PAPER_GIVEN = {
+    "shortening_scale",
     "length_m",
     "width_m",
     "thickness_m",

@@ -29,6 +29,9 @@ class StructureParameters:
         hanger_lever_arm: height of the string's attachment above the beam
             mid-plane (m); the paper's Eq. (2) uses xi - 2 r w'(L) = u - r w'(L),
             i.e. r above the axis.
+        shortening_scale: how much of the beam's shortening -1/2 int_0^L w'^2 dx (Eq. 9) enters the
+            contact's slip xi (and, by virtual work, the axial-force term of the equations of motion):
+            1 as Eq. 9 prints it, 0 for linear kinematics xi = u + a w'(L).
         block_mass, block_inertia: m_s (kg), J_s (kg m^2).
         string_length, string_stiffness: l_s (m), k_s (N/m).
         excitation_position: d_p (m from the clamp).
@@ -56,6 +59,7 @@ class StructureParameters:
     tangential_lever_arm: float
     normal_lever_arm: float
     hanger_lever_arm: float
+    shortening_scale: float
     block_mass: float
     block_inertia: float
     string_length: float
@@ -129,6 +133,7 @@ def structure_from_config(cfg: Mapping, k_t: float, k_n: float, n_elements: int 
         tangential_lever_arm=float(geo["tangential_lever_arm_m"]),
         normal_lever_arm=float(geo["normal_lever_arm_m"]),
         hanger_lever_arm=float(geo["hanger_lever_arm_m"]),
+        shortening_scale=float(geo.get("shortening_scale", 1.0)),
         block_mass=float(block["mass_kg"]),
         block_inertia=float(block["rotary_inertia_kg_m2"]),
         string_length=float(block["string_length_m"]),

@@ -41,7 +41,8 @@ class Augmentation:
     unilateral_exponent: 0 = the linear bilateral spring N0 - k_n eta, p >= 1 = the unilateral
     power law N0 ((delta0 - eta)/delta0)^p with delta0 = p N0 / (c k_n) (the contact may open), c the
     normal_stiffness_factor on the linear chain's k_n (poorly determined by frequencies);
-    preload_drift: relative change of the preload over the record.
+    preload_drift: relative change of the preload over the record; shortening_change: relative change of the beam's
+    shortening in the slip (Eq. 9's integral scaled by 1 + shortening_change; -1: linear kinematics).
     """
 
     extra_damping: float = 0.0
@@ -53,6 +54,7 @@ class Augmentation:
     unilateral_exponent: float = 0.0
     normal_stiffness_factor: float = 1.0
     preload_drift: float = 0.0
+    shortening_change: float = 0.0
 
     def merge(self, other: "Augmentation") -> "Augmentation":
         """Both augmentations' effects (other's non-default fields win)."""
@@ -83,8 +85,11 @@ class IdentifiedModel:
 
     def structure_with(self, aug: Augmentation) -> StructureParameters:
         """The structure with the augmentation's changes; changed masses re-fit k_t and k_n to the identified
-        natural frequencies (the linear chain redone with the effect in the model)."""
+        natural frequencies (the linear chain redone with the effect in the model); a changed shortening leaves them
+        (a second-order term: the linear chain does not see it)."""
         p = self.structure
+        if aug.shortening_change:
+            p = p.replace(shortening_scale=p.shortening_scale * (1.0 + aug.shortening_change))
         if aug.mass_error:
             m = 1.0 + aug.mass_error
             p = p.replace(
