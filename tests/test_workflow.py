@@ -320,6 +320,7 @@ def test_gap_diagnosis_of_default_data_names_no_effect(default_run):
         "channel_time_skew",
         "contact_separation",
         "preload_drift",
+        "beam_shortening",
     }
     for r in d["ranking"]:
         assert {"effect", "heldout_gap_before", "heldout_gap_after", "score"} <= set(r)
