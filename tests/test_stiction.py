@@ -63,3 +63,33 @@ def test_an_edge_that_cannot_be_bracketed_is_unbounded_with_the_reason():
     assert edge == pytest.approx(0.5 - np.sqrt(0.1), abs=1e-6) and why == ""
     edge, why = interval_edge(lambda x: 0.1 * x, grid, 0.1 * grid, 0, +1, 0.0, 1.0)
     assert edge is None and "search bound" in why
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_the_fits_end_at_the_same_optimum_when_the_frequencies_move_by_rounding(default_config, seed):
+    """Frequencies moved by 1e-8 (the eigensolver's and the modal fit's rounding, another machine's BLAS) leave the
+    joint fit, a profile point and the gap diagnosis' contact refit where they were: their Jacobian resolves the flat
+    directions (``stiction.JACOBIAN``). With scipy's default forward steps (1.5e-8) the joint fit from the same start
+    ended 0.07 apart in log10 k_t and 0.8 in log10 k_n, and a profile point's refit missed its own misfit."""
+    from contactid.beam_model import ContactFrequencyMap
+    from contactid.gap.model import _refit_contact
+    from contactid.parameters import structure_from_config
+    from contactid.stiction import _fit_one, _joint_fit
+
+    p = structure_from_config(default_config["structure"], 2e5, 2.4e7)
+    fmap = ContactFrequencyMap(p, 3)
+    # frequencies of k_t = 2.1e5, k_n = 3e7, off by 0.3 % as identified ones are: the optimum is not exact
+    f = np.asarray(fmap(2.1e5, 3e7)) * (1.0 + np.array([0.003, -0.002, 0.0025]))
+    moved = f * (1.0 + 1e-8 * np.random.default_rng(seed).standard_normal(3))
+    sigma = 2e-3 * f
+    lt, ln = np.array([4.0, 7.0]), np.array([6.0, 10.0])
+    a, chi_a = _joint_fit(fmap, f, sigma, np.array([5.3, 7.4]), lt, ln)
+    b, chi_b = _joint_fit(fmap, moved, sigma, np.array([5.3, 7.4]), lt, ln)
+    assert np.allclose(a, b, atol=1e-4) and chi_b == pytest.approx(chi_a, rel=1e-4)
+    # a profile point far from the optimum: refitted from elsewhere, the same misfit
+    x1, c1 = _fit_one(fmap, moved, sigma, "k_n", 9.0, 5.3, lt)
+    x2, c2 = _fit_one(fmap, moved, sigma, "k_n", 9.0, 6.0, lt)
+    assert x2 == pytest.approx(x1, abs=1e-4) and c2 == pytest.approx(c1, rel=1e-6)
+    # the diagnosis' refit of k_t, k_n to the frequencies (relative residuals, from the model's values)
+    q1, q2 = _refit_contact(p, tuple(f)), _refit_contact(p, tuple(moved))
+    assert q2.k_t == pytest.approx(q1.k_t, rel=1e-4) and q2.k_n == pytest.approx(q1.k_n, rel=1e-3)

@@ -54,6 +54,13 @@ def frequency_sigma(freqs_hz: np.ndarray, stat_sigma_hz: np.ndarray, relative_fl
     return np.sqrt(stat**2 + (relative_floor * np.asarray(freqs_hz)) ** 2)
 
 
+# the fits' Jacobian: central differences with steps of 1e-5 of the log stiffnesses. scipy's default forward steps of
+# 1.5e-8 lie within the eigensolver's rounding of the frequencies: a 1e-8 change in the identified frequencies moved
+# the fitted log10 k_t by up to 0.67 and a profile point's by up to 0.09 (docs/measurements.md, "The stiction fits'
+# Jacobian")
+JACOBIAN = {"jac": "3-point", "diff_step": 1e-5}
+
+
 def _residuals(fmap: ContactFrequencyMap, f_id, sigma, log_kt, log_kn):
     return (fmap(10.0**log_kt, 10.0**log_kn) - f_id) / sigma
 
@@ -66,7 +73,9 @@ def _fit_one(params, f_id, sigma, fixed_name, fixed_log, start, bounds):
             return _residuals(params, f_id, sigma, x[0], fixed_log)
         return _residuals(params, f_id, sigma, fixed_log, x[0])
 
-    r = least_squares(res, [start], bounds=([bounds[0]], [bounds[1]]), x_scale=[0.1], xtol=1e-10, ftol=1e-12)
+    r = least_squares(
+        res, [start], bounds=([bounds[0]], [bounds[1]]), x_scale=[0.1], xtol=1e-10, ftol=1e-12, **JACOBIAN
+    )
     return r.x[0], float(2 * r.cost)
 
 
@@ -79,6 +88,7 @@ def _joint_fit(params, f_id, sigma, x0, lt, ln):
         x_scale=[0.1, 1.0],
         xtol=1e-12,
         ftol=1e-14,
+        **JACOBIAN,
     )
     return r.x, float(2 * r.cost)
 

@@ -129,10 +129,12 @@ def identified_model(
 @lru_cache(maxsize=64)
 def _refit_contact(params: StructureParameters, frequencies: tuple) -> StructureParameters:
     """k_t and k_n that best fit the identified natural frequencies (relative least squares on a
-    log scale, from the current values): the stiction fit of the linear chain, redone."""
+    log scale, from the current values): the stiction fit of the linear chain, redone (with its Jacobian,
+    ``stiction.JACOBIAN``)."""
     from scipy.optimize import least_squares
 
     from ..beam_model import ContactFrequencyMap
+    from ..stiction import JACOBIAN
 
     f_id = np.asarray(frequencies)
     fmap = ContactFrequencyMap(params, len(f_id))
@@ -144,6 +146,7 @@ def _refit_contact(params: StructureParameters, frequencies: tuple) -> Structure
         x_scale=0.1,
         xtol=1e-10,
         ftol=1e-12,
+        **JACOBIAN,
     )
     return params.with_contact(float(10.0 ** res.x[0]), float(10.0 ** res.x[1]))
 
