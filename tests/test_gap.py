@@ -285,6 +285,21 @@ def test_effect_missing_from_library_gives_none_and_points_at_the_normal_directi
     assert d.where["heldout_gap_before"] > 0.01  # a real gap, left unexplained
 
 
+@pytest.mark.slow
+def test_one_load_case_names_no_effect_and_says_that_nothing_is_held_out(hc_data):
+    """With the calibration case alone, every gap is the case's own and any refit lowers it: the dashpot the three
+    cases name (test above) is ranked first and shrinks that gap, but no effect is named, and the text says why."""
+    from contactid.gap.report import comparison_lines
+
+    cfg, model, records, linear = hc_data
+    d = _diagnose((cfg, model, {"lc1": records["lc1"]}, linear), ["normal_contact_damping"])
+    assert d.heldout_cases == []
+    assert d.ranking[0]["effect"] == "normal_contact_damping" and d.ranking[0]["reduction"] > 0.5
+    assert d.verdict == "none" and "no load case is held out" in d.reason and "load_cases" in d.reason
+    text = " ".join(comparison_lines({"calibration_case": "lc1", "heldout_cases": []}))
+    assert "no case is held out" in text and "the other load cases are held out" not in text
+
+
 def test_report_section_is_plain_latex_with_and_without_the_benchmark():
     from contactid.gap.report import gap_section
 

@@ -63,8 +63,33 @@ def macros(values: Mapping[str, object]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def report_values(summary: Mapping, consistency: pd.DataFrame) -> dict:
-    """The numbers the report's text quotes, flattened into named values."""
+def case_words(case: str) -> str:
+    """A load case's name in the report's text: "lc4" -> "load case 4"."""
+    return f"load case {case[2:]}" if re.fullmatch(r"lc[0-9]+", case) else case
+
+
+def _case_order(case: str):
+    return (0, int(case[2:])) if re.fullmatch(r"lc[0-9]+", case) else (1, case)
+
+
+def validation_text(validation: Mapping, calibration_case: str) -> str:
+    """The report's sentence (without its full stop) on how the fitted law predicts the load cases it was not fitted
+    on (NRMSE in %), for any number of them: one, several, or none (then it says so)."""
+    others = sorted((c for c in validation if c != calibration_case), key=_case_order)
+    if not others:
+        return "One load case is configured, so there is no other for the law to predict"
+    parts = [rf"\ensuremath{{{_fmt(100 * validation[c])}}}\,\% ({case_words(c)})" for c in others]
+    listed = parts[0] if len(parts) == 1 else ", ".join(parts[:-1]) + " and " + parts[-1]
+    return f"The law predicts the other load case{'s' if len(others) > 1 else ''} with NRMSE {listed}"
+
+
+def report_values(
+    summary: Mapping, consistency: pd.DataFrame, calibration_case: str | None = None, figure_case: str | None = None
+) -> dict:
+    """The numbers the report's text quotes, flattened into named values. ``calibration_case`` (the friction law's
+    fit) and ``figure_case`` (Figs. 4 and 5) name the load cases the text quotes (``nonlinear.calibration_case``,
+    ``nonlinear.figure_case``; by default the first and the last configured), so the text holds for any set of load
+    cases; each case's own values are there too (``lc1recon`` -> ``\\lconerecon``)."""
     v: dict = {}
     f = summary["natural_frequencies_hz"]
     for i, x in enumerate(f, start=1):
@@ -112,6 +137,14 @@ def report_values(summary: Mapping, consistency: pd.DataFrame) -> dict:
         v["fitcorr"] = fr["correlation_e_f_k_c"]
         for case, x in summary.get("validation_nrmse", {}).items():
             v[f"{case}validation"] = 100 * x
+    cases = sorted(summary.get("contact_forces", {}), key=_case_order)
+    if cases:
+        cal = calibration_case if calibration_case in cases else cases[0]
+        fig = figure_case if figure_case in cases else cases[-1]
+        v["calcase"], v["figcase"] = case_words(cal), case_words(fig)
+        v["calknfromneta"] = v[f"{cal}knfromneta"]
+        v["figcaserecon"], v["figcasephase"] = v[f"{fig}recon"], v[f"{fig}phase"]
+        v["validationtext"] = validation_text(summary.get("validation_nrmse", {}), cal)
     return v
 
 

@@ -21,6 +21,8 @@ rule report_fragments:
     params:
         code=CODE_DIGEST,
         structure=config["structure"],
+        calibration_case=config["nonlinear"]["calibration_case"],
+        figure_case=config["nonlinear"]["figure_case"],
     conda:
         "../envs/contactid.yaml"
     log:

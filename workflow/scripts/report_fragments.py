@@ -14,7 +14,9 @@ setup_logging(snakemake.log[0])
 inp, out = snakemake.input, snakemake.output
 summary = json.loads(Path(inp.summary).read_text())
 cons = pd.read_csv(inp.consistency)
-Path(out.numbers).write_text(macros(report_values(summary, cons)))
+Path(out.numbers).write_text(
+    macros(report_values(summary, cons, snakemake.params.calibration_case, snakemake.params.figure_case))
+)
 Path(out.setup).write_text(setup_table(snakemake.params.structure))
 Path(out.datachecks).write_text(data_checks_text(summary))
 Path(out.table1).write_text(

@@ -1195,6 +1195,18 @@ def diagnose(
     if verdict == "none" and steps and steps[0]["effect"] == "model_updating":
         by_update = _updating_verdict(updating, names, first_before, before, shares, scatter, settings)
         verdict, reason = by_update or (verdict, reason)
+    if not held:  # every gap is the calibration case's own, which each refit lowers: no effect is tested
+        verdict, reason = NO_HELDOUT_VERDICT
+        log.warning("gap diagnosis: %s", reason)
     remaining = _remaining_gap(left, left_share, where, last, run, linear, structures)
     sims = {"base": base_sims, **{n: r[1] for n, r in results.items()}}
     return Diagnosis(verdict, reason, rows, where, calibration_case, held, arrays, sims, shrink, steps, remaining)
+
+
+# one load case configured: the candidates are scored on the case they were refitted on (their "held-out" gaps are
+# calibration gaps), which a refit lowers whatever the effect; the ranking and the explanation stay as an audit
+NO_HELDOUT_VERDICT = (
+    "none",
+    "no load case is held out (one is configured): every gap here is the calibration case's own, which refitting any "
+    "candidate lowers, so no effect can be tested; add a second load case (config load_cases) to predict",
+)

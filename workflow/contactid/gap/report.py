@@ -193,7 +193,11 @@ def comparison_lines(diag: dict) -> list[str]:
         r"linear normal spring of Eq.~13) is simulated under each load case's measured force and compared with the",
         r"records at every level of the chain. The friction law was fitted on "
         + _t(diag["calibration_case"])
-        + r"; the other load cases are held out.",
+        + (
+            r"; the other load cases are held out."
+            if diag.get("heldout_cases")
+            else r", the only load case: no case is held out, and every gap below is the calibration case's own."
+        ),
     ]
 
 
