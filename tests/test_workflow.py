@@ -46,6 +46,29 @@ def test_bad_config_fails_before_any_rule(tmp_path, overrides, message):
     assert not (proj / "results").exists() and not (proj / "data").exists()
 
 
+def test_any_set_of_load_cases_plans_the_report_without_a_figure_case(tmp_path):
+    """Two load cases of other names, calibrated on the second, nonlinear.figure_case left out (it falls back to the
+    last case): the whole default target is planned, the report's fragments with it (the report rule read the key
+    the schema does not default, a KeyError before any job)."""
+    proj = make_project(
+        tmp_path,
+        {
+            "load_cases": {
+                "lc2": {"A1_m_per_s2": 17.5, "A2_m_per_s2": 42.5},
+                "lc5": {"A1_m_per_s2": 20.0, "A2_m_per_s2": 50.0},
+            },
+            "nonlinear.calibration_case": "lc5",
+        },
+    )
+    cfg_file = proj / "config" / "config.yaml"
+    cfg = yaml.safe_load(cfg_file.read_text())
+    cfg["nonlinear"].pop("figure_case")
+    cfg_file.write_text(yaml.safe_dump(cfg))
+    res = snakemake(proj, "-n", "--quiet", "rules")
+    assert res.returncode == 0, res.stderr
+    assert "report_fragments" in res.stdout
+
+
 def test_rig_target_makes_raw_records_only_and_the_seed_makes_them(small_run, rig_run, other_seed_run):
     import xarray as xr
 

@@ -22,7 +22,7 @@ rule report_fragments:
         code=CODE_DIGEST,
         structure=config["structure"],
         calibration_case=config["nonlinear"]["calibration_case"],
-        figure_case=config["nonlinear"]["figure_case"],
+        figure_case=figure_case() if load_cases() else None,
     conda:
         "../envs/contactid.yaml"
     log:
