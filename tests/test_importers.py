@@ -153,6 +153,35 @@ def test_csv_with_text_or_a_gap_names_the_line(tmp_path):
         import_record(block, "load_cases.lc1", dual_sine=True)
 
 
+@pytest.mark.parametrize("sep, decimal", [(";", ","), ("\t", "."), ("\t", ","), (";", ".")])
+def test_csv_from_loggers_and_spreadsheets_reads_as_the_plain_one(tmp_path, sep, decimal):
+    """A data logger's or a spreadsheet's CSV: lines of metadata above the header, semicolon, tab or blank separated
+    columns, decimal commas (a European spreadsheet's export): the same record as the plain comma CSV."""
+    block = _block(tmp_path, "csv")
+    plain = import_record(block, "load_cases.lc1", dual_sine=True)
+    lines = (tmp_path / "r.csv").read_text().splitlines()
+    text = ["Logger: DAQ-9174 export", "Date;28.11.2026", "", "# units in the sidecar"]
+    for line in lines:
+        cells = line.split(",")
+        if decimal == ",":
+            cells = [c.replace(".", ",") for c in cells]
+        text.append(sep.join(cells))
+    (tmp_path / "r.csv").write_text("\n".join(text) + "\n", encoding="utf-8-sig")
+    back = import_record(block, "load_cases.lc1", dual_sine=True)
+    np.testing.assert_array_equal(back["force"].values, plain["force"].values)
+    np.testing.assert_array_equal(back["acceleration"].values, plain["acceleration"].values)
+    assert back.attrs["sampling_rate_hz"] == plain.attrs["sampling_rate_hz"]
+    # a bad cell is named by its line in the file, the metadata lines counted
+    bad = text[:]
+    row = 4 + 1 + 99  # the 100th data row
+    cells = bad[row].split(sep)
+    cells[2] = "overload"
+    bad[row] = sep.join(cells)
+    (tmp_path / "r.csv").write_text("\n".join(bad) + "\n")
+    with pytest.raises(RawDataError, match=f"line {row + 1} holds 'overload', not a number"):
+        import_record(block, "load_cases.lc1", dual_sine=True)
+
+
 def test_config_check_refuses_an_incomplete_import_before_any_rule(default_config, tmp_path):
     cfg = copy.deepcopy(default_config)
     block = _block(tmp_path)

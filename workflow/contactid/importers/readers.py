@@ -6,6 +6,7 @@ unit labels against the channel map. Every failure names the file and the channe
 from __future__ import annotations
 
 import os
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -107,29 +108,63 @@ def read_tdms(spec: ImportSpec) -> dict:
     return out
 
 
+CSV_SEPARATORS = {",": ",", ";": ";", "\t": "\t", " ": r"\s+"}
+_DECIMAL_COMMA = re.compile(r"^[-+]?\d*,\d+([eE][-+]?\d+)?$")
+
+
+def csv_layout(path: str, names) -> dict:
+    """How a CSV file is laid out, as the data loggers and spreadsheets that write them differ: the header row (the
+    first line that names every column in ``names``, after any lines of metadata or comments), the separator (comma,
+    semicolon, tab or blanks) and the decimal mark (a comma where the separator is not one). Read from the first
+    256 kB; {} (comma, header on the first line) where no line names them all, so that the missing column is named."""
+    with open(path, encoding="utf-8-sig", errors="replace") as fh:
+        lines = fh.read(262144).splitlines()
+    wanted = {str(n).strip() for n in names}
+    for i, line in enumerate(lines[:200]):
+        for key, sep in CSV_SEPARATORS.items():
+            cells = re.split(sep, line.strip()) if key == " " else line.split(sep)
+            if wanted <= {c.strip().strip('"').strip("'").strip() for c in cells}:
+                data = lines[i + 1 : i + 6]
+                first = (
+                    [c.strip() for c in (re.split(sep, data[0].strip()) if key == " " else data[0].split(sep))]
+                    if data
+                    else []
+                )
+                decimal = "," if key != "," and any(_DECIMAL_COMMA.match(c) for c in first) else "."
+                return {"sep": sep, "decimal": decimal, "skiprows": i}
+    return {}
+
+
 def read_csv(spec: ImportSpec) -> dict:
     """Columns of a CSV file with a header row, each selected by its header; the sampling interval
-    from the time column when the sidecar names one."""
+    from the time column when the sidecar names one. Lines of metadata above the header, semicolon, tab or blank
+    separated columns and decimal commas are recognised (``csv_layout``)."""
     import pandas as pd
 
     path = spec.file
+    names = [ch.channel for ch in spec.channels] + ([spec.time_column] if spec.time_column else [])
+    layout = csv_layout(path, names)
     try:
-        df = pd.read_csv(path)
+        df = pd.read_csv(path, encoding="utf-8-sig", skipinitialspace=True, **layout)
     except Exception as exc:
         raise RawDataError(f"{path}: cannot be read as CSV with a header row ({type(exc).__name__}: {exc})") from None
-    cols = [str(c) for c in df.columns]
+    cols = [str(c).strip() for c in df.columns]
     df.columns = cols
+    first_line = layout.get("skiprows", 0) + 2  # the file's line number of the first data row
 
     def column(name):
         if name not in cols:
             raise _missing(path, "column", name, cols)
-        v = pd.to_numeric(df[name], errors="coerce")
+        cells = df[name]
+        if layout.get("decimal") == "," and not pd.api.types.is_numeric_dtype(cells):  # a text cell: unparsed
+            cells = cells.astype(str).str.replace(",", ".", regex=False)
+        v = pd.to_numeric(cells, errors="coerce")
         bad = np.flatnonzero(v.isna().to_numpy())
         if bad.size:
             cell = df[name].iloc[bad[0]]
             what = "an empty cell" if pd.isna(cell) else f"{str(cell)!r}"
             raise RawDataError(
-                f"{path}: column {name!r} line {int(bad[0]) + 2} holds {what}, not a number "
+                f"{path}: column {name!r} line {int(bad[0]) + first_line} holds {what}, not a number "
                 "(text, a gap, or a truncated line)"
             )
         return _as_samples(v.to_numpy(), path, name)
