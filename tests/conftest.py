@@ -42,6 +42,27 @@ def _shared_run(config, name: str) -> wp.BackgroundRun:
     return _runs[name]
 
 
+# when each run is ready, roughly (the later ones follow the small run and share the machine): a test that reads a run
+# waits for it, so the tests are ordered by the latest run they read, the others first; within one rank they keep
+# their order. The measured run ends last (about 40 s after the acceptance run in a fresh clone): its tests used to
+# wait for it in the middle of tests/test_workflow.py with every other test of that file still to run
+READY_RANK = {
+    "small_run": 1,
+    "other_seed_run": 2,
+    "rig_run": 2,
+    "default_run": 3,
+    "noise_sweep_run": 3,
+    "lower_confidence_run": 4,
+    "measured_run": 5,
+}
+
+
+def pytest_collection_modifyitems(session, config, items):
+    """Tests that read no shared run first, then by the latest shared run they read (``READY_RANK``)."""
+    rank = {id(it): max((READY_RANK.get(f, 0) for f in getattr(it, "fixturenames", ())), default=0) for it in items}
+    items.sort(key=lambda it: rank[id(it)])
+
+
 def pytest_collection_finish(session):
     """Start the runs the selected tests need (in SHARED_RUNS' order: each after the one it follows)."""
     if session.config.option.collectonly:
