@@ -122,14 +122,12 @@ def csv_layout(path: str, names) -> dict:
     wanted = {str(n).strip() for n in names}
     for i, line in enumerate(lines[:200]):
         for key, sep in CSV_SEPARATORS.items():
-            cells = re.split(sep, line.strip()) if key == " " else line.split(sep)
-            if wanted <= {c.strip().strip('"').strip("'").strip() for c in cells}:
-                data = lines[i + 1 : i + 6]
-                first = (
-                    [c.strip() for c in (re.split(sep, data[0].strip()) if key == " " else data[0].split(sep))]
-                    if data
-                    else []
-                )
+
+            def cells(text, key=key, sep=sep):
+                return [c.strip() for c in (re.split(sep, text.strip()) if key == " " else text.split(sep))]
+
+            if wanted <= {c.strip('"').strip("'").strip() for c in cells(line)}:
+                first = cells(lines[i + 1]) if i + 1 < len(lines) else []
                 decimal = "," if key != "," and any(_DECIMAL_COMMA.match(c) for c in first) else "."
                 return {"sep": sep, "decimal": decimal, "skiprows": i}
     return {}
