@@ -54,7 +54,9 @@ def frequency_sigma(freqs_hz: np.ndarray, stat_sigma_hz: np.ndarray, relative_fl
     return np.sqrt(stat**2 + (relative_floor * np.asarray(freqs_hz)) ** 2)
 
 
-# the fits' Jacobian: central differences with steps of 1e-5 of the log stiffnesses. scipy's default forward steps of
+# the fits' Jacobian: central differences with steps of 1e-5 relative to log10 k (scipy's diff_step scales with |x|:
+# 7e-5 at log10 k_t = 7; the variables never come near zero, unlike the updating's log factors, which take absolute
+# steps, contactid.finite_differences). scipy's default forward steps of
 # 1.5e-8 lie within the eigensolver's rounding of the frequencies: a 1e-8 change in the identified frequencies moved
 # the fitted log10 k_t by up to 0.67 and a profile point's by up to 0.09 (docs/measurements.md, "The stiction fits'
 # Jacobian")

@@ -28,10 +28,11 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from .beam_model import assemble, structural_modes
+from .finite_differences import central_difference_jacobian
 from .parameters import StructureParameters
 
 IDENTIFIED = 0.5  # posterior sd / prior sd below this: the data bound the parameter
-DIFF_STEP = 1e-5  # finite-difference step of the MAP fit's Jacobian, relative (on the logs of the parameters)
+DIFF_STEP = 1e-5  # finite-difference step of the MAP fit's Jacobian, absolute, on the logs of the parameters
 
 
 @dataclass(frozen=True)
@@ -228,12 +229,20 @@ class _UpdatingProblem:
             return np.concatenate([self.data_residuals(x), ((x - x_centre) / sd)[free]])
 
         z0 = (x_centre if start is None else np.asarray(start, float))[free]
-        # central differences with steps of 1e-5 (of the logs): the default forward steps (1.5e-8) resolve the flat
-        # directions (the lever arm against k_t, a stiff k_n) no better than the eigensolver's rounding, so the fit
-        # stopped wherever the noisy Jacobian sent it, a posterior misfit several times the optimum's, and a change
-        # of 1e-8 in the frequencies moved the factors by per cents (docs/measurements.md)
+        # central differences with absolute steps of 1e-5 of the logs: the default forward steps (1.5e-8) resolve the
+        # flat directions (the lever arm against k_t, a stiff k_n) no better than the eigensolver's rounding, so the
+        # fit stopped wherever the noisy Jacobian sent it, a posterior misfit several times the optimum's, and a
+        # change of 1e-8 in the frequencies moved the factors by per cents. scipy's diff_step is relative to x,
+        # a step of 1e-5 |ln factor|, 1e-11 at a factor of 1.000001: the posterior sd of a lever arm the data do not
+        # bind came out 0.0002-0.1 (docs/measurements.md, "The updating's Jacobian")
         sol = least_squares(
-            res, z0, jac="3-point", diff_step=DIFF_STEP, x_scale=sd[free] * 0.1, xtol=1e-10, ftol=1e-12, max_nfev=400
+            res,
+            z0,
+            jac=central_difference_jacobian(res, DIFF_STEP),
+            x_scale=sd[free] * 0.1,
+            xtol=1e-10,
+            ftol=1e-12,
+            max_nfev=400,
         )
         x = x_centre.copy()
         x[free] = sol.x

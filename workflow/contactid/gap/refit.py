@@ -376,18 +376,23 @@ def _least_squares_unit(
     residual)."""
     from scipy.optimize import least_squares
 
+    from ..finite_differences import forward_difference_jacobian
+
     size = stacked(run.residual(lo + x0 * (hi - lo))).size
 
     def residual(x):
         r = run.residual(lo + np.clip(x, 0.0, 1.0) * (hi - lo))
         return np.full(size, 1e3) if r is None else stacked(r)
 
+    # absolute steps of 1e-3 of the range: scipy's diff_step is relative to x, 1e-6 of the range at x = 0.001,
+    # below the time-marched residuals' rounding near the low end where small effects lie
+    fun, jac = forward_difference_jacobian(residual, 1e-3, 0.0, 1.0)
     res = least_squares(
-        residual,
+        fun,
         x0,
+        jac=jac,
         bounds=(0.0, 1.0),
         method="trf",
-        diff_step=1e-3,
         xtol=1e-3,
         ftol=1e-6,
         max_nfev=max(3, max_evaluations // 2),
