@@ -353,14 +353,17 @@ def test_report_section_is_plain_latex_with_and_without_the_benchmark():
             "two_effects_one_named": 0.9,
             "remaining_gap_median": 0.005,
             "perturbation_only_median_abs_error": {"mu": 0.05, "kappa": 0.2, "e0": 0.1},
-            "perturbation_only_interval_coverage": {"mu": 1.0, "kappa": 0.9286, "e0": 1.0},
+            "perturbation_only_interval_coverage": {"mu": 1.0, "kappa": 0.9286, "e0": 1.0, "mu_a": 0.8571},
             "perturbation_only_median_abs_bound_error": {"mu_a": 0.004, "e0_a2": 0.012},
-            "perturbation_only_median_interval_halfwidth": {"mu": 0.16, "kappa": 0.6, "e0": 0.37},
+            "perturbation_only_median_interval_halfwidth": {"mu": 0.16, "kappa": 0.6, "e0": 0.37, "mu_a": 0.03},
         },
     }
     assert "Compound benchmark" in gap_section(diag, bench) and "14 with 0" in gap_section(diag, bench)
     assert "$\\kappa$ $92.9$\\,\\%" in gap_section(diag, bench)  # interval coverage, three digits
     assert "$e_0 a^2$ $1.20$\\,\\%" in gap_section(diag, bench)
+    assert "$\\mu a$ $85.7$\\,\\%" in gap_section(diag, bench) and "$\\mu a$ $\\pm$\\,$3.00$" in gap_section(
+        diag, bench
+    )
     par = {
         n: {
             "value": 0.4,
@@ -370,11 +373,12 @@ def test_report_section_is_plain_latex_with_and_without_the_benchmark():
             "interval": [0.33, 0.48],
             "scale": "log",
         }
-        for n in ("e_f", "k_c", "e_t", "kappa", "mu", "e0")
+        for n in ("e_f", "k_c", "e_t", "kappa", "mu", "e0", "mu_a")
     }
     intervals = {"model": "updated", "n_structures": 12, "parameters": {**par, "confidence": 0.95}}
     text = gap_section(diag, None, intervals)
     assert "model-form uncertainty" in text and "e\\_0 at N\\_0" in text and "$0.48" in text
+    assert "mu a (m)" in text and "data bind" in text
     assert "\\n" not in text.replace("\\newcommand", "")
     for text in (gap_section(diag, None), gap_section(diag, bench)):
         assert "\\n" not in text.replace("\\newcommand", "")  # no literal backslash-n reaches LaTeX

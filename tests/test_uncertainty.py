@@ -7,7 +7,14 @@ import numpy as np
 import pytest
 
 from contactid.friction_fit import FitSettings
-from contactid.gap.uncertainty import NAMES, FrictionUncertainty, spread_sd, widened_interval, with_e0
+from contactid.gap.uncertainty import (
+    NAMES,
+    FrictionUncertainty,
+    bound_products,
+    spread_sd,
+    widened_interval,
+    with_e0,
+)
 
 
 def params(mu=0.4, kappa=0.28, e0_scale=1.0):
@@ -59,6 +66,37 @@ def test_coverage_and_relative_halfwidth():
 
 
 @pytest.mark.slow  # rig records, the chain and three friction refits (about 15 s)
+def test_what_the_data_bind_keeps_its_interval_when_the_lever_arm_opens_mus():
+    # structures along two axes: the lever arm +-10 % (mu and e_0 refit as 1/a and 1/a^2: mu a, e_0 a^2 stay),
+    # then E +-1 % with mu +-2 % at the same arm; a = 7.5 mm
+    a = 7.5e-3
+    value = params()
+    i_e0 = NAMES.index("e0")
+    fits = [params(mu=0.4 / s) for s in (0.9, 1.1)] + [params(mu=0.4 * s) for s in (0.98, 1.02)]
+    for f, s in zip(fits, (0.9, 1.1)):
+        f[i_e0] = value[i_e0] / s**2
+    arms = [0.9 * a, 1.1 * a, a, a]
+    profile = np.column_stack([value * 0.99, value * 1.01])
+    sd_cases = np.zeros(6)
+    sd_cases[NAMES.index("mu")] = 0.01
+    out = bound_products(value, profile, sd_cases, a, fits, arms, 0.95)
+    mu_a, e0_a2 = out["mu_a"], out["e0_a2"]
+    assert mu_a["value"] == pytest.approx(0.4 * a) and mu_a["unit"] == "m"
+    half = (np.log(1.02) - np.log(0.98)) / 2
+    assert mu_a["sd_structure"] == pytest.approx(half, rel=1e-9)  # the lever arm's axis adds nothing
+    assert e0_a2["sd_structure"] == pytest.approx(0.0, abs=1e-12)
+    z = 1.959964
+    assert mu_a["interval"][1] == pytest.approx(1.01 * 0.4 * a * np.exp(z * np.hypot(0.01, half)), rel=1e-6)
+    # while mu's own structure spread carries the lever arm's 10 %
+    assert spread_sd(value, fits, pairs=True)[NAMES.index("mu")] > 0.09
+    u = FrictionUncertainty(value, profile, sd_cases, np.zeros(6), profile, 0.95, {}, fits, out)
+    assert u.covers({"mu_a": 0.4 * a * 1.02, "e0_a2": value[NAMES.index("e0")] * a**2 * 1.05}) == {
+        "mu_a": True,
+        "e0_a2": False,
+    }
+    assert u.summary()["e0_a2"]["unit"] == "N m" and u.relative_halfwidth(("mu_a",))["mu_a"] < 0.1
+
+
 def test_the_data_bind_mu_times_the_lever_arm_not_mu(default_config):
     """Scaling the tangential lever arm a by lambda (with k_t / lambda^2, so that the linear data stay the same)
     scales the identified S by 1 / lambda and xi by lambda: the refitted mu moves by 1 / lambda while mu a and

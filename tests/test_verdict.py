@@ -419,6 +419,39 @@ def test_bound_errors_take_the_lever_arm_out_of_mu_and_e0():
     assert b["mu_a"] == pytest.approx(0.0, abs=1e-9) and b["e0_a2"] == pytest.approx(0.0, abs=1e-4)
 
 
+def test_benchmark_scores_the_intervals_of_what_the_data_bind_against_the_rigs_lever_arm():
+    from contactid.contact_laws import stiction_shear_stiffness
+    from contactid.gap.benchmark import compound_score, friction_truth
+
+    truth = {"e_f_n_per_m": 3.857e7, "k_c_per_m": 2.547e5, "e_t_n_per_m": 0.0, "kappa": 0.284, "mu": 0.397}
+    t = friction_truth(truth, 70.0, 0.005)
+    e0 = stiction_shear_stiffness(70.0, 3.857e7, 2.547e5)
+    assert t["mu_a"] == pytest.approx(0.397 * 0.005) and t["e0_a2"] == pytest.approx(e0 * 2.5e-5, rel=1e-12)
+    assert set(friction_truth(truth, 70.0)) == {"mu", "kappa", "e0"}  # no lever arm, no products
+
+    def row(covered, width):
+        return {
+            "effects": {},
+            "updating_accepted": True,
+            "explanation": [],
+            "remaining_gap": {"heldout_gap": 0.005},
+            "friction_errors": {"mu": 0.01, "kappa": 0.1, "e0": -0.02},
+            "friction_covered": covered,
+            "friction_interval_halfwidth": width,
+        }
+
+    base = {"mu": True, "kappa": True, "e0": False}
+    rows = [
+        row(base | {"mu_a": True, "e0_a2": True}, {"mu": 0.2, "kappa": 0.5, "e0": 0.4, "mu_a": 0.05, "e0_a2": 0.06}),
+        row(base | {"mu_a": False, "e0_a2": True}, {"mu": 0.2, "kappa": 0.5, "e0": 0.4, "mu_a": 0.07, "e0_a2": 0.08}),
+        row(base, {"mu": 0.2, "kappa": 0.5, "e0": 0.4}),  # a row scored before the products existed
+    ]
+    s = compound_score(rows)
+    assert s["perturbation_only_interval_coverage"] == {"mu": 1.0, "kappa": 1.0, "e0": 0.0, "mu_a": 0.5, "e0_a2": 1.0}
+    assert s["perturbation_only_median_interval_halfwidth"]["mu_a"] == pytest.approx(0.06)
+    assert s["perturbation_only_median_interval_halfwidth"]["e0"] == pytest.approx(0.4)
+
+
 def test_an_update_that_moves_only_the_transducer_masses_is_the_transducer_mass_error():
     ident = {f: {"posterior_sd": 0.05} for f in ("stiffness_scale", "mass_scale", "transducer_mass_scale")}
     assert (

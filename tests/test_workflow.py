@@ -303,6 +303,14 @@ def test_friction_law_recovers_rig_truth_and_validates(default_run):
         lo, hi = mf[name]["interval"]
         assert lo < truth < hi
     assert mf["mu"]["interval"][0] < fr["intervals"]["mu"][0] and mf["mu"]["interval"][1] > fr["intervals"]["mu"][1]
+    # what the data bind (the rig's lever arm, 4.58 mm, is the model's here): held, and narrower than mu's and e_0's,
+    # which open with the lever arm the random test leaves free
+    a = 0.00458
+    for name, truth, par in (("mu_a", 0.397 * a, "mu"), ("e0_a2", e0_true * a**2, "e0")):
+        lo, hi = mf[name]["interval"]
+        assert lo < truth < hi, (name, lo, truth, hi)
+        plo, phi = mf[par]["interval"]
+        assert (hi - lo) / mf[name]["value"] < 0.5 * (phi - plo) / mf[par]["value"], name
     for fig in ("fig07_e0", "fig08_s_xi", "fig09_s_xidot", "friction_convergence"):
         assert (default_run / "results" / "figures" / f"{fig}.png").stat().st_size > 10000
 
@@ -469,7 +477,7 @@ def test_no_table_cell_prints_more_digits_than_its_interval_supports(default_run
     tex = (default_run / "results/report/gap.tex").read_text()
     body = tex[tex.index("tab:intervals") :].split(r"\midrule")[1].split(r"\bottomrule")[0]
     rows = [line.split(" & ") for line in body.strip().splitlines()]
-    names = ["e_f", "k_c", "e_t", "kappa", "mu", "e0"]
+    names = ["e_f", "k_c", "e_t", "kappa", "mu", "e0", "mu_a", "e0_a2"]  # then what the data bind
     assert len(rows) == len(names)
     for name, cells in zip(names, rows):
         v = intervals[name]

@@ -280,6 +280,7 @@ def compound_row(spec: Mapping, cfg: Mapping, effects: Mapping, item: ItemDiagno
     )
     t_unc = time.perf_counter() - t_unc
     truth = cfg["rig"]["truth"]["friction"]
+    true_arm = cfg["rig"]["true_structure"]["contact_geometry"]["tangential_lever_arm_m"]
     return {
         **dict(spec),
         "verdict": diag.verdict,
@@ -292,12 +293,11 @@ def compound_row(spec: Mapping, cfg: Mapping, effects: Mapping, item: ItemDiagno
         "heldout_gap_before": diag.where.get("heldout_gap_identified", diag.where["heldout_gap_before"]),
         "friction_errors": friction_errors(model, truth, preload),
         "friction_errors_chain": friction_errors(item.chain_model, truth, preload),
-        "bound_errors": bound_errors(
-            model, truth, preload, cfg["rig"]["true_structure"]["contact_geometry"]["tangential_lever_arm_m"]
-        ),
-        "friction_intervals": {n: [float(v) for v in unc.interval[NAMES.index(n)]] for n in ("mu", "kappa", "e0")},
-        "friction_covered": unc.covers(friction_truth(truth, preload)),
-        "friction_interval_halfwidth": unc.relative_halfwidth(("mu", "kappa", "e0")),
+        "bound_errors": bound_errors(model, truth, preload, true_arm),
+        "friction_intervals": {n: [float(v) for v in unc.interval[NAMES.index(n)]] for n in ("mu", "kappa", "e0")}
+        | {n: [float(v) for v in unc.products[n]["interval"]] for n in ("mu_a", "e0_a2")},
+        "friction_covered": unc.covers(friction_truth(truth, preload, true_arm)),
+        "friction_interval_halfwidth": unc.relative_halfwidth(("mu", "kappa", "e0", "mu_a", "e0_a2")),
         "where": diag.where,
         "control_converged": converged,
         "seconds": {
@@ -607,16 +607,20 @@ def compound_config(cfg: Mapping, spec: Mapping) -> dict:
     return out
 
 
-def friction_truth(truth_friction: Mapping, preload: float) -> dict:
-    """The rig's true mu, kappa and e_0 at the preload (N/m, Eq. 22)."""
+def friction_truth(truth_friction: Mapping, preload: float, lever_arm: float | None = None) -> dict:
+    """The rig's true mu, kappa and e_0 at the preload (N/m, Eq. 22), and with its true tangential ``lever_arm`` (m)
+    what the data bind: mu a (m) and e_0 a^2 (N m)."""
     from ..contact_laws import stiction_shear_stiffness
 
     t = truth_friction
-    return {
+    out = {
         "mu": float(t["mu"]),
         "kappa": float(t["kappa"]),
         "e0": float(stiction_shear_stiffness(preload, t["e_f_n_per_m"], t["k_c_per_m"])),
     }
+    if lever_arm is not None:
+        out |= {"mu_a": out["mu"] * float(lever_arm), "e0_a2": out["e0"] * float(lever_arm) ** 2}
+    return out
 
 
 def friction_errors(model, truth_friction: Mapping, preload: float) -> dict:
@@ -661,11 +665,11 @@ def compound_score(rows: list) -> dict:
     bound = {k: [abs(r["bound_errors"][k]) for r in by_n[0] if r.get("bound_errors")] for k in ("mu_a", "e0_a2")}
     covered = {
         k: [bool(r["friction_covered"][k]) for r in by_n[0] if k in (r.get("friction_covered") or {})]
-        for k in ("mu", "kappa", "e0")
+        for k in ("mu", "kappa", "e0", "mu_a", "e0_a2")
     }
     width = {
-        k: [r["friction_interval_halfwidth"][k] for r in by_n[0] if r.get("friction_interval_halfwidth")]
-        for k in ("mu", "kappa", "e0")
+        k: [r["friction_interval_halfwidth"][k] for r in by_n[0] if k in (r.get("friction_interval_halfwidth") or {})]
+        for k in ("mu", "kappa", "e0", "mu_a", "e0_a2")
     }
     return {
         "n": len(rows),

@@ -17,6 +17,10 @@ measure how far they move with what the data cannot tell apart:
 The interval with model form widens the profile interval by z sd on each side, sd = sqrt(sd_cases^2 +
 sd_structure^2), z the normal quantile of the confidence; on a log scale for the positive parameters
 (e_f, k_c, mu, e_0), linear for e_t and kappa, and clipped to the search bounds.
+
+What the data bind (``PRODUCTS``): mu a (m) and e_0 a^2 (N m) with the lever arm a of the structure each value was
+fitted with, the same spreads over load cases (a is one structure's) and over the structures (each refit times
+its own a): an interval that does not widen with the lever arm the random test leaves open.
 """
 
 from __future__ import annotations
@@ -39,6 +43,8 @@ log = logging.getLogger(__name__)
 
 NAMES = (*PARAMETER_NAMES, "e0")  # the five law parameters and e_0 at the preload (Eq. 22)
 LOG_SCALE = np.array([True, True, False, False, True, True])  # e_f, k_c, mu, e_0 spread on a log scale
+# what the data bind when the lever arm is open: (name, parameter, power of a, unit); spread on a log scale
+PRODUCTS = (("mu_a", "mu", 1, "m"), ("e0_a2", "e0", 2, "N m"))
 
 
 @dataclass
@@ -55,36 +61,60 @@ class FrictionUncertainty:
     confidence: float
     case_fits: dict
     structure_fits: list
+    products: dict = dataclasses.field(default_factory=dict)  # {PRODUCTS name: {value, profile, sd_*, interval}}
+
+    def _interval(self, n: str) -> tuple:
+        if n in self.products:
+            return self.products[n]["interval"], self.products[n]["value"]
+        i = NAMES.index(n)
+        return self.interval[i], self.value[i]
 
     def covers(self, truth: Mapping) -> dict:
-        """{name: whether the interval with model form holds the true value} for the names in ``truth``."""
+        """{name: whether the interval with model form holds the true value} for the names in ``truth`` (NAMES
+        and PRODUCTS)."""
         out = {}
-        for i, n in enumerate(NAMES):
+        for n in (*NAMES, *self.products):
             if n in truth and truth[n] is not None:
-                out[n] = bool(self.interval[i, 0] <= float(truth[n]) <= self.interval[i, 1])
+                (lo, hi), _ = self._interval(n)
+                out[n] = bool(lo <= float(truth[n]) <= hi)
         return out
 
     def relative_halfwidth(self, names=NAMES) -> dict:
         """{name: half the interval with model form over the value} (a relative +- of the interval)."""
         out = {}
         for n in names:
-            i = NAMES.index(n)
-            out[n] = float((self.interval[i, 1] - self.interval[i, 0]) / 2.0 / max(abs(self.value[i]), 1e-300))
+            (lo, hi), v = self._interval(n)
+            out[n] = float((hi - lo) / 2.0 / max(abs(v), 1e-300))
         return out
 
     def summary(self) -> dict:
         """JSON-ready {name: {value, profile_interval, sd_cases, sd_structure, interval, scale}}."""
-        return {
-            n: {
-                "value": float(self.value[i]),
-                "profile_interval": [float(v) for v in self.profile[i]],
-                "sd_cases": float(self.sd_cases[i]),
-                "sd_structure": float(self.sd_structure[i]),
-                "interval": [float(v) for v in self.interval[i]],
-                "scale": "log" if LOG_SCALE[i] else "linear",
+        return (
+            {
+                n: {
+                    "value": float(self.value[i]),
+                    "profile_interval": [float(v) for v in self.profile[i]],
+                    "sd_cases": float(self.sd_cases[i]),
+                    "sd_structure": float(self.sd_structure[i]),
+                    "interval": [float(v) for v in self.interval[i]],
+                    "scale": "log" if LOG_SCALE[i] else "linear",
+                }
+                for i, n in enumerate(NAMES)
             }
-            for i, n in enumerate(NAMES)
-        } | {"confidence": self.confidence}
+            | {
+                n: {
+                    "value": float(v["value"]),
+                    "profile_interval": [float(x) for x in v["profile"]],
+                    "sd_cases": float(v["sd_cases"]),
+                    "sd_structure": float(v["sd_structure"]),
+                    "interval": [float(x) for x in v["interval"]],
+                    "scale": "log",
+                    "unit": v["unit"],
+                }
+                for n, v in self.products.items()
+            }
+            | {"confidence": self.confidence}
+        )
 
 
 def with_e0(params, preload: float) -> np.ndarray:
@@ -125,6 +155,41 @@ def widened_interval(profile: np.ndarray, sd: np.ndarray, confidence: float, bou
     return np.column_stack([np.clip(lo, b[:, 0], b[:, 1]), np.clip(hi, b[:, 0], b[:, 1])])
 
 
+def bound_products(
+    value: np.ndarray,
+    profile: np.ndarray,
+    sd_cases: np.ndarray,
+    lever_arm: float,
+    structure_fits,
+    structure_arms,
+    confidence: float,
+) -> dict:
+    """{name: {value, profile, sd_cases, sd_structure, interval, unit}} of PRODUCTS (mu a in m, e_0 a^2 in N m):
+    ``value``/``profile``/``sd_cases`` of NAMES times ``lever_arm`` (m) to the product's power (the load cases share
+    one structure), the structure spread over ``structure_fits`` (rows (6,) in +-pairs) each times its own arm
+    (``structure_arms``, m), the interval widened as ``widened_interval`` does on a log scale."""
+    from scipy.stats import norm
+
+    z = float(norm.ppf(0.5 + confidence / 2.0))
+    out = {}
+    for name, par, power, unit in PRODUCTS:
+        i = NAMES.index(par)
+        scale = float(lever_arm) ** power
+        prof = np.asarray(profile[i], float) * scale
+        alt = np.array([np.log(abs(f[i]) * float(a) ** power) for f, a in zip(structure_fits, structure_arms)])
+        sd_s = float(np.sqrt(np.sum(((alt[1::2] - alt[0::2]) / 2.0) ** 2))) if alt.size >= 2 else 0.0
+        sd = float(np.hypot(sd_cases[i], sd_s))
+        out[name] = {
+            "value": float(value[i]) * scale,
+            "profile": prof,
+            "sd_cases": float(sd_cases[i]),
+            "sd_structure": sd_s,
+            "interval": np.array([prof[0] * np.exp(-z * sd), prof[1] * np.exp(z * sd)]),
+            "unit": unit,
+        }
+    return out
+
+
 def _refit(
     model: IdentifiedModel, rec: RecordHarmonics, settings: FitSettings, seed: int, label: str, intervals: bool = False
 ):
@@ -149,6 +214,7 @@ def friction_uncertainty(
 ) -> FrictionUncertainty:
     """The friction law of ``model`` (fitted on ``records[calibration]``) with its profile intervals and the
     model-form spreads over the other load cases in ``records`` and over ``structures`` (see the module)."""
+    structures = list(structures)
     quiet = logging.getLogger("contactid.friction_fit")
     level = quiet.level
     cal = records[calibration]
@@ -178,6 +244,15 @@ def friction_uncertainty(
     sd_c = spread_sd(value, list(cases.values()))
     sd_s = spread_sd(value, structs, pairs=True)
     interval = widened_interval(profile, np.hypot(sd_c, sd_s), settings.confidence, settings.bounds)
+    products = bound_products(
+        value,
+        profile,
+        sd_c,
+        model.structure.tangential_lever_arm,
+        structs,
+        [p.tangential_lever_arm for p in structures],
+        float(settings.confidence),
+    )
     for i, n in enumerate(NAMES):
         log.info(
             "friction intervals: %s = %.4g, profile [%.4g, %.4g], model-form sd %.3g (cases) %.3g (structure)%s"
@@ -190,4 +265,17 @@ def friction_uncertainty(
             " on ln" if LOG_SCALE[i] else "",
             *interval[i],
         )
-    return FrictionUncertainty(value, profile, sd_c, sd_s, interval, float(settings.confidence), cases, structs)
+    for n, v in products.items():
+        log.info(
+            "friction intervals: %s = %.4g %s (what the data bind), model-form sd %.3g (cases) %.3g (structure) on ln"
+            " -> [%.4g, %.4g]",
+            n,
+            v["value"],
+            v["unit"],
+            v["sd_cases"],
+            v["sd_structure"],
+            *v["interval"],
+        )
+    return FrictionUncertainty(
+        value, profile, sd_c, sd_s, interval, float(settings.confidence), cases, structs, products
+    )
