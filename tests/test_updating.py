@@ -93,12 +93,42 @@ def test_data_of_the_nominal_structure_are_not_updated(nominal):
     assert all(v == 1.0 for v in upd.factors.values())
 
 
+@pytest.mark.slow  # one update (about 5 s)
+def test_an_update_the_random_test_cannot_make_significant_is_offered_for_the_records_to_accept(nominal):
+    truth = apply_factors(nominal, {"transducer_mass_scale": 1.25})
+    f, _, R = data_of(truth)
+    # standard errors of 1 % and residues known to 5 %: the masses' 25 % is not significant on these data alone
+    upd = update_structure(nominal, f, 0.01 * f, R, residue_accuracy=0.05)
+    assert not upd.accepted and upd.accepted_by == ""
+    assert all(v == 1.0 for v in upd.factors.values())  # the nominal structure is kept ...
+    # ... and offered, drawn towards the prior by data this weak but most of the way to the truth
+    assert 1.1 < upd.proposal["factors"]["transducer_mass_scale"] < 1.3
+    test = {"heldout_gap_chain": 0.02, "heldout_gap_updated": 0.008, "record_scatter": 0.001, "accepted": True}
+    acc = upd.accept_proposal(test)
+    assert acc.accepted and acc.accepted_by == "records" and acc.proposal is None and acc.records_test == test
+    assert acc.factors == upd.proposal["factors"]
+    assert acc.structure == apply_factors(nominal.with_contact(acc.k_t, acc.k_n), acc.factors)
+    m = acc.factors["transducer_mass_scale"]
+    assert acc.structure.sensor_masses[0] == pytest.approx(m * nominal.sensor_masses[0], rel=1e-12)
+    assert np.allclose(acc.model_frequencies_hz, f, rtol=5e-3)
+    # each factor's profile is there for the verdict (verdict.updating_effect)
+    assert acc.identifiability["transducer_mass_scale"]["profile_chi2_increase"] > 0
+    # model_updating.json keeps the proposal; the diagnosis's summary keeps what accepted it
+    again = UpdatingResult.from_summary(upd.summary(), nominal)
+    assert again.proposal == upd.proposal and not again.accepted
+    assert UpdatingResult.from_summary(acc.summary(), nominal).accepted_by == "records"
+    with pytest.raises(ValueError, match="no proposal"):
+        acc.accept_proposal(test)
+
+
 def test_updating_settings_and_their_errors():
     s = GapSettings.from_config(
         {"model_updating": {"parameters": ["transducer_mass_scale"], "residue_accuracy": 0.05}}, 1, 25
     )
     assert s.model_updating and s.updating_parameters == ("transducer_mass_scale",) and s.residue_accuracy == 0.05
     assert not GapSettings.from_config({"model_updating": {"enabled": False}}, 1, 25).model_updating
+    assert GapSettings.from_config({}, 1, 25).updating_records_test
+    assert not GapSettings.from_config({"model_updating": {"records_test": False}}, 1, 25).updating_records_test
     assert GapSettings.from_config({}, 1, 25).updating_parameters == tuple(FACTORS)
     with pytest.raises(ValueError, match="gap.model_updating.parameters: unknown"):
         GapSettings.from_config({"model_updating": {"parameters": ["youngs"]}}, 1, 25)

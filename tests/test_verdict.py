@@ -419,6 +419,15 @@ def test_bound_errors_take_the_lever_arm_out_of_mu_and_e0():
     assert b["mu_a"] == pytest.approx(0.0, abs=1e-9) and b["e0_a2"] == pytest.approx(0.0, abs=1e-4)
 
 
+def test_the_records_accept_an_update_that_shrinks_a_gap_above_the_floor_beyond_their_scatter():
+    settings = {"min_gap": 0.006, "noise_factor": 3.0}
+    assert V.records_accept_update(0.0204, 0.0063, 0.001, settings)  # compound-14-s2: 2.0 -> 0.63 %
+    assert not V.records_accept_update(0.0204, 0.0180, 0.001, settings)  # 2.4e-3 < 3 x the scatter
+    assert not V.records_accept_update(0.0050, 0.0010, 0.0001, settings)  # at the floor: nothing to explain
+    assert not V.records_accept_update(0.0204, 0.0300, 0.001, settings)  # worse
+    assert not V.records_accept_update(0.0204, float("nan"), 0.001, settings)
+
+
 def test_benchmark_scores_the_intervals_of_what_the_data_bind_against_the_rigs_lever_arm():
     from contactid.contact_laws import stiction_shear_stiffness
     from contactid.gap.benchmark import compound_score, friction_truth
@@ -642,3 +651,22 @@ def test_contact_opens_tells_a_separating_law_from_a_stiffer_closed_one():
     closed = explanation_text({"explanation": [{**step, "contact_opens": False}], "remaining_gap": left})
     opened = explanation_text({"explanation": [{**step, "contact_opens": True}], "remaining_gap": left})
     assert "never opens" in closed and "never opens" not in opened
+
+
+def test_the_report_says_when_the_records_accepted_the_update():
+    from contactid.gap.report import explanation_text
+
+    step = {
+        "effect": "model_updating",
+        "parameters": {"transducer_mass_scale": 0.925, "k_t": 1.39e7},
+        "heldout_gap_before": 0.1187,
+        "heldout_gap_after": 0.0976,
+        "share": 0.32,
+    }
+    left = {"heldout_gap": 0.0976, "share": 0.68, "at_floor": False, "place": "contact", "place_reason": "x"}
+    upd = {"accepted": True, "accepted_by": "records", "chi2_nominal": 1.08, "chi2_updated": 0.184}
+    by_records = explanation_text({"explanation": [step], "remaining_gap": left, "where": {"model_updating": upd}})
+    assert "not significant on the random test alone" in by_records and "1.08" in by_records
+    by_chi2 = {**upd, "accepted_by": "random_test"}
+    text = explanation_text({"explanation": [step], "remaining_gap": left, "where": {"model_updating": by_chi2}})
+    assert "random test alone" not in text

@@ -244,7 +244,10 @@ def diagnose_item(spec: Mapping, cfg: Mapping, recs: Mapping, cases: list, t0: f
         "" if spec.get("library") is None else f" with a library that lacks {spec['effect']}",
     )
     chain_model = model
-    model, updating = updated_model(chain_model, modal, records[cal], fit_settings, settings, int(cfg["seed"]))
+    held_out = {c: r for c, r in records.items() if c != cal}
+    model, updating = updated_model(
+        chain_model, modal, records[cal], fit_settings, settings, int(cfg["seed"]), held_out=held_out
+    )
     diag = diagnose(
         model,
         records,

@@ -70,7 +70,9 @@ class GapSettings:
     the candidates
     (``contactid.updating``; updating_parameters the structural factors, residue_accuracy the residues' relative
     standard error, frequency_floor the relative model-form uncertainty added to each frequency,
-    updating_confidence the significance an update needs to be accepted)."""
+    updating_confidence the significance an update needs to be accepted, updating_records_test: an update the
+    chi^2 test did not accept is accepted when the dual-sine records' held-out gap shrinks with it,
+    ``verdict.records_accept_update``)."""
 
     n_harmonics: int = 9
     identification_harmonics: int = 25
@@ -94,6 +96,7 @@ class GapSettings:
     frequency_floor: float = 0.001
     updating_confidence: float = 0.95
     updating_prior_sd: tuple = ()  # ((factor, sd of its ln), ...) replacing contactid.updating.FACTORS' priors
+    updating_records_test: bool = True  # the records may accept an update the random test's chi^2 did not
     joint_refit: bool = True  # the explanation's later steps refit the earlier steps' parameters with theirs
     polish_searches: bool = False  # every searched state polished by the integrator (refit.POLISH_SEARCH)
     pair_lookahead: float = 3.0  # where no candidate shrinks a gap above this many min_gap materially, try a pair
@@ -156,6 +159,7 @@ def _updating_settings(b: Mapping) -> dict:
         "updating_confidence": float(b["confidence"]),
         "frequency_floor": float(b["frequency_floor"]),
         "updating_prior_sd": _prior_sd(b.get("prior_sd"), FACTORS),
+        "updating_records_test": bool(b.get("records_test", True)),
     }
 
 
@@ -844,6 +848,40 @@ def heldout_gap_of(
         r = np.concatenate([(As - A).ravel(), (d_sim - d_meas).ravel()]) / np.linalg.norm(A)
         vals.append(np.sum(np.abs(r) ** 2))
     return float(np.sqrt(np.mean(vals)))
+
+
+def records_test_of_update(
+    chain: IdentifiedModel, updated: IdentifiedModel, held_out: Mapping[str, RecordHarmonics], settings: GapSettings
+) -> dict:
+    """What the dual-sine records say of a model update: the held-out gap (``heldout_gap_of``) of the chain's model
+    and of the updated one (each with its own friction law) on the ``held_out`` records, and the records' scatter
+    (sd of the chain's gap over the bootstrap of record blocks, as the diagnosis draws it); ``accepted`` by
+    ``verdict.records_accept_update``."""
+    from .verdict import records_accept_update
+
+    H = settings.n_harmonics
+    cases = list(held_out)
+    HarmonicBalance.forget()  # no Newton history from an earlier diagnosis in this process
+    sims = {
+        label: {c: baseline(m, held_out[c], H)[1] for c in cases}
+        for label, m in (("chain", chain), ("updated", updated))
+    }
+    rng = generator(settings.seed, "gap/bootstrap")
+    boot = {c: _bootstrap_records(held_out[c], rng, settings.n_bootstrap, H) for c in cases}
+    draws = [
+        heldout_gap_of(held_out, cases, H, sims["chain"], {c: boot[c][b] for c in cases})
+        for b in range(settings.n_bootstrap)
+    ]
+    out = {
+        "heldout_gap_chain": heldout_gap_of(held_out, cases, H, sims["chain"]),
+        "heldout_gap_updated": heldout_gap_of(held_out, cases, H, sims["updated"]),
+        "record_scatter": float(np.std(draws)),
+        "cases": cases,
+    }
+    out["accepted"] = records_accept_update(
+        out["heldout_gap_chain"], out["heldout_gap_updated"], out["record_scatter"], settings
+    )
+    return out
 
 
 def _ranking_row(

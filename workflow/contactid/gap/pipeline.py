@@ -5,6 +5,7 @@ the same package functions as the rules, with the same settings from the config.
 from __future__ import annotations
 
 import copy
+import dataclasses
 from typing import Mapping
 
 import numpy as np
@@ -144,6 +145,7 @@ def workflow_models(
         fit_settings,
         settings,
         seed,
+        {c: r for c, r in records.items() if c != calibration_case},
     )
     return records, fit_settings, modal, chain, model, upd
 
@@ -158,53 +160,98 @@ def diagnosed_model(
     fit_settings,
     settings,
     seed: int,
+    held_out=None,
 ):
     """The models a diagnosis of the workflow's datasets works with: (the chain's own model from linear_modes.nc,
     modal.nc and friction_fit.nc; the model to diagnose, the chain's updated by model_updating.json's summary
-    (``updated_model``) or the chain's own when updating is off; the UpdatingResult or None)."""
+    (``updated_model``, which the ``held_out`` records may also accept) or the chain's own when updating is off;
+    the UpdatingResult or None)."""
     from ..updating import UpdatingResult
 
     chain = identified_model(structure_cfg, modes, modal, fit)
     if not updating_summary["enabled"]:
         return chain, chain, None
     upd = UpdatingResult.from_summary(updating_summary, chain.structure)
-    model, upd = updated_model(chain, modal, calibration, fit_settings, settings, seed, upd)
+    model, upd = updated_model(chain, modal, calibration, fit_settings, settings, seed, upd, held_out)
     return chain, model, upd
 
 
-def updated_model(model, modal: xr.Dataset, calibration, fit_settings, settings, seed: int, upd=None):
+def updated_model(model, modal: xr.Dataset, calibration, fit_settings, settings, seed: int, upd=None, held_out=None):
     """The base model updated from the random test before the candidates (``structure_update``, or ``upd`` when
     already computed), with the inverse identification and the friction fit redone on the calibration record
     (``calibration``: its RecordHarmonics). Returns (model to diagnose, UpdatingResult or None when updating is
-    off); the model is the chain's own when the update is not accepted."""
-    import dataclasses
+    off); the model is the chain's own when the update is not accepted. An update the random test's chi^2 test did
+    not accept (its ``proposal``) is accepted when the ``held_out`` records ({case: RecordHarmonics}, the load
+    cases other than the calibration case) show a held-out gap above the floor that the update shrinks beyond
+    their scatter (``settings.updating_records_test``; ``diagnosis.records_test_of_update``); the result then says
+    ``accepted_by`` "records" and keeps the test in ``records_test``."""
     import logging
 
-    from .model import NONE
+    from ..updating import apply_factors
 
     log = logging.getLogger(__name__)
     if upd is None:
         upd = structure_update(model.structure, modal, settings)
     if upd is None:
         return model, None
-    factors = ", ".join(f"{k} {v:.4g}" for k, v in upd.factors.items())
     if not upd.accepted:
+        if upd.proposal is None or not held_out or not getattr(settings, "updating_records_test", False):
+            log.info(
+                "model updating: not accepted (chi2 %.3g -> %.3g for %d factors); the chain's structure is kept",
+                upd.chi2_nominal,
+                upd.chi2_updated,
+                len(upd.factors),
+            )
+            return model, upd
+        from .diagnosis import records_test_of_update
+
+        p = upd.proposal
+        proposed = apply_factors(upd.nominal.with_contact(float(p["k_t"]), float(p["k_n"])), p["factors"])
+        m2 = _refitted(model, proposed, calibration, fit_settings, seed)
+        test = records_test_of_update(model, m2, held_out, settings)
+        factors = ", ".join(f"{k} {v:.4g}" for k, v in p["factors"].items())
+        if not test["accepted"]:
+            log.info(
+                "model updating: not accepted (chi2 %.3g -> %.3g for %d factors; held-out gap %.4g -> %.4g with it, "
+                "records' scatter %.2g); the chain's structure is kept",
+                upd.chi2_nominal,
+                upd.chi2_updated,
+                len(upd.factors),
+                test["heldout_gap_chain"],
+                test["heldout_gap_updated"],
+                test["record_scatter"],
+            )
+            return model, dataclasses.replace(upd, records_test=test)
         log.info(
-            "model updating: not accepted (chi2 %.3g -> %.3g for %d factors); the chain's structure is kept",
+            "model updating: accepted by the records (chi2 %.3g -> %.3g, not significant alone; held-out gap "
+            "%.4g -> %.4g, records' scatter %.2g): %s, k_t %.4g, k_n %.4g N/m; friction law refitted",
             upd.chi2_nominal,
             upd.chi2_updated,
-            len(upd.factors),
+            test["heldout_gap_chain"],
+            test["heldout_gap_updated"],
+            test["record_scatter"],
+            factors,
+            float(p["k_t"]),
+            float(p["k_n"]),
         )
-        return model, upd
+        return m2, upd.accept_proposal(test)
     log.info(
         "model updating: accepted (chi2 %.3g -> %.3g): %s, k_t %.4g, k_n %.4g N/m; friction law refitted",
         upd.chi2_nominal,
         upd.chi2_updated,
-        factors,
+        ", ".join(f"{k} {v:.4g}" for k, v in upd.factors.items()),
         upd.k_t,
         upd.k_n,
     )
-    m2 = dataclasses.replace(model, structure=upd.structure)
+    return _refitted(model, upd.structure, calibration, fit_settings, seed), upd
+
+
+def _refitted(model, structure, calibration, fit_settings, seed: int):
+    """The model with ``structure``, its contact forces identified again from the calibration record and its
+    friction law fitted to them."""
+    from .model import NONE
+
+    m2 = dataclasses.replace(model, structure=structure)
     forces = identified_forces(m2, NONE, calibration)
     fit = fit_friction_law(
         forces.xi,
@@ -218,4 +265,4 @@ def updated_model(model, modal: xr.Dataset, calibration, fit_settings, settings,
         intervals=False,
         label="friction fit after updating",
     )
-    return m2.with_friction(fit.params), upd
+    return m2.with_friction(fit.params)

@@ -79,6 +79,20 @@ def _periodicity_note(step: dict, periodicity: dict) -> str:
     return r" (" + "; ".join(parts) + r": the law is wrong in form there, whatever its harmonic gap)"
 
 
+def _updating_note(step: dict, diag: dict) -> str:
+    """Why a model update was accepted, when the dual-sine records accepted it (the random test alone did not)."""
+    upd = (diag.get("where") or {}).get("model_updating") or {}
+    if step.get("effect") != "model_updating" or upd.get("accepted_by") != "records":
+        return ""
+    return (
+        r" (not significant on the random test alone, $\chi^2$ "
+        + _fmt(upd.get("chi2_nominal", float("nan")), 3)
+        + r" $\to$ "
+        + _fmt(upd.get("chi2_updated", float("nan")), 3)
+        + r"; accepted because it shrinks the held-out gap of the dual-sine records beyond their scatter)"
+    )
+
+
 def explanation_text(diag: dict) -> str:
     """The additive explanation in words (Fig. gap_explanation)."""
     steps, left = diag.get("explanation") or [], diag.get("remaining_gap") or {}
@@ -93,6 +107,7 @@ def explanation_text(diag: dict) -> str:
         periodicity = (diag.get("where") or {}).get("periodicity") or {}
         parts = [
             _t(s["effect"])
+            + _updating_note(s, diag)
             + _law_note(s)
             + _periodicity_note(s, periodicity)
             + r" (refitted: "

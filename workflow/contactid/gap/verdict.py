@@ -194,6 +194,17 @@ def explains_materially(gap: float, after: float, scatter: float, settings) -> b
     )
 
 
+def records_accept_update(gap_chain: float, gap_updated: float, scatter: float, settings) -> bool:
+    """Whether the dual-sine records accept a model update the random test's chi^2 test did not: the chain's
+    held-out gap is above the identification's floor (there is something to explain) and the updated model's is
+    smaller by more than noise_factor x the records' scatter (the test every candidate's step passes). gap_chain,
+    gap_updated: held-out gaps of the chain's model and of the updated one (each with its friction law refitted);
+    scatter: the sd of the chain's gap over the records' bootstrap."""
+    if not (np.isfinite(gap_chain) and np.isfinite(gap_updated)) or at_floor(gap_chain, settings):
+        return False
+    return bool(gap_chain - gap_updated > _setting(settings, "noise_factor") * scatter)
+
+
 def retried(first_thetas: Mapping[str, Sequence], library: Mapping, settings) -> list:
     """The candidates the explanation tries again after its first step: those whose refit alone moved them off
     (a candidate the calibration case sets off on its own is not tried on what later steps leave), or all of them
