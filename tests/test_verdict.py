@@ -419,10 +419,15 @@ def test_bound_errors_take_the_lever_arm_out_of_mu_and_e0():
     assert b["mu_a"] == pytest.approx(0.0, abs=1e-9) and b["e0_a2"] == pytest.approx(0.0, abs=1e-4)
 
 
-def test_the_records_accept_an_update_that_shrinks_a_gap_above_the_floor_beyond_their_scatter():
-    settings = {"min_gap": 0.006, "noise_factor": 3.0}
-    assert V.records_accept_update(0.0204, 0.0063, 0.001, settings)  # compound-14-s2: 2.0 -> 0.63 %
-    assert not V.records_accept_update(0.0204, 0.0180, 0.001, settings)  # 2.4e-3 < 3 x the scatter
+def test_the_records_accept_an_update_that_explains_a_gap_above_the_floor_materially():
+    settings = {"min_gap": 0.006, "noise_factor": 3.0, "min_reduction": 0.5}
+    assert V.records_accept_update(0.0422, 0.0203, 4.8e-5, settings)  # compound-14-s2: 52 %
+    assert V.records_accept_update(0.0683, 0.0078, 4.2e-5, settings)  # compound-3-s1, perturbation only: 89 %
+    # multi-asperity friction on the model's own structure: an update fitted to noise takes 13 % (36 % with a
+    # library that lacks the effect), far beyond the scatter, and must not hide the effect
+    assert not V.records_accept_update(0.0269, 0.0234, 2.8e-5, settings)
+    assert not V.records_accept_update(0.0285, 0.0182, 2.9e-5, settings)
+    assert not V.records_accept_update(0.0204, 0.0090, 0.004, settings)  # 56 %, but 1.1e-2 < 3 x the scatter
     assert not V.records_accept_update(0.0050, 0.0010, 0.0001, settings)  # at the floor: nothing to explain
     assert not V.records_accept_update(0.0204, 0.0300, 0.001, settings)  # worse
     assert not V.records_accept_update(0.0204, float("nan"), 0.001, settings)

@@ -18,8 +18,8 @@ a^2 k_t k_b / (k_t + k_b)).
 The update is accepted when it lowers the data misfit chi^2 by more than chi^2_k(confidence) (0.95 by
 default) for its k structural factors (a significant improvement). Otherwise the nominal structure is kept and
 the update is offered as ``proposal``: the gap diagnosis may still accept it when it shrinks the held-out gap of
-the dual-sine records beyond their scatter (``UpdatingResult.accept_proposal``, ``gap.pipeline.updated_model``):
-with the frequency floor the random test alone cannot make transducer masses 7-22 % off significant, yet the
+the dual-sine records materially (``UpdatingResult.accept_proposal``, ``gap.pipeline.updated_model``): with the
+frequency floor the random test alone cannot make transducer masses 7-22 % off significant, yet the
 update finds them (docs/gap.md, "Model updating").
 """
 

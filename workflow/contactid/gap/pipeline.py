@@ -182,8 +182,8 @@ def updated_model(model, modal: xr.Dataset, calibration, fit_settings, settings,
     (``calibration``: its RecordHarmonics). Returns (model to diagnose, UpdatingResult or None when updating is
     off); the model is the chain's own when the update is not accepted. An update the random test's chi^2 test did
     not accept (its ``proposal``) is accepted when the ``held_out`` records ({case: RecordHarmonics}, the load
-    cases other than the calibration case) show a held-out gap above the floor that the update shrinks beyond
-    their scatter (``settings.updating_records_test``; ``diagnosis.records_test_of_update``); the result then says
+    cases other than the calibration case) show a held-out gap above the floor that the update explains materially
+    (``settings.updating_records_test``; ``diagnosis.records_test_of_update``); the result then says
     ``accepted_by`` "records" and keeps the test in ``records_test``."""
     import logging
 

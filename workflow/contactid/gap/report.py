@@ -89,7 +89,7 @@ def _updating_note(step: dict, diag: dict) -> str:
         + _fmt(upd.get("chi2_nominal", float("nan")), 3)
         + r" $\to$ "
         + _fmt(upd.get("chi2_updated", float("nan")), 3)
-        + r"; accepted because it shrinks the held-out gap of the dual-sine records beyond their scatter)"
+        + r"; accepted because it shrinks the held-out gap of the dual-sine records materially)"
     )
 
 

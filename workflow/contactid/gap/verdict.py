@@ -196,13 +196,16 @@ def explains_materially(gap: float, after: float, scatter: float, settings) -> b
 
 def records_accept_update(gap_chain: float, gap_updated: float, scatter: float, settings) -> bool:
     """Whether the dual-sine records accept a model update the random test's chi^2 test did not: the chain's
-    held-out gap is above the identification's floor (there is something to explain) and the updated model's is
-    smaller by more than noise_factor x the records' scatter (the test every candidate's step passes). gap_chain,
-    gap_updated: held-out gaps of the chain's model and of the updated one (each with its friction law refitted);
-    scatter: the sd of the chain's gap over the records' bootstrap."""
+    held-out gap is above the identification's floor (there is something to explain) and the update explains it
+    materially, as a candidate's step must (``explains_materially``: by min_reduction of it and beyond
+    noise_factor x the records' scatter). gap_chain, gap_updated: held-out gaps of the chain's model and of the
+    updated one (each with its friction law refitted); scatter: the sd of the chain's gap over the records'
+    bootstrap. Beyond the scatter alone is not enough: on rigs whose structure is the model's, updates fitted to the
+    random test's noise took 2-36 % of a contact effect's gap (multi-asperity friction) and hid the effect (the
+    blind benchmark at b4e8536: top-1 46/48)."""
     if not (np.isfinite(gap_chain) and np.isfinite(gap_updated)) or at_floor(gap_chain, settings):
         return False
-    return bool(gap_chain - gap_updated > _setting(settings, "noise_factor") * scatter)
+    return explains_materially(gap_chain, gap_updated, scatter, settings)
 
 
 def retried(first_thetas: Mapping[str, Sequence], library: Mapping, settings) -> list:
