@@ -466,6 +466,37 @@ def test_benchmark_scores_the_intervals_of_what_the_data_bind_against_the_rigs_l
     assert s["perturbation_only_median_interval_halfwidth"]["e0"] == pytest.approx(0.4)
 
 
+def test_an_update_the_records_accepted_is_the_factor_its_profiles_single_out():
+    # the detection ladder's transducer masses +10 %: the chi^2 test did not accept (profile 1.24 < 2^2), the records
+    # did; the masses' profile is 41 times every other factor's: the effect
+    ident = {
+        "stiffness_scale": {"posterior_sd": 0.009, "profile_chi2_increase": 0.03},
+        "mass_scale": {"posterior_sd": 0.007, "profile_chi2_increase": 0.02},
+        "transducer_mass_scale": {"posterior_sd": 0.085, "profile_chi2_increase": 1.24},
+        "tangential_lever_arm_scale": {"posterior_sd": 0.1, "profile_chi2_increase": 0.0},
+    }
+    factors = {
+        "stiffness_scale": 1.0014,
+        "mass_scale": 1.001,
+        "transducer_mass_scale": 1.1016,
+        "tangential_lever_arm_scale": 1.0,
+    }
+    assert V.updating_effect(factors, ident) is None  # as the random test alone would judge it
+    assert V.updating_effect(factors, ident, by_records=True) == "transducer_mass_error"
+    # E as large as the masses (0.5 against 1.24: within a factor 4): no single factor, no effect
+    both = {**ident, "stiffness_scale": {"posterior_sd": 0.009, "profile_chi2_increase": 0.5}}
+    assert V.updating_effect(factors, both, by_records=True) is None
+    # the stiffness singled out: model form without an effect of its own
+    stiff = {
+        **ident,
+        "stiffness_scale": {"posterior_sd": 0.009, "profile_chi2_increase": 2.0},
+        "transducer_mass_scale": {"posterior_sd": 0.085, "profile_chi2_increase": 0.1},
+    }
+    assert V.updating_effect(factors, stiff, by_records=True) is None
+    # an older summary without profiles: nothing to single a factor out with
+    assert V.updating_effect(factors, {f: {"posterior_sd": 0.1} for f in factors}, by_records=True) is None
+
+
 def test_an_update_that_moves_only_the_transducer_masses_is_the_transducer_mass_error():
     ident = {f: {"posterior_sd": 0.05} for f in ("stiffness_scale", "mass_scale", "transducer_mass_scale")}
     assert (

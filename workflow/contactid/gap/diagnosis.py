@@ -988,7 +988,9 @@ def _updating_verdict(updating, names, gap_before, gap_after, shares, scatter, s
     amounts to one effect of the library in use; otherwise None."""
     if shares[0] != max(shares) or not explains_materially(gap_before, gap_after, scatter, settings):
         return None
-    effect = updating_effect(updating.factors, updating.identifiability)
+    effect = updating_effect(
+        updating.factors, updating.identifiability, getattr(updating, "accepted_by", "") == "records"
+    )
     if effect is None or effect not in names:
         return None
     return effect, (
