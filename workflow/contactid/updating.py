@@ -136,15 +136,20 @@ class UpdatingResult:
             summary.get("records_test"),
         )
 
+    def proposed_structure(self) -> StructureParameters:
+        """The structure of the ``proposal``: the nominal structure with its k_t, k_n and factors."""
+        if self.proposal is None or self.nominal is None:
+            raise ValueError("model updating: no proposal to accept (the update was accepted or never computed)")
+        p = self.proposal
+        return apply_factors(self.nominal.with_contact(float(p["k_t"]), float(p["k_n"])), p["factors"])
+
     def accept_proposal(self, records_test: dict) -> "UpdatingResult":
         """This result with its ``proposal`` accepted by the dual-sine records (``records_test``: what they showed,
         kept for the audit): the proposal's factors, k_t, k_n and structure; the identifiability (with each factor's
         profile) is already the proposal's."""
-        if self.proposal is None or self.nominal is None:
-            raise ValueError("model updating: no proposal to accept (the update was accepted or never computed)")
+        structure = self.proposed_structure()
         factors = {k: float(v) for k, v in self.proposal["factors"].items()}
         k_t, k_n = float(self.proposal["k_t"]), float(self.proposal["k_n"])
-        structure = apply_factors(self.nominal.with_contact(k_t, k_n), factors)
         n = 0 if self.model_frequencies_hz is None else len(self.model_frequencies_hz)
         f_best = modal_predictions(structure, n)[0] if n else None
         return dataclasses.replace(

@@ -266,7 +266,7 @@ def diagnose_item(spec: Mapping, cfg: Mapping, recs: Mapping, cases: list, t0: f
 def compound_row(spec: Mapping, cfg: Mapping, effects: Mapping, item: ItemDiagnosis, converged, t_rig: float) -> dict:
     """A compound item's result row: the additive explanation scored against the hidden ``effects``, the friction
     law's errors (relative) and its intervals with the model-form term; seconds of each step."""
-    from .uncertainty import NAMES, friction_uncertainty
+    from .uncertainty import friction_uncertainty
 
     diag, model, updating = item.diag, item.model, item.updating
     cal = cfg["nonlinear"]["calibration_case"]
@@ -297,10 +297,9 @@ def compound_row(spec: Mapping, cfg: Mapping, effects: Mapping, item: ItemDiagno
         "friction_errors": friction_errors(model, truth, preload),
         "friction_errors_chain": friction_errors(item.chain_model, truth, preload),
         "bound_errors": bound_errors(model, truth, preload, true_arm),
-        "friction_intervals": {n: [float(v) for v in unc.interval[NAMES.index(n)]] for n in ("mu", "kappa", "e0")}
-        | {n: [float(v) for v in unc.products[n]["interval"]] for n in ("mu_a", "e0_a2")},
+        "friction_intervals": {n: [float(v) for v in unc.interval_of(n)[0]] for n in SCORED_INTERVALS},
         "friction_covered": unc.covers(friction_truth(truth, preload, true_arm)),
-        "friction_interval_halfwidth": unc.relative_halfwidth(("mu", "kappa", "e0", "mu_a", "e0_a2")),
+        "friction_interval_halfwidth": unc.relative_halfwidth(SCORED_INTERVALS),
         "where": diag.where,
         "control_converged": converged,
         "seconds": {
@@ -544,6 +543,8 @@ COMPOUND_EFFECTS = {
 # candidates that explain a contact effect (a perturbation-only set must name none of them); contact_separation
 # changes the normal law's shape, which the perturbation's hardening also does, so it counts as model form
 CONTACT_EFFECTS = ("normal_contact_damping", "viscous_friction", "multi_asperity_friction", "preload_drift")
+# the friction intervals the compound items score: the law's, then what the data bind (gap.uncertainty.PRODUCTS)
+SCORED_INTERVALS = ("mu", "kappa", "e0", "mu_a", "e0_a2")
 PERTURBATION = {"youngs_modulus": 0.03, "transducer_masses": 0.4, "tangential_lever_arm": 0.08}
 HARDENING_CUBIC = (2.0e19, 6.0e19)  # N/m^3 of the polynomial hardening N0 - k_n eta - k_3 eta^3
 DAMPING_FORMS = ("modal", "stiffness_proportional", "mass_proportional")
@@ -668,11 +669,11 @@ def compound_score(rows: list) -> dict:
     bound = {k: [abs(r["bound_errors"][k]) for r in by_n[0] if r.get("bound_errors")] for k in ("mu_a", "e0_a2")}
     covered = {
         k: [bool(r["friction_covered"][k]) for r in by_n[0] if k in (r.get("friction_covered") or {})]
-        for k in ("mu", "kappa", "e0", "mu_a", "e0_a2")
+        for k in SCORED_INTERVALS
     }
     width = {
         k: [r["friction_interval_halfwidth"][k] for r in by_n[0] if k in (r.get("friction_interval_halfwidth") or {})]
-        for k in ("mu", "kappa", "e0", "mu_a", "e0_a2")
+        for k in SCORED_INTERVALS
     }
     return {
         "n": len(rows),

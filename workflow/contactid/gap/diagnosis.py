@@ -850,6 +850,20 @@ def heldout_gap_of(
     return float(np.sqrt(np.mean(vals)))
 
 
+def bootstrap_draws(records: Mapping[str, RecordHarmonics], cases, settings: GapSettings) -> dict:
+    """{case: (n_bootstrap, j, H) record harmonics resampled over record blocks} for ``cases``, from the
+    diagnosis's own random stream (``settings.seed``, "gap/bootstrap")."""
+    rng = generator(settings.seed, "gap/bootstrap")
+    return {c: _bootstrap_records(records[c], rng, settings.n_bootstrap, settings.n_harmonics) for c in cases}
+
+
+def heldout_gap_draws(records: Mapping[str, RecordHarmonics], cases, H: int, sims_by_case, boot: Mapping) -> np.ndarray:
+    """The held-out gap (``heldout_gap_of``) of ``sims_by_case`` on each bootstrap draw of ``boot``
+    (``bootstrap_draws``)."""
+    n = len(next(iter(boot.values())))
+    return np.array([heldout_gap_of(records, cases, H, sims_by_case, {c: boot[c][b] for c in cases}) for b in range(n)])
+
+
 def records_test_of_update(
     chain: IdentifiedModel, updated: IdentifiedModel, held_out: Mapping[str, RecordHarmonics], settings: GapSettings
 ) -> dict:
@@ -866,12 +880,7 @@ def records_test_of_update(
         label: {c: baseline(m, held_out[c], H)[1] for c in cases}
         for label, m in (("chain", chain), ("updated", updated))
     }
-    rng = generator(settings.seed, "gap/bootstrap")
-    boot = {c: _bootstrap_records(held_out[c], rng, settings.n_bootstrap, H) for c in cases}
-    draws = [
-        heldout_gap_of(held_out, cases, H, sims["chain"], {c: boot[c][b] for c in cases})
-        for b in range(settings.n_bootstrap)
-    ]
+    draws = heldout_gap_draws(held_out, cases, H, sims["chain"], bootstrap_draws(held_out, cases, settings))
     out = {
         "heldout_gap_chain": heldout_gap_of(held_out, cases, H, sims["chain"]),
         "heldout_gap_updated": heldout_gap_of(held_out, cases, H, sims["updated"]),
@@ -1061,10 +1070,7 @@ class _DiagnosisRun:
 
     def draw_bootstrap(self) -> None:
         """Bootstrap over record blocks: the simulations stay fixed, the records are resampled."""
-        rng = generator(self.settings.seed, "gap/bootstrap")
-        self.boot = {
-            c: _bootstrap_records(self.records[c], rng, self.settings.n_bootstrap, self.H) for c in self.score_cases
-        }
+        self.boot = bootstrap_draws(self.records, self.score_cases, self.settings)
 
     def heldout_gap(self, sims_by_case, boot_index=None) -> float:
         """The held-out gap of these simulations (``heldout_gap_of``), on the records or on one bootstrap draw."""
@@ -1078,7 +1084,7 @@ class _DiagnosisRun:
 
     def heldout_gaps(self, sims_by_case) -> tuple[float, np.ndarray]:
         """The held-out gap and its bootstrap draws."""
-        draws = np.array([self.heldout_gap(sims_by_case, b) for b in range(self.settings.n_bootstrap)])
+        draws = heldout_gap_draws(self.records, self.score_cases, self.H, sims_by_case, self.boot)
         return self.heldout_gap(sims_by_case), draws
 
     def next_pass(self, results: dict):

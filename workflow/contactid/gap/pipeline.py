@@ -187,8 +187,6 @@ def updated_model(model, modal: xr.Dataset, calibration, fit_settings, settings,
     ``accepted_by`` "records" and keeps the test in ``records_test``."""
     import logging
 
-    from ..updating import apply_factors
-
     log = logging.getLogger(__name__)
     if upd is None:
         upd = structure_update(model.structure, modal, settings)
@@ -206,8 +204,7 @@ def updated_model(model, modal: xr.Dataset, calibration, fit_settings, settings,
         from .diagnosis import records_test_of_update
 
         p = upd.proposal
-        proposed = apply_factors(upd.nominal.with_contact(float(p["k_t"]), float(p["k_n"])), p["factors"])
-        m2 = _refitted(model, proposed, calibration, fit_settings, seed)
+        m2 = _refitted(model, upd.proposed_structure(), calibration, fit_settings, seed)
         test = records_test_of_update(model, m2, held_out, settings)
         factors = ", ".join(f"{k} {v:.4g}" for k, v in p["factors"].items())
         if not test["accepted"]:

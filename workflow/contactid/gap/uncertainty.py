@@ -63,7 +63,8 @@ class FrictionUncertainty:
     structure_fits: list
     products: dict = dataclasses.field(default_factory=dict)  # {PRODUCTS name: {value, profile, sd_*, interval}}
 
-    def _interval(self, n: str) -> tuple:
+    def interval_of(self, n: str) -> tuple:
+        """(interval with model form (2,), value) of a name of NAMES or PRODUCTS."""
         if n in self.products:
             return self.products[n]["interval"], self.products[n]["value"]
         i = NAMES.index(n)
@@ -75,7 +76,7 @@ class FrictionUncertainty:
         out = {}
         for n in (*NAMES, *self.products):
             if n in truth and truth[n] is not None:
-                (lo, hi), _ = self._interval(n)
+                (lo, hi), _ = self.interval_of(n)
                 out[n] = bool(lo <= float(truth[n]) <= hi)
         return out
 
@@ -83,7 +84,7 @@ class FrictionUncertainty:
         """{name: half the interval with model form over the value} (a relative +- of the interval)."""
         out = {}
         for n in names:
-            (lo, hi), v = self._interval(n)
+            (lo, hi), v = self.interval_of(n)
             out[n] = float((hi - lo) / 2.0 / max(abs(v), 1e-300))
         return out
 
@@ -166,25 +167,28 @@ def bound_products(
 ) -> dict:
     """{name: {value, profile, sd_cases, sd_structure, interval, unit}} of PRODUCTS (mu a in m, e_0 a^2 in N m):
     ``value``/``profile``/``sd_cases`` of NAMES times ``lever_arm`` (m) to the product's power (the load cases share
-    one structure), the structure spread over ``structure_fits`` (rows (6,) in +-pairs) each times its own arm
-    (``structure_arms``, m), the interval widened as ``widened_interval`` does on a log scale."""
-    from scipy.stats import norm
+    one structure), the structure spread (``spread_sd``) over ``structure_fits`` (rows (6,) in +-pairs) each times
+    its own arm (``structure_arms``, m), the interval widened by ``widened_interval`` (log scale, unbounded)."""
 
-    z = float(norm.ppf(0.5 + confidence / 2.0))
+    def times_arm(rows, arm):  # NAMES rows with mu times a and e_0 times a^2
+        w = np.ones(len(NAMES))
+        for _, par, power, _ in PRODUCTS:
+            w[NAMES.index(par)] = float(arm) ** power
+        return np.asarray(rows, float) * (w[:, None] if np.ndim(rows) == 2 else w)
+
+    own = times_arm(value, lever_arm)
+    sd_s = spread_sd(own, [times_arm(f, a) for f, a in zip(structure_fits, structure_arms)], pairs=True)
+    prof = times_arm(profile, lever_arm)
+    interval = widened_interval(prof, np.hypot(sd_cases, sd_s), confidence, [(0.0, np.inf)] * (len(NAMES) - 1))
     out = {}
-    for name, par, power, unit in PRODUCTS:
+    for name, par, _, unit in PRODUCTS:
         i = NAMES.index(par)
-        scale = float(lever_arm) ** power
-        prof = np.asarray(profile[i], float) * scale
-        alt = np.array([np.log(abs(f[i]) * float(a) ** power) for f, a in zip(structure_fits, structure_arms)])
-        sd_s = float(np.sqrt(np.sum(((alt[1::2] - alt[0::2]) / 2.0) ** 2))) if alt.size >= 2 else 0.0
-        sd = float(np.hypot(sd_cases[i], sd_s))
         out[name] = {
-            "value": float(value[i]) * scale,
-            "profile": prof,
+            "value": float(own[i]),
+            "profile": prof[i],
             "sd_cases": float(sd_cases[i]),
-            "sd_structure": sd_s,
-            "interval": np.array([prof[0] * np.exp(-z * sd), prof[1] * np.exp(z * sd)]),
+            "sd_structure": float(sd_s[i]),
+            "interval": interval[i],
             "unit": unit,
         }
     return out

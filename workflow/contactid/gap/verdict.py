@@ -264,7 +264,7 @@ def updating_effect(
     profile is at least UPDATING_Z^2 times every other factor's (1.24 against 0.03 there)."""
     if by_records:
         profiles = {f: identifiability[f].get("profile_chi2_increase") for f in factors}
-        if len(profiles) < 1 or any(v is None for v in profiles.values()):
+        if not profiles or any(v is None for v in profiles.values()):
             return None
         top = max(profiles, key=profiles.get)
         rest = [v for f, v in profiles.items() if f != top]
