@@ -24,6 +24,32 @@ def test_same_seed_same_bytes_other_seed_other_noise(short_cfg):
     assert not np.allclose(raw1["force"].values, raw3["force"].values)
 
 
+@pytest.mark.parametrize("damping", [0.005, lambda f: 0.002 + 1e-5 * f])
+def test_the_modal_sum_is_lfilter_mode_by_mode_bit_for_bit(damping):
+    # the random test's accelerations in one pass over the record (every mode's filter state at once) are the
+    # numbers scipy.signal.lfilter gives mode by mode, summed over the modes in order: the rig's records stay the
+    # same to the last bit
+    import scipy.signal
+
+    from contactid.beam_model import assemble
+    from contactid.rig.random_test import modal_acceleration_filters, modal_acceleration_sum
+    from structures import configured_structure
+
+    filters, sens = modal_acceleration_filters(assemble(configured_structure()), damping, 1.0 / 20480.0)
+    assert len(filters) > 10  # the modes below the simulation's Nyquist frequency
+    rng = np.random.default_rng(3)
+    f = scipy.signal.sosfilt(
+        scipy.signal.butter(8, [5, 1000], "bandpass", fs=20480, output="sos"), rng.standard_normal(40000)
+    )
+    expected = np.zeros((sens.shape[0], f.size))
+    for (num, den), part in zip(filters, sens.T):
+        qdd = scipy.signal.lfilter(num, den, f)
+        for channel, weight in enumerate(part):
+            expected[channel] += qdd * weight
+    got = modal_acceleration_sum(f, filters, sens)
+    assert np.abs(expected).max() > 0 and np.array_equal(got, expected)
+
+
 def test_raw_record_holds_no_truth(short_cfg, tmp_path):
     c = short_cfg
     raw, truth = random_test_datasets(c["structure"], c["rig"], c["random_test"], seed=1)
