@@ -130,34 +130,29 @@ def _element_scatter(w_dof: np.ndarray, theta_dof: np.ndarray) -> tuple[np.ndarr
     return rows[sel], cols[sel], sel
 
 
-def _element_shortening(le: float):
-    """int N'^T N' dx of a Hermite element (the geometric stiffness of a unit axial tension), 1/m."""
-    return (
-        1.0
-        / (30.0 * le)
-        * np.array(
-            [
-                [36, 3 * le, -36, 3 * le],
-                [3 * le, 4 * le**2, -3 * le, -(le**2)],
-                [-36, -3 * le, 36, -3 * le],
-                [3 * le, -(le**2), -3 * le, 4 * le**2],
-            ]
-        )
+def _element_shortening(le):
+    """int N'^T N' dx of a Hermite element (the geometric stiffness of a unit axial tension), 1/m; of elements of
+    length ``le`` (m; a scalar: (4, 4), an array of n: (n, 4, 4))."""
+    z = np.asarray(le, dtype=float)
+    one = np.ones_like(z)
+    return (1.0 / (30.0 * z))[..., None, None] * np.stack(
+        [
+            np.stack([36 * one, 3 * z, -36 * one, 3 * z], -1),
+            np.stack([3 * z, 4 * z**2, -3 * z, -(z**2)], -1),
+            np.stack([-36 * one, -3 * z, 36 * one, -3 * z], -1),
+            np.stack([3 * z, -(z**2), -3 * z, 4 * z**2], -1),
+        ],
+        -2,
     )
 
 
 def shortening_matrix(model: "FEModel") -> np.ndarray:
     """G with int_0^L w'^2 dx = q^T G q, so the beam shortening of Eq. (9) is -q^T G q / 2 (1/m), times the
-    structure's ``shortening_scale`` (1: Eq. 9 as printed; 0: linear kinematics, G = 0)."""
+    structure's ``shortening_scale`` (1: Eq. 9 as printed; 0: linear kinematics, G = 0). The elements' matrices
+    are scattered as ``assemble`` scatters its own (the sums of an element-by-element loop, bit for bit)."""
     G = np.zeros((model.n_dof, model.n_dof))
-    nodes = model.nodes
-    for e in range(len(nodes) - 1):
-        ge = _element_shortening(nodes[e + 1] - nodes[e])
-        dofs = [model.w_dof[e], model.theta_dof[e], model.w_dof[e + 1], model.theta_dof[e + 1]]
-        for a, da in enumerate(dofs):
-            for b, db in enumerate(dofs):
-                if da >= 0 and db >= 0:
-                    G[da, db] += ge[a, b]
+    rows, cols, sel = _element_scatter(model.w_dof, model.theta_dof)
+    np.add.at(G, (rows, cols), _element_shortening(np.diff(model.nodes)).reshape(-1)[sel])
     return G * model.params.shortening_scale
 
 
