@@ -9,6 +9,11 @@ from snakemake.utils import min_version, validate
 
 min_version("9.0")
 
+# the jobs write Python's bytecode caches even where PYTHONDONTWRITEBYTECODE is set (containers often set it; the jobs
+# inherit this process's environment): otherwise every job compiles again the package's sources and, since `make env`
+# installs without compiling them, the libraries it imports (7 s a job where it had been 0.7 s)
+os.environ.pop("PYTHONDONTWRITEBYTECODE", None)
+
 # the package contactid lives in workflow/ (installed into .venv by `make env`; the
 # rule files import it at parse time from the source tree as well)
 sys.path.insert(0, os.path.join(workflow.basedir, "workflow"))
