@@ -93,3 +93,37 @@ def test_the_fits_end_at_the_same_optimum_when_the_frequencies_move_by_rounding(
     # the diagnosis' refit of k_t, k_n to the frequencies (relative residuals, from the model's values)
     q1, q2 = _refit_contact(p, tuple(f)), _refit_contact(p, tuple(moved))
     assert q2.k_t == pytest.approx(q1.k_t, rel=1e-4) and q2.k_n == pytest.approx(q1.k_n, rel=1e-3)
+
+
+def test_a_mass_change_refits_k_n_only_where_the_frequencies_feel_it(default_config, monkeypatch):
+    """The diagnosis' refit of k_t, k_n for a transducer-mass candidate (``gap.model._refit_contact``): with the
+    masses 20 % heavier the frequencies want a normal contact stiffer than rigid. Allowed two decades above the
+    chain's k_n, the refit ran there (100 times the chain's) for a misfit smaller by 2e-4 (a fifth of the frequency
+    floor, 1e-3), and the reduced model's stiff normal mode rose ten-fold, which the integrator resolves with as many
+    times the steps; capped at ``KN_REFIT_ABOVE`` (one decade) the misfit is nearly the same and the mode rises at
+    most sqrt(10)-fold."""
+    from contactid.beam_model import ContactFrequencyMap, assemble
+    from contactid.gap import model as gm
+    from contactid.parameters import structure_from_config
+    from contactid.rig.nonlinear import reduced_model
+
+    p = structure_from_config(default_config["structure"], 1.375e7, 2.686e7)  # a chain's k_t, k_n (benchmark item)
+    f = tuple(np.asarray(ContactFrequencyMap(p, 3)(p.k_t, p.k_n)) * (1.0 + np.array([3e-4, -2e-4, 2.5e-4])))
+    heavy = p.replace(
+        sensor_masses=tuple(1.2 * m for m in p.sensor_masses), force_transducer_mass=1.2 * p.force_transducer_mass
+    )
+
+    def misfit(s):
+        return float(np.linalg.norm(np.asarray(ContactFrequencyMap(s, 3)(s.k_t, s.k_n)) / np.asarray(f) - 1.0))
+
+    def top_hz(s):
+        return float(reduced_model(assemble(s), 8).omega.max() / (2 * np.pi))
+
+    capped = gm._refit_contact.__wrapped__(heavy, f)
+    monkeypatch.setattr(gm, "KN_REFIT_ABOVE", 2.0)
+    wide = gm._refit_contact.__wrapped__(heavy, f)
+    assert wide.k_n > 50 * p.k_n  # the runaway the cap prevents
+    assert capped.k_n <= 10.0 * p.k_n * (1 + 1e-9)
+    assert 0.0 <= misfit(capped) - misfit(wide) < 3e-4 and misfit(capped) < 3e-3
+    assert capped.k_t == pytest.approx(wide.k_t, rel=0.01)
+    assert top_hz(capped) < 1.01 * math.sqrt(10.0) * top_hz(p) and top_hz(wide) > 2.5 * top_hz(capped)
