@@ -127,3 +127,16 @@ def test_a_mass_change_refits_k_n_only_where_the_frequencies_feel_it(default_con
     assert 0.0 <= misfit(capped) - misfit(wide) < 3e-4 and misfit(capped) < 3e-3
     assert capped.k_t == pytest.approx(wide.k_t, rel=0.01)
     assert top_hz(capped) < 1.01 * math.sqrt(10.0) * top_hz(p) and top_hz(wide) > 2.5 * top_hz(capped)
+
+
+def test_the_gap_models_reduced_structure_is_built_once_per_structure(default_config):
+    """Every simulation of the diagnosis asks for the reduced model of its structure (``gap.model.simulator``); an
+    unchanged structure is assembled and reduced once (``_reduced`` is memoised: a rebuild, an assembly and an
+    eigen-solve, costs about 4 ms, and a diagnosis asks some 500 times)."""
+    from contactid.gap.model import _reduced
+    from contactid.parameters import structure_from_config
+
+    p = structure_from_config(default_config["structure"], 1.375e7, 2.686e7)
+    q = structure_from_config(default_config["structure"], 1.375e7, 2.686e7)
+    assert _reduced(p, 8) is _reduced(q, 8)
+    assert _reduced(p.with_contact(1.4e7, p.k_n), 8) is not _reduced(p, 8)

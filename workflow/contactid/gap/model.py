@@ -161,6 +161,7 @@ def _refit_contact(params: StructureParameters, frequencies: tuple) -> Structure
     return params.with_contact(float(10.0 ** res.x[0]), float(10.0 ** res.x[1]))
 
 
+@lru_cache(maxsize=32)
 def _reduced(params: StructureParameters, n_modes: int):
     model = assemble(params)
     return model, reduced_model(model, n_modes)
