@@ -1,5 +1,6 @@
 from pathlib import Path
 
+import pytest
 import yaml
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -79,6 +80,7 @@ def test_the_python_code_is_formatted_and_passes_the_linter():
         assert out.returncode == 0, f"ruff {' '.join(args)}:\n{out.stdout[-3000:]}{out.stderr[-1000:]}"
 
 
+@pytest.mark.slow
 def test_the_workflow_is_formatted_linted_and_documents_every_rule():
     """`snakefmt --no-sort --check` (pyproject.toml: line length 120) and `snakemake --lint` clean over the
     Snakefile and workflow/rules; every rule opens with a docstring, the sentence `snakemake --list-rules` prints."""

@@ -88,6 +88,7 @@ def test_fit_recovers_known_parameters_reproducibly(synthetic):
     assert a.logbook[-1][1] <= a.logbook[0][1]
 
 
+@pytest.mark.slow
 def test_bounds_that_exclude_the_truth_are_flagged(synthetic):
     settings = FitSettings(bounds=((1e6, 1e9), (1e4, 1e7), (0.0, 1e6), (0.0, 0.95), (0.05, 0.3)), generations=10)
     res = fit_friction_law(*synthetic, F0, 70.0, settings, seed=5, n_harmonics_data=25)

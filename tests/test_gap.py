@@ -575,6 +575,7 @@ def test_records_whose_kinematics_lack_the_beams_shortening_name_it(small_config
     assert first["heldout_gap_after"] < 0.3 * d.where["heldout_gap_before"]
 
 
+@pytest.mark.slow
 def test_search_finds_the_time_marching_searchs_optimum(hc_data):
     """The calibration search on harmonic-balance states (within 5e-4 of the integrator's orbit) finds the optimum of
     a search on time-marched states within 1 % and reports the integrator's gap there; with every state polished by

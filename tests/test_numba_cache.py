@@ -10,6 +10,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 import contactid
 from contactid import numba_cache_dir
 from contactid.io import package_digest
@@ -71,6 +73,7 @@ def test_cache_directory_always_ends_in_the_current_digest(tmp_path, monkeypatch
     assert numba_cache_dir("", d) == tmp_path / "xdg" / "contactid" / "numba-cache" / d  # unset
 
 
+@pytest.mark.slow
 def test_changed_callee_is_compiled_afresh_not_served_stale(tmp_path):
     # a copy of the package with a kernel that calls a kernel from another module
     pkgs = tmp_path / "pkgs"
@@ -98,6 +101,7 @@ def test_changed_callee_is_compiled_afresh_not_served_stale(tmp_path):
     assert fourth["result"] == 20.0 and fourth["loaded"] == 1
 
 
+@pytest.mark.slow
 def test_plain_numba_cache_serves_a_changed_callee_stale(tmp_path):
     """Why the directory is keyed by the digest: with numba's own check alone, the caller's cached
     machine code keeps the callee it was compiled with. (Should this start failing, numba has learned

@@ -147,6 +147,7 @@ def no_missing_glyphs():
     assert not missing, missing
 
 
+@pytest.mark.slow
 def test_every_report_figure_is_drawn_at_its_printed_width_with_8pt_text(caught, no_missing_glyphs):
     widths = printed_widths_in()
     assert set(FIGURES) <= set(widths), "report.tex includes each figure at an explicit fraction of \\textwidth"

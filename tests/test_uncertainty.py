@@ -97,6 +97,7 @@ def test_what_the_data_bind_keeps_its_interval_when_the_lever_arm_opens_mus():
     assert u.summary()["e0_a2"]["unit"] == "N m" and u.relative_halfwidth(("mu_a",))["mu_a"] < 0.1
 
 
+@pytest.mark.slow
 def test_the_data_bind_mu_times_the_lever_arm_not_mu(default_config):
     """Scaling the tangential lever arm a by lambda (with k_t / lambda^2, so that the linear data stay the same)
     scales the identified S by 1 / lambda and xi by lambda: the refitted mu moves by 1 / lambda while mu a and
