@@ -186,6 +186,33 @@ def test_fig06_limits_come_from_the_working_method_also_without_truth(caught):
     assert [t.get_text() for t in legend.get_texts()] == ["working method", "paper's chain"]
 
 
+def test_fig06_draws_each_loop_over_the_records_last_periods(caught):
+    """A record of 100 periods whose first periods are a transient 50 times the settled loop: Fig. 6 draws the last
+    LOOP_PERIODS periods (about 400 of 10 000 samples at 100 samples a period), so the transient neither fills the
+    PDF nor sets the axis limits; a dataset that does not give its frequency is drawn whole."""
+    from contactid.paper_figures import LOOP_PERIODS
+
+    f0, fs = 50.0, 5000.0
+    t = np.arange(10_000) / fs
+    transient = 1 + 49 * np.exp(-t / 0.05)
+    v = {
+        "S": 30 * transient * np.sin(2 * np.pi * f0 * t),
+        "xi": 1e-5 * transient * np.cos(2 * np.pi * f0 * t),
+        "N_dyn": 12 * np.sin(2 * np.pi * f0 * t),
+        "eta": 5e-7 * np.sin(2 * np.pi * f0 * t + 0.1),
+    }
+    data = {k: ("time", x) for k, x in v.items()} | {f"{k}_paper": ("time", 8 * x) for k, x in v.items()}
+    ds = xr.Dataset(data, coords={"time": t}, attrs={"excitation_frequency_hz": f0})
+    plot_fig06({"lc1": ds}, "fig06_contact_forces.png", "x.pdf")
+    ax = caught["fig06_contact_forces"].axes[0]
+    n = len(ax.lines[0].get_xdata())
+    assert abs(n - LOOP_PERIODS * fs / f0) <= 2
+    lo, hi = ax.get_ylim()
+    assert 60.0 <= hi - lo <= 1.2 * 60.0  # the settled loop's span, not the transient's
+    plot_fig06({"lc1": ds.assign_attrs(excitation_frequency_hz=None)}, "fig06_contact_forces.png", "x.pdf")
+    assert len(caught["fig06_contact_forces"].axes[0].lines[0].get_xdata()) == t.size
+
+
 def test_the_noise_study_figure_is_drawn_at_the_width_its_section_includes_it(caught, no_missing_glyphs):
     """The noise study's figure (in the report when noise_study.in_report) at the text width, text >= 8 pt."""
     noise, lengths, seeds = np.array([0.001, 0.003, 0.01, 0.03]), np.array([4096, 16384]), np.arange(3)
