@@ -209,6 +209,7 @@ def test_fig06_draws_each_loop_over_the_records_last_periods(caught):
     assert abs(n - LOOP_PERIODS * fs / f0) <= 2
     lo, hi = ax.get_ylim()
     assert 60.0 <= hi - lo <= 1.2 * 60.0  # the settled loop's span, not the transient's
+    ps.pyplot().close(caught.pop("fig06_contact_forces"))
     plot_fig06({"lc1": ds.assign_attrs(excitation_frequency_hz=None)}, "fig06_contact_forces.png", "x.pdf")
     assert len(caught["fig06_contact_forces"].axes[0].lines[0].get_xdata()) == t.size
 

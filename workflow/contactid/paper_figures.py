@@ -14,8 +14,9 @@ from .contact_laws import stiction_shear_stiffness
 from .friction_parameters import fitted_parameters
 
 
-def _periods(t: np.ndarray, f0: float, periods: int = 3):
-    return t <= periods / f0
+def _periods(t: np.ndarray, f0: float, periods: int = 3, last: bool = False):
+    """The samples (a mask of ``t``, s) of the record's first ``periods`` periods of ``f0`` (Hz), or its last."""
+    return t >= t[-1] - periods / f0 if last else t <= periods / f0
 
 
 @ps.print_figure
@@ -88,8 +89,7 @@ def _last_periods(ds: xr.Dataset, periods: int = LOOP_PERIODS):
     f0 = ds.attrs.get("excitation_frequency_hz")
     if not f0 or "time" not in ds.coords:
         return slice(None)
-    t = ds["time"].values
-    return t >= t[-1] - periods / float(f0)
+    return _periods(ds["time"].values, float(f0), periods, last=True)
 
 
 def _loop_panel(ax, ds: xr.Dataset, force: str, motion: str, suffix: str, colour: str, label: str) -> None:
