@@ -87,3 +87,31 @@ def test_bad_raw_files_get_clear_errors(tmp_path, mutate, message):
     with pytest.raises(RawDataError, match=message) as err:
         read_raw(path)
     assert str(path) in str(err.value)
+
+
+def test_jobs_read_datasets_without_importing_pint_and_pint_values_still_convert(tmp_path):
+    """xarray imports pint (0.3-0.4 s, installed for the units test) to check each index it builds; a job of the
+    workflow, which holds no pint value, reads and writes datasets without that import. Once pint is imported, its
+    quantities convert as xarray converts them (the magnitudes)."""
+    import importlib.util
+    import subprocess
+    import sys
+
+    import xarray as xr
+
+    assert importlib.util.find_spec("pint") is not None  # installed: otherwise this test proves nothing
+    path = tmp_path / "x.nc"
+    coords = {"x": ("x", [0.0, 1.0, 2.0], {"units": "s", "long_name": "time"})}
+    write_dataset(xr.Dataset({"y": ("x", np.ones(3), {"units": "N", "long_name": "force"})}, coords=coords), path)
+    code = (
+        "import sys; from contactid.io import load_dataset; ds = load_dataset(sys.argv[1]); "
+        "assert ds['x'].values.tolist() == [0.0, 1.0, 2.0]; print('pint' in sys.modules)"
+    )
+    out = subprocess.run([sys.executable, "-c", code, str(path)], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False", out.stderr
+    import pint
+    from xarray.namedarray.pycompat import array_type
+
+    assert array_type("pint") == (pint.Quantity,)
+    q = pint.UnitRegistry().Quantity(np.array([0.5, 1.5]), "m")
+    assert xr.Dataset(coords={"x": q})["x"].values.tolist() == [0.5, 1.5]

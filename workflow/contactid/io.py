@@ -14,6 +14,7 @@ import hashlib
 import json
 import os
 import subprocess
+import sys
 import tempfile
 from pathlib import Path
 from typing import Mapping
@@ -24,6 +25,34 @@ import xarray as xr
 from . import __version__
 
 ENGINE = "netcdf4"
+
+
+def _defer_pint_until_imported() -> None:
+    """xarray asks, for every index it builds, whether the values are a pint Quantity, and imports pint to know
+    (0.3-0.4 s, in every job of the workflow, when pint is installed: the tests use it to read the units). No value
+    can be a Quantity of a module nobody imported: until pint is in ``sys.modules`` the answer is "no type" without
+    importing it, afterwards xarray's own answer. Where xarray's internals differ (another version), nothing is
+    changed."""
+    try:
+        from xarray.namedarray import pycompat
+
+        cache, real = pycompat._cached_duck_array_modules, pycompat.DuckArrayModule
+    except (ImportError, AttributeError):
+        return
+    if not isinstance(cache, dict) or "pint" in cache:
+        return
+
+    class _PintWhenImported:
+        def __getattr__(self, attr):
+            if "pint" not in sys.modules and attr in ("type", "available"):
+                return () if attr == "type" else False
+            cache["pint"] = real("pint")
+            return getattr(cache["pint"], attr)
+
+    cache["pint"] = _PintWhenImported()
+
+
+_defer_pint_until_imported()
 
 
 class RawDataError(ValueError):
