@@ -115,3 +115,18 @@ def test_jobs_read_datasets_without_importing_pint_and_pint_values_still_convert
     assert array_type("pint") == (pint.Quantity,)
     q = pint.UnitRegistry().Quantity(np.array([0.5, 1.5]), "m")
     assert xr.Dataset(coords={"x": q})["x"].values.tolist() == [0.5, 1.5]
+
+
+def test_jobs_that_fit_nothing_do_not_import_scipy_optimize():
+    """The linear chain's FRF, modal-fit and raw-check jobs, and the contact-force jobs, import the modules of the
+    stiffness fit and of model updating for their models and results alone; scipy.optimize (0.3 s a job) is imported
+    by the fits that use it."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys; import contactid.linear_chain, contactid.updating, contactid.raw_checks, contactid.stiction; "
+        "print('scipy.optimize' in sys.modules)"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False", out.stderr

@@ -9,7 +9,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import brentq, least_squares
 
 from .beam_model import ContactFrequencyMap
 from .parameters import StructureParameters
@@ -75,6 +74,8 @@ def _fit_one(params, f_id, sigma, fixed_name, fixed_log, start, bounds):
             return _residuals(params, f_id, sigma, x[0], fixed_log)
         return _residuals(params, f_id, sigma, fixed_log, x[0])
 
+    from scipy.optimize import least_squares  # here, not at the top: see _joint_fit
+
     r = least_squares(
         res, [start], bounds=([bounds[0]], [bounds[1]]), x_scale=[0.1], xtol=1e-10, ftol=1e-12, **JACOBIAN
     )
@@ -83,6 +84,10 @@ def _fit_one(params, f_id, sigma, fixed_name, fixed_log, start, bounds):
 
 def _joint_fit(params, f_id, sigma, x0, lt, ln):
     """Least-squares fit of (log10 k_t, log10 k_n) from x0; returns (x, chi2)."""
+    # scipy.optimize (0.3 s to import) where the fits use it: most jobs of the linear chain (the FRFs, the modal fit,
+    # the raw checks) import this module through contactid.linear_chain without fitting anything
+    from scipy.optimize import least_squares
+
     r = least_squares(
         lambda x: _residuals(params, f_id, sigma, x[0], x[1]),
         x0,
@@ -128,6 +133,8 @@ def interval_edge(profile, grid, chi2_prof, i_min, direction, chi2_min, threshol
         )
     if fa == 0.0 or fb == 0.0:
         return (a if fa == 0.0 else b), ""
+    from scipy.optimize import brentq
+
     return brentq(lambda x: profile(x) - chi2_min - threshold, a, b, xtol=1e-6), ""
 
 

@@ -30,7 +30,6 @@ from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from .beam_model import assemble, structural_modes
 from .finite_differences import central_difference_jacobian
@@ -280,6 +279,8 @@ class _UpdatingProblem:
         # change of 1e-8 in the frequencies moved the factors by per cents. scipy's diff_step is relative to x,
         # a step of 1e-5 |ln factor|, 1e-11 at a factor of 1.000001: the posterior sd of a lever arm the data do not
         # bind came out 0.0002-0.1 (docs/measurements.md, "The updating's Jacobian")
+        from scipy.optimize import least_squares  # here: the contact-force jobs import this module for its results
+
         sol = least_squares(
             res,
             z0,
