@@ -11,7 +11,9 @@ check_config(config)
 # The chain from the raw records to the gap diagnosis is the workflow's critical path: its jobs go first
 # whenever a core is free (the linear chain, which everything waits for, before the dual-sine rigs), and the
 # figures and tables fill the cores around them. Before, the scheduler ran two dual-sine rigs first and the FRF
-# waited 13 s for a core; with the linear chain alone first, the last rig ran after the diagnosis.
+# waited 13 s for a core; with the linear chain alone first, the last rig ran after the diagnosis. The friction law's
+# outputs (its validations, intervals, Table 4 and Figs. 7-9) are the report's last inputs: without a priority they
+# waited up to 20 s behind the figures of the linear chain, and the report after them.
 CRITICAL_PATH = 10
 
 

@@ -26,6 +26,7 @@ rule friction_fit:
 
 rule validate:
     """The fitted friction law predicting one load case's S(t) from its identified motion and N(t) (Fig. 9)."""
+    priority: CRITICAL_PATH
     input:
         unpack(validate_inputs),
     output:

@@ -33,6 +33,7 @@ rule model_updating:
 rule friction_intervals:
     """The friction law's 95 % intervals with a model-form term: the spread of refits over the other load cases and
     over the structures the random test allows (results/gap/friction_intervals.json)."""
+    priority: CRITICAL_PATH
     input:
         unpack(gap_inputs),
     output:

@@ -152,6 +152,7 @@ rule fig06_contact_forces:
 
 rule friction_outputs:
     """Table 4 and Figs. 7-9: the fitted friction law, its intervals and the validation on every load case."""
+    priority: CRITICAL_PATH
     input:
         fit="results/friction/friction_fit.nc",
         validations=expand("results/{case}/validation.nc", case=load_cases()),
