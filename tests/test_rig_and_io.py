@@ -89,13 +89,22 @@ def test_bad_raw_files_get_clear_errors(tmp_path, mutate, message):
     assert str(path) in str(err.value)
 
 
+def _imports_in_a_fresh_process(module: str, code: str, *args: str) -> bool:
+    """Whether a new interpreter running ``code`` (with ``args`` as sys.argv[1:]) ends with ``module`` imported."""
+    import subprocess
+    import sys
+
+    probe = f"{code}; import sys; print({module!r} in sys.modules)"
+    out = subprocess.run([sys.executable, "-c", probe, *args], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() in ("True", "False"), out.stderr
+    return out.stdout.strip() == "True"
+
+
 def test_jobs_read_datasets_without_importing_pint_and_pint_values_still_convert(tmp_path):
     """xarray imports pint (0.3-0.4 s, installed for the units test) to check each index it builds; a job of the
     workflow, which holds no pint value, reads and writes datasets without that import. Once pint is imported, its
     quantities convert as xarray converts them (the magnitudes)."""
     import importlib.util
-    import subprocess
-    import sys
 
     import xarray as xr
 
@@ -105,10 +114,9 @@ def test_jobs_read_datasets_without_importing_pint_and_pint_values_still_convert
     write_dataset(xr.Dataset({"y": ("x", np.ones(3), {"units": "N", "long_name": "force"})}, coords=coords), path)
     code = (
         "import sys; from contactid.io import load_dataset; ds = load_dataset(sys.argv[1]); "
-        "assert ds['x'].values.tolist() == [0.0, 1.0, 2.0]; print('pint' in sys.modules)"
+        "assert ds['x'].values.tolist() == [0.0, 1.0, 2.0]"
     )
-    out = subprocess.run([sys.executable, "-c", code, str(path)], capture_output=True, text=True, check=True)
-    assert out.stdout.strip() == "False", out.stderr
+    assert not _imports_in_a_fresh_process("pint", code, str(path))
     import pint
     from xarray.namedarray.pycompat import array_type
 
@@ -121,12 +129,5 @@ def test_jobs_that_fit_nothing_do_not_import_scipy_optimize():
     """The linear chain's FRF, modal-fit and raw-check jobs, and the contact-force jobs, import the modules of the
     stiffness fit and of model updating for their models and results alone; scipy.optimize (0.3 s a job) is imported
     by the fits that use it."""
-    import subprocess
-    import sys
-
-    code = (
-        "import sys; import contactid.linear_chain, contactid.updating, contactid.raw_checks, contactid.stiction; "
-        "print('scipy.optimize' in sys.modules)"
-    )
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    assert out.stdout.strip() == "False", out.stderr
+    code = "import contactid.linear_chain, contactid.updating, contactid.raw_checks, contactid.stiction"
+    assert not _imports_in_a_fresh_process("scipy.optimize", code)
