@@ -313,6 +313,11 @@ def test_friction_law_recovers_rig_truth_and_validates(default_run):
         assert (hi - lo) / mf[name]["value"] < 0.5 * (phi - plo) / mf[par]["value"], name
     for fig in ("fig07_e0", "fig08_s_xi", "fig09_s_xidot", "friction_convergence"):
         assert (default_run / "results" / "figures" / f"{fig}.png").stat().st_size > 10000
+    # the rig is the model: both fits pass their model checks, and the report says so
+    checks = {c["check"]: c for c in s["model_checks"]}
+    assert set(checks) == {"stiffness_fit", "friction_fit"} and all(c["passed"] for c in checks.values())
+    assert checks["friction_fit"]["value"] == fr["misfit_nrmse"] and checks["friction_fit"]["limit"] == 0.01
+    assert "Model checks." in (default_run / "results" / "report" / "datachecks.tex").read_text()
 
 
 def test_report_pdf_and_generated_numbers(default_run):

@@ -485,6 +485,8 @@ def _fit_attrs(
         "population": settings.population,
         "generations": settings.generations,
         "regularization": settings.regularization,
+        "confidence": settings.confidence,
+        "misfit_floor": settings.misfit_floor,  # the accuracy the intervals assume for S (contactid.model_checks)
         "warnings": "; ".join(res.warnings) or "none",
     }
     n_total = preload + forces["N_dyn"].values

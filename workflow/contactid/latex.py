@@ -332,7 +332,46 @@ def data_checks_text(summary: Mapping) -> str:
         lines.append(r"Warnings (a value beyond half its limit):\begin{itemize}")
         lines += [rf"\item {plain_text(rec)}: {plain_text(w)}" for rec, w in items]
         lines.append(r"\end{itemize}")
-    return "\n".join(lines) + "\n"
+    lines.append(model_checks_text(summary.get("model_checks") or []))
+    return "\n".join(line for line in lines if line) + "\n"
+
+
+def model_checks_text(checks: list) -> str:
+    """The report's paragraph on each fit against the accuracy it assumes (``contactid.model_checks``; summary.json's
+    ``model_checks``): a sentence per check, the consequence spelled out where one fails. Empty without checks."""
+    said = []
+    for c in checks:
+        v, lim = float(c["value"]), float(c["limit"])
+        if c["check"] == "stiffness_fit":
+            dof = int(c["dof"])
+            head = (
+                rf"The stiffness fit leaves $\chi^2 = {_fmt(v, 3)}$ for {dof} degree{'s' if dof > 1 else ''} of "
+                rf"freedom (limit ${_fmt(lim, 3)}$"
+            )
+            if c["passed"]:
+                said.append(head + "): the nominal structure reproduces the identified frequencies.")
+            else:
+                said.append(
+                    head + rf", $p = {_fmt(c['p_value'], 2)}$): \textbf{{the nominal structure with contact springs "
+                    r"cannot reproduce the identified frequencies within their uncertainty}; $k_t$ and $k_n$ absorb a "
+                    r"structural error (Young's modulus, masses, lever arm, clamp) and their intervals hold for the "
+                    r"nominal structure only. Model updating (the gap diagnosis) says which structural change the data "
+                    r"support."
+                )
+        elif c["check"] == "friction_fit":
+            head = rf"The friction law fits the identified $S$ to ${_fmt(100 * v, 3)}\,\%$ (NRMSE)"
+            if c["passed"]:
+                said.append(head + rf", within the ${_fmt(100 * lim, 3)}\,\%$ its intervals assume.")
+            else:
+                said.append(
+                    head + rf", \textbf{{${_fmt(v / lim, 3)}$ times the ${_fmt(100 * lim, 3)}\,\%$ its intervals "
+                    r"assume} (\texttt{friction.misfit\_floor}): the law, or the $S$ it is fitted to, does not "
+                    r"describe the record to that accuracy, and its parameters carry a model-form error their "
+                    r"profile-likelihood intervals do not hold; the gap section says where it lies."
+                )
+    if not said:
+        return ""
+    return r"\paragraph{Model checks.} Each fit against the accuracy it assumes. " + " ".join(said)
 
 
 def plain_text(text: str) -> str:

@@ -4,6 +4,7 @@ from contactid.friction_fit import friction_fit_dataset, settings_from_config
 from contactid.friction_parameters import fitted_parameters
 from contactid.io import load_dataset, provenance, write_dataset
 from contactid.logs import fmt, setup_logging
+from contactid.model_checks import friction_fit_check
 
 log = setup_logging(snakemake.log[0])
 p = snakemake.params
@@ -25,3 +26,5 @@ log.info(
     ds.attrs["e0_at_preload_n_per_m"],
     ds.attrs["misfit_nrmse"],
 )
+check = friction_fit_check(ds.attrs["misfit_nrmse"], ds.attrs["misfit_floor"])
+(log.info if check["passed"] else log.warning)("%s", check["message"])

@@ -3,6 +3,7 @@
 from contactid.io import load_dataset, provenance, write_dataset
 from contactid.linear_chain import stiction_dataset
 from contactid.logs import fmt, setup_logging
+from contactid.model_checks import stiffness_fit_check
 
 log = setup_logging(snakemake.log[0])
 p = snakemake.params
@@ -20,3 +21,6 @@ log.info(
     float(ds["k_n"]),
     fmt(ds["k_n_interval"].values),
 )
+check = stiffness_fit_check(ds.attrs["chi2_min"], ds.sizes["mode"], ds.attrs["confidence"])
+if check is not None:
+    (log.info if check["passed"] else log.warning)("%s", check["message"])

@@ -4,6 +4,7 @@ import json
 
 from contactid.io import load_dataset
 from contactid.logs import setup_logging
+from contactid.model_checks import model_checks
 from contactid.reporting import (
     contact_force_summary,
     friction_summary,
@@ -15,7 +16,8 @@ from contactid.reporting import (
 log = setup_logging(snakemake.log[0])
 inp = snakemake.input
 truth = load_dataset(inp.truth) if "truth" in inp.keys() else None
-summary = linear_summary(load_dataset(inp.modal), load_dataset(inp.stiction), truth)
+stiction = load_dataset(inp.stiction)
+summary = linear_summary(load_dataset(inp.modal), stiction, truth)
 checks = {k[len("check_") :]: load_dataset(v) for k, v in inp.items() if k.startswith("check_")}
 truths = {k[len("truth_") :]: load_dataset(v) for k, v in inp.items() if k.startswith("truth_")}
 summary.update(load_case_summary(checks, truths))
@@ -23,9 +25,12 @@ summary["data_warnings"]["random_test"] = json.loads(load_dataset(inp.frf).attrs
 forces = {k[len("forces_") :]: load_dataset(v) for k, v in inp.items() if k.startswith("forces_")}
 nnms = {k[len("nnm_") :]: load_dataset(v) for k, v in inp.items() if k.startswith("nnm_")}
 summary.update(contact_force_summary(forces, nnms))
-if "fit" in inp.keys():
+fit = load_dataset(inp.fit) if "fit" in inp.keys() else None
+if fit is not None:
     validations = {k[len("validation_") :]: load_dataset(v) for k, v in inp.items() if k.startswith("validation_")}
-    summary.update(friction_summary(load_dataset(inp.fit), validations))
+    summary.update(friction_summary(fit, validations))
+# each fit against the accuracy it assumes (contactid.model_checks); the report's "Model checks" paragraph
+summary["model_checks"] = model_checks(stiction.attrs, stiction.sizes["mode"], None if fit is None else fit.attrs)
 if "friction_intervals" in inp.keys():
     with open(inp.friction_intervals) as fh:
         summary["friction"]["model_form_intervals"] = model_form_summary(json.load(fh))
