@@ -177,3 +177,21 @@ def test_the_scattered_shortening_matrix_adds_what_an_element_loop_adds():
     q[m.theta_dof[m.theta_dof >= 0]] = 2 * m.nodes[m.theta_dof >= 0]
     L = m.nodes[-1]
     assert q @ G @ q == pytest.approx(4 * L**3 / 3, rel=1e-12)
+
+
+@pytest.mark.parametrize("scale", [0.9, 0.97, 1.05, 1.1])
+def test_the_frequency_map_at_a_stiffness_scale_is_the_structure_with_that_e(scale, default_config):
+    """The stiffness fit's map at scale s (K_0 + (s - 1) K_E in the structure's Ritz basis) against the full
+    eigenproblem of the structure with E x s; and linear_modes.nc's scale rebuilds that structure
+    (parameters.identified_structure)."""
+    from contactid.parameters import identified_structure, structure_from_config
+
+    p = configured_structure(tangential_lever_arm=0.00458)
+    fmap = ContactFrequencyMap(p, 3)
+    full = natural_frequencies(p.replace(youngs_modulus=scale * p.youngs_modulus).with_contact(1.43e7, 2.37e7), 3)
+    np.testing.assert_allclose(fmap(1.43e7, 2.37e7, scale), full, rtol=1e-8)
+    cfg = default_config["structure"]
+    built = identified_structure(cfg, {"k_t": 1.43e7, "k_n": 2.37e7, "stiffness_scale": scale})
+    plain = structure_from_config(cfg, 1.43e7, 2.37e7)
+    assert built == plain.replace(youngs_modulus=scale * plain.youngs_modulus)
+    assert identified_structure(cfg, {"k_t": 1.43e7, "k_n": 2.37e7}) == plain  # a dataset without a scale: E as given

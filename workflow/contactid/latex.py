@@ -96,6 +96,13 @@ def report_values(
         v[f"freq{i}"] = x
     st = summary["stiction"]
     v["kt"] = st["k_t"]
+    sd = float(st.get("stiffness_scale_sd", 0.0))
+    v["stiffnessclause"] = (
+        rf", with Young's modulus free within a prior of ${_fmt(100 * sd, 2)}\,\%$ sd (fitted: "
+        rf"${_fmt(st['stiffness_scale'], 4)}$ times the model's),"
+        if sd > 0
+        else ", with the model's Young's modulus,"
+    )
     v["ktlow"], v["kthigh"] = st["k_t_interval"]
     if "k_n" in st:
         v["kn"] = st["k_n"]

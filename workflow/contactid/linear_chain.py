@@ -15,7 +15,7 @@ import xarray as xr
 from .beam_model import assemble, shape_on_grid, structural_modes
 from .io import RawDataError
 from .modal_fit import fit_modes
-from .parameters import structure_from_config
+from .parameters import identified_structure, structure_from_config
 from .signals import h1_frf
 from .stiction import frequency_sigma, stiction_stiffness
 
@@ -247,6 +247,7 @@ def stiction_dataset(modal: xr.Dataset, structure_cfg: Mapping, stiction_cfg: Ma
         tuple(stiction_cfg.get("k_t_bounds_n_per_m", (1e5, 1e9))),
         tuple(stiction_cfg.get("k_n_bounds_n_per_m", (1e5, 1e11))),
         float(stiction_cfg["confidence"]),
+        stiffness_scale_sd=float(stiction_cfg.get("stiffness_scale_sd", 0.0)),
     )
     gt, pt = fit.profiles["k_t"]
     gn, pn = fit.profiles["k_n"]
@@ -276,6 +277,14 @@ def stiction_dataset(modal: xr.Dataset, structure_cfg: Mapping, stiction_cfg: Ma
                     "nonfinite_meaning": "inf: the data do not bound k_n from above",
                 },
             ),
+            "stiffness_scale": (
+                (),
+                fit.stiffness_scale,
+                {
+                    "units": "1",
+                    "long_name": "Young's modulus over the config's at the best fit (stiction.stiffness_scale_sd)",
+                },
+            ),
             "model_frequency": (
                 "mode",
                 fit.model_frequencies_hz,
@@ -295,6 +304,7 @@ def stiction_dataset(modal: xr.Dataset, structure_cfg: Mapping, stiction_cfg: Ma
         attrs={
             "chi2_min": fit.chi2_min,
             "confidence": fit.confidence,
+            "stiffness_scale_sd": float(stiction_cfg.get("stiffness_scale_sd", 0.0)),
             "k_t_bounded": int(fit.k_t_bounded),
             "k_n_bounded_above": int(fit.k_n_bounded_above),
             "k_n_bounded_below": int(fit.k_n_bounded_below),
@@ -322,7 +332,8 @@ def linear_modes_dataset(
     u_i, y_si, theta_si, the contact coordinates xi_i, eta_i and the values at
     the sensors and the driving point."""
     k_t, k_n, how = contact_stiffness_for_modes(stiction, k_n_prior)
-    params = structure_from_config(structure_cfg, k_t, k_n)
+    scale = float(stiction["stiffness_scale"]) if "stiffness_scale" in stiction else 1.0
+    params = identified_structure(structure_cfg, {"k_t": k_t, "k_n": k_n, "stiffness_scale": scale})
     model = assemble(params)
     modes = structural_modes(model, n_modes)
     x = np.linspace(0.0, params.length, grid_points)
@@ -366,6 +377,11 @@ def linear_modes_dataset(
             ),
             "k_t": ((), k_t, {"units": "N/m", "long_name": "tangential contact stiffness used"}),
             "k_n": ((), k_n, {"units": "N/m", "long_name": "normal contact stiffness used"}),
+            "stiffness_scale": (
+                (),
+                scale,
+                {"units": "1", "long_name": "Young's modulus used over the config's (the stiffness fit's scale)"},
+            ),
         },
         coords={
             "x": ("x", x, {"units": "m", "long_name": "distance from the clamp"}),

@@ -21,13 +21,13 @@ from .identification import (
     nonlinear_mode_coefficients,
     nrmse,
 )
-from .parameters import structure_from_config
+from .parameters import identified_structure
 from .raw_checks import driving_point_index
 
 
 def linear_model(structure_cfg: Mapping, linear_modes: xr.Dataset) -> FEModel:
     """The identified linear FE model (the stiffnesses the linear chain chose)."""
-    return assemble(structure_from_config(structure_cfg, float(linear_modes["k_t"]), float(linear_modes["k_n"])))
+    return assemble(identified_structure(structure_cfg, linear_modes))
 
 
 def _record(raw: xr.Dataset):

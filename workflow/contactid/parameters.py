@@ -149,3 +149,13 @@ def structure_from_config(cfg: Mapping, k_t: float, k_n: float, n_elements: int 
         axial_inertia=True,  # always in the model (a switch for the analytic checks of the bare beam)
         n_elements=int(n_elements if n_elements is not None else cfg["fe_elements"]),
     )
+
+
+def identified_structure(cfg: Mapping, linear_modes) -> StructureParameters:
+    """The linear structure the chain identified: the config's ``structure`` block (``cfg``) with the contact
+    stiffnesses k_t, k_n of ``linear_modes`` (linear_modes.nc, or any mapping with those keys) and, where it has one,
+    its ``stiffness_scale``: Young's modulus times the scale the stiffness fit found (``stiction.stiffness_scale_sd``;
+    1 where the fit kept the model's E)."""
+    p = structure_from_config(cfg, float(linear_modes["k_t"]), float(linear_modes["k_n"]))
+    scale = float(linear_modes["stiffness_scale"]) if "stiffness_scale" in linear_modes else 1.0
+    return p if scale == 1.0 else p.replace(youngs_modulus=scale * p.youngs_modulus)

@@ -67,8 +67,11 @@ def table3(stiction: xr.Dataset, truth: xr.Dataset | None) -> pd.DataFrame:
 
 
 def stiction_summary(stiction: xr.Dataset) -> dict:
-    """The ``stiction`` block of summary.json: k_t and k_n, or k_n_lower_bound."""
+    """The ``stiction`` block of summary.json: k_t and k_n, or k_n_lower_bound; the structure's stiffness scale."""
     out = {"k_t": float(stiction["k_t"]), "k_t_interval": [float(v) for v in stiction["k_t_interval"].values]}
+    if "stiffness_scale" in stiction:  # Young's modulus over the config's, and the sd of its prior (0: held at 1)
+        out["stiffness_scale"] = float(stiction["stiffness_scale"])
+        out["stiffness_scale_sd"] = float(stiction.attrs.get("stiffness_scale_sd", 0.0))
     lo, hi = (float(v) for v in stiction["k_n_interval"].values)
     if math.isinf(hi):
         out["k_n_lower_bound"] = lo

@@ -24,7 +24,9 @@ class StiffnessFit:
     data only give a lower bound on k_n (then ``k_n_lower_bound`` holds it);
     model_frequencies_hz: frequencies at the best fit; chi2_min: minimum of the
     weighted misfit; profiles: dict of (grid, chi2) arrays per parameter;
-    notes: {parameter: why a side is not bounded} (empty where both are).
+    notes: {parameter: why a side is not bounded} (empty where both are);
+    stiffness_scale: the structure's Young's modulus over the model's at the best fit (1 where the fit
+    keeps the structure, ``stiffness_scale_sd`` 0).
     """
 
     k_t: float
@@ -39,6 +41,7 @@ class StiffnessFit:
     confidence: float
     profiles: dict
     notes: dict
+    stiffness_scale: float = 1.0
 
     @property
     def k_n_lower_bound(self) -> float:
@@ -62,32 +65,70 @@ def frequency_sigma(freqs_hz: np.ndarray, stat_sigma_hz: np.ndarray, relative_fl
 JACOBIAN = {"jac": "3-point", "diff_step": 1e-5}
 
 
-def _residuals(fmap: ContactFrequencyMap, f_id, sigma, log_kt, log_kn):
-    return (fmap(10.0**log_kt, 10.0**log_kn) - f_id) / sigma
+# the structure's stiffness scale s (Young's modulus over the model's), where the fit frees it: ln s searched within
+# these bounds, with a Gaussian prior of sd ``stiffness_scale_sd`` on ln s (one more residual, ln s / sd)
+LN_SCALE_BOUNDS = (float(np.log(0.5)), float(np.log(2.0)))
 
 
-def _fit_one(params, f_id, sigma, fixed_name, fixed_log, start, bounds):
-    """Fit the free log-stiffness with the other fixed; returns (x, chi2)."""
+def _residuals(fmap: ContactFrequencyMap, f_id, sigma, log_kt, log_kn, ln_s=None, s_sd=0.0):
+    """Weighted frequency residuals at (log10 k_t, log10 k_n), and with ``ln_s`` (the log stiffness scale) the
+    prior's residual ln s / ``s_sd`` after them."""
+    if ln_s is None:
+        return (fmap(10.0**log_kt, 10.0**log_kn) - f_id) / sigma
+    r = (fmap(10.0**log_kt, 10.0**log_kn, float(np.exp(ln_s))) - f_id) / sigma
+    return np.append(r, ln_s / s_sd)
+
+
+def _fit_one(params, f_id, sigma, fixed_name, fixed_log, start, bounds, s_sd=0.0, start_s=0.0):
+    """Fit the free log-stiffness (and, with ``s_sd`` > 0, the log stiffness scale from ``start_s``) with the other
+    stiffness fixed; returns (the free stiffness's log10, chi2, ln s)."""
+    scaled = s_sd > 0
 
     def res(x):
+        ln_s = x[1] if scaled else None
         if fixed_name == "k_n":
-            return _residuals(params, f_id, sigma, x[0], fixed_log)
-        return _residuals(params, f_id, sigma, fixed_log, x[0])
+            return _residuals(params, f_id, sigma, x[0], fixed_log, ln_s, s_sd)
+        return _residuals(params, f_id, sigma, fixed_log, x[0], ln_s, s_sd)
 
     from scipy.optimize import least_squares  # here, not at the top: see _joint_fit
 
+    if not scaled:
+        r = least_squares(
+            res, [start], bounds=([bounds[0]], [bounds[1]]), x_scale=[0.1], xtol=1e-10, ftol=1e-12, **JACOBIAN
+        )
+        return r.x[0], float(2 * r.cost), 0.0
+    lo, hi = LN_SCALE_BOUNDS
     r = least_squares(
-        res, [start], bounds=([bounds[0]], [bounds[1]]), x_scale=[0.1], xtol=1e-10, ftol=1e-12, **JACOBIAN
+        res,
+        [start, start_s],
+        bounds=([bounds[0], lo], [bounds[1], hi]),
+        x_scale=[0.1, 0.01],
+        xtol=1e-10,
+        ftol=1e-12,
+        **JACOBIAN,
     )
-    return r.x[0], float(2 * r.cost)
+    return r.x[0], float(2 * r.cost), float(r.x[1])
 
 
-def _joint_fit(params, f_id, sigma, x0, lt, ln):
-    """Least-squares fit of (log10 k_t, log10 k_n) from x0; returns (x, chi2)."""
+def _joint_fit(params, f_id, sigma, x0, lt, ln, s_sd=0.0):
+    """Least-squares fit of (log10 k_t, log10 k_n) from x0, and with ``s_sd`` > 0 of the log stiffness scale too
+    (x0 then has three entries); returns (x, chi2)."""
     # scipy.optimize (0.3 s to import) where the fits use it: most jobs of the linear chain (the FRFs, the modal fit,
     # the raw checks) import this module through contactid.linear_chain without fitting anything
     from scipy.optimize import least_squares
 
+    if s_sd > 0:
+        lo, hi = LN_SCALE_BOUNDS
+        r = least_squares(
+            lambda x: _residuals(params, f_id, sigma, x[0], x[1], x[2], s_sd),
+            x0,
+            bounds=([lt[0], ln[0], lo], [lt[1], ln[1], hi]),
+            x_scale=[0.1, 1.0, 0.01],
+            xtol=1e-12,
+            ftol=1e-14,
+            **JACOBIAN,
+        )
+        return r.x, float(2 * r.cost)
     r = least_squares(
         lambda x: _residuals(params, f_id, sigma, x[0], x[1]),
         x0,
@@ -100,14 +141,16 @@ def _joint_fit(params, f_id, sigma, x0, lt, ln):
     return r.x, float(2 * r.cost)
 
 
-def _profiles(params, f_id, sigma, best, lt, ln, n_profile):
-    """Profile misfit of each parameter on a log grid (the other refitted from the joint best):
-    {name: (log grid, chi2, the other parameter's fitted log value)}."""
+def _profiles(params, f_id, sigma, best, lt, ln, n_profile, s_sd=0.0):
+    """Profile misfit of each parameter on a log grid (the other, and the stiffness scale where it is free, refitted
+    from the joint best): {name: (log grid, chi2, the other parameter's fitted log value, the fitted ln s)}."""
     out = {}
+    ln_s = float(best[2]) if s_sd > 0 else 0.0
     for name, rng, idx, other_rng in (("k_n", ln, 1, lt), ("k_t", lt, 0, ln)):
         grid = np.unique(np.concatenate([np.linspace(rng[0], rng[1], n_profile), [best[idx]]]))
-        fits = [_fit_one(params, f_id, sigma, name, x, best[1 - idx], other_rng) for x in grid]
-        out[name] = (grid, np.array([c for _, c in fits]), np.array([o for o, _ in fits]))
+        fits = [_fit_one(params, f_id, sigma, name, x, best[1 - idx], other_rng, s_sd, ln_s) for x in grid]
+        out[name] = tuple(np.array([f[k] for f in fits]) for k in (1, 0, 2))
+        out[name] = (grid, *out[name])
     return out
 
 
@@ -146,6 +189,7 @@ def stiction_stiffness(
     k_n_bounds=(1e5, 1e11),
     confidence: float = 0.95,
     n_profile: int = 25,
+    stiffness_scale_sd: float = 0.0,
 ) -> StiffnessFit:
     """Fit k_t and k_n (N/m) of Eq. (13) to the identified natural frequencies.
 
@@ -156,25 +200,37 @@ def stiction_stiffness(
     bracketed, means the data do not bound the parameter on that side (the
     reason is in ``notes``). Where a profile finds a lower misfit than the joint
     fit (a second minimum), the joint fit is restarted from there.
+
+    ``stiffness_scale_sd`` > 0 frees the structure's Young's modulus too: a scale s (the structure's E over the
+    model's) with a Gaussian prior of that sd on ln s adds ln s / sd to the residuals, and every profile refits it.
+    The frequencies' errors of a structure whose stiffness is uncertain are correlated (every mode moves with
+    sqrt(s)); held at s = 1, the fit gives that error to k_t and k_n: on a beam 3 % softer than the model, k_t 20 %
+    low and k_n 6.6 times too soft with an interval that excluded the truth (docs/measurements.md, twenty-third
+    session). With sd 0 the structure is the model's (s = 1), the fit as before.
     """
     f_id = np.asarray(f_id_hz, dtype=float)
     sigma = np.asarray(sigma_hz, dtype=float)
+    s_sd = float(stiffness_scale_sd)
+    if not s_sd >= 0:
+        raise ValueError(f"stiffness_scale_sd = {stiffness_scale_sd}: give a relative sd >= 0 (0: the model's E)")
+    scaled = s_sd > 0
     params = ContactFrequencyMap(params, len(f_id))
     lt, ln = np.log10(k_t_bounds), np.log10(k_n_bounds)
     # start: a coarse scan in k_t with k_n at the geometric mid of its range
     grid_t = np.linspace(lt[0], lt[1], 17)
     c0 = [np.sum(_residuals(params, f_id, sigma, g, ln.mean()) ** 2) for g in grid_t]
-    best, chi2_min = _joint_fit(params, f_id, sigma, [grid_t[int(np.argmin(c0))], ln.mean()], lt, ln)
-    prof = _profiles(params, f_id, sigma, best, lt, ln, n_profile)
+    x0 = [grid_t[int(np.argmin(c0))], ln.mean()] + ([0.0] if scaled else [])
+    best, chi2_min = _joint_fit(params, f_id, sigma, x0, lt, ln, s_sd)
+    prof = _profiles(params, f_id, sigma, best, lt, ln, n_profile, s_sd)
     # a profile below the joint fit: the joint fit stopped in a second minimum; restart from the lowest point
-    name, (grid, chi2_p, other) = min(prof.items(), key=lambda kv: kv[1][1].min())
+    name, (grid, chi2_p, other, ln_s) = min(prof.items(), key=lambda kv: kv[1][1].min())
     i = int(np.argmin(chi2_p))
     if chi2_p[i] < chi2_min - 1e-9 * (1.0 + chi2_min):
         x0 = [other[i], grid[i]] if name == "k_n" else [grid[i], other[i]]
-        x1, c1 = _joint_fit(params, f_id, sigma, x0, lt, ln)
+        x1, c1 = _joint_fit(params, f_id, sigma, x0 + ([ln_s[i]] if scaled else []), lt, ln, s_sd)
         if c1 < chi2_min:
             best, chi2_min = x1, c1
-            prof = _profiles(params, f_id, sigma, best, lt, ln, n_profile)
+            prof = _profiles(params, f_id, sigma, best, lt, ln, n_profile, s_sd)
     chi2_min = min([chi2_min] + [float(p[1].min()) for p in prof.values()])
     from scipy.stats import chi2  # here: scipy.stats takes 0.3 s to import
 
@@ -184,9 +240,9 @@ def stiction_stiffness(
     for name, rng, idx, other_rng in (("k_n", ln, 1, lt), ("k_t", lt, 0, ln)):
 
         def profile(x, name=name, other_rng=other_rng, idx=idx):
-            return _fit_one(params, f_id, sigma, name, x, best[1 - idx], other_rng)[1]
+            return _fit_one(params, f_id, sigma, name, x, best[1 - idx], other_rng, s_sd, best[2] if scaled else 0.0)[1]
 
-        grid, chi2_p, _ = prof[name]
+        grid, chi2_p, _, _ = prof[name]
         profiles[name] = (10.0**grid, chi2_p)
         i_min = int(np.argmin(chi2_p))
         (lo, why_lo), (hi, why_hi) = (interval_edge(profile, grid, chi2_p, i_min, d, chi2_min, thr) for d in (-1, +1))
@@ -195,7 +251,8 @@ def stiction_stiffness(
             w for w in (f"lower: {why_lo}" if lo is None else "", f"upper: {why_hi}" if hi is None else "") if w
         )
         lo_hi[name] = (10.0 ** (lo if lo is not None else rng[0]), 10.0**hi if hi is not None else np.inf)
-    f_best = params(10.0 ** best[0], 10.0 ** best[1])
+    scale = float(np.exp(best[2])) if scaled else 1.0
+    f_best = params(10.0 ** best[0], 10.0 ** best[1], scale)
     return StiffnessFit(
         k_t=float(10.0 ** best[0]),
         k_n=float(10.0 ** best[1]),
@@ -209,4 +266,5 @@ def stiction_stiffness(
         confidence=confidence,
         profiles=profiles,
         notes=notes,
+        stiffness_scale=scale,
     )

@@ -5,7 +5,7 @@ import json
 from contactid.io import load_dataset, provenance, read_raw, write_dataset
 from contactid.logs import fmt, setup_logging
 from contactid.nonlinear_chain import contact_forces_dataset
-from contactid.parameters import structure_from_config
+from contactid.parameters import identified_structure
 from contactid.updating import UpdatingResult
 
 log = setup_logging(snakemake.log[0])
@@ -18,7 +18,7 @@ if "updating" in inp.keys():  # the structures the random test allows (model upd
     with open(inp.updating) as fh:
         upd = json.load(fh)
     if upd["enabled"]:
-        nominal = structure_from_config(snakemake.params.structure, float(modes["k_t"]), float(modes["k_n"]))
+        nominal = identified_structure(snakemake.params.structure, modes)
         structures = UpdatingResult.from_summary(upd, nominal).posterior_structures()
 ds = contact_forces_dataset(
     read_raw(inp.raw, dual_sine=True),

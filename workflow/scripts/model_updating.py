@@ -6,13 +6,13 @@ from contactid.gap.diagnosis import GapSettings
 from contactid.gap.pipeline import structure_update
 from contactid.io import load_dataset, write_text
 from contactid.logs import setup_logging
-from contactid.parameters import structure_from_config
+from contactid.parameters import identified_structure
 
 log = setup_logging(snakemake.log[0])
 p = snakemake.params
 modes = load_dataset(snakemake.input.modes)
 settings = GapSettings.from_config(p.gap, int(p.seed), int(p.n_harmonics))
-structure = structure_from_config(p.structure, float(modes["k_t"]), float(modes["k_n"]))
+structure = identified_structure(p.structure, modes)
 upd = structure_update(structure, load_dataset(snakemake.input.modal), settings)
 summary = {"enabled": upd is not None, **(upd.summary() if upd is not None else {})}
 write_text(snakemake.output[0], json.dumps(summary, indent=2, default=float))

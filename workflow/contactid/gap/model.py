@@ -25,7 +25,7 @@ from ..beam_model import assemble
 from ..friction_parameters import fitted_parameters
 from ..harmonics import aperiodic_share, periodic_grid, periodic_harmonics
 from ..identification import damping_by_mode
-from ..parameters import StructureParameters, structure_from_config
+from ..parameters import StructureParameters, identified_structure
 from ..rig.nonlinear import ContactParameters, DualSineSimulator, reduced_model
 from .records import RecordHarmonics
 
@@ -112,8 +112,7 @@ def identified_model(
     oversampling: int = 8,
 ) -> IdentifiedModel:
     """The identified model from the chain's datasets (linear_modes.nc, modal.nc, friction_fit.nc)."""
-    k_t, k_n = float(linear_modes["k_t"]), float(linear_modes["k_n"])
-    params = structure_from_config(structure_cfg, k_t, k_n)
+    params = identified_structure(structure_cfg, linear_modes)
     return IdentifiedModel(
         params,
         tuple(float(z) for z in modal["damping_ratio"].values),
