@@ -59,6 +59,6 @@ def test_the_report_says_what_a_failed_check_means_and_a_passed_one_in_a_clause(
     bad = model_checks_text(
         model_checks({"chi2_min": 13.1, "confidence": 0.95}, 3, {"misfit_nrmse": 0.476, "misfit_floor": 0.01})
     )
-    assert bad.count(r"\textbf{") == 2 and "hold for the nominal structure only" in bad
+    assert bad.count(r"\textbf{") == 2 and "hold for the model's structure only" in bad
     assert bad.count("{") == bad.count("}")  # balanced for LaTeX
     assert model_checks_text([]) == ""

@@ -144,16 +144,16 @@ def test_the_gap_models_reduced_structure_is_built_once_per_structure(default_co
 
 @pytest.mark.parametrize("scale", [0.97, 1.0, 1.03])
 def test_a_beam_whose_stiffness_is_off_keeps_k_t_and_its_interval_on_the_truth_with_the_stiffness_scale_free(scale):
-    """A rig whose beam has E x ``scale``: with the structure's stiffness scale free (prior sd 2 %), k_t comes within
-    4 % of the truth and its interval holds it, k_n is bounded from below only (the frequencies barely move with it),
-    and the scale follows the rig's. Held at the model's E, the 3 % softer beam gave k_t 20 % low and a k_n interval
-    6.6 x below the truth (tests/test_model_checks.py)."""
+    """A rig whose beam has E x ``scale``: with the structure's stiffness scale free (prior sd 5 %, the default), k_t
+    comes within 2 % of the truth and its interval holds it, k_n is bounded from below only (the frequencies barely
+    move with it), and the scale follows the rig's. Held at the model's E, the 3 % softer beam gave k_t 20 % low and a
+    k_n interval 6.6 x below the truth (tests/test_model_checks.py)."""
     nominal = configured_structure(tangential_lever_arm=0.00458, youngs_modulus=2.164e11)
     rig = configured_structure(tangential_lever_arm=0.00458, youngs_modulus=2.164e11 * scale)
     truth = (1.43e7, 2.37e7)
     f = natural_frequencies(rig.with_contact(*truth), 3)
-    fit = stiction_stiffness(nominal, f, frequency_sigma(f, np.zeros(3), 1e-3), stiffness_scale_sd=0.02)
-    assert fit.k_t == pytest.approx(truth[0], rel=0.04)
+    fit = stiction_stiffness(nominal, f, frequency_sigma(f, np.zeros(3), 1e-3), stiffness_scale_sd=0.05)
+    assert fit.k_t == pytest.approx(truth[0], rel=0.02)
     assert fit.k_t_interval[0] < truth[0] < fit.k_t_interval[1]
     assert fit.k_n_interval[0] < truth[1] and not fit.k_n_bounded_above
     assert abs(fit.stiffness_scale - scale) < 0.4 * abs(scale - 1) + 1e-4  # the prior pulls it towards 1

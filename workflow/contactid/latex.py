@@ -356,14 +356,14 @@ def model_checks_text(checks: list) -> str:
                 rf"freedom (limit ${_fmt(lim, 3)}$"
             )
             if c["passed"]:
-                said.append(head + "): the nominal structure reproduces the identified frequencies.")
+                said.append(head + "): the structure with contact springs reproduces the identified frequencies.")
             else:
                 said.append(
-                    head + rf", $p = {_fmt(c['p_value'], 2)}$): \textbf{{the nominal structure with contact springs "
+                    head + rf", $p = {_fmt(c['p_value'], 2)}$): \textbf{{the structure with contact springs "
                     r"cannot reproduce the identified frequencies within their uncertainty}; $k_t$ and $k_n$ absorb a "
-                    r"structural error (Young's modulus, masses, lever arm, clamp) and their intervals hold for the "
-                    r"nominal structure only. Model updating (the gap diagnosis) says which structural change the data "
-                    r"support."
+                    r"structural error (masses, lever arm, clamp, or a Young's modulus beyond its prior) and their "
+                    r"intervals hold for the model's structure only. Model updating (the gap diagnosis) says which "
+                    r"structural change the data support."
                 )
         elif c["check"] == "friction_fit":
             head = rf"The friction law fits the identified $S$ to ${_fmt(100 * v, 3)}\,\%$ (NRMSE)"

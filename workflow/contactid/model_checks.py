@@ -8,7 +8,7 @@ whether the identified model is fit for the records. Two fits state their own ac
   two stiffnesses, its minimum chi^2 follows a chi^2 law with n - 2 degrees of freedom when the nominal
   structure is right. A minimum beyond that law's ``confidence`` quantile means the structure with contact
   springs cannot reproduce the frequencies: k_t and k_n then absorb a structural error (Young's modulus,
-  masses, lever arm, clamp), and their intervals hold for the nominal structure only. On a rig 3 % softer
+  masses, lever arm, clamp), and their intervals hold for the model's structure only. On a rig 3 % softer
   than the model (E), the fit put k_n at 3.6e6 N/m (truth 2.37e7) with an interval that excluded the truth,
   at chi^2 = 13.1 for one degree of freedom (docs/measurements.md, twenty-third session);
 - the friction fit (Table 4) profiles its intervals with the identified S assumed accurate to
@@ -40,14 +40,16 @@ def stiffness_fit_check(chi2_min: float, n_frequencies: int, confidence: float) 
     head = f"stiffness fit: chi^2 = {value:.3g} for {dof} degree{'s' if dof > 1 else ''} of freedom"
     if passed:
         message = (
-            f"{head} (limit {limit:.3g} at {100 * confidence:g} %): the nominal structure reproduces the frequencies"
+            f"{head} (limit {limit:.3g} at {100 * confidence:g} %): the structure with contact springs reproduces the "
+            "frequencies"
         )
     else:
         message = (
-            f"{head}, beyond the limit {limit:.3g} at {100 * confidence:g} % (p = {p:.2g}): the nominal structure "
-            "with contact springs cannot reproduce the identified frequencies within their uncertainty; k_t and k_n "
-            "absorb a structural error (Young's modulus, masses, lever arm, clamp) and their intervals hold for the "
-            "nominal structure only. Model updating (the gap diagnosis) says which structural change the data support"
+            f"{head}, beyond the limit {limit:.3g} at {100 * confidence:g} % (p = {p:.2g}): the structure with "
+            "contact springs cannot reproduce the identified frequencies within their uncertainty; k_t and k_n "
+            "absorb a structural error (masses, lever arm, clamp, or a Young's modulus beyond its prior) and their "
+            "intervals hold for the model's structure only. Model updating (the gap diagnosis) says which structural "
+            "change the data support"
         )
     return {
         "check": "stiffness_fit",
