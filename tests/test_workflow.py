@@ -473,6 +473,9 @@ def test_no_table_cell_prints_more_digits_than_its_interval_supports(default_run
         for cells in rows:
             name = cells[0].replace("\\_", "_")
             r = csv.loc[name]
+            if cells[1] == "$--$":  # no value: the data bound it from one side only (k_n), the row gives that bound
+                assert r["reported_as"] == "lower bound" and np.isnan(r[value]), f"{table} {name}"
+                continue
             allowed = significant_digits(float(r[value]), float(r[low]), float(r[high]))
             assert digits(cells[1]) <= max(allowed, 1), f"{table} {name}: {cells[1]} ({allowed} digits supported)"
             if allowed == 0:
