@@ -240,6 +240,7 @@ def stiction_dataset(modal: xr.Dataset, structure_cfg: Mapping, stiction_cfg: Ma
         f_id, modal["natural_frequency_std"].values, float(stiction_cfg["frequency_uncertainty_floor"])
     )
     params = structure_from_config(structure_cfg, 1e7, 1e8)
+    scale_sd = float(stiction_cfg.get("stiffness_scale_sd", 0.0))
     fit = stiction_stiffness(
         params,
         f_id,
@@ -247,7 +248,7 @@ def stiction_dataset(modal: xr.Dataset, structure_cfg: Mapping, stiction_cfg: Ma
         tuple(stiction_cfg.get("k_t_bounds_n_per_m", (1e5, 1e9))),
         tuple(stiction_cfg.get("k_n_bounds_n_per_m", (1e5, 1e11))),
         float(stiction_cfg["confidence"]),
-        stiffness_scale_sd=float(stiction_cfg.get("stiffness_scale_sd", 0.0)),
+        stiffness_scale_sd=scale_sd,
     )
     gt, pt = fit.profiles["k_t"]
     gn, pn = fit.profiles["k_n"]
@@ -304,7 +305,7 @@ def stiction_dataset(modal: xr.Dataset, structure_cfg: Mapping, stiction_cfg: Ma
         attrs={
             "chi2_min": fit.chi2_min,
             "confidence": fit.confidence,
-            "stiffness_scale_sd": float(stiction_cfg.get("stiffness_scale_sd", 0.0)),
+            "stiffness_scale_sd": scale_sd,
             "k_t_bounded": int(fit.k_t_bounded),
             "k_n_bounded_above": int(fit.k_n_bounded_above),
             "k_n_bounded_below": int(fit.k_n_bounded_below),

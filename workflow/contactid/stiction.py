@@ -92,22 +92,17 @@ def _fit_one(params, f_id, sigma, fixed_name, fixed_log, start, bounds, s_sd=0.0
 
     from scipy.optimize import least_squares  # here, not at the top: see _joint_fit
 
-    if not scaled:
-        r = least_squares(
-            res, [start], bounds=([bounds[0]], [bounds[1]]), x_scale=[0.1], xtol=1e-10, ftol=1e-12, **JACOBIAN
-        )
-        return r.x[0], float(2 * r.cost), 0.0
     lo, hi = LN_SCALE_BOUNDS
     r = least_squares(
         res,
-        [start, start_s],
-        bounds=([bounds[0], lo], [bounds[1], hi]),
-        x_scale=[0.1, 0.01],
+        [start, start_s] if scaled else [start],
+        bounds=([bounds[0], lo], [bounds[1], hi]) if scaled else ([bounds[0]], [bounds[1]]),
+        x_scale=[0.1, 0.01] if scaled else [0.1],
         xtol=1e-10,
         ftol=1e-12,
         **JACOBIAN,
     )
-    return r.x[0], float(2 * r.cost), float(r.x[1])
+    return r.x[0], float(2 * r.cost), float(r.x[1]) if scaled else 0.0
 
 
 def _joint_fit(params, f_id, sigma, x0, lt, ln, s_sd=0.0):
@@ -117,23 +112,13 @@ def _joint_fit(params, f_id, sigma, x0, lt, ln, s_sd=0.0):
     # the raw checks) import this module through contactid.linear_chain without fitting anything
     from scipy.optimize import least_squares
 
-    if s_sd > 0:
-        lo, hi = LN_SCALE_BOUNDS
-        r = least_squares(
-            lambda x: _residuals(params, f_id, sigma, x[0], x[1], x[2], s_sd),
-            x0,
-            bounds=([lt[0], ln[0], lo], [lt[1], ln[1], hi]),
-            x_scale=[0.1, 1.0, 0.01],
-            xtol=1e-12,
-            ftol=1e-14,
-            **JACOBIAN,
-        )
-        return r.x, float(2 * r.cost)
+    scaled = s_sd > 0
+    lo, hi = LN_SCALE_BOUNDS
     r = least_squares(
-        lambda x: _residuals(params, f_id, sigma, x[0], x[1]),
+        lambda x: _residuals(params, f_id, sigma, x[0], x[1], x[2] if scaled else None, s_sd),
         x0,
-        bounds=([lt[0], ln[0]], [lt[1], ln[1]]),
-        x_scale=[0.1, 1.0],
+        bounds=([lt[0], ln[0], lo], [lt[1], ln[1], hi]) if scaled else ([lt[0], ln[0]], [lt[1], ln[1]]),
+        x_scale=[0.1, 1.0, 0.01] if scaled else [0.1, 1.0],
         xtol=1e-12,
         ftol=1e-14,
         **JACOBIAN,
@@ -149,8 +134,8 @@ def _profiles(params, f_id, sigma, best, lt, ln, n_profile, s_sd=0.0):
     for name, rng, idx, other_rng in (("k_n", ln, 1, lt), ("k_t", lt, 0, ln)):
         grid = np.unique(np.concatenate([np.linspace(rng[0], rng[1], n_profile), [best[idx]]]))
         fits = [_fit_one(params, f_id, sigma, name, x, best[1 - idx], other_rng, s_sd, ln_s) for x in grid]
-        out[name] = tuple(np.array([f[k] for f in fits]) for k in (1, 0, 2))
-        out[name] = (grid, *out[name])
+        other, chi2, ln_s_fit = (np.array(column) for column in zip(*fits))
+        out[name] = (grid, chi2, other, ln_s_fit)
     return out
 
 
