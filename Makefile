@@ -17,9 +17,9 @@ unexport PYTHONDONTWRITEBYTECODE
 # requirements.txt instead of fetching one into an isolated build environment (8 -> 4 s)
 PY := $(VENV)/bin/python
 # the interpreter the environment is made from (PYTHON=... overrides): the distribution's /usr/bin/python3 where it is
-# the pins' Python (3.11) and can make a venv, else the first python3 on PATH. Debian's is built with profile-guided and
-# link-time optimisation, pyenv's default build (first on this machine's PATH) is not: pure Python runs 1.5-1.75x as
-# fast, and the workflow ran in 88 s instead of 101 s (CPU 159 s against 189 s) with bit-identical results
+# the pins' Python (3.11) and can make a venv, else the first python3 on PATH. On this machine Debian's runs pure Python
+# 1.5-1.75x as fast as pyenv's (first on PATH; its default build is configured without --enable-optimizations), and
+# the workflow ran in 88 s instead of 101 s (CPU 159 s against 189 s) with bit-identical results
 PYTHON ?= $(shell for p in /usr/bin/python3 python3; do \
 	$$p -c 'import sys, venv, ensurepip; sys.exit(sys.version_info[:2] != (3, 11))' >/dev/null 2>&1 \
 	&& { command -v $$p; exit 0; }; done; echo python3)
