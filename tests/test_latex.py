@@ -31,8 +31,20 @@ def test_digits_follow_the_interval_and_a_value_lost_in_it_prints_as_zero():
     cols = {"parameter": "", "identified": "identified", "interval_low": "low", "interval_high": "high"}
     lines = tabular(df, cols, "c", "tab:t4", intervals={"identified": ("interval_low", "interval_high")}).splitlines()
     assert r"e\_t & $0$ & $0$ & $16000$ \\" in lines
-    assert r"mu & $0.3957$ & $0.394$ & $0.397$ \\" in lines
-    assert r"e\_f & $3.8\times10^{7}$ & $2.94\times10^{7}$ & $5.85\times10^{7}$ \\" in lines
+    # the bounds to the value's last digit: 0.3957 in 0.3941-0.3973 (at 3 digits, 0.394-0.397, the interval read
+    # as twice its width and off-centre), 3.8e7 in 2.9e7-5.8e7
+    assert r"mu & $0.3957$ & $0.3941$ & $0.3973$ \\" in lines
+    assert r"e\_f & $3.8\times10^{7}$ & $2.9\times10^{7}$ & $5.8\times10^{7}$ \\" in lines
+
+
+def test_mode_numbers_print_whole_and_frequencies_to_the_hundredth():
+    # Table 1 of the report: a row read as one float Series printed the modes as 1.00, 2.00; 3 significant digits
+    # printed 166.9153 Hz as 167 beside the paper's 166.2
+    df = pd.DataFrame({"mode": [1, 2], "identified_hz": [54.7918, 166.9153], "diff_pct": [-0.106113, 0.000257]})
+    cols = {"mode": "mode", "identified_hz": "f (Hz)", "diff_pct": "diff"}
+    lines = tabular(df, cols, "c", "tab:x", decimals={"identified_hz": 2}).splitlines()
+    assert r"$1$ & $54.79$ & $-0.106$ \\" in lines
+    assert r"$2$ & $166.92$ & $2.57\times10^{-4}$ \\" in lines
 
 
 def test_a_plain_number_with_more_integer_digits_than_asked_is_rounded_to_them():
@@ -107,3 +119,20 @@ def test_the_text_quotes_the_configured_calibration_and_figure_cases_for_any_set
     assert "\\newcommand{\\validationtext}{The law predicts" in macros(v)
     one = report_values(_summary(["lc1"], {"lc1": 0.01}), cons, calibration_case="lc1", figure_case="lc3")
     assert one["figcase"] == "load case 1" and "no other" in one["validationtext"]
+
+
+def test_k_n_is_said_as_a_bound_where_the_data_bound_it_from_one_side_only():
+    # "interval 5.678e6--{--}" read as a typesetting slip: a lower bound says "k_n >= ...", a value its interval
+    from contactid.latex import report_values
+
+    cons = pd.DataFrame(
+        columns=["scenario", "max_abs_err_pct", "k_t_n_per_m", "tangential_lever_arm_m", "youngs_modulus_pa"]
+    )
+    below = report_values(_summary(["lc1"], {"lc1": 0.01}), cons, calibration_case="lc1", figure_case="lc1")
+    assert below["knclause"] == r"$k_n \geq 1.000\times10^{6}$\,N/m: the frequencies bound it from below only"
+    both = _summary(["lc1"], {"lc1": 0.01})
+    both["stiction"] = {**both["stiction"], "k_n": 2.4e7, "k_n_interval": [2.0e7, 2.9e7]}
+    v = report_values(both, cons, calibration_case="lc1", figure_case="lc1")
+    assert v["knclause"] == (
+        r"$k_n = 2.400\times10^{7}$\,N/m, bounded on both sides (interval $2.000\times10^{7}$--$2.900\times10^{7}$)"
+    )

@@ -104,14 +104,21 @@ def report_values(
         else ", with the model's Young's modulus,"
     )
     v["ktlow"], v["kthigh"] = st["k_t_interval"]
+    # knclause: what the report says of k_n, a value with its interval or, where the frequencies bound it from below
+    # only, that bound (an interval with no upper end printed as "lower--{--}" read as a typesetting slip)
     if "k_n" in st:
         v["kn"] = st["k_n"]
         v["knlow"], v["knhigh"] = st["k_n_interval"]
         v["knstatement"] = "bounded on both sides"
+        v["knclause"] = (
+            rf"$k_n = {_fmt(st['k_n'])}$\,N/m, bounded on both sides (interval ${_fmt(v['knlow'])}$--"
+            rf"${_fmt(v['knhigh'])}$)"
+        )
     else:
         v["kn"] = st["k_n_lower_bound"]
         v["knlow"], v["knhigh"] = st["k_n_lower_bound"], float("inf")
         v["knstatement"] = "bounded from below only"
+        v["knclause"] = rf"$k_n \geq {_fmt(st['k_n_lower_bound'])}$\,N/m: the frequencies bound it from below only"
     tr = summary.get("truth", {})
     # rigtruth: the records come from the virtual rig and its truth is known (the report's text scores against it);
     # false for measured records, where the report says what it compares with instead
@@ -193,11 +200,15 @@ def tabular(
     label: str,
     digits: int = 3,
     intervals: Mapping[str, tuple[str, str]] | None = None,
+    decimals: Mapping[str, int] | None = None,
 ) -> str:
     """A booktabs table from selected columns (header text per column, LaTeX as given). Numbers print with
-    ``digits`` significant digits, a column named in ``intervals`` (column -> (low column, high column)) with the
-    digits its interval supports (``significant_digits``); text cells are escaped. A column whose name holds "truth"
-    and that has no value at all (measured records) is left out."""
+    ``digits`` significant digits; a column named in ``decimals`` (column -> n) with n decimals (frequencies in Hz to
+    the hundredth, as Table 1 of the paper gives them); a column named in ``intervals`` (column -> (low column, high
+    column)) with the digits its interval supports (``significant_digits``), and its interval's bounds to the same
+    decimal place (an interval printed coarser than its value reads as wider or narrower than it is). Whole numbers
+    (a mode's number) print as such; text cells are escaped. A column whose name holds "truth" and that has no value
+    at all (measured records) is left out."""
     # a truth column with no value at all (measured records: no truth) is left out, not printed as dashes
     columns = {
         c: h
@@ -205,17 +216,36 @@ def tabular(
         if not ("truth" in c and c in df and pd.to_numeric(df[c], errors="coerce").isna().all())
     }
     head = " & ".join(columns.values()) + r" \\"
+    decimals = dict(decimals or {})
+    # the place of the last digit each interval's value prints to, {bound column: power of ten}, per row
+    bound_place: list[dict] = [{} for _ in range(len(df))]
+    for col, (lo, hi) in (intervals or {}).items():
+        for i, (x, a, b) in enumerate(zip(df[col], df[lo], df[hi])):
+            n = significant_digits(float(x), float(a), float(b)) if np.isfinite(x) else 0
+            if n and x != 0:
+                place = math.floor(math.log10(abs(float(x)))) - n + 1
+                bound_place[i].update({lo: place, hi: place})
     rows = []
-    for _, r in df.iterrows():
+    for i in range(len(df)):
         cells = []
         for col in columns:
-            x = r[col]
+            x = df[col].iloc[i]  # by column: a row (iterrows) would cast a whole-number column to float
             if not isinstance(x, (int, float, np.number)) or isinstance(x, (bool, np.bool_)):
                 cells.append(escape(x))
                 continue
+            if isinstance(x, (int, np.integer)):
+                cells.append(f"${int(x)}$")
+                continue
+            if col in decimals and math.isfinite(x):
+                cells.append(f"${float(x):.{decimals[col]}f}$")
+                continue
             n = digits
             if intervals and col in intervals:
-                n = significant_digits(float(x), float(r[intervals[col][0]]), float(r[intervals[col][1]]))
+                n = significant_digits(
+                    float(x), float(df[intervals[col][0]].iloc[i]), float(df[intervals[col][1]].iloc[i])
+                )
+            elif col in bound_place[i] and math.isfinite(x) and x != 0:
+                n = max(1, math.floor(math.log10(abs(float(x)))) - bound_place[i][col] + 1)
             cells.append("$0$" if n == 0 else f"${_fmt(x, n)}$")
         rows.append(" & ".join(cells) + r" \\")
     spec = "l" + "r" * (len(columns) - 1)

@@ -33,6 +33,7 @@ Path(out.table1).write_text(
         },
         "Natural frequencies at low-level random excitation (paper, Table 1).",
         "tab:t1",
+        decimals={"identified_hz": 2, "paper_hz": 2, "truth_hz": 2},
     )
 )
 Path(out.table3).write_text(
