@@ -40,22 +40,23 @@ def test_clean_winner_is_named_with_its_bootstrap_p_better():
     name, reason = verdict(rows, 0.02, 1e-4, PLACE, SETTINGS, boots)
     assert name == "viscous_friction"
     assert reason == (
-        "viscous_friction shrinks the held-out gap from 0.02 to 0.002 (90.0%); runner-up "
-        "structural_damping 0.012; bootstrap P(better) 0.75"
+        "viscous_friction shrinks the held-out gap from 2 % to 0.2 % (90.0%); runner-up "
+        "structural_damping 1.2 %; bootstrap P(better) 0.75"
     )
 
 
 def test_a_sole_candidate_wins_without_runner_up():
     name, reason = verdict([row("viscous_friction", 0.002)], 0.02, 1e-4, PLACE, SETTINGS)
     assert name == "viscous_friction"
-    assert "runner-up - nan" in reason and "P(better) 1.00" in reason
+    assert "runner-up -;" in reason and "P(better) 1.00" in reason
 
 
 def test_gap_below_min_gap_gives_none():
     rows = [row("viscous_friction", 0.0005, before=0.0059)]
     name, reason = verdict(rows, 0.0059, 1e-5, PLACE, SETTINGS)
     assert name == "none"
-    assert reason.startswith("the held-out gap 0.0059 is below gap.min_gap = 0.006")
+    # gaps in per cent, as the report prints them beside this reason; the setting as the config writes it
+    assert reason.startswith("the held-out gap 0.59 % is below gap.min_gap = 0.006 (0.6 %)")
     # at the threshold itself the gap counts (strict inequality): the clean winner is named
     assert (
         verdict([row("viscous_friction", 0.0005, before=0.006)], 0.006, 1e-5, PLACE, SETTINGS)[0] == "viscous_friction"
@@ -65,7 +66,7 @@ def test_gap_below_min_gap_gives_none():
 def test_gap_within_the_records_scatter_gives_none():
     rows = [row("viscous_friction", 0.002)]
     name, reason = verdict(rows, 0.02, 0.007, PLACE, SETTINGS)  # 0.02 < 3 x 0.007
-    assert name == "none" and reason == "the held-out gap 0.02 is within 3.0 x the records' scatter 0.007"
+    assert name == "none" and reason == "the held-out gap 2 % is within 3.0 x the records' scatter 0.7 %"
     assert verdict(rows, 0.02, 0.0066, PLACE, SETTINGS)[0] == "viscous_friction"  # 0.02 > 3 x 0.0066
 
 
@@ -93,7 +94,7 @@ def test_runner_up_too_close_gives_none():
     assert name == "none"
     assert reason == (
         "viscous_friction and normal_contact_damping explain the gap about equally (held-out gaps "
-        "0.004, 0.0059; separation 1.5)"
+        "0.4 %, 0.59 %; separation 1.5)"
     )
     rows = [row("viscous_friction", 0.004), row("normal_contact_damping", 0.006)]  # exactly 1.5 x: separated
     assert verdict(rows, 0.02, 1e-4, PLACE, SETTINGS)[0] == "viscous_friction"

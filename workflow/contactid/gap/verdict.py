@@ -150,12 +150,14 @@ def verdict(
         second = next((r for r in rows if r is not best), None)
         if before < min_gap:
             reason = (
-                f"the held-out gap {before:.3g} is below gap.min_gap = {min_gap:g}: the identified model "
-                f"reproduces the records as well as the chain's own identification allows (best candidate "
+                f"the held-out gap {_pct(before)} is below gap.min_gap = {min_gap:g} ({_pct(min_gap)}): the identified "
+                f"model reproduces the records as well as the chain's own identification allows (best candidate "
                 f"{best['effect']}: {best['reduction']:.1%})"
             )
         elif before < noise_factor * scatter:
-            reason = f"the held-out gap {before:.3g} is within {noise_factor} x the records' scatter {scatter:.2g}"
+            reason = (
+                f"the held-out gap {_pct(before)} is within {noise_factor} x the records' scatter {_pct(scatter, 2)}"
+            )
         elif best["reduction"] < min_reduction or best["reduction_interval"][0] <= 0:
             reason = (
                 f"no candidate shrinks the held-out gap by {min_reduction:.0%} (best: {best['effect']}, "
@@ -164,7 +166,7 @@ def verdict(
         elif second is not None and second["heldout_gap_after"] < separation * best["heldout_gap_after"]:
             reason = (
                 f"{best['effect']} and {second['effect']} explain the gap about equally (held-out gaps "
-                f"{best['heldout_gap_after']:.3g}, {second['heldout_gap_after']:.3g}; separation {separation})"
+                f"{_pct(best['heldout_gap_after'])}, {_pct(second['heldout_gap_after'])}; separation {separation})"
             )
         else:
             verdict = best["effect"]
@@ -174,12 +176,17 @@ def verdict(
                 p_better = float("nan")
             else:
                 p_better = float(np.mean(np.asarray(boots[best["effect"]]) < np.asarray(boots[second["effect"]])))
+            runner_up = f"{second['effect']} {_pct(second['heldout_gap_after'])}" if second else "-"
             reason = (
-                f"{best['effect']} shrinks the held-out gap from {before:.3g} to {best['heldout_gap_after']:.3g} "
-                f"({best['reduction']:.1%}); runner-up {second['effect'] if second else '-'} "
-                f"{second['heldout_gap_after'] if second else float('nan'):.3g}; bootstrap P(better) {p_better:.2f}"
+                f"{best['effect']} shrinks the held-out gap from {_pct(before)} to {_pct(best['heldout_gap_after'])} "
+                f"({best['reduction']:.1%}); runner-up {runner_up}; bootstrap P(better) {p_better:.2f}"
             )
     return verdict, reason
+
+
+def _pct(gap: float, digits: int = 3) -> str:
+    """A held-out gap (a fraction) for people: in per cent, as the report prints every gap ("0.298 %")."""
+    return f"{100 * float(gap):.{digits}g} %"
 
 
 def explains_materially(gap: float, after: float, scatter: float, settings) -> bool:
