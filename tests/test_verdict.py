@@ -160,7 +160,7 @@ def test_drift_beyond_drift_factor_is_non_stationary():
     assert V.DEFAULT_PLACE.drift_z == 8.0
     name, reason = place(drift(1.0, 9.0, 12.0, change=0.05), quiet_stage(), ID_RES, SCATTER)  # median 9 > 8
     assert (
-        name == "non_stationary" and reason == "the records' harmonics drift by 0.05 over a record (9 standard errors)"
+        name == "non_stationary" and reason == "the records' harmonics drift by 5 % over a record (9 standard errors)"
     )
     assert place(drift(1.0, 8.0, 12.0), quiet_stage(), ID_RES, SCATTER)[0] == "tangential_contact"  # median 8: not > 8
 
@@ -168,7 +168,7 @@ def test_drift_beyond_drift_factor_is_non_stationary():
 def test_sensor_misfit_beyond_residual_factor_is_structure_or_measurement():
     assert V.DEFAULT_PLACE.residual_factor == 20.0
     name, reason = place(drift(1, 1, 1), quiet_stage(), [0.021, 0.03, 0.001], SCATTER)  # median ratio 21
-    assert name == "structure_or_measurement" and "(sensor misfit 0.021, 21 x the scatter)" in reason
+    assert name == "structure_or_measurement" and "(sensor misfit 2.1 %, 21 x the scatter)" in reason
     assert place(drift(1, 1, 1), quiet_stage(), [0.02, 0.03, 0.001], SCATTER)[0] == "tangential_contact"  # 20: not > 20
 
 

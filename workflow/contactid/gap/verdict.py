@@ -82,12 +82,12 @@ def place(
     if np.median(z) > thresholds.drift_z:
         change = np.median([v["change"] for v in drift.values()])
         return "non_stationary", (
-            f"the records' harmonics drift by {change:.2g} over a record ({np.median(z):.0f} standard errors)"
+            f"the records' harmonics drift by {_pct(change, 2)} over a record ({np.median(z):.0f} standard errors)"
         )
     if np.median(id_res / scatter) > thresholds.residual_factor:
         return "structure_or_measurement", (
             f"the linear structure and sensor model cannot fit the records at w "
-            f"and 3w (sensor misfit {np.median(id_res):.2g}, "
+            f"and 3w (sensor misfit {_pct(np.median(id_res), 2)}, "
             f"{np.median(id_res / scatter):.0f} x the scatter)"
         )
     if stage["open_fraction"] > 0:
