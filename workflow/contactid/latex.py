@@ -10,6 +10,8 @@ from typing import Mapping
 import numpy as np
 import pandas as pd
 
+from .model_checks import FRICTION_CONSEQUENCE, FRICTION_FINDING, STIFFNESS_CONSEQUENCE, STIFFNESS_FINDING
+
 
 def _fmt(v, digits: int = 4) -> str:
     """A number in LaTeX (scientific notation as \\num-like m \\times 10^{e})."""
@@ -373,6 +375,9 @@ def data_checks_text(summary: Mapping) -> str:
     return "\n".join(line for line in lines if line) + "\n"
 
 
+TEX_SYMBOLS = {"k_t": "$k_t$", "k_n": "$k_n$", "S": "$S$"}  # the model checks' symbols in LaTeX
+
+
 def model_checks_text(checks: list) -> str:
     """The report's paragraph on each fit against the accuracy it assumes (``contactid.model_checks``; summary.json's
     ``model_checks``): a sentence per check, the consequence spelled out where one fails. Empty without checks."""
@@ -389,11 +394,10 @@ def model_checks_text(checks: list) -> str:
                 said.append(head + "): the structure with contact springs reproduces the identified frequencies.")
             else:
                 said.append(
-                    head + rf", $p = {_fmt(c['p_value'], 2)}$): \textbf{{the structure with contact springs "
-                    r"cannot reproduce the identified frequencies within their uncertainty}; $k_t$ and $k_n$ absorb a "
-                    r"structural error (masses, lever arm, clamp, or a Young's modulus beyond its prior) and their "
-                    r"intervals hold for the model's structure only. Model updating (the gap diagnosis) says which "
-                    r"structural change the data support."
+                    head
+                    + rf", $p = {_fmt(c['p_value'], 2)}$): \textbf{{{STIFFNESS_FINDING}}}; "
+                    + STIFFNESS_CONSEQUENCE.format(**TEX_SYMBOLS)
+                    + "."
                 )
         elif c["check"] == "friction_fit":
             head = rf"The friction law fits the identified $S$ to ${_fmt(100 * v, 3)}\,\%$ (NRMSE)"
@@ -402,9 +406,11 @@ def model_checks_text(checks: list) -> str:
             else:
                 said.append(
                     head + rf", \textbf{{${_fmt(v / lim, 3)}$ times the ${_fmt(100 * lim, 3)}\,\%$ its intervals "
-                    r"assume} (\texttt{friction.misfit\_floor}): the law, or the $S$ it is fitted to, does not "
-                    r"describe the record to that accuracy, and its parameters carry a model-form error their "
-                    r"profile-likelihood intervals do not hold; the gap section says where it lies."
+                    r"assume} (\texttt{friction.misfit\_floor}): "
+                    + FRICTION_FINDING.format(**TEX_SYMBOLS)
+                    + "; "
+                    + FRICTION_CONSEQUENCE
+                    + "."
                 )
     if not said:
         return ""

@@ -23,6 +23,23 @@ from __future__ import annotations
 
 import math
 
+# What a failed check means, said once for the rule logs (plain text) and the report (LaTeX, ``contactid.latex``):
+# the finding, then its consequence; {k_t}, {k_n} and {S} are the symbols as each medium writes them
+STIFFNESS_FINDING = (
+    "the structure with contact springs cannot reproduce the identified frequencies within their uncertainty"
+)
+STIFFNESS_CONSEQUENCE = (
+    "{k_t} and {k_n} absorb a structural error (masses, lever arm, clamp, or a Young's modulus beyond its prior) and "
+    "their intervals hold for the model's structure only. Model updating (the gap diagnosis) says which structural "
+    "change the data support"
+)
+FRICTION_FINDING = "the law, or the {S} it is fitted to, does not describe the record to that accuracy"
+FRICTION_CONSEQUENCE = (
+    "its parameters carry a model-form error their profile-likelihood intervals do not hold (the gap diagnosis says "
+    "where it lies)"
+)
+PLAIN = {"k_t": "k_t", "k_n": "k_n", "S": "S"}
+
 
 def stiffness_fit_check(chi2_min: float, n_frequencies: int, confidence: float) -> dict | None:
     """The stiffness fit's consistency: ``chi2_min`` (the weighted misfit's minimum over k_t, k_n) against the
@@ -45,11 +62,8 @@ def stiffness_fit_check(chi2_min: float, n_frequencies: int, confidence: float) 
         )
     else:
         message = (
-            f"{head}, beyond the limit {limit:.3g} at {100 * confidence:g} % (p = {p:.2g}): the structure with "
-            "contact springs cannot reproduce the identified frequencies within their uncertainty; k_t and k_n "
-            "absorb a structural error (masses, lever arm, clamp, or a Young's modulus beyond its prior) and their "
-            "intervals hold for the model's structure only. Model updating (the gap diagnosis) says which structural "
-            "change the data support"
+            f"{head}, beyond the limit {limit:.3g} at {100 * confidence:g} % (p = {p:.2g}): {STIFFNESS_FINDING}; "
+            + STIFFNESS_CONSEQUENCE.format(**PLAIN)
         )
     return {
         "check": "stiffness_fit",
@@ -74,9 +88,7 @@ def friction_fit_check(misfit_nrmse: float, misfit_floor: float) -> dict:
         ratio = value / limit if limit > 0 else math.inf
         message = (
             f"{head}, {ratio:.3g} times the accuracy its intervals assume ({100 * limit:.3g} %, "
-            "friction.misfit_floor): the law, or the S it is fitted to, does not describe the record to that "
-            "accuracy; the parameters carry a model-form error their profile-likelihood intervals do not hold "
-            "(the gap diagnosis says where it lies)"
+            f"friction.misfit_floor): {FRICTION_FINDING.format(**PLAIN)}; {FRICTION_CONSEQUENCE}"
         )
     return {"check": "friction_fit", "value": value, "limit": limit, "passed": passed, "message": message}
 
