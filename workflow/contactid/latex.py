@@ -219,14 +219,17 @@ def tabular(
     }
     head = " & ".join(columns.values()) + r" \\"
     decimals = dict(decimals or {})
-    # the place of the last digit each interval's value prints to, {bound column: power of ten}, per row
-    bound_place: list[dict] = [{} for _ in range(len(df))]
+    # per row, the digits an interval's value prints with (``significant_digits``) and its bounds' digits, which end at
+    # the value's last digit; every other number prints with ``digits``
+    row_digits: list[dict] = [{} for _ in range(len(df))]
     for col, (lo, hi) in (intervals or {}).items():
         for i, (x, a, b) in enumerate(zip(df[col], df[lo], df[hi])):
-            n = significant_digits(float(x), float(a), float(b)) if np.isfinite(x) else 0
-            if n and x != 0:
+            n = row_digits[i][col] = significant_digits(float(x), float(a), float(b))
+            if n and math.isfinite(x) and x != 0:
                 place = math.floor(math.log10(abs(float(x)))) - n + 1
-                bound_place[i].update({lo: place, hi: place})
+                for bound, y in ((lo, a), (hi, b)):
+                    if math.isfinite(y) and y != 0:
+                        row_digits[i][bound] = max(1, math.floor(math.log10(abs(float(y)))) - place + 1)
     rows = []
     for i in range(len(df)):
         cells = []
@@ -241,13 +244,7 @@ def tabular(
             if col in decimals and math.isfinite(x):
                 cells.append(f"${float(x):.{decimals[col]}f}$")
                 continue
-            n = digits
-            if intervals and col in intervals:
-                n = significant_digits(
-                    float(x), float(df[intervals[col][0]].iloc[i]), float(df[intervals[col][1]].iloc[i])
-                )
-            elif col in bound_place[i] and math.isfinite(x) and x != 0:
-                n = max(1, math.floor(math.log10(abs(float(x)))) - bound_place[i][col] + 1)
+            n = row_digits[i].get(col, digits)
             cells.append("$0$" if n == 0 else f"${_fmt(x, n)}$")
         rows.append(" & ".join(cells) + r" \\")
     spec = "l" + "r" * (len(columns) - 1)
