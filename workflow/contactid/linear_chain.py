@@ -340,6 +340,11 @@ def linear_modes_dataset(
     x = np.linspace(0.0, params.length, grid_points)
     phi, dphi = shape_on_grid(model, modes.shapes, x)
     V = modes.shapes
+    attrs = {"k_n_choice": how, "normalisation": "phi^T M phi = 1"}
+    # the stiffness fit's prior and weights, for a diagnosis that redoes the fit (``gap.model.IdentifiedModel``)
+    attrs["stiffness_scale_sd"] = float(stiction.attrs.get("stiffness_scale_sd", 0.0))
+    if "frequency_sigma" in stiction:
+        attrs["frequency_sigma_hz"] = np.asarray(stiction["frequency_sigma"].values, dtype=float)
     return xr.Dataset(
         {
             "natural_frequency": (
@@ -389,5 +394,5 @@ def linear_modes_dataset(
             "mode": np.arange(1, n_modes + 1),
             "sensor": list(structure_cfg["sensors"]["names"]),
         },
-        attrs={"k_n_choice": how, "normalisation": "phi^T M phi = 1"},
+        attrs=attrs,
     )

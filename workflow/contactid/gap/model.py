@@ -72,7 +72,10 @@ class IdentifiedModel:
     """The chain's identified model: structure (with identified k_t, k_n), damping ratios of the
     identified structural modes (by order), friction parameters (e_f, k_c, e_t, kappa, mu), preload
     N0 (N), the number of stuck modes kept and the integration oversampling; the reading of Eq. 21
-    the friction law was fitted with (``regularization``, from friction_fit.nc)."""
+    the friction law was fitted with (``regularization``, from friction_fit.nc). The chain's stiffness fit, for
+    a candidate that redoes it (``structure_with``): the identified natural frequencies (Hz), their weights
+    ``frequency_sigma`` (Hz; empty: relative residuals), the prior sd of ln(E / ``config_modulus``)
+    (``stiffness_scale_sd``; 0: E held) and the config's Young's modulus ``config_modulus`` (Pa)."""
 
     structure: StructureParameters
     damping: tuple
@@ -82,11 +85,15 @@ class IdentifiedModel:
     oversampling: int = 8
     frequencies: tuple = ()
     regularization: str = "none"
+    frequency_sigma: tuple = ()
+    stiffness_scale_sd: float = 0.0
+    config_modulus: float = 0.0
 
     def structure_with(self, aug: Augmentation) -> StructureParameters:
         """The structure with the augmentation's changes; changed masses re-fit k_t and k_n to the identified
-        natural frequencies (the linear chain redone with the effect in the model); a changed shortening leaves them
-        (a second-order term: the linear chain does not see it)."""
+        natural frequencies, and Young's modulus with them where the chain's stiffness fit freed it (the linear
+        chain's stiffness fit redone with the effect in the model, ``_refit_contact``); a changed shortening leaves
+        them (a second-order term: the linear chain does not see it)."""
         p = self.structure
         if aug.shortening_change:
             p = p.replace(shortening_scale=p.shortening_scale * (1.0 + aug.shortening_change))
@@ -96,7 +103,9 @@ class IdentifiedModel:
                 sensor_masses=tuple(m * x for x in p.sensor_masses), force_transducer_mass=m * p.force_transducer_mass
             )
             if self.frequencies:
-                p = _refit_contact(p, self.frequencies)
+                p = _refit_contact(
+                    p, self.frequencies, self.frequency_sigma, self.stiffness_scale_sd, self.config_modulus
+                )
         return p
 
     def with_friction(self, friction) -> "IdentifiedModel":
@@ -111,8 +120,13 @@ def identified_model(
     n_modes: int = 8,
     oversampling: int = 8,
 ) -> IdentifiedModel:
-    """The identified model from the chain's datasets (linear_modes.nc, modal.nc, friction_fit.nc)."""
+    """The identified model from the chain's datasets (linear_modes.nc, modal.nc, friction_fit.nc); the stiffness
+    fit's prior and weights from linear_modes.nc's attributes where it has them (otherwise E held, relative
+    residuals: the fit of datasets written before they were kept)."""
     params = identified_structure(structure_cfg, linear_modes)
+    scale = float(linear_modes["stiffness_scale"]) if "stiffness_scale" in linear_modes else 1.0
+    attrs = getattr(linear_modes, "attrs", {})
+    sigma = tuple(float(s) for s in np.atleast_1d(attrs.get("frequency_sigma_hz", ())))
     return IdentifiedModel(
         params,
         tuple(float(z) for z in modal["damping_ratio"].values),
@@ -122,6 +136,9 @@ def identified_model(
         int(oversampling),
         tuple(float(f) for f in modal["natural_frequency"].values),
         str(friction_fit.attrs["regularization"]),
+        sigma if len(sigma) == modal.sizes["mode"] else (),
+        float(attrs.get("stiffness_scale_sd", 0.0)),
+        params.youngs_modulus / scale,
     )
 
 
@@ -130,10 +147,24 @@ KN_REFIT_ABOVE = 1.0
 
 
 @lru_cache(maxsize=64)
-def _refit_contact(params: StructureParameters, frequencies: tuple) -> StructureParameters:
-    """k_t and k_n that best fit the identified natural frequencies (relative least squares on a log scale, from the
-    current values): the stiction fit of the linear chain, redone (with its Jacobian, ``stiction.JACOBIAN``), k_t
-    within two decades of its value, k_n from two decades below to ``KN_REFIT_ABOVE`` decades above.
+def _refit_contact(
+    params: StructureParameters,
+    frequencies: tuple,
+    sigma: tuple = (),
+    scale_sd: float = 0.0,
+    config_modulus: float = 0.0,
+) -> StructureParameters:
+    """k_t and k_n (and, with ``scale_sd`` > 0, Young's modulus) that best fit the identified natural frequencies
+    (Hz): the stiffness fit of the linear chain (``stiction.stiction_stiffness``), redone from the current values
+    (with its Jacobian, ``stiction.JACOBIAN``); k_t within two decades of its value, k_n from two decades below to
+    ``KN_REFIT_ABOVE`` decades above.
+
+    Residuals (f - f_id) / ``sigma`` (the chain's weights, Hz; empty: relative residuals f / f_id - 1) and, with
+    ``scale_sd`` > 0, the chain's prior ln(E / ``config_modulus``) / ``scale_sd`` on a free E within
+    ``stiction.LN_SCALE_BOUNDS`` of the config's. Held at the chain's E, a mass candidate's refit gave the chain's
+    stiffness scale (1.0043 on transducer masses 30 % heavy: the scale had taken up part of the mass error) to the
+    refitted structure, and the candidate's calibration settled at +62 %; with E refitted as the chain fits it,
+    at +30.5 % (docs/measurements.md, twenty-fifth session).
 
     Above, the frequencies hardly feel k_n (the contact is rigid for them): refitted up to two decades above, k_n ran
     to that bound, 100 times the chain's value, at a transducer-mass error of 10 % or more, for a misfit smaller by
@@ -143,15 +174,35 @@ def _refit_contact(params: StructureParameters, frequencies: tuple) -> Structure
     from scipy.optimize import least_squares
 
     from ..beam_model import ContactFrequencyMap
-    from ..stiction import JACOBIAN
+    from ..stiction import JACOBIAN, LN_SCALE_BOUNDS
 
     f_id = np.asarray(frequencies)
     fmap = ContactFrequencyMap(params, len(f_id))
     x0 = np.log10([params.k_t, params.k_n])
+    lo, hi = x0 - 2, x0 + [2, KN_REFIT_ABOVE]
+    weights = np.asarray(sigma, dtype=float) if len(sigma) == len(f_id) else f_id
+    if scale_sd > 0 and config_modulus > 0:
+        ln_s0 = float(np.log(params.youngs_modulus / config_modulus))  # the current E over the config's
+
+        def residuals(x):
+            r = (fmap(10.0 ** x[0], 10.0 ** x[1], float(np.exp(x[2]))) - f_id) / weights
+            return np.append(r, (ln_s0 + x[2]) / scale_sd)
+
+        res = least_squares(
+            residuals,
+            [*x0, 0.0],
+            bounds=([*lo, LN_SCALE_BOUNDS[0] - ln_s0], [*hi, LN_SCALE_BOUNDS[1] - ln_s0]),
+            x_scale=[0.1, 0.1, 0.01],
+            xtol=1e-10,
+            ftol=1e-12,
+            **JACOBIAN,
+        )
+        p = params.with_contact(float(10.0 ** res.x[0]), float(10.0 ** res.x[1]))
+        return p.replace(youngs_modulus=params.youngs_modulus * float(np.exp(res.x[2])))
     res = least_squares(
-        lambda x: fmap(10.0 ** x[0], 10.0 ** x[1]) / f_id - 1,
+        lambda x: (fmap(10.0 ** x[0], 10.0 ** x[1]) - f_id) / weights,
         x0,
-        bounds=(x0 - 2, x0 + [2, KN_REFIT_ABOVE]),
+        bounds=(lo, hi),
         x_scale=0.1,
         xtol=1e-10,
         ftol=1e-12,
