@@ -78,3 +78,41 @@ def test_a_channel_delay_search_holds_the_random_tests_common_delay():
     # where zero is no worse, zero
     flat = _per_channel_theta(lambda th: (1.0,), LIBRARY["channel_time_skew"], rec, 10, common)
     assert np.all(flat == 0.0)
+
+
+def test_a_state_that_differs_from_its_neighbours_does_not_stop_the_search():
+    """A calibration gap evaluated from another start can land on another periodic state (the transducer-mass
+    candidate at +41.2 %: gap 0.036 beside 0.0165 at +41.7 %, 0.0153 when reached from elsewhere). Beside the best
+    point it made the quadratic through the two a wall, and the search stopped at +41.7 % on data 30 % heavy; points
+    closer than 2 xatol now count once (the better), and the search goes on to the minimum."""
+    calls = []
+
+    def r(t):
+        calls.append(t)
+        return np.array([t - 0.3, 0.002])
+
+    points = {t: r(t) for t in (0.075, 0.4167, 1.05)}
+    points[0.4117] = 3.0 * r(0.4117)  # the other state
+    calls.clear()
+    best = residual_line_search(r, points, 0.075, 1.05, xatol=3.9e-3, max_evaluations=10)
+    assert best == pytest.approx(0.3, abs=3.9e-3)
+    assert len(calls) <= 2
+
+
+def test_a_model_the_data_contradict_refines_its_bracket():
+    """Where the quadratic's minimum falls on an evaluated point worse than the best (there, on the real data set,
+    the other periodic state above), that point is set aside and the bracket around the best halved on both sides;
+    the search then finds the basin the wide trio did not see (here a residual that changes branch between 0.1 and
+    0.4, as the mass candidate's does where its frequency refit reaches its k_n cap)."""
+    calls = []
+
+    def r(t):
+        calls.append(t)
+        return np.array([t - 0.3, 0.002]) if 0.1 <= t <= 0.4 else np.array([t - 0.4117, 0.06])
+
+    points = {t: r(t) for t in (0.075, 0.4167, 1.05)}
+    points[0.4117] = np.array([0.05, 0.06])  # the trio's minimum, worse than at 0.4167
+    calls.clear()
+    best = residual_line_search(r, points, 0.075, 1.05, xatol=3.9e-3, max_evaluations=10)
+    assert calls[:2] == pytest.approx([0.5 * (0.4167 + 0.075), 0.5 * (0.4167 + 1.05)])
+    assert best == pytest.approx(0.3, abs=3.9e-3)
