@@ -201,7 +201,7 @@ def updated_model(model, modal: xr.Dataset, calibration, fit_settings, settings,
                 len(upd.factors),
             )
             return model, upd
-        from .diagnosis import records_test_of_update
+        from .diagnosis import records_attribution, records_test_of_update
 
         p = upd.proposal
         m2 = _refitted(model, upd.proposed_structure(), calibration, fit_settings, seed)
@@ -219,6 +219,17 @@ def updated_model(model, modal: xr.Dataset, calibration, fit_settings, settings,
                 test["record_scatter"],
             )
             return model, dataclasses.replace(upd, records_test=test)
+        test["attribution"] = records_attribution(
+            model,
+            p["factors"],
+            lambda f: _without_factor(model, upd, f),
+            calibration,
+            held_out,
+            fit_settings.bounds,
+            test["record_scatter"],
+            test["heldout_gap_chain"],
+            settings,
+        )
         log.info(
             "model updating: accepted by the records (chi2 %.3g -> %.3g, not significant alone; held-out gap "
             "%.4g -> %.4g, records' scatter %.2g): %s, k_t %.4g, k_n %.4g N/m; friction law refitted",
@@ -241,6 +252,20 @@ def updated_model(model, modal: xr.Dataset, calibration, fit_settings, settings,
         upd.k_n,
     )
     return _refitted(model, upd.structure, calibration, fit_settings, seed), upd
+
+
+def _without_factor(model, upd, factor: str):
+    """The structure of ``upd``'s proposal with ``factor`` at 1 (the others as proposed), k_t and k_n refitted to the
+    chain's frequencies (``gap.model._refit_contact``, E as the factors set it)."""
+    from ..updating import apply_factors
+    from .model import _refit_contact
+
+    p = upd.proposal
+    factors = {k: (1.0 if k == factor else float(v)) for k, v in p["factors"].items()}
+    s = apply_factors(upd.nominal.with_contact(float(p["k_t"]), float(p["k_n"])), factors)
+    if not model.frequencies:
+        return s
+    return _refit_contact(s, model.frequencies, model.frequency_sigma, 0.0, model.config_modulus)
 
 
 def _refitted(model, structure, calibration, fit_settings, seed: int):

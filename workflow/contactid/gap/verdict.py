@@ -215,6 +215,17 @@ def records_accept_update(gap_chain: float, gap_updated: float, scatter: float, 
     return explains_materially(gap_chain, gap_updated, scatter, settings)
 
 
+def records_carry_factor(gap_chain: float, alone: float, without: float, scatter: float, settings) -> bool:
+    """Whether the dual-sine records put an accepted update on one factor: that factor's effect alone (held-out gap
+    ``alone``) explains the chain's gap materially (``records_accept_update``) and the update without the factor
+    (``without``) leaves ``settings.separation`` times as much, as a verdict's runner-up must
+    (``diagnosis.records_attribution``)."""
+    return (
+        records_accept_update(gap_chain, alone, scatter, settings)
+        and without >= _setting(settings, "separation") * alone
+    )
+
+
 def retried(first_thetas: Mapping[str, Sequence], library: Mapping, settings) -> list:
     """The candidates the explanation tries again after its first step: those whose refit alone moved them off
     (a candidate the calibration case sets off on its own is not tried on what later steps leave), or all of them
@@ -255,7 +266,10 @@ UPDATING_Z = 2.0  # a factor moved when |ln factor| exceeds this many posterior 
 
 
 def updating_effect(
-    factors: Mapping[str, float], identifiability: Mapping[str, Mapping], by_records: bool = False
+    factors: Mapping[str, float],
+    identifiability: Mapping[str, Mapping],
+    by_records: bool = False,
+    attribution: Mapping | None = None,
 ) -> str | None:
     """The library effect an accepted model update amounts to: when exactly one structural factor moved and it maps
     to an effect (UPDATING_EFFECTS), that effect; else None. A factor moved when holding it at its nominal value
@@ -268,7 +282,12 @@ def updating_effect(
     ``by_records``: the update was accepted by the dual-sine records, not by the random test's chi^2 test, whose
     profiles then stay below UPDATING_Z^2 (the detection ladder's transducer masses +10 %: 1.1-1.2). The records
     have shown the update is real; the random test's profiles still say which factor carries it: the one whose
-    profile is at least UPDATING_Z^2 times every other factor's (1.24 against 0.03 there)."""
+    profile is at least UPDATING_Z^2 times every other factor's (1.24 against 0.03 there). Where the profiles do not
+    tell (the ladder's transducer masses +3 %: 0.081 against the mass scale's 0.045), the records' own
+    ``attribution`` (``diagnosis.records_attribution``: the factor whose effect alone explains the gap and without
+    which the update does not) names it."""
+    if by_records and attribution and attribution.get("effect"):
+        return str(attribution["effect"])
     if by_records:
         profiles = {f: identifiability[f].get("profile_chi2_increase") for f in factors}
         if not profiles or any(v is None for v in profiles.values()):
