@@ -925,9 +925,13 @@ def records_attribution(
     cases = list(held_out)
 
     def heldout(model, aug):
-        model = evaluate(model, aug, calibration, bounds, H)[1]
-        sims = {c: evaluate(model, aug, held_out[c], None, H, refit=False)[2] for c in cases}
-        return heldout_gap_of(held_out, cases, H, sims)
+        try:
+            model = evaluate(model, aug, calibration, bounds, H)[1]
+            sims = {c: evaluate(model, aug, held_out[c], None, H, refit=False)[2] for c in cases}
+            return heldout_gap_of(held_out, cases, H, sims)
+        except (ValueError, FloatingPointError) as exc:  # the law or the simulation fails there: it explains nothing
+            log.info("model updating, by the records: %s", exc)
+            return float("inf")
 
     out, named = {}, []
     for f, v in factors.items():
@@ -937,7 +941,7 @@ def records_attribution(
         HarmonicBalance.forget()
         alone = heldout(chain, LIBRARY[effect].augmentation(UPDATING_THETA[f](float(v))))
         without = heldout(dataclasses.replace(chain, structure=structure_without(f)), NONE)
-        out[f] = {"alone": alone, "without": without}
+        out[f] = {k: (g if np.isfinite(g) else None) for k, g in (("alone", alone), ("without", without))}
         if records_carry_factor(gap_chain, alone, without, record_scatter, settings):
             named.append(effect)
         log.info(
@@ -1062,11 +1066,8 @@ def _updating_verdict(updating, names, gap_before, gap_after, shares, scatter, s
         return None
     if attribution and attribution.get("effect") == effect and by_records:
         f = next(k for k, v in UPDATING_EFFECTS.items() if v == effect)
-        g = attribution["factors"][f]
-        why = (
-            f"the records tell the factor: {effect} alone leaves {g['alone']:.3g}, the update without it "
-            f"{g['without']:.3g}"
-        )
+        g = {k: ("nothing finite" if v is None else f"{v:.3g}") for k, v in attribution["factors"][f].items()}
+        why = f"the records tell the factor: {effect} alone leaves {g['alone']}, the update without it {g['without']}"
     elif by_records:
         why = f"the random test's profiles put it on the {effect.replace('_error', '')} factor"
     else:
