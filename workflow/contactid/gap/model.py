@@ -75,7 +75,9 @@ class IdentifiedModel:
     the friction law was fitted with (``regularization``, from friction_fit.nc). The chain's stiffness fit, for
     a candidate that redoes it (``structure_with``): the identified natural frequencies (Hz), their weights
     ``frequency_sigma`` (Hz; empty: relative residuals), the prior sd of ln(E / ``config_modulus``)
-    (``stiffness_scale_sd``; 0: E held) and the config's Young's modulus ``config_modulus`` (Pa)."""
+    (``stiffness_scale_sd``; 0: E held), the config's Young's modulus ``config_modulus`` (Pa), and whether the
+    frequencies bound k_n (``k_n_bounded``: the linear modes use the fit's k_n; otherwise they use the prior, and a
+    refit holds it)."""
 
     structure: StructureParameters
     damping: tuple
@@ -88,6 +90,7 @@ class IdentifiedModel:
     frequency_sigma: tuple = ()
     stiffness_scale_sd: float = 0.0
     config_modulus: float = 0.0
+    k_n_bounded: bool = True
 
     def structure_with(self, aug: Augmentation) -> StructureParameters:
         """The structure with the augmentation's changes; changed masses re-fit k_t and k_n to the identified
@@ -104,7 +107,12 @@ class IdentifiedModel:
             )
             if self.frequencies:
                 p = _refit_contact(
-                    p, self.frequencies, self.frequency_sigma, self.stiffness_scale_sd, self.config_modulus
+                    p,
+                    self.frequencies,
+                    self.frequency_sigma,
+                    self.stiffness_scale_sd,
+                    self.config_modulus,
+                    self.k_n_bounded,
                 )
         return p
 
@@ -139,6 +147,7 @@ def identified_model(
         sigma if len(sigma) == modal.sizes["mode"] else (),
         float(attrs.get("stiffness_scale_sd", 0.0)),
         params.youngs_modulus / scale,
+        str(attrs.get("k_n_choice", "best fit")) == "best fit",
     )
 
 
@@ -153,6 +162,7 @@ def _refit_contact(
     sigma: tuple = (),
     scale_sd: float = 0.0,
     config_modulus: float = 0.0,
+    refit_k_n: bool = True,
 ) -> StructureParameters:
     """k_t and k_n (and, with ``scale_sd`` > 0, Young's modulus) that best fit the identified natural frequencies
     (Hz): the stiffness fit of the linear chain (``stiction.stiction_stiffness``), redone from the current values
@@ -165,6 +175,12 @@ def _refit_contact(
     stiffness scale (1.0043 on transducer masses 30 % heavy: the scale had taken up part of the mass error) to the
     refitted structure, and the candidate's calibration settled at +62 %; with E refitted as the chain fits it,
     at +30.5 % (docs/measurements.md, twenty-fifth session).
+
+    ``refit_k_n`` False: where the frequencies bound k_n from one side only, the chain's linear modes use the prior
+    k_n, not the fit's; so does the refit (the fit is the chain's, k_n then set to the prior: at no mass change the
+    chain's structure). Returning the fit's k_n moved it to the cap, ten times the prior, at any mass change (+0.8 %
+    on a compound benchmark item): the candidate then stood for a normal contact ten times stiffer, and explained
+    61 % of what a preload drift left of a multi-asperity friction's gap.
 
     Above, the frequencies hardly feel k_n (the contact is rigid for them): refitted up to two decades above, k_n ran
     to that bound, 100 times the chain's value, at a transducer-mass error of 10 % or more, for a misfit smaller by
@@ -181,11 +197,18 @@ def _refit_contact(
     x0 = np.log10([params.k_t, params.k_n])
     lo, hi = x0 - 2, x0 + [2, KN_REFIT_ABOVE]
     weights = np.asarray(sigma, dtype=float) if len(sigma) == len(f_id) else f_id
+
+    def contact(x):
+        return float(10.0 ** x[0]), float(10.0 ** x[1])
+
+    def result(x):  # k_n held where the chain's modes use the prior: the fit's k_n (flat there) is not used
+        return float(10.0 ** x[0]), (float(10.0 ** x[1]) if refit_k_n else params.k_n)
+
     if scale_sd > 0 and config_modulus > 0:
         ln_s0 = float(np.log(params.youngs_modulus / config_modulus))  # the current E over the config's
 
         def residuals(x):
-            r = (fmap(10.0 ** x[0], 10.0 ** x[1], float(np.exp(x[2]))) - f_id) / weights
+            r = (fmap(*contact(x), float(np.exp(x[2]))) - f_id) / weights
             return np.append(r, (ln_s0 + x[2]) / scale_sd)
 
         res = least_squares(
@@ -197,10 +220,10 @@ def _refit_contact(
             ftol=1e-12,
             **JACOBIAN,
         )
-        p = params.with_contact(float(10.0 ** res.x[0]), float(10.0 ** res.x[1]))
+        p = params.with_contact(*result(res.x))
         return p.replace(youngs_modulus=params.youngs_modulus * float(np.exp(res.x[2])))
     res = least_squares(
-        lambda x: (fmap(10.0 ** x[0], 10.0 ** x[1]) - f_id) / weights,
+        lambda x: (fmap(*contact(x)) - f_id) / weights,
         x0,
         bounds=(lo, hi),
         x_scale=0.1,
@@ -208,7 +231,7 @@ def _refit_contact(
         ftol=1e-12,
         **JACOBIAN,
     )
-    return params.with_contact(float(10.0 ** res.x[0]), float(10.0 ** res.x[1]))
+    return params.with_contact(*result(res.x))
 
 
 @lru_cache(maxsize=32)
