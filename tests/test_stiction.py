@@ -201,3 +201,32 @@ def test_a_mass_candidates_refit_redoes_the_chains_stiffness_fit_with_youngs_mod
     same = _refit_contact.__wrapped__(chain, tuple(f), tuple(sigma), 0.05, E0)
     assert same.youngs_modulus == pytest.approx(chain.youngs_modulus, rel=1e-5)
     assert same.k_t == pytest.approx(chain.k_t, rel=1e-3)
+
+
+def test_where_k_n_is_the_prior_a_mass_candidates_refit_keeps_it(default_config):
+    """The frequencies bound k_n from one side only (the default data, most benchmark rigs): the chain's linear modes
+    use the prior k_n. A mass candidate's refit keeps it (``refit_k_n`` False, from linear_modes.nc's k_n_choice); at
+    no mass change it returns the chain's structure. Returning the fit's k_n, flat there, a mass change of +0.8 % set
+    k_n to the cap, ten times the prior: the candidate stood for another normal contact."""
+    from contactid.gap.model import KN_REFIT_ABOVE, _refit_contact
+    from contactid.parameters import structure_from_config
+
+    nominal = structure_from_config(default_config["structure"], 1.0e7, 1.0e8)
+    E0 = nominal.youngs_modulus
+    truth = nominal.with_contact(1.43e7, 1.0e9)  # a contact the frequencies see as rigid
+    f = natural_frequencies(truth, 3)
+    sigma = frequency_sigma(f, np.zeros(3), 1e-3)
+    fit = stiction_stiffness(nominal, f, sigma, stiffness_scale_sd=0.05)
+    assert not fit.k_n_bounded_above
+    prior = 2.37e7
+    chain = nominal.with_contact(fit.k_t, prior).replace(youngs_modulus=E0 * fit.stiffness_scale)
+    heavier = chain.replace(sensor_masses=tuple(1.008 * m for m in chain.sensor_masses))
+    free = _refit_contact.__wrapped__(heavier, tuple(f), tuple(sigma), 0.05, E0)
+    held = _refit_contact.__wrapped__(heavier, tuple(f), tuple(sigma), 0.05, E0, False)
+    assert free.k_n > 5 * prior and free.k_n <= 10**KN_REFIT_ABOVE * prior * (1 + 1e-9)  # the runaway
+    assert held.k_n == prior
+    same = _refit_contact.__wrapped__(chain, tuple(f), tuple(sigma), 0.05, E0, False)
+    # within the cap of the fit's k_n (a decade above the prior; the chain's own fit went further): k_t within 0.3 %,
+    # E within 0.05 % (here -0.25 % and +0.04 %)
+    assert same.k_n == prior and same.k_t == pytest.approx(chain.k_t, rel=3e-3)
+    assert same.youngs_modulus == pytest.approx(chain.youngs_modulus, rel=5e-4)
