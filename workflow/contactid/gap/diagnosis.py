@@ -48,6 +48,7 @@ from .verdict import (
     gap_shares,
     open_fraction,
     place as _place_of,
+    records_carry_factor,
     retried,
     updating_effect,
 )
@@ -919,8 +920,6 @@ def records_attribution(
     the mass scale's 0.045; the records: the masses alone leave 0.0026 of the chain's 0.0246, the update without
     them 0.0074, its k_t and k_n refitted taking up part of it). Returns {"factors": {factor: {"alone": gap,
     "without": gap}}, "effect": name or None}."""
-    from .verdict import UPDATING_EFFECTS, records_carry_factor
-
     H = settings.n_harmonics
     cases = list(held_out)
 
