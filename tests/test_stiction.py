@@ -230,3 +230,41 @@ def test_where_k_n_is_the_prior_a_mass_candidates_refit_keeps_it(default_config)
     # E within 0.05 % (here -0.25 % and +0.04 %)
     assert same.k_n == prior and same.k_t == pytest.approx(chain.k_t, rel=3e-3)
     assert same.youngs_modulus == pytest.approx(chain.youngs_modulus, rel=5e-4)
+
+
+def test_records_attribution_structure_without_a_factor_keeps_the_prior_k_n(default_config):
+    """The records' attribution (``gap.pipeline._without_factor``) redoes the stiffness fit of the proposal with one
+    factor at 1 as a mass candidate's refit does: where the chain's modes use the prior k_n, it keeps it (before,
+    the fit's flat k_n ran towards the cap, and the structure without the factor stood for another normal
+    contact); where the frequencies bound k_n, it is refitted."""
+    from types import SimpleNamespace
+
+    from contactid.gap.pipeline import _without_factor
+    from contactid.parameters import structure_from_config
+
+    nominal = structure_from_config(default_config["structure"], 1.0e7, 1.0e8)
+    E0 = nominal.youngs_modulus
+    truth = nominal.with_contact(1.43e7, 1.0e9)  # a contact the frequencies see as rigid
+    f = natural_frequencies(truth, 3)
+    sigma = frequency_sigma(f, np.zeros(3), 1e-3)
+    prior = 2.37e7
+    upd = SimpleNamespace(
+        nominal=nominal,
+        proposal={
+            "factors": {"stiffness_scale": 1.0, "mass_scale": 1.0, "transducer_mass_scale": 0.992},
+            "k_t": 1.43e7,
+            "k_n": prior,
+        },
+    )
+
+    def model(bounded):
+        return SimpleNamespace(
+            frequencies=tuple(f), frequency_sigma=tuple(sigma), config_modulus=E0, k_n_bounded=bounded
+        )
+
+    held = _without_factor(model(False), upd, "stiffness_scale")  # transducer masses 0.8 % light stay
+    free = _without_factor(model(True), upd, "stiffness_scale")
+    assert held.k_n == prior
+    assert free.k_n > 5 * prior  # flat: the fit's k_n runs towards the cap
+    # k_t refitted to the frequencies either way (the lighter transducers leave it within a few per cent)
+    assert held.k_t == pytest.approx(1.43e7, rel=0.05) and held.k_t != 1.43e7

@@ -256,7 +256,8 @@ def updated_model(model, modal: xr.Dataset, calibration, fit_settings, settings,
 
 def _without_factor(model, upd, factor: str):
     """The structure of ``upd``'s proposal with ``factor`` at 1 (the others as proposed), k_t and k_n refitted to the
-    chain's frequencies (``gap.model._refit_contact``, E as the factors set it)."""
+    chain's frequencies (``gap.model._refit_contact``, E as the factors set it; k_n kept where the chain's modes use
+    the prior k_n, as a mass candidate's refit keeps it)."""
     from ..updating import apply_factors
     from .model import _refit_contact
 
@@ -265,7 +266,9 @@ def _without_factor(model, upd, factor: str):
     s = apply_factors(upd.nominal.with_contact(float(p["k_t"]), float(p["k_n"])), factors)
     if not model.frequencies:
         return s
-    return _refit_contact(s, model.frequencies, model.frequency_sigma, 0.0, model.config_modulus)
+    return _refit_contact(
+        s, model.frequencies, model.frequency_sigma, 0.0, model.config_modulus, getattr(model, "k_n_bounded", True)
+    )
 
 
 def _refitted(model, structure, calibration, fit_settings, seed: int):
