@@ -518,6 +518,97 @@ def test_every_figure_and_the_report_section_for_any_diagnosis(tmp_path, steps, 
         assert "nothing is added" in text and "structure\\_or\\_measurement" in text
 
 
+def test_the_waterfall_starts_where_the_explanation_starts_and_its_labels_fit():
+    """A model update as the first step starts from the chain's held-out gap (the shares are of its power), not from
+    where.heldout_gap_before, the updated model's: drawn from the latter, the update's bar rose above the first one
+    (a benchmark item, 17.3 -> 16.6 %, drawn from 16.6 %). Every label line fits the bar's width."""
+    from contactid.gap.figures import WATERFALL_LABEL_WIDTH, waterfall_bars
+
+    steps = [
+        {
+            "effect": "model_updating",
+            "parameters": {"transducer_mass_scale": 0.8},
+            "heldout_gap_before": 0.173,
+            "heldout_gap_after": 0.166,
+            "share": 0.074,
+        },
+        {
+            "effect": "structural_damping",
+            "parameters": {"extra_damping_ratio": 0.009},
+            "heldout_gap_before": 0.166,
+            "heldout_gap_after": 0.0086,
+            "share": 0.92,
+        },
+        {
+            "effect": "transducer_mass_error",
+            "parameters": {"mass_error": 0.05},
+            "heldout_gap_before": 0.0086,
+            "heldout_gap_after": 0.0037,
+            "share": 0.002,
+        },
+    ]
+    diag = _synthetic_diagnosis(steps, "structural_damping", 0.0037)
+    diag["where"]["heldout_gap_before"] = 0.166  # the updated model's
+    diag["remaining_gap"]["place"] = "structure_or_measurement"
+    labels, bottoms, heights, colors = waterfall_bars(diag)
+    assert heights[0] == pytest.approx(17.3) and bottoms[0] == 0.0
+    # each step spans its before -> after, so the bars join
+    for k, st in enumerate(steps, start=1):
+        assert bottoms[k] + heights[k] == pytest.approx(100 * st["heldout_gap_before"])
+        assert bottoms[k] == pytest.approx(100 * st["heldout_gap_after"])
+    assert heights[-1] == pytest.approx(0.37) and colors[-1] == "tab:blue"  # at the floor
+    assert all(len(line) <= WATERFALL_LABEL_WIDTH for label in labels for line in label.split("\n"))
+    assert labels[2].endswith("(92 %)")
+
+
+def test_a_winner_near_the_floor_keeps_its_reduction_readable(monkeypatch):
+    """The ranking's reduction label sits inside its bar in white; a bar too short to hold it (a winner that takes
+    the gap to the floor) gets it beside its whisker in black (it was white on white, clipped to "-9")."""
+    from contactid import print_style as ps
+    from contactid.gap import figures
+
+    steps = [
+        {
+            "effect": "transducer_mass_error",
+            "parameters": {"mass_error": -0.3},
+            "heldout_gap_before": 0.04,
+            "heldout_gap_after": 0.002,
+            "share": 0.99,
+        }
+    ]
+    diag = _synthetic_diagnosis(steps, "transducer_mass_error", 0.002)
+    drawn = {}
+    monkeypatch.setattr(ps, "save", lambda fig, png, pdf=None: drawn.setdefault("fig", fig))
+    figures.ranking(diag, "ranking.png")
+    texts = {t.get_gid(): t for t in drawn["fig"].axes[0].texts if t.get_gid()}
+    short, long_ = texts["reduction:transducer_mass_error"], texts["reduction:viscous_friction"]
+    assert short.get_color() == "black" and short.get_position()[0] > 0.2  # right of the 0.2 % bar
+    assert long_.get_color() == "white" and short.get_text() == "−95 %"
+    ps.pyplot().close(drawn["fig"])
+
+
+def test_a_benchmark_item_not_diagnosed_still_gets_its_files_and_figures(tmp_path):
+    """An item the rig could not simulate: its diagnosis.json says so, gap.nc has no variables, and each figure the
+    gap_benchmark_figures target draws says why (no step fails after the item's result exists)."""
+    import json
+    from pathlib import Path
+
+    import xarray as xr
+
+    from contactid.gap.benchmark import write_item_diagnosis
+    from contactid.gap.figures import failed_item_figures
+
+    out = {"diagnosis": tmp_path / "diagnosis.json", "dataset": tmp_path / "gap.nc"}
+    write_item_diagnosis(out, {"kind": "blind", "effect": "preload_drift"}, None, failed="lc3 is not finite")
+    d = json.loads(out["diagnosis"].read_text())
+    assert d["failed"] == "lc3 is not finite" and d["benchmark_item"]["effect"] == "preload_drift"
+    with xr.open_dataset(out["dataset"], engine="netcdf4") as ds:
+        assert not ds.data_vars and ds.attrs["failed"] == "lc3 is not finite"
+    figs = {v: str(tmp_path / f"gap_{v}.png") for v in ("stages", "explanation")}
+    failed_item_figures(d["failed"], figs)
+    assert all(Path(p).stat().st_size > 1000 for p in figs.values())
+
+
 @pytest.mark.slow
 def test_polish_searches_setting_polishes_every_searched_state(hc_data, monkeypatch):
     """gap.polish_searches reaches the candidate's search (as an argument of the task, so that a worker process sees

@@ -221,10 +221,13 @@ def gap_inputs(wildcards):
     return inputs
 
 
+# the gap diagnosis's figures (contactid.gap.figures: IN_REPORT + DIAGNOSTIC), one PNG each
+GAP_VIEWS = ("stages", "harmonics", "cycle", "force_state", "ranking", "shrink", "explanation")
+
+
 def gap_outputs():
     return ["results/gap/diagnosis.json", "results/gap/gap.nc", "results/gap/friction_intervals.json"] + [
-        f"results/gap/gap_{v}.png"
-        for v in ("stages", "harmonics", "cycle", "force_state", "ranking", "shrink", "explanation")
+        f"results/gap/gap_{v}.png" for v in GAP_VIEWS
     ]
 
 

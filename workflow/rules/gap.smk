@@ -125,6 +125,8 @@ rule gap_benchmark_item:
     """One blind-benchmark item: rig records with a hidden effect, the chain's identification and the gap diagnosis, scored against the hidden truth."""
     output:
         item="results/gap_benchmark/items/{item}.json",
+        diagnosis="results/gap_benchmark/items/{item}/diagnosis.json",
+        dataset="results/gap_benchmark/items/{item}/gap.nc",
     params:
         code=CODE_DIGEST,
         spec=lambda wc: {**benchmark_items(), **ladder_items()}[wc.item],
@@ -143,6 +145,33 @@ rule gap_benchmark_item:
         "logs/gap_benchmark/{item}.log",
     script:
         "../scripts/gap_benchmark_item.py"
+
+
+rule gap_benchmark_item_figures:
+    """One benchmark item's gap figures and report section, drawn from its diagnosis as `snakemake gap` draws the configured data's."""
+    input:
+        diagnosis="results/gap_benchmark/items/{item}/diagnosis.json",
+        dataset="results/gap_benchmark/items/{item}/gap.nc",
+    output:
+        **{v: f"results/gap_benchmark/items/{{item}}/gap_{v}.png" for v in GAP_VIEWS},
+        tex="results/gap_benchmark/items/{item}/gap.tex",
+    params:
+        code=CODE_DIGEST,
+        place=config["gap"].get("place"),
+    wildcard_constraints:
+        item=r"[a-z_]+-[0-9]+-s[0-9]+",
+    conda:
+        "../envs/contactid.yaml"
+    log:
+        "logs/gap_benchmark/{item}_figures.log",
+    script:
+        "../scripts/gap_benchmark_item_figures.py"
+
+
+rule gap_benchmark_figures:
+    """Target: every blind-benchmark item's gap figures and report section (results/gap_benchmark/items/ITEM/)."""
+    input:
+        expand("results/gap_benchmark/items/{item}/gap.tex", item=list(benchmark_items())),
 
 
 rule gap_benchmark:

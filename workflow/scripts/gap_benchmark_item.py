@@ -11,7 +11,11 @@ from contactid.logs import setup_logging
 
 log = setup_logging(snakemake.log[0])
 numba.set_num_threads(max(1, min(int(snakemake.threads), numba.config.NUMBA_NUM_THREADS)))
-row = run_item(snakemake.params.spec, snakemake.params.config)
+row = run_item(
+    snakemake.params.spec,
+    snakemake.params.config,
+    {"diagnosis": snakemake.output.diagnosis, "dataset": snakemake.output.dataset},
+)
 row["item"] = snakemake.wildcards.item
 write_text(snakemake.output.item, json.dumps(_clean(row), indent=2))
 log.info("%s: effect %s (%.4g) -> verdict %s", row["item"], row["effect"], row["magnitude"], row["verdict"])

@@ -336,9 +336,34 @@ def blind_row(spec: Mapping, item: ItemDiagnosis, converged, t_rig: float) -> di
     }
 
 
-def run_item(spec: Mapping, cfg: Mapping) -> dict:
+def write_item_diagnosis(
+    outputs: Mapping, spec: Mapping, item: "ItemDiagnosis | None", n_harmonics: int = 9, failed: str = ""
+) -> None:
+    """An item's diagnosis as ``snakemake gap`` writes it: ``outputs["diagnosis"]`` (diagnosis.json, with the item's
+    spec under ``benchmark_item``) and ``outputs["dataset"]`` (gap.nc), from which ``gap_benchmark_figures`` draws
+    every gap figure and the report's gap section; ``n_harmonics``: the harmonics the diagnosis compares
+    (gap.n_harmonics). An item the rig could not simulate (``item`` None) gets a diagnosis.json that says so
+    (``failed``) and a gap.nc without variables."""
+    import json
+
+    import xarray as xr
+
+    from ..io import write_dataset, write_text
+    from .output import _clean, diagnosis_json, gap_dataset
+
+    if item is None:
+        write_text(outputs["diagnosis"], json.dumps(_clean({"failed": failed, "benchmark_item": dict(spec)}), indent=2))
+        write_dataset(xr.Dataset(attrs={"failed": failed}), outputs["dataset"])
+        return
+    extra = {"seconds": item.t_diag, "benchmark_item": dict(spec)}
+    write_dataset(gap_dataset(item.diag, item.records, int(n_harmonics)), outputs["dataset"])
+    write_text(outputs["diagnosis"], diagnosis_json(item.diag, extra))
+
+
+def run_item(spec: Mapping, cfg: Mapping, outputs: Mapping | None = None) -> dict:
     """Generate the item's rig records, identify the model from them, diagnose; the result row. ``cfg``: the base
-    config (keys left out: the schema's defaults)."""
+    config (keys left out: the schema's defaults). ``outputs`` ({"diagnosis": path, "dataset": path}, optional):
+    where to write the item's diagnosis.json and gap.nc (``write_item_diagnosis``)."""
     from ..config import with_defaults
     from .pipeline import rig_records
 
@@ -360,10 +385,15 @@ def run_item(spec: Mapping, cfg: Mapping) -> dict:
         log.warning(
             "benchmark item (%s): the rig's records of %s are not finite; not diagnosed", spec["kind"], ", ".join(bad)
         )
+        if outputs:
+            failed = f"the rig's records of {', '.join(bad)} are not finite"
+            write_item_diagnosis(outputs, spec, None, failed=failed)
         return failed_row(spec, bad, converged, t_rig)
     log.info("rig records made in %.1f s; identifying the model", t_rig)
     item = diagnose_item(spec, cfg, recs, cases, t0, t_rig)
     diag = item.diag
+    if outputs:
+        write_item_diagnosis(outputs, spec, item, int(cfg["gap"]["n_harmonics"]))
     if spec["kind"] == "compound":
         row = compound_row(spec, cfg, effects, item, converged, t_rig)
         log.info(

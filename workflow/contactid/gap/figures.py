@@ -226,7 +226,18 @@ def ranking(diag: dict, png: str, pdf: str | None = None):
             continue
         err = [[max(b["end"] - b["low"], 0)], [max(b["high"] - b["end"], 0)]]
         ax.barh(y, b["end"], 0.6, xerr=err, color="tab:blue", capsize=2, gid=f"bar:{b['effect']}")
-        ax.text(0.02 * right, y, f"−{100 * b['reduction']:.0f} %", va="center", color="white", fontsize=8)
+        # inside the bar where it is long enough to hold the label, else beside its whisker (a winner near the floor)
+        inside = b["end"] >= 0.15 * right
+        x = 0.02 * right if inside else max(b["end"], b["high"] if np.isfinite(b["high"]) else 0.0) + 0.01 * right
+        ax.text(
+            x,
+            y,
+            f"−{100 * b['reduction']:.0f} %",
+            va="center",
+            color="white" if inside else "black",
+            fontsize=8,
+            gid=f"reduction:{b['effect']}",
+        )
     ax.axvline(before, color="k", ls="--", lw=1.2, label=f"before (identified model): {before:.2g} %")
     ax.axvline(floor, color="tab:red", ls=":", lw=1.5, label=f"gap.min_gap: {floor:.2g} %")
     ax.axvline(scatter, color="0.4", ls="-.", lw=1.0, label=f"records' scatter: {scatter:.1g} %")
@@ -298,29 +309,53 @@ def shrink(diag: dict, png: str, pdf: str | None = None):
     ps.save(fig, png, pdf)
 
 
-@ps.print_figure
-def explanation(diag: dict, png: str, pdf: str | None = None):
-    """The additive explanation as a waterfall: the identified model's held-out gap, what each added effect
-    removes (its share of the gap's power), what remains; the identification's floor (gap.min_gap) drawn."""
-    plt = ps.pyplot()
+WATERFALL_LABEL_WIDTH = 14  # characters per line of a waterfall bar's label (five bars fit the printed width)
+
+
+def waterfall_bars(diag: dict) -> tuple[list, list, list, list]:
+    """The waterfall's bars (labels, bottoms, heights in %, colours): the held-out gap the explanation starts from
+    (the chain's identified model, before a model update that is its first step), what each step removes (labelled
+    with its share of the gap's power) and what remains."""
+    import textwrap
+
     steps = diag.get("explanation") or []
     left = diag.get("remaining_gap") or {}
-    before = diag["where"]["heldout_gap_before"]
-    fig, ax = plt.subplots(figsize=(W, 3.0))
-    labels, bottoms, heights, colors = ["identified model"], [0.0], [100 * before], ["0.5"]
+    # the explanation's shares are of the gap it starts from: the first step's "before" (a model update's first step
+    # starts from the chain's model, whose gap where.heldout_gap_identified keeps; where.heldout_gap_before is the
+    # updated model's)
+    before = _num(steps[0]["heldout_gap_before"]) if steps else _num(diag["where"]["heldout_gap_before"])
+
+    def wrap(text: str) -> str:
+        return textwrap.fill(text, WATERFALL_LABEL_WIDTH, break_on_hyphens=False)
+
+    labels, bottoms, heights, colors = ["identified\nmodel"], [0.0], [100 * before], ["0.5"]
     for s in steps:
         law = " (never opens)" if never_opens(s) else ""
-        labels.append(f"+ {_name(s['effect'])}{law}\n({100 * s['share']:.0f} % of the power)")
-        bottoms.append(100 * s["heldout_gap_after"])
-        heights.append(100 * (s["heldout_gap_before"] - s["heldout_gap_after"]))
+        labels.append(f"{wrap('+ ' + _name(s['effect']) + law)}\n({100 * _num(s['share']):.0f} %)")
+        bottoms.append(100 * _num(s["heldout_gap_after"]))
+        heights.append(100 * (_num(s["heldout_gap_before"]) - _num(s["heldout_gap_after"])))
         colors.append("tab:green")
-    remaining = left.get("heldout_gap", before)
-    labels.append(f"remaining\n({_name(left.get('place', diag['where'].get('place', '?')))})")
+    remaining = _num(left.get("heldout_gap", before))
+    labels.append("remaining\n" + wrap(f"({_name(left.get('place', diag['where'].get('place', '?')))})"))
     bottoms.append(0.0)
     heights.append(100 * remaining)
     colors.append("tab:red" if not left.get("at_floor") else "tab:blue")
+    return labels, bottoms, heights, colors
+
+
+@ps.print_figure
+def explanation(diag: dict, png: str, pdf: str | None = None):
+    """The additive explanation as a waterfall (``waterfall_bars``): the identified model's held-out gap, what each
+    added effect removes (its share of the gap's power), what remains; the identification's floor (gap.min_gap)
+    drawn."""
+    plt = ps.pyplot()
+    steps = diag.get("explanation") or []
+    left = diag.get("remaining_gap") or {}
+    labels, bottoms, heights, colors = waterfall_bars(diag)
+    lines = max(label.count("\n") + 1 for label in labels)
+    fig, ax = plt.subplots(figsize=(W, 2.5 + 0.14 * lines))
     x = np.arange(len(labels))
-    ax.bar(x, heights, bottom=bottoms, color=colors, width=0.6)
+    ax.bar(x, heights, bottom=bottoms, color=colors, width=0.6, gid="waterfall")
     if left.get("floor") is not None:
         ax.axhline(
             100 * left["floor"], color="tab:red", ls=":", lw=1.5, label=f"gap.min_gap = {100 * left['floor']:.2g} %"
@@ -329,7 +364,9 @@ def explanation(diag: dict, png: str, pdf: str | None = None):
     ax.set_xticks(x, labels)
     ax.set_ylabel("held-out gap (%)")
     ax.set_title(
-        "The held-out gap explained step by step" if steps else "No effect explains the held-out gap materially"
+        "The held-out gap explained step by step (each step's share of its power)"
+        if steps
+        else "No effect explains the held-out gap materially"
     )
     ax.grid(axis="y", alpha=0.3)
     fig.tight_layout(rect=(0, 0.3 / fig.get_size_inches()[1], 1, 1))
@@ -351,3 +388,14 @@ def all_figures(diagnosis_path: str, gap_path: str, out: dict, thresholds: Place
     with xr.open_dataset(gap_path, engine="netcdf4") as ds:
         for view in DIAGNOSTIC:
             globals()[view](ds, out[view], out.get(f"{view}_pdf"))
+
+
+def failed_item_figures(reason: str, out: dict) -> None:
+    """A benchmark item the rig could not simulate has no diagnosis: each of its figures (``out``: view -> PNG) says
+    why instead."""
+    plt = ps.pyplot()
+    for view, png in out.items():
+        fig, ax = plt.subplots(figsize=(W, 1.2))
+        ax.axis("off")
+        ax.text(0.5, 0.5, f"not diagnosed: {reason}", ha="center", va="center", wrap=True)
+        ps.save(fig, png)
