@@ -584,6 +584,13 @@ def test_a_winner_near_the_floor_keeps_its_reduction_readable(monkeypatch):
     short, long_ = texts["reduction:transducer_mass_error"], texts["reduction:viscous_friction"]
     assert short.get_color() == "black" and short.get_position()[0] > 0.2  # right of the 0.2 % bar
     assert long_.get_color() == "white" and short.get_text() == "−95 %"
+    legend = [t.get_text() for t in drawn.pop("fig").legends[0].texts]
+    assert any(t.startswith("before (identified model)") for t in legend)
+    # the candidates tried on an updated model: the line says so
+    diag["explanation"] = [{**steps[0], "effect": "model_updating", "parameters": {}}, *steps]
+    figures.ranking(diag, "ranking.png")
+    legend = [t.get_text() for t in drawn["fig"].legends[0].texts]
+    assert any(t.startswith("before (updated model)") for t in legend)
     ps.pyplot().close(drawn["fig"])
 
 

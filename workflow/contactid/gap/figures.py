@@ -238,7 +238,10 @@ def ranking(diag: dict, png: str, pdf: str | None = None):
             fontsize=8,
             gid=f"reduction:{b['effect']}",
         )
-    ax.axvline(before, color="k", ls="--", lw=1.2, label=f"before (identified model): {before:.2g} %")
+    # the candidates are tried on the model diagnosed: the chain's, or the updated one where an update was accepted
+    updated = any(st.get("effect") == "model_updating" for st in diag.get("explanation") or [])
+    model = "updated model" if updated else "identified model"
+    ax.axvline(before, color="k", ls="--", lw=1.2, label=f"before ({model}): {before:.2g} %")
     ax.axvline(floor, color="tab:red", ls=":", lw=1.5, label=f"gap.min_gap: {floor:.2g} %")
     ax.axvline(scatter, color="0.4", ls="-.", lw=1.0, label=f"records' scatter: {scatter:.1g} %")
     ax.set_yticks(range(len(bars)), [_name(b["effect"]) for b in bars])
