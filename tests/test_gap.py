@@ -594,6 +594,17 @@ def test_a_winner_near_the_floor_keeps_its_reduction_readable(monkeypatch):
     ps.pyplot().close(drawn["fig"])
 
 
+def test_the_stage_figure_writes_its_numbers_as_people_do():
+    """Two significant digits without powers of ten where people write none (a contact-separation item's held-out
+    gap of 283 % was printed 2.8e+02 %)."""
+    from contactid.gap.figures import _stage_value_text
+
+    assert _stage_value_text(283.4, (0.006, "gap.min_gap")) == "280 %  (gap.min_gap: 0.6 %)"
+    assert _stage_value_text(0.00073, ()) == "0.00073 %"
+    assert _stage_value_text(751.2, (0.25, "normal_limit")) == "750 %  (normal_limit: 25 %)"
+    assert _stage_value_text(0.0, ()) == "0" and _stage_value_text(float("nan"), ()) == "n/a"
+
+
 def test_a_benchmark_item_not_diagnosed_still_gets_its_files_and_figures(tmp_path):
     """An item the rig could not simulate: its diagnosis.json says so, gap.nc has no variables, and each figure the
     gap_benchmark_figures target draws says why (no step fails after the item's result exists)."""

@@ -64,10 +64,22 @@ def stage_rows(diag: dict, thresholds: PlaceThresholds = DEFAULT_PLACE) -> list[
     return rows
 
 
+def _two_digits(v: float) -> str:
+    """A number to two significant digits as people write it: 280, 17, 0.64, 0.0007 (not 2.8e+02 or 7e-04); below
+    1e-4 in powers of ten (1.2e-05)."""
+    if not np.isfinite(v):
+        return "n/a"
+    if v == 0:
+        return "0"
+    if abs(v) < 1e-4:
+        return f"{v:.2g}"
+    return f"{float(f'{v:.2g}'):.12f}".rstrip("0").rstrip(".")
+
+
 def _stage_value_text(v: float, limit: tuple) -> str:
     """The stage figure's right-hand column: the value (%), and the threshold it is compared with."""
-    text = "0" if v == 0 else ("n/a" if not np.isfinite(v) else f"{v:.2g} %")
-    return text + (f"  ({limit[1]}: {100 * limit[0]:.2g} %)" if limit else "")
+    text = "0" if v == 0 else ("n/a" if not np.isfinite(v) else f"{_two_digits(v)} %")
+    return text + (f"  ({limit[1]}: {_two_digits(100 * limit[0])} %)" if limit else "")
 
 
 @ps.print_figure
@@ -241,8 +253,8 @@ def ranking(diag: dict, png: str, pdf: str | None = None):
     # the candidates are tried on the model diagnosed: the chain's, or the updated one where an update was accepted
     updated = any(st.get("effect") == "model_updating" for st in diag.get("explanation") or [])
     model = "updated model" if updated else "identified model"
-    ax.axvline(before, color="k", ls="--", lw=1.2, label=f"before ({model}): {before:.2g} %")
-    ax.axvline(floor, color="tab:red", ls=":", lw=1.5, label=f"gap.min_gap: {floor:.2g} %")
+    ax.axvline(before, color="k", ls="--", lw=1.2, label=f"before ({model}): {_two_digits(before)} %")
+    ax.axvline(floor, color="tab:red", ls=":", lw=1.5, label=f"gap.min_gap: {_two_digits(floor)} %")
     ax.axvline(scatter, color="0.4", ls="-.", lw=1.0, label=f"records' scatter: {scatter:.1g} %")
     ax.set_yticks(range(len(bars)), [_name(b["effect"]) for b in bars])
     ax.set_ylim(len(bars) - 0.4, -0.6)
@@ -361,7 +373,11 @@ def explanation(diag: dict, png: str, pdf: str | None = None):
     ax.bar(x, heights, bottom=bottoms, color=colors, width=0.6, gid="waterfall")
     if left.get("floor") is not None:
         ax.axhline(
-            100 * left["floor"], color="tab:red", ls=":", lw=1.5, label=f"gap.min_gap = {100 * left['floor']:.2g} %"
+            100 * left["floor"],
+            color="tab:red",
+            ls=":",
+            lw=1.5,
+            label=f"gap.min_gap = {_two_digits(100 * left['floor'])} %",
         )
         fig.legend(loc="lower center", frameon=False)
     ax.set_xticks(x, labels)
