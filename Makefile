@@ -50,8 +50,9 @@ reproduce: env
 test: env
 	$(PY) -m pytest -q
 
+# the unit tests on $(CORES) worker processes (pytest-xdist; they share no state): 35 s instead of 54 s on this machine
 test-fast: env
-	$(PY) -m pytest -q -m "not workflow and not slow"
+	$(PY) -m pytest -q -n $(CORES) -m "not workflow and not slow"
 
 # the formatter and the linter (pyproject.toml); `make test` checks both too
 lint: env
