@@ -239,6 +239,7 @@ def test_records_attribution_structure_without_a_factor_keeps_the_prior_k_n(defa
     contact); where the frequencies bound k_n, it is refitted."""
     from types import SimpleNamespace
 
+    from contactid.gap.model import IdentifiedModel
     from contactid.gap.pipeline import _without_factor
     from contactid.parameters import structure_from_config
 
@@ -258,8 +259,15 @@ def test_records_attribution_structure_without_a_factor_keeps_the_prior_k_n(defa
     )
 
     def model(bounded):
-        return SimpleNamespace(
-            frequencies=tuple(f), frequency_sigma=tuple(sigma), config_modulus=E0, k_n_bounded=bounded
+        return IdentifiedModel(
+            nominal,
+            (0.005,),
+            (3.857e7, 2.547e5, 1.0e4, 0.284, 0.397),
+            70.0,
+            frequencies=tuple(f),
+            frequency_sigma=tuple(sigma),
+            config_modulus=E0,
+            k_n_bounded=bounded,
         )
 
     held = _without_factor(model(False), upd, "stiffness_scale")  # transducer masses 0.8 % light stay

@@ -105,16 +105,24 @@ class IdentifiedModel:
             p = p.replace(
                 sensor_masses=tuple(m * x for x in p.sensor_masses), force_transducer_mass=m * p.force_transducer_mass
             )
-            if self.frequencies:
-                p = _refit_contact(
-                    p,
-                    self.frequencies,
-                    self.frequency_sigma,
-                    self.stiffness_scale_sd,
-                    self.config_modulus,
-                    self.k_n_bounded,
-                )
+            p = self.refit_stiffness(p)
         return p
+
+    def refit_stiffness(self, structure: StructureParameters, free_modulus: bool = True) -> StructureParameters:
+        """``structure`` with the chain's stiffness fit redone on it (``_refit_contact``): k_t and k_n fitted to the
+        identified natural frequencies with the chain's weights, Young's modulus with them under the chain's prior
+        where ``free_modulus`` and the chain freed it (otherwise as ``structure`` has it), and k_n held where the
+        chain's modes use the prior k_n. Without identified frequencies, ``structure`` as it is."""
+        if not self.frequencies:
+            return structure
+        return _refit_contact(
+            structure,
+            self.frequencies,
+            self.frequency_sigma,
+            self.stiffness_scale_sd if free_modulus else 0.0,
+            self.config_modulus,
+            self.k_n_bounded,
+        )
 
     def with_friction(self, friction) -> "IdentifiedModel":
         return dataclasses.replace(self, friction=tuple(float(x) for x in friction))

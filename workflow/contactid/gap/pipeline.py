@@ -255,20 +255,15 @@ def updated_model(model, modal: xr.Dataset, calibration, fit_settings, settings,
 
 
 def _without_factor(model, upd, factor: str):
-    """The structure of ``upd``'s proposal with ``factor`` at 1 (the others as proposed), k_t and k_n refitted to the
-    chain's frequencies (``gap.model._refit_contact``, E as the factors set it; k_n kept where the chain's modes use
-    the prior k_n, as a mass candidate's refit keeps it)."""
+    """The structure of ``upd``'s proposal with ``factor`` at 1 (the others as proposed), its stiffness fit redone as
+    a mass candidate's is (``IdentifiedModel.refit_stiffness``: k_t and k_n refitted to the chain's frequencies, k_n
+    kept where the chain's modes use the prior k_n), E as the factors set it."""
     from ..updating import apply_factors
-    from .model import _refit_contact
 
     p = upd.proposal
     factors = {k: (1.0 if k == factor else float(v)) for k, v in p["factors"].items()}
     s = apply_factors(upd.nominal.with_contact(float(p["k_t"]), float(p["k_n"])), factors)
-    if not model.frequencies:
-        return s
-    return _refit_contact(
-        s, model.frequencies, model.frequency_sigma, 0.0, model.config_modulus, getattr(model, "k_n_bounded", True)
-    )
+    return model.refit_stiffness(s, free_modulus=False)
 
 
 def _refitted(model, structure, calibration, fit_settings, seed: int):
