@@ -605,6 +605,24 @@ def test_the_stage_figure_writes_its_numbers_as_people_do():
     assert _stage_value_text(0.0, ()) == "0" and _stage_value_text(float("nan"), ()) == "n/a"
 
 
+def test_the_waterfall_title_tells_a_gap_at_the_floor_from_one_nothing_explains(monkeypatch):
+    """No step: a held-out gap at the identification's floor has nothing to explain (the default data, 0.3 %); one
+    above it is one that no effect explains."""
+    from contactid import print_style as ps
+    from contactid.gap import figures
+
+    titles = []
+    monkeypatch.setattr(
+        ps, "save", lambda fig, png, pdf=None: (titles.append(fig.axes[0].get_title()), ps.pyplot().close(fig))
+    )
+    diag = _synthetic_diagnosis([], "none", None)
+    figures.explanation(diag, "explanation.png")
+    diag["remaining_gap"].update(heldout_gap=0.003, at_floor=True)
+    figures.explanation(diag, "explanation.png")
+    assert titles[0] == "No effect explains the held-out gap materially"
+    assert titles[1].startswith("The held-out gap is at the identification's own floor")
+
+
 def test_a_benchmark_item_not_diagnosed_still_gets_its_files_and_figures(tmp_path):
     """An item the rig could not simulate: its diagnosis.json says so, gap.nc has no variables, and each figure the
     gap_benchmark_figures target draws says why (no step fails after the item's result exists)."""

@@ -382,11 +382,13 @@ def explanation(diag: dict, png: str, pdf: str | None = None):
         fig.legend(loc="lower center", frameon=False)
     ax.set_xticks(x, labels)
     ax.set_ylabel("held-out gap (%)")
-    ax.set_title(
-        "The held-out gap explained step by step (each step's share of its power)"
-        if steps
-        else "No effect explains the held-out gap materially"
-    )
+    if steps:
+        title = "The held-out gap explained step by step (each step's share of its power)"
+    elif left.get("at_floor"):  # nothing above what the identification itself leaves
+        title = "The held-out gap is at the identification's own floor: nothing to explain"
+    else:
+        title = "No effect explains the held-out gap materially"
+    ax.set_title(title)
     ax.grid(axis="y", alpha=0.3)
     fig.tight_layout(rect=(0, 0.3 / fig.get_size_inches()[1], 1, 1))
     ps.save(fig, png, pdf)
