@@ -174,6 +174,12 @@ rule gap_benchmark_figures:
         expand("results/gap_benchmark/items/{item}/gap.tex", item=list(benchmark_items())),
 
 
+rule gap_ladder_figures:
+    """Target: every detection-ladder item's gap figures and report section (results/gap_benchmark/items/ITEM/)."""
+    input:
+        expand("results/gap_benchmark/items/{item}/gap.tex", item=list(ladder_items())),
+
+
 rule gap_benchmark:
     """The blind benchmark's summary: top-1 accuracy, false alarms and confusion over every item (results/gap_benchmark/benchmark.json)."""
     input:
