@@ -635,7 +635,7 @@ def test_a_benchmark_item_not_diagnosed_still_gets_its_files_and_figures(tmp_pat
     from contactid.gap.figures import failed_item_figures
 
     out = {"diagnosis": tmp_path / "diagnosis.json", "dataset": tmp_path / "gap.nc"}
-    write_item_diagnosis(out, {"kind": "blind", "effect": "preload_drift"}, None, failed="lc3 is not finite")
+    write_item_diagnosis(out, {"kind": "blind", "effect": "preload_drift"}, None, 9, failed="lc3 is not finite")
     d = json.loads(out["diagnosis"].read_text())
     assert d["failed"] == "lc3 is not finite" and d["benchmark_item"]["effect"] == "preload_drift"
     with xr.open_dataset(out["dataset"], engine="netcdf4") as ds:

@@ -337,7 +337,7 @@ def blind_row(spec: Mapping, item: ItemDiagnosis, converged, t_rig: float) -> di
 
 
 def write_item_diagnosis(
-    outputs: Mapping, spec: Mapping, item: "ItemDiagnosis | None", n_harmonics: int = 9, failed: str = ""
+    outputs: Mapping, spec: Mapping, item: "ItemDiagnosis | None", n_harmonics: int, failed: str = ""
 ) -> None:
     """An item's diagnosis as ``snakemake gap`` writes it: ``outputs["diagnosis"]`` (diagnosis.json, with the item's
     spec under ``benchmark_item``) and ``outputs["dataset"]`` (gap.nc), from which ``gap_benchmark_figures`` draws
@@ -370,6 +370,7 @@ def run_item(spec: Mapping, cfg: Mapping, outputs: Mapping | None = None) -> dic
     t0 = time.perf_counter()
     cfg, effects = item_config(with_defaults(cfg), spec)
     cases = sorted(cfg["load_cases"], key=lambda c: int(c[2:]))
+    n_harmonics = int(cfg["gap"]["n_harmonics"])  # what the diagnosis compares, and its gap.nc holds
     hidden = hidden_text(spec, effects)
     log.info(
         "benchmark item (%s, seed %d): %s; making the rig records of %s",
@@ -387,13 +388,13 @@ def run_item(spec: Mapping, cfg: Mapping, outputs: Mapping | None = None) -> dic
         )
         if outputs:
             failed = f"the rig's records of {', '.join(bad)} are not finite"
-            write_item_diagnosis(outputs, spec, None, failed=failed)
+            write_item_diagnosis(outputs, spec, None, n_harmonics, failed=failed)
         return failed_row(spec, bad, converged, t_rig)
     log.info("rig records made in %.1f s; identifying the model", t_rig)
     item = diagnose_item(spec, cfg, recs, cases, t0, t_rig)
     diag = item.diag
     if outputs:
-        write_item_diagnosis(outputs, spec, item, int(cfg["gap"]["n_harmonics"]))
+        write_item_diagnosis(outputs, spec, item, n_harmonics)
     if spec["kind"] == "compound":
         row = compound_row(spec, cfg, effects, item, converged, t_rig)
         log.info(
