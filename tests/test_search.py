@@ -96,7 +96,7 @@ def test_a_state_that_differs_from_its_neighbours_does_not_stop_the_search():
     calls.clear()
     best = residual_line_search(r, points, 0.075, 1.05, xatol=3.9e-3, max_evaluations=10)
     assert best == pytest.approx(0.3, abs=3.9e-3)
-    assert len(calls) <= 2
+    assert len(calls) <= 4  # two to reach the minimum, the wide bracket's check at most two more
 
 
 def test_a_model_the_data_contradict_refines_its_bracket():
@@ -116,3 +116,25 @@ def test_a_model_the_data_contradict_refines_its_bracket():
     best = residual_line_search(r, points, 0.075, 1.05, xatol=3.9e-3, max_evaluations=10)
     assert calls[:2] == pytest.approx([0.5 * (0.4167 + 0.075), 0.5 * (0.4167 + 1.05)])
     assert best == pytest.approx(0.3, abs=3.9e-3)
+
+
+@pytest.mark.parametrize(
+    "shape, k, c", [("exp", 6, 0.1), ("sinh", 8, 0.1), ("exp", 8, 0.2), ("sinh", 5, 0.1), ("sinh", 8, 0.2)]
+)
+def test_a_model_through_a_wide_bracket_does_not_confirm_its_own_minimum(shape, k, c):
+    """Residuals far from quadratic over the scan's bracket (-0.41, 0.075, 1.05, the transducer-mass candidate's on a
+    range of -0.9 to 3): the quadratic through the three points put its minimum on the middle point, and the search
+    stopped there with no evaluation (0.075 for a minimum at 0.1 or 0.2). A minimum the model puts on the best point
+    while both its evaluated neighbours lie farther than VERIFY_BRACKET x xatol is checked once, at the midpoints,
+    before it is accepted. (On the transducer-mass data set of benchmarks/gap_diagnosis.py, rounding alone, a real
+    FFT in place of a complex one, made the search stop at +41.2 % with a calibration gap of 0.0147 beside 0.0025 at
+    +30.7 %.)"""
+    f = (
+        (lambda t: np.array([np.exp(k * (t - c)) - 1, 0.01]))
+        if shape == "exp"
+        else (lambda t: np.array([np.sinh(k * (t - c)), 0.01]))
+    )
+    points = {t: f(t) for t in (-0.4125, 0.075, 1.05)}
+    theta = residual_line_search(f, points, -0.4125, 1.05, 3.9e-3, 12)
+    assert theta == pytest.approx(c, abs=0.01)
+    assert len(points) <= 3 + 12

@@ -58,6 +58,11 @@ def _separated(points: dict, thetas, spacing: float, norm) -> list:
     return kept
 
 
+# a model's minimum at the best point is accepted where the best point's evaluated neighbours lie within this many
+# xatol; farther, the bracket is refined once (the midpoints) before it is
+VERIFY_BRACKET = 16
+
+
 def residual_line_search(
     residual: Callable[[float], np.ndarray | None],
     points: dict,
@@ -87,6 +92,7 @@ def residual_line_search(
 
     evaluations = 0
     suspect: set = set()  # points a model was contradicted at: left out of the models
+    verified: set = set()  # best points whose wide bracket was refined once
     while True:
         ok = sorted(th for th in points if low <= th <= high and points[th] is not None and th not in suspect)
         ok = _separated(points, ok, 2 * xatol, norm)
@@ -104,8 +110,13 @@ def residual_line_search(
         nearest = min(points, key=lambda th: abs(nxt - th))
         if abs(nxt - nearest) <= xatol:
             if nearest == best or norm(nearest) <= norm(best):
-                break
-            suspect.add(nearest)
+                wide = [b for b in (lo_b, hi_b) if abs(b - best) > VERIFY_BRACKET * xatol]
+                if best in verified or len(wide) < 2:
+                    break
+                # a model through points far apart confirms its own minimum only: the bracket is refined once
+                verified.add(best)
+            else:
+                suspect.add(nearest)
             mids = [0.5 * (best + b) for b in (lo_b, hi_b) if abs(b - best) > 8 * xatol]
             mids = [m for m in mids if min(abs(m - th) for th in points) > xatol]
             if not mids or evaluations + len(mids) > max_evaluations:
