@@ -83,7 +83,11 @@ def residual_line_search(
     and the bracket refined: the midpoints between the best point and its neighbours (each side wider than 8
     ``xatol``) are evaluated and the models go on from the narrower trio. Without this, a state that differed between
     neighbouring thetas (the transducer-mass candidate at +41.2 %: gap 0.036 beside 0.0165 at +41.7 %, 0.0153 when
-    reached from elsewhere: another periodic state) stopped the search at +41.7 % on data 30 % heavy. Returns the best
+    reached from elsewhere: another periodic state) stopped the search at +41.7 % on data 30 % heavy. A minimum the
+    model puts on the best point while both of the best point's evaluated neighbours lie farther than
+    ``VERIFY_BRACKET`` xatol is accepted only after that bracket has been refined once the same way (a quadratic
+    through points far apart confirms its own minimum: residuals far from quadratic stopped on the scan's middle
+    point). Returns the best
     evaluated theta (of ``points`` and the new ones; ``points`` is updated)."""
 
     def norm(th):
