@@ -263,11 +263,19 @@ class InverseHarmonics:
 
 
 def inverse_harmonics(
-    model: FEModel, zeta: np.ndarray, F_coef: np.ndarray, A_coef: np.ndarray, f0: float, n_iterations: int = 8
+    model: FEModel,
+    zeta: np.ndarray,
+    F_coef: np.ndarray,
+    A_coef: np.ndarray,
+    f0: float,
+    n_iterations: int = 8,
+    grid_factor: int = 4,
 ) -> InverseHarmonics:
     """Per-harmonic inverse identification from the force harmonics F_coef (K,) and the sensor
     acceleration harmonics A_coef (j, K) (convention of Eq. 16). The axial-force term of Eq. 1
-    (G q S) mixes harmonics; it is moved to the known side and updated by fixed-point iteration."""
+    (G q S) mixes harmonics; it is moved to the known side and updated by fixed-point iteration, its products
+    evaluated on ``grid_factor`` x K points of one period (at least 4: above 3K the bins 1..K take no alias;
+    benchmarks/identification_kernels.py times 4 against the 8 of before)."""
     modes = all_modes(model)
     phi = modes.shapes
     wn = 2 * np.pi * modes.frequencies_hz
@@ -282,7 +290,9 @@ def inverse_harmonics(
     n_dof = phi.shape[0]
     # one-period grid for the nonlinear terms: a product of two K-harmonic signals has harmonics up to 2K, which M > 3K
     # points keep off the bins 1..K (no aliasing: the same harmonics to rounding as on 8K points, at half the cost)
-    M = 4 * K
+    if grid_factor < 4:
+        raise ValueError(f"inverse_harmonics: grid_factor = {grid_factor}; give 4 or more (3K points alias)")
+    M = int(grid_factor) * K
     geo_coef = np.zeros((n_dof, K), dtype=complex)  # harmonics of G q S (generalized force)
     W = np.arange(1, K + 1) * w0
     g = 1.0 / (wn[:, None] ** 2 - W[None, :] ** 2 + 2j * zeta[:, None] * wn[:, None] * W[None, :])  # (modes, K)
