@@ -139,3 +139,28 @@ def test_damping_above_the_identified_modes_grows_as_the_identified_ratios_do():
     # the ceiling: ratios that would exceed 2 stay at 2
     steep = damping_by_mode(red.beam_mode, 0.2 * f[beam[:3]] / f[beam[0]], f)
     assert steep.max() == pytest.approx(2.0) and np.all(steep <= 2.0)
+
+
+def test_the_nonlinear_terms_grid_of_4k_points_gives_the_harmonics_of_8k():
+    """The inverse identification's axial-force term and shortening are products of two K-harmonic signals (up to 2K
+    harmonics): on 4K points (the default) the bins 1..K take no alias, and the result equals 8K points' to rounding;
+    3K points alias and are refused."""
+    from contactid.identification import inverse_harmonics, modal_damping_vector
+
+    model = assemble(configured_structure())
+    zeta = modal_damping_vector(model, np.array([0.004, 0.003, 0.002]))
+    rng = np.random.default_rng(3)
+    K = 25
+    F = np.zeros(K, complex)
+    F[[0, 2]] = [7.5, 1.9j]
+    A = (rng.normal(size=(3, K)) + 1j * rng.normal(size=(3, K))) * np.exp(-0.3 * np.arange(K))
+    A[:, [0, 2]] *= 40.0
+    a = inverse_harmonics(model, zeta, F, A, 54.38)
+    b = inverse_harmonics(model, zeta, F, A, 54.38, grid_factor=8)
+    for k in ("S", "N_dyn", "xi", "eta", "xi_dot", "q"):
+        x, y = getattr(a, k), getattr(b, k)
+        assert np.linalg.norm(x - y) <= 1e-12 * np.linalg.norm(y), k
+    # the shortening matters here: without it (G = 0) xi would be xi_lin
+    assert np.linalg.norm(a.xi - model.xi_vector @ a.q) > 1e-6 * np.linalg.norm(a.xi)
+    with pytest.raises(ValueError, match="grid_factor = 3"):
+        inverse_harmonics(model, zeta, F, A, 54.38, grid_factor=3)
