@@ -5,10 +5,8 @@ Each package function is timed beside the plain version it replaced, run in the 
 the two results are compared (the change is one of speed only):
 - ``identification.inverse_harmonics``: its nonlinear term on 4K points with the real FFT, against 8K points with the
   complex FFT (the harmonics must agree within 1e-12 of their norm);
-- ``beam_model.ContactFrequencyMap``: the springs' reduced matrices and the block's energy vectors made once, against
-  the outer products and the modes' full-space shapes made at every call (the frequencies bit for bit);
-- the map on a structure whose Ritz basis the Cholesky factor of V^T M V could not make (transducer masses 7.5 %
-  heavy), against the full eigenproblem it then fell back to (within 1e-8).
+- ``beam_model.ContactFrequencyMap`` on a structure whose Ritz basis the Cholesky factor of V^T M V could not make
+  (transducer masses 7.5 % heavy), against the full eigenproblem it then fell back to (within 1e-8).
 
 Usage: .venv/bin/python benchmarks/identification_kernels.py
 """
@@ -29,7 +27,7 @@ sys.path.insert(0, str(ROOT / "tests"))
 import contactid.identification as ident  # noqa: E402
 from contactid.beam_model import ContactFrequencyMap, all_modes, assemble  # noqa: E402
 from contactid.identification import inverse_harmonics, modal_damping_vector  # noqa: E402
-from structures import configured_structure  # noqa: E402
+from structures import configured_structure, dual_sine_harmonics, mass_candidate_structure  # noqa: E402
 
 
 def best_of(f, repeat=5, number=20) -> float:
@@ -48,34 +46,14 @@ def complex_fft_spectrum(x, H):
     return np.fft.fft(x, axis=-1)[..., 1 : H + 1]
 
 
-def plain_frequencies(fmap: ContactFrequencyMap, k_t: float, k_n: float) -> np.ndarray:
-    """The map's frequencies as its call computed them before: outer products and the modes' shapes in full space."""
-    m = fmap.model
-    n_check = min(m.n_dof, fmap.n_modes + 6)
-    V, K0r, xr, er = fmap._basis
-    lam, vr = np.linalg.eigh(K0r + k_t * np.outer(xr, xr) + k_n * np.outer(er, er))
-    lam, vec = lam[:n_check], V @ vr[:, :n_check]
-    p = m.params
-    frac = (
-        p.block_mass * ((m.block_lateral_vector @ vec) ** 2 + (m.block_axial_vector @ vec) ** 2)
-        + p.block_inertia * vec[m.thetas_dof] ** 2
-    )
-    keep = np.flatnonzero(frac < fmap.max_block_fraction)[: fmap.n_modes]
-    return np.sqrt(np.clip(lam[keep], 0, None)) / (2 * np.pi)
-
-
 def main() -> None:
     # the inverse identification on the configured structure, a dual-sine-like record's 25 harmonics
     p = configured_structure()
     model = assemble(p)
     all_modes(model)
     zeta = modal_damping_vector(model, np.array([0.004, 0.003, 0.002]))
-    rng = np.random.default_rng(1)
-    K, f0 = 25, 54.38
-    F = np.zeros(K, complex)
-    F[[0, 2]] = [7.5, 1.9j]
-    A = (rng.normal(size=(3, K)) + 1j * rng.normal(size=(3, K))) * np.exp(-0.3 * np.arange(K))
-    A[:, [0, 2]] *= 40.0
+    f0 = 54.38
+    F, A = dual_sine_harmonics(1)
     now = inverse_harmonics(model, zeta, F, A, f0)
     t_now = best_of(lambda: inverse_harmonics(model, zeta, F, A, f0))
     real_fft, ident.positive_spectrum = ident.positive_spectrum, complex_fft_spectrum
@@ -92,23 +70,9 @@ def main() -> None:
         f"inverse_harmonics: {t_now * 1e3:.2f} ms now, {t_plain * 1e3:.2f} ms plain (8K points, complex FFT): "
         f"x{t_plain / t_now:.2f}; results within {dev:.1e} (goal 1e-12: {'met' if dev <= 1e-12 else 'NOT met'})"
     )
-    # the frequency map's call
-    fmap = ContactFrequencyMap(p, 3)
+    # the map on a mass candidate's structure: the Ritz basis kept, against the full eigenproblem (over the fit's box)
     grid = [(kt, kn) for kt in np.logspace(5, 9, 5) for kn in np.logspace(5, 11, 5)]
-    same = all(np.array_equal(fmap(kt, kn), plain_frequencies(fmap, kt, kn)) for kt, kn in grid)
-    t_now = best_of(lambda: fmap(1.43e7, 2.37e7), number=500)
-    t_plain = best_of(lambda: plain_frequencies(fmap, 1.43e7, 2.37e7), number=500)
-    print(
-        f"ContactFrequencyMap call: {t_now * 1e6:.0f} us now, {t_plain * 1e6:.0f} us plain: x{t_plain / t_now:.2f}; "
-        f"frequencies {'bit for bit' if same else 'NOT the same'} over the fit's box"
-    )
-    # the map on a mass candidate's structure: the Ritz basis kept, against the full eigenproblem
-    q = configured_structure(
-        youngs_modulus=215782073068.41495,
-        force_transducer_mass=0.022575,
-        sensor_masses=(0.006235, 0.006235, 0.006235),
-        k_t=14941288.94,
-    )
+    q = mass_candidate_structure()
     ritz = ContactFrequencyMap(q, 3)
     full = ContactFrequencyMap(q, 3)
     full._basis = None  # what the map did on this structure before: the full eigenproblem at every call

@@ -5,7 +5,7 @@ import pytest
 
 from contactid.analytic import beam_frequencies_hz, clamped_free_eigenvalues, clamped_pinned_eigenvalues
 from contactid.beam_model import ContactFrequencyMap, assemble, natural_frequencies, shape_on_grid, structural_modes
-from structures import configured_structure
+from structures import configured_structure, mass_candidate_structure
 
 
 def bare_beam(**kw):
@@ -89,12 +89,7 @@ def test_frequency_map_keeps_its_ritz_basis_where_a_static_shape_nearly_lies_in_
     """The eta static shape lies within 4e-8 of the lowest 20 modes' span: on this structure (a mass candidate's,
     transducers 7.5 % heavy) the Cholesky factor of V^T M V failed and the map solved the full eigenproblem at every
     call; Gram-Schmidt in the mass metric keeps the basis and the map exact to 1e-8."""
-    p = configured_structure(
-        youngs_modulus=215782073068.41495,
-        force_transducer_mass=0.022575,
-        sensor_masses=(0.006235, 0.006235, 0.006235),
-        k_t=14941288.94,
-    )
+    p = mass_candidate_structure()
     fmap = ContactFrequencyMap(p, 3)
     assert fmap._basis is not None and fmap._basis[0].shape[1] == 22  # 20 modes and both static shapes
     for kt in np.logspace(5, 9, 5):

@@ -14,7 +14,7 @@ from contactid.identification import (
     nrmse,
 )
 from contactid.rig.nonlinear import ContactParameters, DualSineSimulator, reduced_model
-from structures import configured_structure
+from structures import configured_structure, dual_sine_harmonics
 
 P = configured_structure(tangential_lever_arm=0.00458, youngs_modulus=2.164e11, k_t=1.4276e7, k_n=2.37e7, n_elements=24)
 
@@ -149,12 +149,7 @@ def test_the_nonlinear_terms_grid_of_4k_points_gives_the_harmonics_of_8k():
 
     model = assemble(configured_structure())
     zeta = modal_damping_vector(model, np.array([0.004, 0.003, 0.002]))
-    rng = np.random.default_rng(3)
-    K = 25
-    F = np.zeros(K, complex)
-    F[[0, 2]] = [7.5, 1.9j]
-    A = (rng.normal(size=(3, K)) + 1j * rng.normal(size=(3, K))) * np.exp(-0.3 * np.arange(K))
-    A[:, [0, 2]] *= 40.0
+    F, A = dual_sine_harmonics(3)
     a = inverse_harmonics(model, zeta, F, A, 54.38)
     b = inverse_harmonics(model, zeta, F, A, 54.38, grid_factor=8)
     for k in ("S", "N_dyn", "xi", "eta", "xi_dot", "q"):

@@ -342,13 +342,6 @@ class ContactFrequencyMap:
                 static = np.linalg.solve(self._k0, np.column_stack([m.xi_vector, m.eta_vector]))
                 V = np.column_stack([phi, _m_orthonormal_complement(phi, static, m.mass)])
                 self._basis = (V, V.T @ self._k0 @ V, V.T @ m.xi_vector, V.T @ m.eta_vector)
-                xr, er = self._basis[2:]
-                # the contact springs' reduced matrices and the block's kinetic-energy vectors in the basis, made once
-                self._reduced = (
-                    np.outer(xr, xr),
-                    np.outer(er, er),
-                    np.vstack([m.block_lateral_vector @ V, m.block_axial_vector @ V, V[m.thetas_dof]]),
-                )
             except np.linalg.LinAlgError:
                 self._basis = None
 
@@ -359,22 +352,19 @@ class ContactFrequencyMap:
         m = self.model
         n_check = min(m.n_dof, self.n_modes + 6)
         ds = float(stiffness_scale) - 1.0
-        p = m.params
         if self._basis is not None:
             V, K0r, xr, er = self._basis
-            xx, ee, block = self._reduced
-            Kr = K0r + k_t * xx + k_n * ee
+            Kr = K0r + k_t * np.outer(xr, xr) + k_n * np.outer(er, er)
             lam, vr = np.linalg.eigh(Kr + ds * self._stiffness_part()[1] if ds else Kr)
-            lam = lam[:n_check]
-            lat, ax, rot = block @ vr[:, :n_check]  # the block's motions in the modes, from the basis's
-            frac = p.block_mass * (lat**2 + ax**2) + p.block_inertia * rot**2
+            lam, vec = lam[:n_check], V @ vr[:, :n_check]
         else:
             K = self._k0 + k_t * self._xx + k_n * self._ee + (ds * self._stiffness_part()[0] if ds else 0.0)
             lam, vec = scipy.linalg.eigh(K, m.mass, subset_by_index=[0, n_check - 1])
-            frac = (
-                p.block_mass * ((m.block_lateral_vector @ vec) ** 2 + (m.block_axial_vector @ vec) ** 2)
-                + p.block_inertia * vec[m.thetas_dof] ** 2
-            )
+        p = m.params
+        frac = (
+            p.block_mass * ((m.block_lateral_vector @ vec) ** 2 + (m.block_axial_vector @ vec) ** 2)
+            + p.block_inertia * vec[m.thetas_dof] ** 2
+        )
         keep = np.flatnonzero(frac < self.max_block_fraction)[: self.n_modes]
         if len(keep) < self.n_modes:
             raise ValueError(f"fewer than {self.n_modes} structural modes among the lowest {n_check}")
