@@ -25,7 +25,7 @@ PYTHON ?= $(shell for p in /usr/bin/python3 python3; do \
 	&& { command -v $$p; exit 0; }; done; echo python3)
 CORES ?= 2
 
-.PHONY: env bytecode reproduce test test-fast lint slurm-test clean-results tex
+.PHONY: env warm-up reproduce test test-fast lint slurm-test clean-results tex
 
 env: $(VENV)/.installed tex
 
@@ -34,20 +34,20 @@ $(VENV)/.installed: requirements.txt pyproject.toml
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet --no-compile -r requirements.txt
 	$(PY) -m pip install --quiet --no-deps --no-build-isolation -e .
-	$(MAKE) --no-print-directory bytecode
+	$(MAKE) --no-print-directory warm-up
 	touch $@
 
-# the bytecode of the modules the workflow imports, written once here instead of by the workflow's first jobs (each
-# compiles what it imports that no job has yet, several at once): Snakemake's own, planning the default target, and
-# every module of the package with what it imports, side by side on two processes (about 10 s; the first run
-# of the workflow then took 87 s instead of 99 s on this machine). A plan that fails (a broken config) is left to the
-# run to report.
-bytecode:
-	@$(VENV)/bin/snakemake --dry-run --quiet >/dev/null 2>&1 & \
+# what the workflow's first jobs would otherwise compile, each what no job has yet and several at once (the first run
+# took 99 s instead of 76-79 s on this machine): the bytecode of the modules it imports (Snakemake's own, planning the
+# default target, and every module of the package with what it imports) and numba's kernels (contactid
+# compile-kernels, into .snakemake/numba-cache/<code digest>), on two processes (about 20 s). A plan or a config that
+# fails is left to the workflow to report.
+warm-up:
+	@{ $(VENV)/bin/snakemake --dry-run --quiet >/dev/null 2>&1; $(PY) -m contactid compile-kernels --group rig; } & \
 	$(PY) -c "import importlib, pkgutil, contactid; \
 	[importlib.import_module(m.name) for m in pkgutil.walk_packages(contactid.__path__, 'contactid.')]; \
-	import snakemake.script, matplotlib.pyplot, xarray.backends.netCDF4_, netCDF4"; \
-	status=$$?; wait; exit $$status
+	import snakemake.script, matplotlib.pyplot, xarray.backends.netCDF4_, netCDF4" \
+	&& $(PY) -m contactid compile-kernels --group contact; status=$$?; wait; exit $$status
 
 tex:
 	@if ! command -v latexmk >/dev/null 2>&1; then \

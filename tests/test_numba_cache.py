@@ -116,3 +116,35 @@ def test_plain_numba_cache_serves_a_changed_callee_stale(tmp_path):
     (pkg / "probe_callee.py").write_text(CALLEE.format(value="20.0"))
     stale = run("plainprobe", tmp_path, cache)
     assert stale["result"] == 1.0 and stale["loaded"] == 1
+
+
+def cached_signatures(cache: Path) -> set:
+    """(kernel file, signature) of every compiled kernel under numba cache directory ``cache``, read from numba's
+    index files (*.nbi: a pickled format version, then the pickled (source stamp, {(signature, target): file}))."""
+    import pickle
+
+    found = set()
+    for index in cache.rglob("*.nbi"):
+        with open(index, "rb") as fh:
+            pickle.load(fh)
+            _, overloads = pickle.loads(fh.read())
+        found |= {(index.name, str(key[0])) for key in overloads}
+    return found
+
+
+@pytest.mark.workflow
+def test_compile_kernels_leaves_the_workflows_jobs_nothing_to_compile(small_run, tmp_path):
+    """`contactid compile-kernels` (make env runs it) compiles every kernel signature the small run's jobs compiled
+    (rig, fit, harmonic balance, the gap's candidates); one it missed would be compiled by the first run's jobs again."""
+    cache = tmp_path / "cache"
+    out = subprocess.run(
+        [sys.executable, "-m", "contactid", "compile-kernels", "config/config.yaml", "--cache", str(cache)],
+        cwd=small_run,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert out.returncode == 0 and "not compiled ahead" not in out.stdout, out.stdout + out.stderr
+    ours, workflows = cached_signatures(cache), cached_signatures(small_run / ".snakemake" / "numba-cache")
+    assert len(workflows) >= 25  # the rig's integrator and its callees, the fit's population, harmonic balance
+    assert workflows <= ours, sorted(workflows - ours)

@@ -1,7 +1,9 @@
-"""Command line: `python -m contactid {audit, check-config} ...` (also installed as the `contactid` command).
+"""Command line: `python -m contactid {audit, check-config, compile-kernels} ...` (also installed as the `contactid`
+command).
 
-audit         the provenance and integrity of every dataset in results/ and data/
-check-config  a config file against the schema and the cross-field checks, before any rule runs
+audit            the provenance and integrity of every dataset in results/ and data/
+check-config     a config file against the schema and the cross-field checks, before any rule runs
+compile-kernels  numba's kernels compiled into the workflow's cache ahead of its first run (`make env` runs it)
 """
 
 import argparse
@@ -44,6 +46,34 @@ def check_config_main(argv) -> int:
     return 0
 
 
+def compile_kernels_main(argv) -> int:
+    """Compile numba's kernels into the cache the workflow's jobs read (.snakemake/numba-cache/<code digest> under
+    the project directory), so that its first run does not compile them in its jobs. Where the config cannot be
+    read, says so and leaves the compiling to the workflow (exit 0: nothing is lost)."""
+    import yaml
+
+    from . import use_numba_cache_under
+    from .kernels import KERNEL_GROUPS, compile_kernels
+
+    parser = argparse.ArgumentParser(prog="contactid compile-kernels", description=compile_kernels_main.__doc__)
+    parser.add_argument("config", nargs="?", default="config/config.yaml", help="the config file (YAML)")
+    parser.add_argument(
+        "--group", choices=sorted(KERNEL_GROUPS), action="append", help="only these kernels (default: all)"
+    )
+    parser.add_argument("--cache", default=".snakemake/numba-cache", help="the cache's base directory")
+    args = parser.parse_args(argv)
+    cache = use_numba_cache_under(args.cache)
+    try:
+        with open(args.config) as fh:
+            cfg = yaml.safe_load(fh) or {}
+        compile_kernels(cfg, args.group)
+    except Exception as exc:  # a broken config is the workflow's to report, with its file and key
+        print(f"contactid compile-kernels: not compiled ahead ({args.config}: {exc}); the workflow's jobs will")
+        return 0
+    print(f"contactid compile-kernels: {', '.join(args.group or sorted(KERNEL_GROUPS))} kernels in {cache}")
+    return 0
+
+
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     parser = argparse.ArgumentParser(
@@ -51,11 +81,12 @@ def main(argv=None) -> int:
         description="contactid: contact-force identification at a micro-vibro-impacting joint (the workflow's "
         "command-line tools; the workflow itself runs with `snakemake`).",
     )
-    sub = parser.add_subparsers(dest="command", metavar="{audit,check-config}")
+    sub = parser.add_subparsers(dest="command", metavar="{audit,check-config,compile-kernels}")
     sub.add_parser(
         "audit", help="check the provenance and integrity of every dataset (results/, data/)", add_help=False
     )
     sub.add_parser("check-config", help="validate a config file before any rule runs", add_help=False)
+    sub.add_parser("compile-kernels", help="compile numba's kernels ahead of the first run", add_help=False)
     if not argv:
         parser.print_help()
         return 2
@@ -64,6 +95,8 @@ def main(argv=None) -> int:
         from .audit import main as audit_main
 
         return audit_main(argv[1:])
+    if args.command == "compile-kernels":
+        return compile_kernels_main(argv[1:])
     return check_config_main(argv[1:])
 
 
