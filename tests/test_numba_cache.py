@@ -135,7 +135,7 @@ def cached_signatures(cache: Path) -> set:
 @pytest.mark.workflow
 def test_compile_kernels_leaves_the_workflows_jobs_nothing_to_compile(small_run, tmp_path):
     """`contactid compile-kernels` (make env runs it) compiles every kernel signature the small run's jobs compiled
-    (rig, fit, harmonic balance, the gap's candidates); one it missed would be compiled by the first run's jobs again."""
+    (rig, fit, harmonic balance, the gap's candidates); one it missed the first run's jobs would compile."""
     cache = tmp_path / "cache"
     out = subprocess.run(
         [sys.executable, "-m", "contactid", "compile-kernels", "config/config.yaml", "--cache", str(cache)],
