@@ -4,7 +4,8 @@
 #   make test-fast  - set up, then run the unit tests alone (not the workflow nor the slow in-process ones)
 #   make lint       - ruff format --check, ruff check, snakefmt --check and snakemake --lint (`ruff format .` and
 #                     `snakefmt --no-sort Snakefile workflow/rules` rewrite the code in the project's style)
-#   make env        - create .venv/ with the pinned packages (and TeX Live via apt where missing)
+#   make env        - create .venv/ with the pinned packages (and TeX Live via apt where missing), then make warm-up
+#   make warm-up    - write the workflow's bytecode and compile numba's kernels ahead of its first run
 
 VENV := .venv
 # Python writes the compiled modules (__pycache__) of the package once; a container that sets
