@@ -2,25 +2,49 @@ import os
 import sys
 from pathlib import Path
 
+import pytest
+import yaml
+
 # one BLAS thread per process: the tests' matrices are small, and on a shared 2-core machine OpenBLAS's threads
 # oversubscribe the cores (the stiction fit's eigen-solves ran 7x slower); Snakemake runs started by the tests
 # inherit it, as two jobs run side by side on --cores 2. A value set by the caller wins.
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
-
-import pytest
-import yaml
-
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "workflow"))
 sys.path.insert(0, str(ROOT / "tests"))
+
+
+def _kernels_for_this_session() -> str:
+    """A numba cache for the kernels the tests run in their own process: a copy of those `make env` compiled for the
+    workflow (contactid compile-kernels, .snakemake/numba-cache/<code digest> in the repository), so that they are not
+    compiled again (numba keys a cache by the sources' directory, and a fresh clone's are new), while what the tests
+    compile beyond them stays out of the repository's cache (the projects' runs are seeded from it:
+    tests/workflow_projects.py). Removed at exit."""
+    import atexit
+    import shutil
+    import tempfile
+
+    from workflow_projects import code_digest
+
+    digest = code_digest(ROOT / "workflow" / "contactid")
+    tmp = Path(tempfile.mkdtemp(prefix="contactid-test-kernels-"))
+    atexit.register(shutil.rmtree, tmp, True)
+    compiled = ROOT / ".snakemake" / "numba-cache" / digest
+    if compiled.is_dir():
+        shutil.copytree(compiled, tmp / digest)
+    return str(tmp / digest)
+
+
+if "NUMBA_CACHE_DIR" not in os.environ:  # a value set by the caller wins
+    os.environ["NUMBA_CACHE_DIR"] = _kernels_for_this_session()
 
 import workflow_projects as wp  # noqa: E402
 
 # The workflow runs the integration tests read, each in a project of its own (tests/workflow_projects.py):
 # name -> (prepare, the run it follows, nice). They start in the background as soon as pytest knows which
-# selected tests need them, so that they run while other tests do: the small run first (it compiles numba's
-# kernels once), then the others with its compiled kernels; the acceptance run (the longest chain) at normal
-# priority, the short ones at nice 10. Read only: a test that changes a project works on a copy.
+# selected tests need them, so that they run while other tests do: the small run first (with the kernels make env
+# compiled, it compiles any others once), then the others with its compiled kernels; the acceptance run (the longest
+# chain) at normal priority, the short ones at nice 10. Read only: a test that changes a project works on a copy.
 SHARED_RUNS = {
     "small_run": (wp.prepare_small_run, None, 0),
     "default_run": (wp.prepare_default_run, "small_run", 0),

@@ -11,9 +11,10 @@ them (conftest.py's SHARED_RUNS), so that they run while other tests do; ``Backg
 test first needs the results.
 
 numba compiles the package's kernels once per project (its cache, .snakemake/numba-cache/<code digest>/,
-is keyed by the sources' absolute directories): tens of seconds of CPU per project. A project made once the
-shared small run has finished gets that run's compiled kernels (``seed_kernels``), so that only the first
-project compiles them; the workflow's own results do not depend on it.
+is keyed by the sources' absolute directories): tens of seconds of CPU per project. A project gets compiled
+kernels (``seed_kernels``): those `make env` compiled in the repository (``contactid compile-kernels``), and once
+the shared small run has finished, that run's, so that no project compiles what another has; the workflow's own
+results do not depend on it.
 """
 
 from __future__ import annotations
@@ -49,11 +50,14 @@ KERNEL_DONOR: "BackgroundRun | None" = None
 
 
 def kernel_donor() -> Path | None:
-    """KERNEL_DONOR's project if its run has finished successfully (never waits)."""
+    """KERNEL_DONOR's project if its run has finished successfully (never waits), else the repository itself
+    where `make env` compiled the kernels of this code (``contactid compile-kernels``), else None."""
     run = KERNEL_DONOR
-    if run is None or run.proc is None or run.proc.poll() != 0:
-        return None
-    return run.proj
+    if run is not None and run.proc is not None and run.proc.poll() == 0:
+        return run.proj
+    if (ROOT / ".snakemake" / "numba-cache" / code_digest(ROOT / "workflow" / "contactid")).is_dir():
+        return ROOT
+    return None
 
 
 def code_digest(package: Path) -> str:
