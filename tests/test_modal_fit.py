@@ -121,6 +121,16 @@ def test_h1_and_coherence_equal_scipys_welch_and_csd(n, segment_length, overlap,
     assert est.n_averages == 1 + (n - segment_length) // step
 
 
+@pytest.mark.parametrize("n", [7, 1024, 65536])
+def test_the_periodic_hann_window_is_scipys(n):
+    import scipy.signal
+
+    from contactid.signals import periodic_window
+
+    np.testing.assert_allclose(periodic_window("hann", n), scipy.signal.get_window("hann", n), rtol=0, atol=1e-15)
+    np.testing.assert_array_equal(periodic_window("hamming", n), scipy.signal.get_window("hamming", n))
+
+
 def _three_modes_with_noise(seed=3, noise=0.02):
     rng = np.random.default_rng(seed)
     f = np.arange(0, 500, 0.3125)

@@ -25,16 +25,25 @@ class FRFEstimate:
 def segment_spectra(x: np.ndarray, segment_length: int, step: int, window: str) -> np.ndarray:
     """One-sided spectra (rfft) of Welch's segments of each row of ``x`` (n_channels, n): segments of
     ``segment_length`` samples every ``step`` (the whole segments only, as scipy.signal.welch takes them), each less
-    its mean (``detrend="constant"``) and times ``window`` (scipy.signal.get_window's, periodic). Returns
+    its mean (``detrend="constant"``) and times ``window`` (``periodic_window``). Returns
     (n_channels, n_segments, segment_length // 2 + 1), unscaled."""
     from numpy.lib.stride_tricks import sliding_window_view
-    from scipy.signal import get_window
 
     n_seg = 1 + (x.shape[-1] - segment_length) // step
     segs = sliding_window_view(x, segment_length, axis=-1)[:, : (n_seg - 1) * step + 1 : step]
     segs = segs - segs.mean(axis=-1, keepdims=True)
-    segs *= get_window(window, segment_length)
+    segs *= periodic_window(window, segment_length)
     return np.fft.rfft(segs, axis=-1)
+
+
+def periodic_window(window: str, n: int) -> np.ndarray:
+    """scipy.signal.get_window(window, n): the periodic window of Welch's segments; the Hann window (the config's
+    default) as 0.5 - 0.5 cos(2 pi k / n), within 2.3e-16 of scipy's, without importing scipy.signal (1.2 s here)."""
+    if window in ("hann", "hanning"):
+        return 0.5 - 0.5 * np.cos(2 * np.pi * np.arange(n) / n)
+    from scipy.signal import get_window
+
+    return get_window(window, n)
 
 
 def h1_frf(
