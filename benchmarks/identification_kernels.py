@@ -1,12 +1,16 @@
-"""Benchmark: the inverse identification and the stiffness fit's frequency map (issue 14: a compound benchmark item
-calls the one about 300 times and the other 7-9 thousand times).
+"""Benchmark: the inverse identification, the stiffness fit's frequency map and the random test's FRF (issue 14: a
+compound benchmark item calls the first about 300 times, the second 7-9 thousand times, the third five times on
+the random test's 655360 samples).
 
 Each package function is timed beside the plain version it replaced, run in the same process on the same input, and
 the two results are compared (the change is one of speed only):
 - ``identification.inverse_harmonics``: its nonlinear term on 4K points with the real FFT, against 8K points with the
   complex FFT (the harmonics must agree within 1e-12 of their norm);
 - ``beam_model.ContactFrequencyMap`` on a structure whose Ritz basis the Cholesky factor of V^T M V could not make
-  (transducer masses 7.5 % heavy), against the full eigenproblem it then fell back to (within 1e-8).
+  (transducer masses 7.5 % heavy), against the full eigenproblem it then fell back to (within 1e-8);
+- ``signals.h1_frf`` on a random-test-sized record (a force and three responses), from each channel's segment spectra
+  computed once, against scipy.signal.welch and csd per response as it was computed before (H1 and coherence within
+  1e-11).
 
 Usage: .venv/bin/python benchmarks/identification_kernels.py
 """
@@ -27,6 +31,7 @@ sys.path.insert(0, str(ROOT / "tests"))
 import contactid.identification as ident  # noqa: E402
 from contactid.beam_model import ContactFrequencyMap, all_modes, assemble  # noqa: E402
 from contactid.identification import inverse_harmonics, modal_damping_vector  # noqa: E402
+from contactid.signals import h1_frf  # noqa: E402
 from structures import configured_structure, dual_sine_harmonics, mass_candidate_structure  # noqa: E402
 
 
@@ -44,6 +49,42 @@ def best_of(f, repeat=5, number=20) -> float:
 def complex_fft_spectrum(x, H):
     """The bins 1..H by the complex FFT, as period_coefficients computed them before."""
     return np.fft.fft(x, axis=-1)[..., 1 : H + 1]
+
+
+def welch_csd_frf(force, responses, fs, segment_length, overlap=0.5, window="hann"):
+    """H1 and coherence as h1_frf computed them before: scipy.signal.welch of the force, then csd and welch per
+    response."""
+    import scipy.signal
+
+    kw = dict(fs=fs, window=window, nperseg=segment_length, noverlap=int(round(overlap * segment_length)))
+    _, gff = scipy.signal.welch(force, detrend="constant", **kw)
+    h1, coh = [], []
+    for x in responses:
+        gfx = scipy.signal.csd(force, x, detrend="constant", **kw)[1]
+        gxx = scipy.signal.welch(x, detrend="constant", **kw)[1]
+        h1.append(gfx / gff)
+        coh.append(np.abs(gfx) ** 2 / (gff * gxx))
+    return np.array(h1), np.array(coh)
+
+
+def frf_comparison() -> None:
+    """h1_frf against welch and csd on 128 s at 5120 Hz, segments of 65536 samples (the default config's)."""
+    rng = np.random.default_rng(7)
+    force = rng.standard_normal(655360)
+    responses = np.array([np.convolve(force, rng.standard_normal(40), "same") for _ in range(3)])
+    responses += 0.05 * rng.standard_normal(responses.shape)
+    now = h1_frf(force, responses, 5120.0, 65536)
+    plain = welch_csd_frf(force, responses, 5120.0, 65536)
+    t_now = best_of(lambda: h1_frf(force, responses, 5120.0, 65536), repeat=3, number=3)
+    t_plain = best_of(lambda: welch_csd_frf(force, responses, 5120.0, 65536), repeat=3, number=3)
+    dev = max(
+        np.max(np.abs(now.h1[:, 1:] / plain[0][:, 1:] - 1)), np.max(np.abs(now.coherence[:, 1:] - plain[1][:, 1:]))
+    )
+    print(
+        f"h1_frf on 655360 samples, 4 channels: {t_now * 1e3:.0f} ms now, {t_plain * 1e3:.0f} ms plain (welch + csd "
+        f"per response): x{t_plain / t_now:.1f}; H1 and coherence within {dev:.1e} "
+        f"(goal 1e-11: {'met' if dev <= 1e-11 else 'NOT met'})"
+    )
 
 
 def main() -> None:
@@ -84,6 +125,7 @@ def main() -> None:
         f"{t_plain * 1e6:.0f} us with the full eigenproblem: x{t_plain / t_now:.1f}; frequencies within {dev:.1e} "
         f"(goal 1e-8: {'met' if dev <= 1e-8 else 'NOT met'})"
     )
+    frf_comparison()
 
 
 if __name__ == "__main__":
