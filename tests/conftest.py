@@ -14,29 +14,33 @@ sys.path.insert(0, str(ROOT / "workflow"))
 sys.path.insert(0, str(ROOT / "tests"))
 
 
-def _kernels_for_this_session() -> str:
-    """A numba cache for the kernels the tests run in their own process: a copy of those `make env` compiled for the
-    workflow (contactid compile-kernels, .snakemake/numba-cache/<code digest> in the repository), so that they are not
-    compiled again (numba keys a cache by the sources' directory, and a fresh clone's are new), while what the tests
-    compile beyond them stays out of the repository's cache (the projects' runs are seeded from it:
+def _kernels_for_this_session(compiled: Path) -> str:
+    """A numba cache for the kernels the tests run in their own process: a copy of ``compiled``, those `make env`
+    compiled for the workflow (contactid compile-kernels, .snakemake/numba-cache/<code digest> in the repository), so
+    that they are not compiled again (numba keys a cache by the sources' directory, and a fresh clone's are new), while
+    what the tests compile beyond them stays out of the repository's cache (the projects' runs are seeded from it:
     tests/workflow_projects.py). Removed at exit."""
     import atexit
     import shutil
     import tempfile
 
-    from workflow_projects import code_digest
-
-    digest = code_digest(ROOT / "workflow" / "contactid")
     tmp = Path(tempfile.mkdtemp(prefix="contactid-test-kernels-"))
     atexit.register(shutil.rmtree, tmp, True)
-    compiled = ROOT / ".snakemake" / "numba-cache" / digest
-    if compiled.is_dir():
-        shutil.copytree(compiled, tmp / digest)
-    return str(tmp / digest)
+    shutil.copytree(compiled, tmp / compiled.name)
+    return str(tmp / compiled.name)
 
 
-if "NUMBA_CACHE_DIR" not in os.environ:  # a value set by the caller wins
-    os.environ["NUMBA_CACHE_DIR"] = _kernels_for_this_session()
+def _compiled_for_this_code() -> Path:
+    from workflow_projects import code_digest
+
+    return ROOT / ".snakemake" / "numba-cache" / code_digest(ROOT / "workflow" / "contactid")
+
+
+# a value set by the caller wins; without kernels compiled for this code (the code changed since make env, and no
+# workflow run in the repository has compiled it), the package's own cache (~/.cache/contactid/numba-cache/<digest>),
+# which keeps what one session compiles for the next
+if "NUMBA_CACHE_DIR" not in os.environ and _compiled_for_this_code().is_dir():
+    os.environ["NUMBA_CACHE_DIR"] = _kernels_for_this_session(_compiled_for_this_code())
 
 import workflow_projects as wp  # noqa: E402
 
