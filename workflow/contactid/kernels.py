@@ -21,16 +21,21 @@ def _structure_and_rig(config: Mapping) -> tuple[dict, dict]:
     return filled["structure"], filled["rig"]
 
 
+def _simulator(structure: Mapping, rig: Mapping):
+    """The rig's dual-sine simulator of ``structure`` and ``rig`` and its excitation frequency (rad/s)."""
+    from .rig.dual_sine import build_simulator, dual_sine_settings
+
+    settings = dual_sine_settings(rig, {}, 5120.0)
+    return build_simulator(structure, rig, settings), 2 * np.pi * float(settings["excitation_frequency_hz"])
+
+
 def _rig_kernels(structure: Mapping, rig: Mapping) -> None:
     """The rig's time integrator (``integrate`` and its callees) and its random test's modal filter."""
     from .beam_model import assemble
-    from .rig.dual_sine import build_simulator, dual_sine_settings
     from .rig.random_test import modal_acceleration_filters, modal_acceleration_sum
     from .rig.structure import rig_structure
 
-    settings = dual_sine_settings(rig, {}, 5120.0)
-    sim = build_simulator(structure, rig, settings)
-    w = 2 * np.pi * float(settings["excitation_frequency_hz"])
+    sim, w = _simulator(structure, rig)
     sim.start_from_linear(1.0, 0.2, w)
     sim.run(1.0, 0.2, w, 64, store_from=32)
     model = assemble(rig_structure(structure, rig))
@@ -40,13 +45,10 @@ def _rig_kernels(structure: Mapping, rig: Mapping) -> None:
 
 def _harmonic_balance_kernels(structure: Mapping, rig: Mapping) -> None:
     """Harmonic balance's contact paths and tangents (the gap diagnosis and the friction intervals)."""
-    from .rig.dual_sine import build_simulator, dual_sine_settings
     from .rig.harmonic_balance import HarmonicBalance
     from .rig.nonlinear import force_coefficients
 
-    settings = dual_sine_settings(rig, {}, 5120.0)
-    sim = build_simulator(structure, rig, settings)
-    w = 2 * np.pi * float(settings["excitation_frequency_hz"])
+    sim, w = _simulator(structure, rig)
     for contact in (sim.contact, dataclasses.replace(sim.contact, iwan_share=0.3)):  # with Iwan's sliders
         hb = HarmonicBalance(sim.red, contact, sim.zeta, w, 3, 16)
         hb.solve(force_coefficients(1.0, 0.2), max_iter=1)
