@@ -30,19 +30,14 @@ def _kernels_for_this_session(compiled: Path) -> str:
     return str(tmp / compiled.name)
 
 
-def _compiled_for_this_code() -> Path:
-    from workflow_projects import code_digest
-
-    return ROOT / ".snakemake" / "numba-cache" / code_digest(ROOT / "workflow" / "contactid")
-
+import workflow_projects as wp  # noqa: E402
 
 # a value set by the caller wins; without kernels compiled for this code (the code changed since make env, and no
 # workflow run in the repository has compiled it), the package's own cache (~/.cache/contactid/numba-cache/<digest>),
-# which keeps what one session compiles for the next
-if "NUMBA_CACHE_DIR" not in os.environ and _compiled_for_this_code().is_dir():
-    os.environ["NUMBA_CACHE_DIR"] = _kernels_for_this_session(_compiled_for_this_code())
-
-import workflow_projects as wp  # noqa: E402
+# which keeps what one session compiles for the next. (workflow_projects imports no kernel module: numba reads the
+# variable when a kernel module first imports it.)
+if "NUMBA_CACHE_DIR" not in os.environ and (_compiled := wp.repository_kernels()).is_dir():
+    os.environ["NUMBA_CACHE_DIR"] = _kernels_for_this_session(_compiled)
 
 # The workflow runs the integration tests read, each in a project of its own (tests/workflow_projects.py):
 # name -> (prepare, the run it follows, nice). They start in the background as soon as pytest knows which

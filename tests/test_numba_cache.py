@@ -141,8 +141,10 @@ def test_compile_kernels_leaves_the_workflows_jobs_nothing_to_compile(default_ru
 
     Its cache is the repository's, where make env compiled this code's kernels (in a fresh clone, as CI's, nothing
     else has written there; the runs started from copies of it), else one it compiles now."""
+    from workflow_projects import repository_kernels
+
     digest = package_digest()
-    cache = PACKAGE.parents[1] / ".snakemake" / "numba-cache" / digest
+    cache = repository_kernels()
     if not cache.is_dir():
         cache = tmp_path / "cache"
         out = subprocess.run(

@@ -49,13 +49,19 @@ def set_dotted(cfg: dict, dotted: str, value) -> None:
 KERNEL_DONOR: "BackgroundRun | None" = None
 
 
+def repository_kernels() -> Path:
+    """The repository's numba cache for its code (.snakemake/numba-cache/<code digest>): where `make env` compiled the
+    kernels (``contactid compile-kernels``) and the workflow run in the repository caches them; it may not exist."""
+    return ROOT / ".snakemake" / "numba-cache" / code_digest(ROOT / "workflow" / "contactid")
+
+
 def kernel_donor() -> Path | None:
     """KERNEL_DONOR's project if its run has finished successfully (never waits), else the repository itself
-    where `make env` compiled the kernels of this code (``contactid compile-kernels``), else None."""
+    where kernels of this code were compiled (``repository_kernels``), else None."""
     run = KERNEL_DONOR
     if run is not None and run.proc is not None and run.proc.poll() == 0:
         return run.proj
-    if (ROOT / ".snakemake" / "numba-cache" / code_digest(ROOT / "workflow" / "contactid")).is_dir():
+    if repository_kernels().is_dir():
         return ROOT
     return None
 
