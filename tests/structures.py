@@ -1,6 +1,7 @@
 """The configured structure for tests that need a StructureParameters of their own (it has no defaults of its
-own: config/config.yaml is where the structure's values live), a mass candidate's structure, and a dual-sine
-record's harmonics for the inverse identification; the benchmarks use them too."""
+own: config/config.yaml is where the structure's values live), a mass candidate's structure, a dual-sine
+record's harmonics for the inverse identification, and H1 as scipy's welch and csd give it; the benchmarks use them
+too."""
 
 from dataclasses import replace
 from functools import lru_cache
@@ -49,3 +50,19 @@ def dual_sine_harmonics(seed: int, K: int = 25) -> tuple[np.ndarray, np.ndarray]
     A = (rng.normal(size=(3, K)) + 1j * rng.normal(size=(3, K))) * np.exp(-0.3 * np.arange(K))
     A[:, [0, 2]] *= 40.0
     return F, A
+
+
+def welch_csd_frf(force, responses, fs, segment_length, overlap=0.5, window="hann"):
+    """(frequencies (Hz), H1, coherence) as contactid.signals.h1_frf computed them before: scipy.signal.welch of the
+    force, then csd and welch per response (constant detrending, the overlap rounded to whole samples)."""
+    import scipy.signal
+
+    kw = dict(fs=fs, window=window, nperseg=segment_length, noverlap=int(round(overlap * segment_length)))
+    f, gff = scipy.signal.welch(force, detrend="constant", **kw)
+    h1, coh = [], []
+    for x in responses:
+        gfx = scipy.signal.csd(force, x, detrend="constant", **kw)[1]
+        gxx = scipy.signal.welch(x, detrend="constant", **kw)[1]
+        h1.append(gfx / gff)
+        coh.append(np.abs(gfx) ** 2 / (gff * gxx))
+    return f, np.array(h1), np.array(coh)
