@@ -92,6 +92,7 @@ class GapSettings:
         "mass_scale",
         "transducer_mass_scale",
         "tangential_lever_arm_scale",
+        "clamp_compliance_scale",
     )
     residue_accuracy: float = 0.01
     frequency_floor: float = 0.001
@@ -170,10 +171,11 @@ def _prior_sd(block, factors) -> tuple:
     for name, v in dict(block or {}).items():
         if name not in factors:
             raise ValueError(f"gap.model_updating.prior_sd: unknown factor {name!r}; choose from {', '.join(factors)}")
-        if not isinstance(v, (int, float)) or isinstance(v, bool) or not 0.0 < float(v) <= 2.0:
+        top = factors[name].max_prior_sd
+        if not isinstance(v, (int, float)) or isinstance(v, bool) or not 0.0 < float(v) <= top:
             raise ValueError(
                 f"gap.model_updating.prior_sd.{name} = {v!r}: give the relative spread of the factor "
-                f"(sd of its ln) as a number in (0, 2], for example 0.02 for a value known to 2 %"
+                f"(sd of its ln) as a number in (0, {top:g}], for example 0.02 for a value known to 2 %"
             )
         out.append((str(name), float(v)))
     return tuple(sorted(out))
