@@ -1045,11 +1045,15 @@ def _updating_summary(updating, model: IdentifiedModel) -> dict:
 
 
 def _updating_step(updating, gap_before: float, gap_after: float) -> dict:
-    """The explanation's step 0 when the model updating was accepted: the factors and the held-out gap it took
-    away."""
+    """The explanation's step 0 when the model updating was accepted: the factors (and the clamp's stiffness in N m/rad
+    where the data bind its compliance, which a test engineer reads more easily than the factor) and the held-out gap
+    it took away."""
+    k_clamp = updating.structure.clamp_rotational_stiffness
+    bound = (updating.identifiability.get("clamp_compliance_scale") or {}).get("bound_by_data", False)
+    clamp = {"clamp_rotational_stiffness_nm_per_rad": k_clamp} if bound and np.isfinite(k_clamp) else {}
     return {
         "effect": "model_updating",
-        "parameters": {**updating.factors, "k_t": updating.k_t, "k_n": updating.k_n},
+        "parameters": {**updating.factors, **clamp, "k_t": updating.k_t, "k_n": updating.k_n},
         "heldout_gap_before": gap_before,
         "heldout_gap_after": gap_after,
     }
