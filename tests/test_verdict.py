@@ -738,3 +738,33 @@ def test_the_report_says_when_the_records_accepted_the_update():
     by_chi2 = {**upd, "accepted_by": "random_test"}
     text = explanation_text({"explanation": [step], "remaining_gap": left, "where": {"model_updating": by_chi2}})
     assert "random test alone" not in text
+
+
+def test_a_step_names_the_candidates_the_records_cannot_tell_from_it():
+    from contactid.gap.report import explanation_text
+
+    # a compliant clamp's gap (1.13 %): a channel skew and a normal dashpot leave 0.553 % and 0.554 %
+    gaps = {
+        "channel_time_skew": 0.00553,
+        "normal_contact_damping": 0.00554,
+        "viscous_friction": 0.0081,
+        "structural_damping": 0.0084,
+        "preload_drift": float("nan"),
+    }
+    # below 1.5 x 0.00553 = 0.0083 (gap.separation, as the verdict separates a winner), closest first
+    assert V.indistinguishable(gaps, "channel_time_skew", SETTINGS) == ["normal_contact_damping", "viscous_friction"]
+    assert (
+        V.indistinguishable({"viscous_friction": 0.005, "structural_damping": 0.0075}, "viscous_friction", SETTINGS)
+        == []
+    )
+    # the explanation keeps them with its step; a later step has its own pass's
+    first = {"viscous_friction": 0.012, "structural_damping": 0.013, "normal_contact_damping": 0.03}
+    second = {"structural_damping": 0.0119, "normal_contact_damping": 0.005}
+    steps, left, _ = _explain(first, [second])
+    assert [s["effect"] for s in steps] == ["viscous_friction", "normal_contact_damping"] and left == 0.005
+    assert steps[0]["alternatives"] == ["structural_damping"] and steps[1]["alternatives"] == []
+    # and the report says them in words
+    step = {**steps[0], "share": 0.9}
+    left = {"heldout_gap": 0.012, "share": 0.1, "at_floor": False, "place": "contact", "place_reason": "x"}
+    text = explanation_text({"explanation": [step], "remaining_gap": left})
+    assert r"viscous\_friction (or, as well within gap.separation on these records, structural\_damping)" in text

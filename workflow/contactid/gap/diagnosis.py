@@ -46,6 +46,7 @@ from .verdict import (
     at_floor,
     explains_materially,
     gap_shares,
+    indistinguishable,
     open_fraction,
     place as _place_of,
     records_carry_factor,
@@ -771,9 +772,10 @@ def explain(
     first: {name: (calibration, sims, residuals)} of the first pass; heldout_gap(sims) the held-out gap of a
     model's simulations; later: the candidates tried after the first pass (``verdict.retried``; None: all);
     periodicity(cal, sims): a step's ``model_periodicity`` (None: not reported).
-    Returns (steps [{effect, parameters, heldout_gap_before, heldout_gap_after, share}], the gap left,
+    Returns (steps [{effect, parameters, heldout_gap_before, heldout_gap_after, alternatives, share}], the gap left,
     (calibration, sims) of the last step or None). share: the part of the held-out gap's power (its square) the step
-    removes; the shares and the remaining share sum to 1."""
+    removes; the shares and the remaining share sum to 1. alternatives: the candidates of the step's pass that the
+    records cannot tell from its effect (``verdict.indistinguishable``), closest first."""
     steps, gap, last, results, remaining = [], before, None, first, list(names)
     beyond_scatter = settings.noise_factor * scatter
 
@@ -786,7 +788,7 @@ def explain(
         if not gaps:
             break
         best = min(gaps, key=gaps.get)  # ties: library order
-        chosen = [(best, results[best], gaps[best])]
+        chosen = [(best, results[best], gaps[best], indistinguishable(gaps, best, settings))]
         if not explains_materially(gap, gaps[best], scatter, settings):
             others = [n for n in remaining if n != best and (later is None or n in later)]
             lookahead = settings.pair_lookahead
@@ -807,14 +809,15 @@ def explain(
                 best2,
                 gaps2[best2],
             )
-            chosen.append((best2, results2[best2], gaps2[best2]))
-        for name, (cal, sims, _), after in chosen:
+            chosen.append((best2, results2[best2], gaps2[best2], indistinguishable(gaps2, best2, settings)))
+        for name, (cal, sims, _), after, alternatives in chosen:
             steps.append(
                 {
                     "effect": name,
                     "parameters": _parameter_values(name, cal),
                     "heldout_gap_before": gap,
                     "heldout_gap_after": after,
+                    "alternatives": alternatives,
                     "contact_opens": contact_opens(cal, sims, getattr(settings, "place", DEFAULT_PLACE).open_limit),
                 }
             )

@@ -93,6 +93,14 @@ def _updating_note(step: dict, diag: dict) -> str:
     )
 
 
+def _alternatives_note(step: dict) -> str:
+    """The step's alternatives in words: the candidates the records cannot tell from its effect."""
+    alt = step.get("alternatives") or []
+    if not alt:
+        return ""
+    return r" (or, as well within gap.separation on these records, " + " or ".join(_t(a) for a in alt) + ")"
+
+
 def explanation_text(diag: dict) -> str:
     """The additive explanation in words (Fig. gap_explanation)."""
     steps, left = diag.get("explanation") or [], diag.get("remaining_gap") or {}
@@ -107,6 +115,7 @@ def explanation_text(diag: dict) -> str:
         periodicity = (diag.get("where") or {}).get("periodicity") or {}
         parts = [
             _t(s["effect"])
+            + _alternatives_note(s)
             + _updating_note(s, diag)
             + _law_note(s)
             + _periodicity_note(s, periodicity)

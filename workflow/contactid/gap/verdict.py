@@ -201,6 +201,17 @@ def explains_materially(gap: float, after: float, scatter: float, settings) -> b
     )
 
 
+def indistinguishable(gaps: Mapping[str, float], best: str, settings) -> list:
+    """The candidates of one explanation pass the records cannot tell from the one added (``best``): those whose
+    held-out gap after is below ``separation`` times its own (the rule by which the verdict calls a winner), closest
+    first. gaps: {candidate: held-out gap after it} of the pass. A step with such alternatives says which effect
+    explains the gap only up to them (a compliant clamp's 1.13 % was taken to 0.553 % by a channel skew and to
+    0.554 % by a normal dashpot)."""
+    limit = _setting(settings, "separation") * gaps[best]
+    others = [n for n, g in gaps.items() if n != best and np.isfinite(g) and g < limit]
+    return sorted(others, key=lambda n: gaps[n])
+
+
 def records_accept_update(gap_chain: float, gap_updated: float, scatter: float, settings) -> bool:
     """Whether the dual-sine records accept a model update the random test's chi^2 test did not: the chain's
     held-out gap is above the identification's floor (there is something to explain) and the update explains it
