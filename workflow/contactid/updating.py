@@ -7,7 +7,9 @@ shapes at the sensors and the drive point), which carry the mode shapes and the 
 frequencies alone. Updating fits the stuck contact's k_t, k_n and scale factors of the structure to both,
 as a maximum a posteriori estimate: each structural factor x_j = ln(theta_j / theta_j,nominal) has a
 Gaussian prior N(0, s_j^2) (its plausible spread about the nominal value), so parameters the data do not
-bound stay at their nominal values instead of wandering along a valley.
+bound stay at their nominal values instead of wandering along a valley. The clamp's factor scales its rotational
+compliance 1/k_c, a rigid clamp taken as CLAMP_RIGID once it moves; as a rigid clamp gives the fit no gradient, the fit
+is started again from each factor's further ``starts`` and keeps the lower posterior misfit.
 
 Identifiability is stated per parameter from the linearised posterior: the posterior standard deviation
 over the prior's (``posterior_over_prior``); a ratio below IDENTIFIED (0.5) means the data bound the
