@@ -40,9 +40,12 @@ def test_masses_and_stiffness_off_are_found_and_the_lever_arm_is_stated_unbound(
     # each factor's profile: holding the masses at nominal costs the posterior more than 2^2, the lever arm not 1
     assert ident["transducer_mass_scale"]["profile_chi2_increase"] > 4  # moved (UPDATING_Z = 2)
     assert ident["tangential_lever_arm_scale"]["profile_chi2_increase"] < 1
+    # the significance bar counts E, the density and the masses, not the lever arm nor the rigid clamp the data leave at
+    # their priors: about chi^2_3(0.95) = 7.81, not chi^2_5's 11.07
+    assert 2.5 < upd.effective_factors < 3.5 and 7.0 < upd.chi2_threshold < 8.5
     # the summary rebuilds the same structure
     again = UpdatingResult.from_summary(upd.summary(), nominal)
-    assert again.structure == upd.structure
+    assert again.structure == upd.structure and again.chi2_threshold == upd.chi2_threshold
 
 
 @pytest.mark.slow  # two updates (about 3 s each)
@@ -179,3 +182,41 @@ def test_a_measured_lever_arm_prior_sets_its_posterior(nominal):
     lever = upd.identifiability["tangential_lever_arm_scale"]
     assert lever["prior_sd"] == 0.01 and lever["posterior_sd"] <= 0.01
     assert upd.identifiability["stiffness_scale"]["prior_sd"] == FACTORS["stiffness_scale"].prior_sd
+
+
+def test_the_updates_bar_is_the_null_quantile_of_its_chi2_drop_with_factors_the_data_leave_at_their_prior():
+    # a linear model with a Gaussian prior, as the update is linearised: k_t and k_n (wide priors) in both fits, then a
+    # factor the data bind, one they leave at its prior, one half bound and one correlated with the first. Drawn
+    # under the nominal structure, the drop from the contact-only fit to the full fit exceeds the bar in 5 % of draws;
+    # chi^2_4's bar, every factor counted whole, would accept a nominal structure far less often than stated
+    from scipy.stats import chi2
+
+    from contactid.updating import chi2_drop_threshold, null_drop_weights
+
+    rng = np.random.default_rng(7)
+    n = 12
+    J = rng.normal(size=(n, 6))
+    J[:, 2] *= 30.0  # bound
+    J[:, 3] *= 1e-4  # at its prior
+    J[:, 4] *= 3.0  # about half bound (prior sd 0.3: J^T J / P about 1)
+    J[:, 5] = 0.8 * J[:, 2] + 10.0 * rng.normal(size=n)  # correlated with the first
+    sd = np.array([3.0, 3.0, 0.5, 0.5, 0.3, 0.5])
+    w = null_drop_weights(J, sd)
+    assert 2.0 < w.sum() < 3.5 and w.max() <= 1.0 + 1e-12
+    bar = chi2_drop_threshold(w, 0.95)
+    assert bar < chi2.ppf(0.95, 4)
+
+    P = np.diag(1.0 / sd**2)
+    y = rng.normal(size=(40000, n))
+
+    def misfit(cols):  # the prior-weighted least-squares fit of each draw over the columns cols
+        Jc = J[:, cols]
+        x = np.linalg.solve(Jc.T @ Jc + P[np.ix_(cols, cols)], Jc.T @ y.T)
+        return np.sum((y.T - Jc @ x) ** 2, axis=0)
+
+    drop = misfit([0, 1]) - misfit(list(range(6)))
+    assert np.mean(drop > bar) == pytest.approx(0.05, abs=0.006)
+    assert np.mean(drop > chi2.ppf(0.95, 4)) < 0.03
+    # every factor bound, with no prior to speak of: chi^2_k itself
+    assert chi2_drop_threshold(np.ones(3), 0.95) == pytest.approx(chi2.ppf(0.95, 3), rel=1e-12)
+    assert chi2_drop_threshold(np.zeros(3), 0.95) == np.inf

@@ -17,12 +17,14 @@ parameter, otherwise it is set by its prior. The strongest posterior correlation
 trades off against (for example k_t against the tangential lever arm: the frequencies see about
 a^2 k_t k_b / (k_t + k_b)).
 
-The update is accepted when it lowers the data misfit chi^2 by more than chi^2_k(confidence) (0.95 by
-default) for its k structural factors (a significant improvement). Otherwise the nominal structure is kept and
-the update is offered as ``proposal``: the gap diagnosis may still accept it when it shrinks the held-out gap of
-the dual-sine records materially (``UpdatingResult.accept_proposal``, ``gap.pipeline.updated_model``): with the
-frequency floor the random test alone cannot make transducer masses 7-22 % off significant, yet the
-update finds them (docs/gap.md, "Model updating").
+The update is accepted when it lowers the data misfit chi^2 by more than the drop the nominal structure would give
+with probability 1 - confidence (0.95 by default): chi^2_k(confidence) for k factors the data bind, less where the
+data leave a factor at its prior (the drop's null distribution from the hat matrices of the prior-weighted fits,
+``null_drop_weights``; a rigid clamp's compliance, a lever arm the data do not see add nothing to it). Otherwise the
+nominal structure is kept and the update is offered as ``proposal``: the gap diagnosis may still accept it when it
+shrinks the held-out gap of the dual-sine records materially (``UpdatingResult.accept_proposal``,
+``gap.pipeline.updated_model``): with the frequency floor the random test alone cannot make transducer masses 7-22 %
+off significant, yet the update finds them (docs/gap.md, "Model updating").
 """
 
 from __future__ import annotations
@@ -137,6 +139,10 @@ class UpdatingResult:
     # what accepted it: "random_test" (the chi^2 test), "records" (the dual-sine records' held-out gap), "" (nothing)
     accepted_by: str = ""
     records_test: dict | None = None  # the records' test of the proposal: held-out gaps, scatter (when run)
+    # the drop of chi^2 the random test needed (chi2_drop_threshold) and the sum of its null weights, the number of
+    # factors the data bind (null_drop_weights; 5 bound factors: 5 and chi^2_5(0.95) = 11.07)
+    chi2_threshold: float = math.nan
+    effective_factors: float = math.nan
 
     @classmethod
     def from_summary(cls, summary: dict, params: StructureParameters) -> "UpdatingResult":
@@ -159,6 +165,8 @@ class UpdatingResult:
             summary.get("proposal"),
             str(summary.get("accepted_by", "random_test" if summary["accepted"] else "")),
             summary.get("records_test"),
+            _threshold(summary.get("chi2_threshold", math.nan)),
+            float(summary.get("effective_factors", math.nan)),
         )
 
     def proposed_structure(self) -> StructureParameters:
@@ -227,7 +235,14 @@ class UpdatingResult:
             "proposal": self.proposal,
             "accepted_by": self.accepted_by,
             "records_test": self.records_test,
+            "chi2_threshold": self.chi2_threshold if math.isfinite(self.chi2_threshold) else None,  # null: inf
+            "effective_factors": self.effective_factors,
         }
+
+
+def _threshold(value) -> float:
+    """chi2_threshold as model_updating.json keeps it: null for inf (no drop significant), missing in older files."""
+    return math.inf if value is None else float(value)
 
 
 def apply_factors(params: StructureParameters, factors: dict) -> StructureParameters:
@@ -321,6 +336,43 @@ class _UpdatingProblem:
         return x, sol
 
 
+def null_drop_weights(data_jacobian, sd, n_contact: int = 2) -> np.ndarray:
+    """The weights lambda_i of the update's chi^2 drop under the nominal structure: drop ~ sum_i lambda_i chi^2_1.
+
+    data_jacobian: (n_data, p) Jacobian of the scaled data residuals (unit variance) in x = (ln k_t, ln k_n, ln
+    factors); sd: (p,) prior sds of x; the first ``n_contact`` entries are fitted in the nominal fit too. Linearised,
+    a fit with the Gaussian prior P = diag(1 / sd^2) leaves the residual (I - H) e with the hat matrix
+    H = J (J^T J + P)^-1 J^T, so the drop from the nominal fit (H0, the contact columns) to the update (H1) is
+    e^T [(I - H0)^2 - (I - H1)^2] e, whose null distribution is sum_i lambda_i chi^2_1 over that matrix's eigenvalues.
+    A factor the data bind adds a weight near 1 (k bound factors: chi^2_k), one the data leave at its prior a
+    weight near 0 (posterior sd / prior sd r: 1 - r^4 for a factor uncorrelated with the others)."""
+    J = np.asarray(data_jacobian, float)
+    P = np.diag(1.0 / np.asarray(sd, float) ** 2)
+    eye = np.eye(J.shape[0])
+
+    def rest(cols):  # I - H over the columns cols
+        Jc = J[:, cols]
+        return eye - Jc @ np.linalg.solve(Jc.T @ Jc + P[np.ix_(cols, cols)], Jc.T)
+
+    R0, R1 = rest(list(range(n_contact))), rest(list(range(J.shape[1])))
+    A = R0 @ R0 - R1 @ R1
+    return np.clip(np.linalg.eigvalsh(0.5 * (A + A.T)), 0.0, None)
+
+
+def chi2_drop_threshold(weights, confidence: float) -> float:
+    """The drop of chi^2 that sum_i w_i chi^2_1 (``null_drop_weights``) exceeds with probability 1 - confidence, by
+    Satterthwaite's match of mean and variance, c chi^2_nu with c = sum w^2 / sum w, nu = (sum w)^2 / sum w^2 (exact
+    where every weight is 0 or 1: k weights of 1 give chi^2_k(confidence)); inf where no weight is left (the data
+    bind no factor, and no drop is significant)."""
+    from scipy.stats import chi2  # here: scipy.stats takes 0.3 s to import
+
+    w = np.asarray(weights, float)
+    s1, s2 = float(w.sum()), float((w**2).sum())
+    if s1 <= 1e-9:
+        return math.inf
+    return float(s2 / s1 * chi2.ppf(confidence, s1 * s1 / s2))
+
+
 def _posterior_identifiability(jacobian, sd, labels: list) -> tuple[np.ndarray, dict]:
     """(covariance of x from the Jacobian of the residuals (data + prior) at the optimum, the linearised posterior;
     {label: posterior sd, prior sd, their ratio, whether the data bound it (ratio < IDENTIFIED), the parameter it
@@ -389,10 +441,11 @@ def update_structure(
             x2, sol2 = problem.fit(x_start, free, start=x_alt)
             if sol2.cost < sol.cost:
                 x1, sol = x2, sol2
-    chi2_updated = float(np.sum(problem.data_residuals(x1) ** 2))
-    from scipy.stats import chi2 as chi2_dist  # here: scipy.stats takes 0.3 s to import
-
-    accepted = bool(names) and bool(chi2_nominal - chi2_updated > chi2_dist.ppf(confidence, len(names)))
+    data_residuals = problem.data_residuals(x1)
+    chi2_updated = float(np.sum(data_residuals**2))
+    weights = null_drop_weights(sol.jac[: data_residuals.size], sd)
+    threshold = chi2_drop_threshold(weights, confidence)
+    accepted = bool(names) and bool(chi2_nominal - chi2_updated > threshold)
     cov, ident = _posterior_identifiability(sol.jac, sd, ["k_t", "k_n"] + names)
     # each factor's profile: the posterior misfit's rise when it is held at its nominal value (also for an update
     # not accepted here: the records may accept it, and the verdict reads the profiles)
@@ -425,4 +478,6 @@ def update_structure(
             "k_n": float(np.exp(x1[1])),
         },
         "random_test" if accepted else "",
+        chi2_threshold=threshold,
+        effective_factors=float(np.sum(weights)),
     )

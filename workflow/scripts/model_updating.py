@@ -18,10 +18,13 @@ summary = {"enabled": upd is not None, **(upd.summary() if upd is not None else 
 write_text(snakemake.output[0], json.dumps(summary, indent=2, default=float))
 if upd is not None:
     log.info(
-        "model updating %s: chi2 %.3g -> %.3g; %s; not bound by the data: %s",
+        "model updating %s: chi2 %.3g -> %.3g (significant above a drop of %.3g, %.2g factors bound); %s; not bound by "
+        "the data: %s",
         "accepted" if upd.accepted else "not accepted",
         upd.chi2_nominal,
         upd.chi2_updated,
+        upd.chi2_threshold,
+        upd.effective_factors,
         ", ".join(f"{k} {v:.4g}" for k, v in upd.factors.items()),
         ", ".join(k for k, v in upd.identifiability.items() if not v["bound_by_data"]) or "none",
     )

@@ -195,10 +195,12 @@ def updated_model(model, modal: xr.Dataset, calibration, fit_settings, settings,
     if not upd.accepted:
         if upd.proposal is None or not held_out or not getattr(settings, "updating_records_test", False):
             log.info(
-                "model updating: not accepted (chi2 %.3g -> %.3g for %d factors); the chain's structure is kept",
+                "model updating: not accepted (chi2 %.3g -> %.3g, a drop below %.3g for the %.2g factors the data "
+                "bind); the chain's structure is kept",
                 upd.chi2_nominal,
                 upd.chi2_updated,
-                len(upd.factors),
+                upd.chi2_threshold,
+                upd.effective_factors,
             )
             return model, upd
         from .diagnosis import records_attribution, records_test_of_update
@@ -209,11 +211,12 @@ def updated_model(model, modal: xr.Dataset, calibration, fit_settings, settings,
         factors = ", ".join(f"{k} {v:.4g}" for k, v in p["factors"].items())
         if not test["accepted"]:
             log.info(
-                "model updating: not accepted (chi2 %.3g -> %.3g for %d factors; held-out gap %.4g -> %.4g with it, "
-                "records' scatter %.2g); the chain's structure is kept",
+                "model updating: not accepted (chi2 %.3g -> %.3g, a drop below %.3g for the %.2g factors the data "
+                "bind; held-out gap %.4g -> %.4g with it, records' scatter %.2g); the chain's structure is kept",
                 upd.chi2_nominal,
                 upd.chi2_updated,
-                len(upd.factors),
+                upd.chi2_threshold,
+                upd.effective_factors,
                 test["heldout_gap_chain"],
                 test["heldout_gap_updated"],
                 test["record_scatter"],
@@ -244,9 +247,12 @@ def updated_model(model, modal: xr.Dataset, calibration, fit_settings, settings,
         )
         return m2, upd.accept_proposal(test)
     log.info(
-        "model updating: accepted (chi2 %.3g -> %.3g): %s, k_t %.4g, k_n %.4g N/m; friction law refitted",
+        "model updating: accepted (chi2 %.3g -> %.3g, a drop above %.3g for the %.2g factors the data bind): %s, "
+        "k_t %.4g, k_n %.4g N/m; friction law refitted",
         upd.chi2_nominal,
         upd.chi2_updated,
+        upd.chi2_threshold,
+        upd.effective_factors,
         ", ".join(f"{k} {v:.4g}" for k, v in upd.factors.items()),
         upd.k_t,
         upd.k_n,
