@@ -72,6 +72,27 @@ def test_a_compliant_clamp_is_found_with_the_masses_and_a_rigid_one_is_stated_un
     assert upd.factors["transducer_mass_scale"] == pytest.approx(1.4, rel=0.02)
 
 
+@pytest.mark.slow  # two updates (about 2 s each)
+def test_a_finite_clamp_is_updated_from_its_own_gradient(nominal, monkeypatch):
+    # a configured clamp of 5e5 N m/rad has a gradient at its nominal value: the fit's further start (1e3 x the
+    # compliance, for a rigid clamp) is not run, and the clamp is still found on either side of it
+    import contactid.updating as updating
+
+    fits = []
+    fit = updating._UpdatingProblem.fit
+    monkeypatch.setattr(updating._UpdatingProblem, "fit", lambda self, *a, **k: fits.append(1) or fit(self, *a, **k))
+    finite = nominal.replace(clamp_rotational_stiffness=5.0e5)
+    for k_c in (2.5e5, 1.0e6):
+        fits.clear()
+        f, _, R = data_of(apply_factors(finite, {"transducer_mass_scale": 1.2}).replace(clamp_rotational_stiffness=k_c))
+        upd = update_structure(finite, f, 5e-4 * f, R, residue_accuracy=0.005)
+        assert upd.accepted
+        # a clamp twice as stiff as the nominal one is bound more loosely (posterior sd of its log 1.3): 0.95e6
+        assert upd.structure.clamp_rotational_stiffness == pytest.approx(k_c, rel=0.1)
+        assert upd.factors["transducer_mass_scale"] == pytest.approx(1.2, rel=0.02)
+        assert len(fits) == 2 + len(upd.factors)  # nominal, update, one profile per factor: no further start
+
+
 @pytest.mark.slow  # three updates (about 3 s each)
 def test_the_update_ends_at_the_same_optimum_when_the_data_move_by_rounding(nominal):
     # a structure the four factors without the clamp's cannot represent (a compliant clamp): the posterior misfit stays

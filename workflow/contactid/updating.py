@@ -57,6 +57,8 @@ class StructuralFactor:
     # rigid clamp's compliance) has no gradient there, and a fit from the nominal value alone would not move it
     starts: tuple = ()
     max_prior_sd: float = 2.0  # the largest prior spread gap.model_updating.prior_sd may give it
+    # whether the nominal structure needs the further starts (None: always); a finite clamp has a gradient already
+    needs_starts: Callable[[StructureParameters], bool] | None = None
 
 
 def _scale_masses(p: StructureParameters, m: float) -> StructureParameters:
@@ -109,6 +111,7 @@ FACTORS = {
             _scale_clamp_compliance,
             starts=(1.0e3,),
             max_prior_sd=10.0,
+            needs_starts=lambda p: not math.isfinite(p.clamp_rotational_stiffness),
         ),
     )
 }
@@ -435,7 +438,8 @@ def update_structure(
     x_start[:2] = x0[:2]  # the contact parameters start (and their wide prior is centred) at the refitted k_t, k_n
     x1, sol = problem.fit(x_start, free)
     for i, name in enumerate(names):  # the further starts of factors with no gradient at their nominal value
-        for start in FACTORS[name].starts:
+        factor = FACTORS[name]
+        for start in factor.starts if factor.needs_starts is None or factor.needs_starts(params) else ():
             x_alt = x1.copy()
             x_alt[2 + i] = np.log(start)
             x2, sol2 = problem.fit(x_start, free, start=x_alt)
