@@ -1076,7 +1076,9 @@ def _updating_verdict(updating, names, gap_before, gap_after, shares, scatter, s
         f = next(k for k, v in UPDATING_EFFECTS.items() if v == effect)
         g = {k: ("nothing finite" if v is None else f"{v:.3g}") for k, v in attribution["factors"][f].items()}
         why = f"the records tell the factor: {effect} alone leaves {g['alone']}, the update without it {g['without']}"
-    elif by_records:
+    elif by_records or not any(
+        (updating.identifiability[f].get("profile_chi2_increase") or 0.0) > UPDATING_Z**2 for f in updating.factors
+    ):
         why = f"the random test's profiles put it on the {effect.replace('_error', '')} factor"
     else:
         why = f"only the {effect.replace('_error', '')} factor moved beyond {UPDATING_Z:g} standard deviations"
