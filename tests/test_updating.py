@@ -15,6 +15,7 @@ def nominal(default_config):
 
 
 FOUR = ("stiffness_scale", "mass_scale", "transducer_mass_scale", "tangential_lever_arm_scale")  # without the clamp
+FIVE = (*FOUR, "clamp_compliance_scale")  # without the force transducer's own factor
 
 
 def data_of(p, n=3):
@@ -26,7 +27,7 @@ def data_of(p, n=3):
 def test_masses_and_stiffness_off_are_found_and_the_lever_arm_is_stated_unbound(nominal):
     truth = apply_factors(nominal, {"stiffness_scale": 1.03, "transducer_mass_scale": 1.4})
     f, sd, R = data_of(truth)
-    upd = update_structure(nominal, f, sd, R, residue_accuracy=0.01)
+    upd = update_structure(nominal, f, sd, R, residue_accuracy=0.01, factors=FIVE)
     assert upd.accepted and upd.chi2_updated < 0.05 * upd.chi2_nominal
     assert upd.factors["transducer_mass_scale"] == pytest.approx(1.4, rel=0.05)
     # E and the density trade off (the frequencies see E / rho): their ratio is what the data give
@@ -48,11 +49,39 @@ def test_masses_and_stiffness_off_are_found_and_the_lever_arm_is_stated_unbound(
     assert again.structure == upd.structure and again.chi2_threshold == upd.chi2_threshold
 
 
+@pytest.mark.slow  # three updates (about 3 s each)
+def test_accelerometers_off_apart_from_the_force_transducer_are_told_apart(nominal):
+    # accelerometers 30 % light, the force transducer as configured (a real rig's transducers are weighed apart):
+    # transducer_mass_scale alone moves them together, a compromise that leaves chi^2 1.4 and put 10 % of a light
+    # force transducer into the dual-sine records' model (a rig so made: a held-out gap of 1.28 % left, against 0.75 %
+    # with the force transducer's own factor). Together, the factors put the change on the accelerometers
+    from contactid.gap.verdict import updating_effect
+
+    truth = nominal.replace(sensor_masses=tuple(0.7 * m for m in nominal.sensor_masses))
+    f, R = modal_predictions(truth, 3)
+    five = update_structure(nominal, f, 5e-4 * f, R, residue_accuracy=0.005, factors=FIVE)
+    six = update_structure(nominal, f, 5e-4 * f, R, residue_accuracy=0.005)
+    assert "force_transducer_mass_scale" in six.factors and six.accepted and five.accepted
+    assert six.chi2_updated < 0.3 * five.chi2_updated
+    sensors = six.factors["transducer_mass_scale"]
+    assert sensors == pytest.approx(0.7, abs=0.06)  # five factors: 0.88 for both
+    assert sensors * six.factors["force_transducer_mass_scale"] == pytest.approx(1.0, abs=0.05)
+    assert six.structure.force_transducer_mass == pytest.approx(nominal.force_transducer_mass, rel=0.05)
+    # two mass factors that moved are one library effect, the transducer-mass error
+    assert updating_effect(six.factors, six.identifiability) == "transducer_mass_error"
+    # every transducer 40 % heavy: the force transducer's own factor stays near 1
+    f, R = modal_predictions(apply_factors(nominal, {"transducer_mass_scale": 1.4}), 3)
+    upd = update_structure(nominal, f, 5e-4 * f, R, residue_accuracy=0.005)
+    assert upd.factors["transducer_mass_scale"] == pytest.approx(1.4, rel=0.05)
+    assert upd.factors["force_transducer_mass_scale"] == pytest.approx(1.0, abs=0.05)
+    assert updating_effect(upd.factors, upd.identifiability) == "transducer_mass_error"
+
+
 @pytest.mark.slow  # two updates (about 3 s each)
 def test_a_compliant_clamp_is_found_with_the_masses_and_a_rigid_one_is_stated_unbound(nominal):
     # the clamp's compliance has no gradient at the rigid clamp: the fit's second start finds it. With the four other
     # factors alone these data leave chi^2 2.99 and E 4.3 % off instead of 3 %
-    five = (*FOUR, "clamp_compliance_scale")
+    five = FIVE
     truth = apply_factors(nominal, {"stiffness_scale": 0.97, "transducer_mass_scale": 1.4})
     f, sd, R = data_of(truth.replace(clamp_rotational_stiffness=2.0e5))
     upd = update_structure(nominal, f, sd, R, residue_accuracy=0.01, factors=five)
@@ -87,8 +116,8 @@ def test_a_finite_clamp_is_updated_from_its_own_gradient(nominal, monkeypatch):
         f, _, R = data_of(apply_factors(finite, {"transducer_mass_scale": 1.2}).replace(clamp_rotational_stiffness=k_c))
         upd = update_structure(finite, f, 5e-4 * f, R, residue_accuracy=0.005)
         assert upd.accepted
-        # a clamp twice as stiff as the nominal one is bound more loosely (posterior sd of its log 1.3): 0.95e6
-        assert upd.structure.clamp_rotational_stiffness == pytest.approx(k_c, rel=0.1)
+        # a clamp twice as stiff as the nominal one is bound more loosely (posterior sd of its log about 1.3): 0.87e6
+        assert upd.structure.clamp_rotational_stiffness == pytest.approx(k_c, rel=0.2)
         assert upd.factors["transducer_mass_scale"] == pytest.approx(1.2, rel=0.02)
         assert len(fits) == 2 + len(upd.factors)  # nominal, update, one profile per factor: no further start
 

@@ -774,3 +774,28 @@ def test_a_step_names_the_candidates_the_records_cannot_tell_from_it():
     left = {"heldout_gap": 0.012, "share": 0.1, "at_floor": False, "place": "contact", "place_reason": "x"}
     text = explanation_text({"explanation": [step], "remaining_gap": left})
     assert r"viscous\_friction (or, as well within gap.separation on these records, structural\_damping)" in text
+
+
+def test_the_two_transducer_mass_factors_that_moved_are_one_effect():
+    ident = {
+        "stiffness_scale": {"posterior_sd": 0.009, "profile_chi2_increase": 0.05},
+        "transducer_mass_scale": {"posterior_sd": 0.08, "profile_chi2_increase": 9.0},
+        "force_transducer_mass_scale": {"posterior_sd": 0.2, "profile_chi2_increase": 6.0},
+    }
+    factors = {"stiffness_scale": 1.001, "transducer_mass_scale": 0.77, "force_transducer_mass_scale": 1.25}
+    assert V.updating_effect(factors, ident) == "transducer_mass_error"
+    # E moved as well: model form beside the masses, no single effect
+    moved_e = {**ident, "stiffness_scale": {"posterior_sd": 0.009, "profile_chi2_increase": 5.0}}
+    assert V.updating_effect(factors, moved_e) is None
+    # neither alone above 2^2 (they trade off): the masses' factors single themselves out against E's 0.05 ...
+    traded = {
+        **ident,
+        "transducer_mass_scale": {"posterior_sd": 0.1, "profile_chi2_increase": 1.8},
+        "force_transducer_mass_scale": {"posterior_sd": 0.3, "profile_chi2_increase": 1.5},
+    }
+    assert V.updating_effect(factors, traded) == "transducer_mass_error"
+    # ... not against an E of comparable profile
+    assert (
+        V.updating_effect(factors, {**traded, "stiffness_scale": {"posterior_sd": 0.009, "profile_chi2_increase": 1.0}})
+        is None
+    )

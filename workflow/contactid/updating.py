@@ -95,6 +95,14 @@ FACTORS = {
         StructuralFactor(
             "transducer_mass_scale", "every transducer mass (accelerometers and force transducer)", 0.5, _scale_masses
         ),
+        # the force transducer against the accelerometers: transducer_mass_scale moves them together, this one the force
+        # transducer's alone (at the drive point; the residues tell it from the accelerometers' to about half its prior)
+        StructuralFactor(
+            "force_transducer_mass_scale",
+            "the force transducer's mass, beyond transducer_mass_scale (the accelerometers' and its own)",
+            0.5,
+            lambda p, m: p.replace(force_transducer_mass=m * p.force_transducer_mass),
+        ),
         StructuralFactor(
             "tangential_lever_arm_scale",
             "the tangential lever arm (height of the contact line)",

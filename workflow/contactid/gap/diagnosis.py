@@ -92,6 +92,7 @@ class GapSettings:
         "stiffness_scale",
         "mass_scale",
         "transducer_mass_scale",
+        "force_transducer_mass_scale",
         "tangential_lever_arm_scale",
         "clamp_compliance_scale",
     )
