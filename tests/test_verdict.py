@@ -794,7 +794,15 @@ def test_the_two_transducer_mass_factors_that_moved_are_one_effect():
         "force_transducer_mass_scale": {"posterior_sd": 0.3, "profile_chi2_increase": 1.5},
     }
     assert V.updating_effect(factors, traded) == "transducer_mass_error"
-    # ... not against an E of comparable profile
+    # held at nominal together (the update's group profile), the two masses' factors moved: the effect, whatever E's
+    grouped = {
+        f: {**d, "group": "transducer_masses", "group_profile_chi2_increase": 7.5}
+        for f, d in traded.items()
+        if f != "stiffness_scale"
+    }
+    e_comparable = {"stiffness_scale": {"posterior_sd": 0.009, "profile_chi2_increase": 1.0}}
+    assert V.updating_effect(factors, {**traded, **grouped, **e_comparable}) == "transducer_mass_error"
+    # ... where it stays below 2^2 together as well, not against an E of comparable profile
     assert (
         V.updating_effect(factors, {**traded, "stiffness_scale": {"posterior_sd": 0.009, "profile_chi2_increase": 1.0}})
         is None

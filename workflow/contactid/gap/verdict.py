@@ -307,10 +307,20 @@ def updating_effect(
     if by_records and attribution and attribution.get("effect"):
         return str(attribution["effect"])
 
+    # the units a profile is taken of: a factor, or the factors of a group held at nominal together (the two
+    # transducer-mass factors), with the largest of its members' profiles
+    units: dict = {}
+    for f in factors:
+        d = identifiability[f]
+        unit = d.get("group") or f
+        prof = d.get("group_profile_chi2_increase", d.get("profile_chi2_increase"))
+        prev = units.get(unit, (None, None))[1]
+        units[unit] = (UPDATING_EFFECTS.get(f), prof if prev is None or (prof is not None and prof > prev) else prev)
+
     def has_moved(f, v):
         d = identifiability[f]
         if "profile_chi2_increase" in d:
-            return d["profile_chi2_increase"] > UPDATING_Z**2
+            return units[d.get("group") or f][1] > UPDATING_Z**2
         return abs(np.log(v)) > UPDATING_Z * max(d["posterior_sd"], 1e-12)
 
     moved = [] if by_records else [f for f, v in factors.items() if has_moved(f, v)]
@@ -319,13 +329,12 @@ def updating_effect(
         return effects.pop() if len(effects) == 1 else None
     # significant as a whole (by the records, or by the random test with no factor's profile above UPDATING_Z^2 on
     # its own: the ladder's transducer masses +10 %, chi^2 8.17 -> 0.31 against a bar of 7.78, the masses' profile
-    # 1.24): the factor whose profile singles it out
-    profiles = {f: identifiability[f].get("profile_chi2_increase") for f in factors}
-    if not profiles or any(v is None for v in profiles.values()):
+    # 1.24): the unit whose profile singles it out
+    if not units or any(p is None for _, p in units.values()):
         return None
-    top = max(profiles, key=profiles.get)
-    effect = UPDATING_EFFECTS.get(top)
-    rest = [v for f, v in profiles.items() if f != top and (effect is None or UPDATING_EFFECTS.get(f) != effect)]
-    if profiles[top] <= 0 or any(v * UPDATING_Z**2 > profiles[top] for v in rest):
+    top = max(units, key=lambda u: units[u][1])
+    effect, peak = units[top]
+    others = [p for u, (e, p) in units.items() if u != top and (effect is None or e != effect)]
+    if peak <= 0 or any(p * UPDATING_Z**2 > peak for p in others):
         return None
     return effect
