@@ -1078,11 +1078,12 @@ def _updating_verdict(updating, names, gap_before, gap_after, shares, scatter, s
         g = {k: ("nothing finite" if v is None else f"{v:.3g}") for k, v in attribution["factors"][f].items()}
         why = f"the records tell the factor: {effect} alone leaves {g['alone']}, the update without it {g['without']}"
     elif by_records or not any(
-        (updating.identifiability[f].get("profile_chi2_increase") or 0.0) > UPDATING_Z**2 for f in updating.factors
+        (d.get("group_profile_chi2_increase", d.get("profile_chi2_increase")) or 0.0) > UPDATING_Z**2
+        for d in (updating.identifiability[f] for f in updating.factors)
     ):
-        why = f"the random test's profiles put it on the {effect.replace('_error', '')} factor"
+        why = f"the random test's profiles put it on the {effect.replace('_error', '')} factors"
     else:
-        why = f"only the {effect.replace('_error', '')} factor moved beyond {UPDATING_Z:g} standard deviations"
+        why = f"only the {effect.replace('_error', '')} factors moved beyond {UPDATING_Z:g} standard deviations"
     return effect, (
         f"model updating ({', '.join(f'{k} {v:.3g}' for k, v in updating.factors.items())}) takes the "
         f"held-out gap from {gap_before:.3g} to {gap_after:.3g} ({shares[0]:.0%} of its power); {why}"
