@@ -9,12 +9,15 @@ as a maximum a posteriori estimate: each structural factor x_j = ln(theta_j / th
 Gaussian prior N(0, s_j^2) (its plausible spread about the nominal value), so parameters the data do not
 bound stay at their nominal values instead of wandering along a valley. The clamp's factor scales its rotational
 compliance 1/k_c, a rigid clamp taken as CLAMP_RIGID once it moves; as a rigid clamp gives the fit no gradient, the fit
-is started again from each factor's further ``starts`` and keeps the lower posterior misfit.
+is started again from each factor's further ``starts`` and keeps the lower posterior misfit. The force transducer's
+mass has a factor of its own beyond the common one of every transducer (a rig's transducers are off apart).
 
 Identifiability is stated per parameter from the linearised posterior: the posterior standard deviation
 over the prior's (``posterior_over_prior``); a ratio below IDENTIFIED (0.5) means the data bound the
-parameter, otherwise it is set by its prior. The strongest posterior correlation names the parameter it
-trades off against (for example k_t against the tangential lever arm: the frequencies see about
+parameter, otherwise it is set by its prior. Each factor's profile (the posterior misfit's rise when it is held at
+its nominal value) says whether it moved; the factors of a PROFILE_GROUPS group (the two transducer-mass factors, each
+partly taken up by the other) are also held at nominal together. The strongest posterior correlation names the
+parameter it trades off against (for example k_t against the tangential lever arm: the frequencies see about
 a^2 k_t k_b / (k_t + k_b)).
 
 The update is accepted when it lowers the data misfit chi^2 by more than the drop the nominal structure would give
