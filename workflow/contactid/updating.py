@@ -434,9 +434,9 @@ def update_structure(
     f_id_hz, f_sigma_hz: (n,) identified natural frequencies and their standard errors (Hz); residues:
     (n_sensors, n) |R_si| of the modal fit (or None: frequencies alone); residue_accuracy: relative standard
     error of a residue; factors: names of FACTORS to update; contact_prior_sd: prior sd of ln k_t and
-    ln k_n (wide); confidence: the update is accepted when chi^2 drops by more than chi^2_k(confidence); prior_sd:
-    {factor: sd of its ln} replacing FACTORS' prior spreads (a lever arm measured to 1 %: 0.01). See the
-    module's docstring."""
+    ln k_n (wide); confidence: the update is accepted when chi^2 drops by more than ``chi2_drop_threshold``
+    (chi^2_k(confidence) for k factors the data bind); prior_sd: {factor: sd of its ln} replacing FACTORS' prior
+    spreads (a lever arm measured to 1 %: 0.01). See the module's docstring."""
     f_id = np.asarray(f_id_hz, float)
     f_sd = np.asarray(f_sigma_hz, float)
     n = f_id.size
