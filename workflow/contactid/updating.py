@@ -466,26 +466,25 @@ def update_structure(
     threshold = chi2_drop_threshold(weights, confidence)
     accepted = bool(names) and bool(chi2_nominal - chi2_updated > threshold)
     cov, ident = _posterior_identifiability(sol.jac, sd, ["k_t", "k_n"] + names)
+
     # each factor's profile: the posterior misfit's rise when it is held at its nominal value (also for an update
     # not accepted here: the records may accept it, and the verdict reads the profiles)
-    if names:
-        for i, name in enumerate(names):
-            hold = free.copy()
-            hold[2 + i] = False
-            _, sol_i = problem.fit(x_start, hold, start=x1)  # from the update: the others are near their optimum
-            ident[name]["profile_chi2_increase"] = float(max(2.0 * (sol_i.cost - sol.cost), 0.0))
-        # factors that together make one quantity (the transducer masses: all of them, and the force transducer's
-        # beyond): held at nominal together, as each alone is partly taken up by the other
-        for group, members in PROFILE_GROUPS.items():
-            idx = [i for i, name in enumerate(names) if name in members]
-            if len(idx) < 2:
-                continue
-            hold = free.copy()
-            hold[[2 + i for i in idx]] = False
-            _, sol_g = problem.fit(x_start, hold, start=x1)
+    def profile(idx) -> float:  # the posterior misfit's rise with the factors idx held at nominal
+        hold = free.copy()
+        hold[[2 + i for i in idx]] = False
+        _, sol_h = problem.fit(x_start, hold, start=x1)  # from the update: the others are near their optimum
+        return float(max(2.0 * (sol_h.cost - sol.cost), 0.0))
+
+    for i, name in enumerate(names):
+        ident[name]["profile_chi2_increase"] = profile([i])
+    # factors that together make one quantity (the transducer masses: all of them, and the force transducer's
+    # beyond): held at nominal together, as each alone is partly taken up by the other
+    for group, members in PROFILE_GROUPS.items():
+        idx = [i for i, name in enumerate(names) if name in members]
+        if len(idx) > 1:
+            rise = profile(idx)
             for i in idx:
-                ident[names[i]]["group"] = group
-                ident[names[i]]["group_profile_chi2_increase"] = float(max(2.0 * (sol_g.cost - sol.cost), 0.0))
+                ident[names[i]].update(group=group, group_profile_chi2_increase=rise)
     x = x1 if accepted else x0
     f_best, _ = modal_predictions(problem.structure(x), n)
     return UpdatingResult(

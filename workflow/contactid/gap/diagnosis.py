@@ -47,6 +47,7 @@ from .verdict import (
     explains_materially,
     gap_shares,
     indistinguishable,
+    moved_factors,
     open_fraction,
     place as _place_of,
     records_carry_factor,
@@ -1077,10 +1078,7 @@ def _updating_verdict(updating, names, gap_before, gap_after, shares, scatter, s
         f = next(k for k, v in UPDATING_EFFECTS.items() if v == effect)
         g = {k: ("nothing finite" if v is None else f"{v:.3g}") for k, v in attribution["factors"][f].items()}
         why = f"the records tell the factor: {effect} alone leaves {g['alone']}, the update without it {g['without']}"
-    elif by_records or not any(
-        (d.get("group_profile_chi2_increase", d.get("profile_chi2_increase")) or 0.0) > UPDATING_Z**2
-        for d in (updating.identifiability[f] for f in updating.factors)
-    ):
+    elif by_records or not moved_factors(updating.factors, updating.identifiability):
         why = f"the random test's profiles put it on the {effect.replace('_error', '')} factors"
     else:
         why = f"only the {effect.replace('_error', '')} factors moved beyond {UPDATING_Z:g} standard deviations"

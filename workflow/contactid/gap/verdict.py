@@ -281,6 +281,26 @@ UPDATING_Z = 2.0  # a factor moved when |ln factor| exceeds this many posterior 
 # with 2.1-2.7 sd, were called "none" although the update took their held-out gap from 5 % to 0.3 %)
 
 
+def _profile(ident: Mapping) -> float | None:
+    """A factor's profile as the verdict reads it: its group's (held at nominal with the group's other factors,
+    ``updating.PROFILE_GROUPS``) where it has one, else its own (None in an older model_updating.json)."""
+    return ident.get("group_profile_chi2_increase", ident.get("profile_chi2_increase"))
+
+
+def moved_factors(factors: Mapping[str, float], identifiability: Mapping[str, Mapping]) -> list:
+    """The factors of an update that moved on their own: holding the factor (with its group) at its nominal value
+    raises the posterior misfit by more than UPDATING_Z^2, or, without a profile (an older model_updating.json),
+    |ln factor| > UPDATING_Z posterior sd."""
+
+    def has_moved(f, v):
+        d = identifiability[f]
+        if "profile_chi2_increase" in d:
+            return _profile(d) > UPDATING_Z**2
+        return abs(np.log(v)) > UPDATING_Z * max(d["posterior_sd"], 1e-12)
+
+    return [f for f, v in factors.items() if has_moved(f, v)]
+
+
 def updating_effect(
     factors: Mapping[str, float],
     identifiability: Mapping[str, Mapping],
@@ -306,24 +326,12 @@ def updating_effect(
     which the update does not) names it."""
     if by_records and attribution and attribution.get("effect"):
         return str(attribution["effect"])
-
     # the units a profile is taken of: a factor, or the factors of a group held at nominal together (the two
-    # transducer-mass factors), with the largest of its members' profiles
-    units: dict = {}
-    for f in factors:
-        d = identifiability[f]
-        unit = d.get("group") or f
-        prof = d.get("group_profile_chi2_increase", d.get("profile_chi2_increase"))
-        prev = units.get(unit, (None, None))[1]
-        units[unit] = (UPDATING_EFFECTS.get(f), prof if prev is None or (prof is not None and prof > prev) else prev)
-
-    def has_moved(f, v):
-        d = identifiability[f]
-        if "profile_chi2_increase" in d:
-            return units[d.get("group") or f][1] > UPDATING_Z**2
-        return abs(np.log(v)) > UPDATING_Z * max(d["posterior_sd"], 1e-12)
-
-    moved = [] if by_records else [f for f, v in factors.items() if has_moved(f, v)]
+    # transducer-mass factors, which share their group's profile)
+    units = {
+        identifiability[f].get("group") or f: (UPDATING_EFFECTS.get(f), _profile(identifiability[f])) for f in factors
+    }
+    moved = [] if by_records else moved_factors(factors, identifiability)
     if moved:  # the factors that moved amount to one effect (both transducer-mass factors: one) or to none
         effects = {UPDATING_EFFECTS.get(f) for f in moved}
         return effects.pop() if len(effects) == 1 else None
