@@ -328,8 +328,18 @@ def test_later_passes_try_only_the_candidates_that_moved_alone():
 
 
 def test_material_and_floor_rules():
-    assert V.explains_materially(0.04, 0.02, 1e-4, SETTINGS)
-    assert not V.explains_materially(0.04, 0.0201, 1e-4, SETTINGS)
+    # what lies above the floor (0.006) in quadrature: 0.04 -> sqrt(0.04^2 - 0.006^2) = 0.039547; half of it is
+    # left at sqrt(0.019774^2 + 0.006^2) = 0.020664
+    assert V.explainable(0.04, SETTINGS) == pytest.approx(0.0395474, rel=1e-5)
+    assert V.explainable(0.005, SETTINGS) == 0.0
+    assert V.explains_materially(0.04, 0.0206, 1e-4, SETTINGS)
+    assert not V.explains_materially(0.04, 0.0208, 1e-4, SETTINGS)
+    # near the floor: 0.0108 (1.8 x the floor, explainable 0.00898) to 0.0057 removes all of it; to 0.0089 leaves
+    # 0.00657 of it (73 %); the whole gap's half (0.0054), the rule before, lies below the floor
+    assert V.explains_materially(0.0108, 0.0057, 1e-4, SETTINGS)
+    assert not V.explains_materially(0.0108, 0.0089, 1e-4, SETTINGS)
+    assert V.explains_materially(0.0108, 0.0073, 1e-4, SETTINGS)  # explainable 0.00898 -> 0.00416
+    assert not V.explains_materially(0.0108, 0.0073, 2e-3, SETTINGS)  # but not beyond 3 x the records' scatter
     assert not V.explains_materially(0.04, 0.01, 0.01, SETTINGS)
     assert not V.explains_materially(0.04, float("inf"), 1e-4, SETTINGS)
     assert V.at_floor(0.0059, SETTINGS) and not V.at_floor(0.006, SETTINGS)

@@ -189,15 +189,26 @@ def _pct(gap: float, digits: int = 3) -> str:
     return f"{100 * float(gap):.{digits}g} %"
 
 
+def explainable(gap: float, settings) -> float:
+    """The part of a held-out gap an effect can explain: what lies above the identification's own floor (min_gap),
+    taken in quadrature as an rms is, sqrt(gap^2 - min_gap^2) (0 at or below the floor)."""
+    return float(np.sqrt(max(gap**2 - _setting(settings, "min_gap") ** 2, 0.0)))
+
+
 def explains_materially(gap: float, after: float, scatter: float, settings) -> bool:
-    """Whether an added effect shrinks what is left of the held-out gap materially: by at least
-    min_reduction of it, and by more than noise_factor x the records' scatter (the additive explanation's
-    stopping rule; gap and after are the held-out gaps before and after the step)."""
+    """Whether an added effect shrinks what is left of the held-out gap materially: what is left above the
+    identification's floor (``explainable``) by at least min_reduction, and the gap by more than noise_factor x the
+    records' scatter (the additive explanation's stopping rule; gap and after are the held-out gaps before and after
+    the step). Measured against the floor because no effect takes a gap below it: with min_reduction of the whole
+    gap, a step could never be added once the gap was below twice the floor, and two-effect items whose first step
+    left 1.3-1.8 x the floor (a damping ratio beside a normal dashpot or viscous friction) stopped there."""
     if not (np.isfinite(gap) and np.isfinite(after)):
         return False
-    drop = gap - after
+    shrink = explainable(gap, settings) - explainable(after, settings)
     return bool(
-        drop >= _setting(settings, "min_reduction") * gap and drop > _setting(settings, "noise_factor") * scatter
+        shrink >= _setting(settings, "min_reduction") * explainable(gap, settings)
+        and shrink > 0.0
+        and gap - after > _setting(settings, "noise_factor") * scatter
     )
 
 
@@ -215,8 +226,8 @@ def indistinguishable(gaps: Mapping[str, float], best: str, settings) -> list:
 def records_accept_update(gap_chain: float, gap_updated: float, scatter: float, settings) -> bool:
     """Whether the dual-sine records accept a model update the random test's chi^2 test did not: the chain's
     held-out gap is above the identification's floor (there is something to explain) and the update explains it
-    materially, as a candidate's step must (``explains_materially``: by min_reduction of it and beyond
-    noise_factor x the records' scatter). gap_chain, gap_updated: held-out gaps of the chain's model and of the
+    materially, as a candidate's step must (``explains_materially``: by min_reduction of what lies above the floor and
+    beyond noise_factor x the records' scatter). gap_chain, gap_updated: held-out gaps of the chain's model and of the
     updated one (each with its friction law refitted); scatter: the sd of the chain's gap over the records'
     bootstrap. Beyond the scatter alone is not enough: on rigs whose structure is the model's, updates fitted to the
     random test's noise took 2-36 % of a contact effect's gap (multi-asperity friction) and hid the effect (the
