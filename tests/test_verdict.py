@@ -457,6 +457,11 @@ def test_the_records_accept_an_update_that_explains_a_gap_above_the_floor_materi
     assert not V.records_accept_update(0.0269, 0.0234, 2.8e-5, settings)
     assert not V.records_accept_update(0.0285, 0.0182, 2.9e-5, settings)
     assert not V.records_accept_update(0.0204, 0.0090, 0.004, settings)  # 56 %, but 1.1e-2 < 3 x the scatter
+    # against the whole gap, not what lies above the floor as an explanation's step: the detection ladder's channel
+    # skew at a third (seed 1) had an update that took 1.57 % to 0.79 % and stood in for half the skew
+    assert V.explains_materially(0.0157, 0.0079, 1e-5, settings)
+    assert not V.records_accept_update(0.0157, 0.0079, 1e-5, settings)
+    assert not V.explains_most(0.0157, 0.0079, 1e-5, settings) and V.explains_most(0.0157, 0.0078, 1e-5, settings)
     assert not V.records_accept_update(0.0050, 0.0010, 0.0001, settings)  # at the floor: nothing to explain
     assert not V.records_accept_update(0.0204, 0.0300, 0.001, settings)  # worse
     assert not V.records_accept_update(0.0204, float("nan"), 0.001, settings)

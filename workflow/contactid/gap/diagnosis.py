@@ -45,6 +45,7 @@ from .verdict import (
     acts_where,
     at_floor,
     explains_materially,
+    explains_most,
     gap_shares,
     indistinguishable,
     moved_factors,
@@ -1067,7 +1068,7 @@ def _updating_step(updating, gap_before: float, gap_after: float) -> dict:
 def _updating_verdict(updating, names, gap_before, gap_after, shares, scatter, settings) -> tuple[str, str] | None:
     """(verdict, reason) when the accepted update explains most of the gap (the largest share, materially) and
     amounts to one effect of the library in use; otherwise None."""
-    if shares[0] != max(shares) or not explains_materially(gap_before, gap_after, scatter, settings):
+    if shares[0] != max(shares) or not explains_most(gap_before, gap_after, scatter, settings):
         return None
     by_records = getattr(updating, "accepted_by", "") == "records"
     attribution = (getattr(updating, "records_test", None) or {}).get("attribution")

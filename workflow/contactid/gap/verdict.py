@@ -189,6 +189,19 @@ def _pct(gap: float, digits: int = 3) -> str:
     return f"{100 * float(gap):.{digits}g} %"
 
 
+def explains_most(gap: float, after: float, scatter: float, settings) -> bool:
+    """Whether a change of the model explains most of a held-out gap: it shrinks the whole gap by at least
+    min_reduction and by more than noise_factor x the records' scatter. The test of a model update (by the records, and
+    as a verdict), as a candidate's verdict asks min_reduction of the whole gap; an explanation's steps ask
+    ``explains_materially`` instead."""
+    if not (np.isfinite(gap) and np.isfinite(after)):
+        return False
+    drop = gap - after
+    return bool(
+        drop >= _setting(settings, "min_reduction") * gap and drop > _setting(settings, "noise_factor") * scatter
+    )
+
+
 def explainable(gap: float, settings) -> float:
     """The part of a held-out gap an effect can explain: what lies above the identification's own floor (min_gap),
     taken in quadrature as an rms is, sqrt(gap^2 - min_gap^2) (0 at or below the floor)."""
@@ -233,15 +246,17 @@ def indistinguishable(gaps: Mapping[str, float], best: str, settings) -> list:
 def records_accept_update(gap_chain: float, gap_updated: float, scatter: float, settings) -> bool:
     """Whether the dual-sine records accept a model update the random test's chi^2 test did not: the chain's
     held-out gap is above the identification's floor (there is something to explain) and the update explains it
-    materially, as a candidate's step must (``explains_materially``: by min_reduction of what lies above the floor and
-    beyond noise_factor x the records' scatter). gap_chain, gap_updated: held-out gaps of the chain's model and of the
+    by min_reduction of it and beyond noise_factor x the records' scatter (``explains_most``: measured against the whole
+    gap, not only what lies above the floor as an explanation's step is; with the latter, the detection ladder's channel
+    skew at a third, seed 1, had an update accepted, 1.57 -> 0.79 %, that stood in for half the skew, and the verdict
+    went to none). gap_chain, gap_updated: held-out gaps of the chain's model and of the
     updated one (each with its friction law refitted); scatter: the sd of the chain's gap over the records'
     bootstrap. Beyond the scatter alone is not enough: on rigs whose structure is the model's, updates fitted to the
     random test's noise took 2-36 % of a contact effect's gap (multi-asperity friction) and hid the effect (the
     blind benchmark at b4e8536: top-1 46/48)."""
     if not (np.isfinite(gap_chain) and np.isfinite(gap_updated)) or at_floor(gap_chain, settings):
         return False
-    return explains_materially(gap_chain, gap_updated, scatter, settings)
+    return explains_most(gap_chain, gap_updated, scatter, settings)
 
 
 def records_carry_factor(gap_chain: float, alone: float, without: float, scatter: float, settings) -> bool:
