@@ -108,7 +108,9 @@ def explanation_text(diag: dict) -> str:
         text = (
             r"No candidate shrinks the held-out gap materially (by gap.min\_reduction $="
             + _fmt(left.get("min_reduction", float("nan")), 2)
-            + r"$ of it, beyond the records' scatter), so "
+            + r"$ of what lies above the floor, gap.min\_gap "
+            + _pct(left.get("floor"))
+            + r"; by a factor of gap.separation; beyond the records' scatter), so "
             r"nothing is added to the identified model. "
         )
     else:
