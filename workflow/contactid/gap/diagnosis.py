@@ -1066,8 +1066,9 @@ def _updating_step(updating, gap_before: float, gap_after: float) -> dict:
 
 
 def _updating_verdict(updating, names, gap_before, gap_after, shares, scatter, settings) -> tuple[str, str] | None:
-    """(verdict, reason) when the accepted update explains most of the gap (the largest share, materially) and
-    amounts to one effect of the library in use; otherwise None."""
+    """(verdict, reason) when the accepted update explains most of the gap (the largest share, and min_reduction of
+    the whole gap as a candidate's verdict needs: ``verdict.explains_most``) and amounts to one effect of the library
+    in use; otherwise None."""
     if shares[0] != max(shares) or not explains_most(gap_before, gap_after, scatter, settings):
         return None
     by_records = getattr(updating, "accepted_by", "") == "records"

@@ -223,9 +223,10 @@ def explains_materially(gap: float, after: float, scatter: float, settings) -> b
     - the gap shrinks by more than noise_factor x the records' scatter."""
     if not (np.isfinite(gap) and np.isfinite(after)):
         return False
-    shrink = explainable(gap, settings) - explainable(after, settings)
+    above = explainable(gap, settings)
+    shrink = above - explainable(after, settings)
     return bool(
-        shrink >= _setting(settings, "min_reduction") * explainable(gap, settings)
+        shrink >= _setting(settings, "min_reduction") * above
         and shrink > 0.0
         and gap >= _setting(settings, "separation") * after
         and gap - after > _setting(settings, "noise_factor") * scatter
