@@ -277,3 +277,53 @@ def test_the_updates_bar_is_the_null_quantile_of_its_chi2_drop_with_factors_the_
     # every factor bound, with no prior to speak of: chi^2_k itself
     assert chi2_drop_threshold(np.ones(3), 0.95) == pytest.approx(chi2.ppf(0.95, 3), rel=1e-12)
     assert chi2_drop_threshold(np.zeros(3), 0.95) == np.inf
+
+
+@pytest.mark.slow  # a small rig with a drift, its chain, an update and two drift refits (about 6 s)
+def test_records_that_drift_judge_an_update_on_what_the_drift_leaves(small_config):
+    # transducers 7 % heavy and the preload drifting by 15 % over each record: the drift, common to the chain's model
+    # and the updated one, sits in both held-out gaps and hides the update; refitted on each model it does not
+    import copy
+
+    from contactid.friction_fit import settings_from_config
+    from contactid.gap.diagnosis import records_drift, records_test_of_update
+    from contactid.gap.pipeline import _refitted, identify, rig_records, structure_update
+    from contactid.gap.records import record_harmonics
+
+    cfg = copy.deepcopy(small_config)
+    st = cfg["structure"]
+    cfg["rig"]["true_structure"] = {
+        "sensors": {"masses_kg": [MASSES * m for m in st["sensors"]["masses_kg"]]},
+        "force_transducer_mass_kg": MASSES * st["force_transducer_mass_kg"],
+    }
+    cases = ["lc1", "lc2", "lc3"]
+    recs, _ = rig_records(cfg, {"preload_drift": DRIFT}, 3, cases)
+    chain, _, modal, _ = identify(cfg, recs["random_test"], recs["lc1"])
+    records = {c: record_harmonics(recs[c], c, 25) for c in cases}
+    held_out = {c: records[c] for c in cases[1:]}
+    assert records_drift(held_out, 9)
+    fit_settings = settings_from_config(cfg["friction"])
+    settings = GapSettings.from_config({**cfg["gap"], "candidates": ["preload_drift"]}, 3, 25)
+    upd = structure_update(chain.structure, modal, settings)
+    structure = upd.structure if upd.accepted else upd.proposed_structure()
+    updated = _refitted(chain, structure, records["lc1"], fit_settings, 3)
+    plain = records_test_of_update(chain, updated, held_out, settings)
+    test = records_test_of_update(chain, updated, held_out, settings, records["lc1"], fit_settings)
+    # without the calibration record the test is today's: the drift's share of both gaps
+    assert "preload_drift" not in plain
+    assert test["heldout_gap_chain_alone"] == pytest.approx(plain["heldout_gap_chain"], rel=1e-9)
+    assert test["heldout_gap_updated_alone"] == pytest.approx(plain["heldout_gap_updated"], rel=1e-9)
+    for label in ("chain", "updated"):
+        assert test["preload_drift"][label] == pytest.approx(DRIFT, rel=0.3)
+    ratio_alone = test["heldout_gap_updated_alone"] / test["heldout_gap_chain_alone"]
+    ratio = test["heldout_gap_updated"] / test["heldout_gap_chain"]
+    assert ratio < 0.5 < ratio_alone, test
+    assert test["accepted"] and not plain["accepted"]
+    # a library without the drift leaves the test as it was
+    no_drift = GapSettings.from_config(cfg["gap"], 3, 25)  # the small config's library: two contact effects
+    assert "preload_drift" not in records_test_of_update(
+        chain, updated, held_out, no_drift, records["lc1"], fit_settings
+    )
+
+
+MASSES, DRIFT = 1.07, 0.15

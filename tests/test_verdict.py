@@ -773,6 +773,10 @@ def test_the_report_says_when_the_records_accepted_the_update():
     upd = {"accepted": True, "accepted_by": "records", "chi2_nominal": 1.08, "chi2_updated": 0.184}
     by_records = explanation_text({"explanation": [step], "remaining_gap": left, "where": {"model_updating": upd}})
     assert "not significant on the random test alone" in by_records and "1.08" in by_records
+    assert "drift" not in by_records
+    drifting = {**upd, "records_test": {"preload_drift": {"chain": 0.16, "updated": 0.15}, "accepted": True}}
+    text = explanation_text({"explanation": [step], "remaining_gap": left, "where": {"model_updating": drifting}})
+    assert "what their preload drift leaves" in text
     by_chi2 = {**upd, "accepted_by": "random_test"}
     text = explanation_text({"explanation": [step], "remaining_gap": left, "where": {"model_updating": by_chi2}})
     assert "random test alone" not in text

@@ -156,7 +156,8 @@ class UpdatingResult:
     proposal: dict | None = None
     # what accepted it: "random_test" (the chi^2 test), "records" (the dual-sine records' held-out gap), "" (nothing)
     accepted_by: str = ""
-    records_test: dict | None = None  # the records' test of the proposal: held-out gaps, scatter (when run)
+    # the records' test of the proposal (when run): held-out gaps, scatter, the drift where they drift
+    records_test: dict | None = None
     # the drop of chi^2 the random test needed (chi2_drop_threshold) and the sum of its null weights, the number of
     # factors the data bind (null_drop_weights; 5 bound factors: 5 and chi^2_5(0.95) = 11.07)
     chi2_threshold: float = math.nan

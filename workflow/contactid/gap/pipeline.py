@@ -207,7 +207,7 @@ def updated_model(model, modal: xr.Dataset, calibration, fit_settings, settings,
 
         p = upd.proposal
         m2 = _refitted(model, upd.proposed_structure(), calibration, fit_settings, seed)
-        test = records_test_of_update(model, m2, held_out, settings)
+        test = records_test_of_update(model, m2, held_out, settings, calibration, fit_settings)
         factors = ", ".join(f"{k} {v:.4g}" for k, v in p["factors"].items())
         if not test["accepted"]:
             log.info(
@@ -230,7 +230,7 @@ def updated_model(model, modal: xr.Dataset, calibration, fit_settings, settings,
             held_out,
             fit_settings.bounds,
             test["record_scatter"],
-            test["heldout_gap_chain"],
+            test.get("heldout_gap_chain_alone", test["heldout_gap_chain"]),  # the attribution's gaps hold no drift
             settings,
         )
         log.info(

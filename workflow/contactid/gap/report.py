@@ -80,7 +80,8 @@ def _periodicity_note(step: dict, periodicity: dict) -> str:
 
 
 def _updating_note(step: dict, diag: dict) -> str:
-    """Why a model update was accepted, when the dual-sine records accepted it (the random test alone did not)."""
+    """Why a model update was accepted, when the dual-sine records accepted it (the random test alone did not; records
+    that drift are compared with the drift refitted, ``diagnosis.records_test_of_update``)."""
     upd = (diag.get("where") or {}).get("model_updating") or {}
     if step.get("effect") != "model_updating" or upd.get("accepted_by") != "records":
         return ""
@@ -89,7 +90,12 @@ def _updating_note(step: dict, diag: dict) -> str:
         + _fmt(upd.get("chi2_nominal", float("nan")), 3)
         + r" $\to$ "
         + _fmt(upd.get("chi2_updated", float("nan")), 3)
-        + r"; accepted because it shrinks the held-out gap of the dual-sine records materially)"
+        + r"; accepted because it shrinks the held-out gap of the dual-sine records materially"
+        + (
+            r", compared on what their preload drift leaves, the drift refitted on each model)"
+            if "preload_drift" in (upd.get("records_test") or {})
+            else r")"
+        )
     )
 
 
