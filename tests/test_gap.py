@@ -683,7 +683,41 @@ def test_polish_searches_setting_polishes_every_searched_state(hc_data, monkeypa
     assert len(seen) > 3 and seen.count(True) == 1  # the optimum alone
 
 
-@pytest.mark.slow
+@pytest.mark.slow  # a rig with channels read off, its chain, the update and three candidates (about 20 s)
+def test_channels_read_off_their_sensitivity_are_named_from_the_random_tests_relative_gains(small_config):
+    """The rig reads its three channels with 1.01, 0.98 and 1.03 (channel_gain_error 0.03), in every test. The random
+    test's residues give the gains relative to one another (the update fits them as the measurement chain's); the
+    candidate applies them on the dual-sine records and explains the gap, searching nothing."""
+    from contactid.gap.pipeline import updated_model
+
+    cfg = copy.deepcopy(small_config)
+    recs, _ = rig_records(cfg, {"channel_gain_error": 0.03}, 3, CASES)
+    chain, modes, modal, frf = identify(cfg, recs["random_test"], recs["lc1"])
+    records = {c: record_harmonics(recs[c], c, 25) for c in CASES}
+    names = ["channel_gain_error", "transducer_mass_error", "normal_contact_damping"]
+    settings = GapSettings.from_config({**cfg["gap"], "candidates": names, "n_bootstrap": 50}, 1, 25)
+    fit_settings = settings_from_config(cfg["friction"])
+    held_out = {c: records[c] for c in CASES[1:]}
+    model, upd = updated_model(chain, modal, records["lc1"], fit_settings, settings, 1, held_out=held_out)
+    truth = np.array([1.01, 0.98, 1.03])
+    relative = truth / np.exp(np.mean(np.log(truth)))
+    np.testing.assert_allclose(upd.channel_gains, relative, atol=0.006)
+    assert all(0 < sd < 0.01 for sd in upd.channel_gain_sd)
+    # the structure is left alone: no factor moved by the channels
+    factors = upd.factors if upd.accepted else upd.proposal["factors"]
+    assert max(abs(np.log(v)) for v in factors.values()) < 0.1, factors  # taken as calibrated: a clamp 900 x softer
+    d = diagnose(model, records, "lc1", settings, fit_settings, linear_stage(model, frf, modal), updating=upd)
+    assert d.verdict == "channel_gain_error", d.reason
+    step = next(s for s in d.explanation if s["effect"] == "channel_gain_error")
+    assert step["heldout_gap_after"] < 0.3 * step["heldout_gap_before"]
+    gains = 1 + np.array([step["parameters"][f"gain_error_{k}"] for k in range(3)])
+    np.testing.assert_allclose(gains, upd.channel_gains, rtol=1e-12)  # applied as the random test gave them
+    # without the random test's gains (no update) the candidate adds nothing
+    bare = diagnose(chain, records, "lc1", settings, fit_settings, linear_stage(chain, frf, modal))
+    row = next(r for r in bare.ranking if r["effect"] == "channel_gain_error")
+    assert all(v == 0.0 for v in row["parameters"].values())
+
+
 @pytest.mark.slow
 def test_records_whose_kinematics_lack_the_beams_shortening_name_it(small_config):
     """A rig without Eq. 9's shortening (linear kinematics, as a simulator may have it): the gap lies in the even

@@ -1,6 +1,8 @@
 """Harmonic balance (rig.harmonic_balance, used by the gap diagnosis) against the time integrator it
 replaces: the periodic steady states agree on every load level and model effect."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -21,6 +23,7 @@ EFFECTS = {
     "structural_damping": Augmentation(extra_damping=0.005),
     "transducer_mass_error": Augmentation(mass_error=-0.3),
     "channel_time_skew": Augmentation(delays=(2e-5, -1e-5, 0.0)),
+    "channel_gain_error": Augmentation(gains=(1.02, 0.97, 1.0)),
     "preload_drift": Augmentation(preload_drift=0.1),
 }
 
@@ -192,3 +195,24 @@ def test_the_settling_tolerance_is_a_setting_of_the_context(model):
     assert np.array_equal(explicit, default)
     rel = np.abs(loose - default).max() / np.abs(default).max()
     assert 0.0 < rel < 0.05
+
+
+def test_channel_gains_scale_what_each_channel_records_and_the_inverse_identification_removes_them(model):
+    from contactid.gap.refit import deskewed
+
+    rec, g = record("lc1"), np.array([1.02, 0.97, 1.0])
+    HarmonicBalance.forget()  # each from the same start: no Newton history between the two
+    plain = simulate(model, Augmentation(), rec, method="harmonic_balance", hb_harmonics=18, polish=False)
+    HarmonicBalance.forget()
+    gained = simulate(
+        model, Augmentation(gains=tuple(g)), rec, method="harmonic_balance", hb_harmonics=18, polish=False
+    )
+    np.testing.assert_allclose(gained.acceleration, g[:, None] * plain.acceleration, rtol=1e-12, atol=0)
+    # the contact's motion is the model's own: a gain is the measurement chain's, not the structure's
+    np.testing.assert_allclose(gained.contact["xi"], plain.contact["xi"], rtol=1e-12, atol=0)
+    measured = dataclasses.replace(rec, acceleration=gained.acceleration)
+    np.testing.assert_allclose(deskewed(measured, (), tuple(g)), plain.acceleration, rtol=1e-12, atol=0)
+    # delays and gains together: each removed
+    both = deskewed(measured, (1e-5, 0.0, 0.0), tuple(g))
+    h = np.arange(1, both.shape[1] + 1)
+    np.testing.assert_allclose(both[0], plain.acceleration[0] * np.exp(1j * 2 * np.pi * F0 * h * 1e-5), rtol=1e-12)

@@ -327,3 +327,34 @@ def test_records_that_drift_judge_an_update_on_what_the_drift_leaves(small_confi
 
 
 MASSES, DRIFT = 1.07, 0.15
+
+
+@pytest.mark.slow  # three updates (about 4 s each)
+def test_channel_gains_are_the_measurement_chains_and_leave_the_structure_alone(nominal):
+    # channels read 2.5 % high and 2 % low: the residues of the nominal structure, each sensor's scaled by its gain
+    f, sd, R = data_of(nominal)
+    g = np.array([1.0, 1.025, 0.98])
+    taken_as_calibrated = update_structure(nominal, f, sd, g[:, None] * R, residue_accuracy=0.01)
+    with_gains = update_structure(nominal, f, sd, g[:, None] * R, residue_accuracy=0.01, gain_sd=0.03)
+    # taken as calibrated, the gains are read as structure: factors move by per cents and chi^2 stays high
+    moved = max(
+        abs(np.log(v))
+        for v in (taken_as_calibrated.proposal or {"factors": taken_as_calibrated.factors})["factors"].values()
+    )
+    assert moved > 0.03 and taken_as_calibrated.chi2_nominal > 10
+    # fitted as the measurement chain's (with k_t and k_n, in the nominal fit too): no update, the gains found
+    assert not with_gains.accepted and with_gains.chi2_nominal < 1.0
+    assert all(v == 1.0 for v in with_gains.factors.values())
+    ratio = np.array(with_gains.channel_gains) / g
+    assert np.ptp(ratio) < 0.005  # each channel's gain to 0.5 %, up to the factor all share (the masses' scale)
+    assert len(with_gains.channel_gain_sd) == 3 and all(0 < s < 0.03 for s in with_gains.channel_gain_sd)
+    # the summary keeps them
+    again = UpdatingResult.from_summary(with_gains.summary(), nominal)
+    assert again.channel_gains == with_gains.channel_gains
+    # a structure off and calibrated channels: the residues do not call the channels miscalibrated, the update is made
+    # without gains and accepted
+    truth = apply_factors(nominal, {"transducer_mass_scale": 1.3})
+    f2, sd2, R2 = data_of(truth)
+    upd = update_structure(nominal, f2, sd2, R2, residue_accuracy=0.01, gain_sd=0.03)
+    assert upd.accepted and upd.factors["transducer_mass_scale"] == pytest.approx(1.3, rel=0.05)
+    assert upd.channel_gains == () and upd.channel_gain_sd == ()

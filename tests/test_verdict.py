@@ -677,6 +677,10 @@ def test_refitted_magnitude_maps_candidate_parameters_to_the_rigs_units():
     assert refitted_magnitude(
         "channel_time_skew", {"delay_2": 3e-5, "delay_0": 1e-5, "delay_1": 2e-5}
     ) == pytest.approx(3e-5)
+    # the rig reads channel k of 3 with 1 + m (-1)^k (k + 1) / 3: gain errors (1, -2, 3) % are m = 0.03
+    assert refitted_magnitude(
+        "channel_gain_error", {"gain_error_0": 0.01, "gain_error_2": 0.03, "gain_error_1": -0.02}
+    ) == pytest.approx(0.03)
     assert refitted_magnitude("contact_separation", {"exponent": 1.5, "stiffness_factor": 1.0}) is None
     assert refitted_magnitude("viscous_friction", None) is None
 

@@ -357,6 +357,7 @@ def test_gap_diagnosis_of_default_data_names_no_effect(default_run):
         "contact_separation",
         "preload_drift",
         "beam_shortening",
+        "channel_gain_error",
     }
     for r in d["ranking"]:
         assert {"effect", "heldout_gap_before", "heldout_gap_after", "score"} <= set(r)

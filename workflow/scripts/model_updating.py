@@ -28,3 +28,8 @@ if upd is not None:
         ", ".join(f"{k} {v:.4g}" for k, v in upd.factors.items()),
         ", ".join(k for k, v in upd.identifiability.items() if not v["bound_by_data"]) or "none",
     )
+    if upd.channel_gains:
+        log.info(
+            "the channels' gains relative to one another on the residues (the measurement chain's): %s",
+            ", ".join(f"{g:.4f} (sd {s:.4f})" for g, s in zip(upd.channel_gains, upd.channel_gain_sd)),
+        )

@@ -33,6 +33,7 @@ RANGES = {
     "multi_asperity_friction": (0.5, 1.0),
     "transducer_mass_error": (0.15, 0.5),
     "channel_time_skew": (1.0e-5, 4.0e-5),
+    "channel_gain_error": (0.015, 0.05),  # channels 0.5-5 % off: a calibration's tolerance
     "contact_separation": (5.05, 5.2),  # lc3 (1.43 x lc1) separates; above, its motion stops settling
     "preload_drift": (0.05, 0.2),
 }
@@ -42,6 +43,7 @@ EXPECTED_PLACE = {
     "structural_damping": "structure_or_measurement",
     "transducer_mass_error": "structure_or_measurement",
     "channel_time_skew": "structure_or_measurement",
+    "channel_gain_error": "structure_or_measurement",
     "normal_contact_damping": "normal_contact",
     "contact_separation": "normal_contact",
     "viscous_friction": "tangential_contact",
@@ -132,7 +134,9 @@ def ladder_items(cfg: Mapping, seed: int) -> dict:
 def refitted_magnitude(effect: str, parameters: Mapping | None) -> float | None:
     """The rig magnitude a candidate's refitted parameters amount to (None where the two are not comparable:
     contact separation's rig magnitude is a load factor, the candidate's a normal-law shape). Channel skew: the
-    rig delays channel k of n by m (k + 1) / n; m is the least-squares fit of the refitted per-channel delays."""
+    rig delays channel k of n by m (k + 1) / n; m is the least-squares fit of the refitted per-channel delays.
+    Channel gains: the rig reads channel k of n with 1 + m (-1)^k (k + 1) / n; m is the least-squares fit of the
+    refitted gain errors."""
     if not parameters:
         return None
     direct = {
@@ -149,6 +153,10 @@ def refitted_magnitude(effect: str, parameters: Mapping | None) -> float | None:
         d = np.array([parameters[k] for k in sorted(parameters, key=lambda k: int(k.rsplit("_", 1)[1]))])
         shape = np.arange(1, d.size + 1) / d.size
         return float(d @ shape / (shape @ shape))
+    if effect == "channel_gain_error":
+        g = np.array([parameters[k] for k in sorted(parameters, key=lambda k: int(k.rsplit("_", 1)[1]))])
+        shape = (-1.0) ** np.arange(g.size) * np.arange(1, g.size + 1) / g.size
+        return float(g @ shape / (shape @ shape))
     return None
 
 

@@ -174,6 +174,17 @@ register(
         acts_on="any",
     )
 )
+register(
+    Candidate(
+        "channel_gain_error",
+        "each accelerometer channel read with its own sensitivity error, 1 + g times its acceleration: the gains "
+        "relative to one another that the random test's residues show (applied as they are, not searched)",
+        (Parameter("gain_error", "1", -0.2, 0.2),),
+        lambda th: Augmentation(gains=tuple(1.0 + float(x) for x in th)),
+        per_channel=True,
+        acts_on="structure_or_measurement",
+    )
+)
 
 BUILTIN = tuple(LIBRARY)
 

@@ -103,6 +103,7 @@ class GapSettings:
     updating_confidence: float = 0.95
     updating_prior_sd: tuple = ()  # ((factor, sd of its ln), ...) replacing contactid.updating.FACTORS' priors
     updating_records_test: bool = True  # the records may accept an update the random test's chi^2 did not
+    updating_gain_sd: float = 0.03  # prior sd of ln of each channel's sensitivity on the residues (0: calibrated)
     joint_refit: bool = True  # the explanation's later steps refit the earlier steps' parameters with theirs
     polish_searches: bool = False  # every searched state polished by the integrator (refit.POLISH_SEARCH)
     pair_lookahead: float = 3.0  # where no candidate shrinks a gap above this many min_gap materially, try a pair
@@ -164,6 +165,7 @@ def _updating_settings(b: Mapping) -> dict:
         "residue_accuracy": float(b["residue_accuracy"]),
         "updating_confidence": float(b["confidence"]),
         "frequency_floor": float(b["frequency_floor"]),
+        "updating_gain_sd": float(b["channel_gain_sd"]),
         "updating_prior_sd": _prior_sd(b.get("prior_sd"), FACTORS),
         "updating_records_test": bool(b.get("records_test", True)),
     }
@@ -569,6 +571,7 @@ def _candidate(
     joint: bool = True,
     alone: dict | None = None,
     channel_delays=None,
+    channel_gains=None,
 ):
     """One candidate added to the explanation's earlier steps ``base_steps`` ((name, theta), ...): calibrated on
     the calibration case (with ``joint``, together with the earlier steps' parameters, ``joint_candidate``;
@@ -576,7 +579,8 @@ def _candidate(
     ``alone``: {name: theta} of the first pass (each candidate alone); a joint refit also starts between the
     earlier steps' optimum and this candidate's own (two effects that can stand in for each other, viscous friction
     and a normal dashpot, leave a ridge between the one-effect optimum and the truth). ``channel_delays``: the random
-    test's per-channel delays (``refit.calibrate``). Returns (calibration, sims, residuals) by case."""
+    test's per-channel delays and ``channel_gains`` its channels' relative gains (``refit.calibrate``). Returns
+    (calibration, sims, residuals) by case."""
     rec = records[calibration_case]
     # per-channel effects (channel delays) trade off with no contact effect and would add a dimension per channel:
     # they are held, and a per-channel candidate is refitted on the earlier steps held
@@ -622,6 +626,7 @@ def _candidate(
             start=base_sims[calibration_case],
             base=base,
             channel_delays=channel_delays,
+            channel_gains=channel_gains,
         )
         cal = dataclasses.replace(cal, steps=tuple(base_steps) + ((name, cal.theta),))
     sims = {calibration_case: None}
@@ -1174,6 +1179,7 @@ class _DiagnosisRun:
     base_sims: dict
     boot: dict = field(default_factory=dict)
     channel_delays: np.ndarray | None = None  # the random test's per-channel delays (s), where known
+    channel_gains: np.ndarray | None = None  # the random test's channel gains relative to one another, where known
 
     @property
     def H(self) -> int:
@@ -1194,6 +1200,7 @@ class _DiagnosisRun:
             H=self.H,
             max_evaluations=self.settings.max_evaluations,
             channel_delays=self.channel_delays,
+            channel_gains=self.channel_gains,
             polish_searches=self.settings.polish_searches,
             **extra,
         )
@@ -1278,7 +1285,9 @@ def diagnose(
     chain's own model when ``model`` is its update (``gap.pipeline.updated_model``; ``updating`` its
     UpdatingResult): the explanation then starts with the update's step. ``channel_delays``: each accelerometer
     channel's delay on the force (s) as the random test shows it (``random_test_delays``), held in common by the
-    channel-delay candidate's refit; None: that refit searches every channel's delay from zero."""
+    channel-delay candidate's refit; None: that refit searches every channel's delay from zero. The channels' gains
+    relative to one another, as the random test's residues show them (``updating.channel_gains``), are what the
+    channel-gain candidate applies; without them it adds nothing."""
     H = settings.n_harmonics
     if calibration_case not in records:
         raise ValueError(f"gap: the calibration case {calibration_case!r} is not among the load cases {list(records)}")
@@ -1298,6 +1307,9 @@ def diagnose(
         workers,
         base_sims,
         channel_delays=None if channel_delays is None else np.asarray(channel_delays, dtype=float),
+        channel_gains=np.asarray(updating.channel_gains, dtype=float)
+        if updating is not None and len(getattr(updating, "channel_gains", ()) or ())
+        else None,
     )
     # candidates: calibrate, predict the held-out cases (forked before the localisation runs numba's
     # parallel friction kernel in this process)

@@ -37,7 +37,8 @@ class Augmentation:
     extra_damping: modal damping ratio added to the beam's modes; hunt_crossley: alpha (s/m) of
     N (1 - alpha deta/dt); viscous: sigma_2 (N s/m) of S + sigma_2 dxi/dt; iwan_share: share of the
     tangential contact carried by a Maxwell-slip (Iwan) element; mass_error: relative error of
-    every transducer mass; delays: (j,) s, acceleration channels late on the force;
+    every transducer mass; delays: (j,) s, acceleration channels late on the force; gains: (j,) each acceleration
+    channel reads g times its acceleration (a sensitivity error);
     unilateral_exponent: 0 = the linear bilateral spring N0 - k_n eta, p >= 1 = the unilateral
     power law N0 ((delta0 - eta)/delta0)^p with delta0 = p N0 / (c k_n) (the contact may open), c the
     normal_stiffness_factor on the linear chain's k_n (poorly determined by frequencies);
@@ -51,6 +52,7 @@ class Augmentation:
     iwan_share: float = 0.0
     mass_error: float = 0.0
     delays: tuple = ()
+    gains: tuple = ()
     unilateral_exponent: float = 0.0
     normal_stiffness_factor: float = 1.0
     preload_drift: float = 0.0
@@ -302,11 +304,14 @@ class SimResult:
     extra: dict = field(default_factory=dict)
 
 
-def _delay(coef: np.ndarray, delays, w: float) -> np.ndarray:
-    if not len(delays):
-        return coef
-    h = np.arange(1, coef.shape[-1] + 1)
-    return coef * np.exp(-1j * np.outer(np.asarray(delays, dtype=float), h * w))
+def _channels(coef: np.ndarray, aug: "Augmentation", w: float) -> np.ndarray:
+    """The sensors' harmonics (j, H) as the channels record them: each late by its delay and read with its gain."""
+    if len(aug.delays):
+        h = np.arange(1, coef.shape[-1] + 1)
+        coef = coef * np.exp(-1j * np.outer(np.asarray(aug.delays, dtype=float), h * w))
+    if len(aug.gains):
+        coef = coef * np.asarray(aug.gains, dtype=float)[:, None]
+    return coef
 
 
 STEADY_STATE = contextvars.ContextVar("steady_state", default="harmonic_balance")
@@ -441,7 +446,7 @@ def _periodic_result(
     n_per = g["t"].size
     acc = np.zeros((periodic.A.shape[0], H + 1), dtype=complex)
     acc[:, : periodic.A.shape[1]] = periodic.A[:, : H + 1]
-    A = _delay(sim.red.sensors @ acc[:, 1:], aug.delays, w)
+    A = _channels(sim.red.sensors @ acc[:, 1:], aug, w)
     sig = {"S": g["S"], "N": g["N"], "xi": g["xi"], "eta": g["eta"], "xi_dot": g["dxi"], "eta_dot": g["deta"]}
     contact, means = _contact_harmonics(sig, 0.0, w, n_per, H)
     dt = 2 * np.pi / w / n_per
@@ -494,9 +499,9 @@ def _marched_result(
     t1 = out["t"][0]
     if aug.preload_drift:
         third = (rec.periods // 3) * n_per
-        first = _delay(periodic_harmonics(acc[:, :third], t1, w, n_per, H), aug.delays, w)
-        last = _delay(periodic_harmonics(acc[:, -third:], out["t"][n_rec - third], w, n_per, H), aug.delays, w)
-    A = _delay(periodic_harmonics(acc, t1, w, n_per, H), aug.delays, w)
+        first = _channels(periodic_harmonics(acc[:, :third], t1, w, n_per, H), aug, w)
+        last = _channels(periodic_harmonics(acc[:, -third:], out["t"][n_rec - third], w, n_per, H), aug, w)
+    A = _channels(periodic_harmonics(acc, t1, w, n_per, H), aug, w)
     sig = {
         "S": out["S"],
         "N": out["N"],

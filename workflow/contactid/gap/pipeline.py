@@ -107,6 +107,7 @@ def structure_update(structure, modal: xr.Dataset, settings):
         settings.updating_parameters,
         confidence=settings.updating_confidence,
         prior_sd=dict(settings.updating_prior_sd),
+        gain_sd=float(getattr(settings, "updating_gain_sd", 0.0)),
     )
 
 

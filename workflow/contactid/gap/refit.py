@@ -69,12 +69,16 @@ def augmented_zeta(fe, damping, extra: float) -> np.ndarray:
     return zeta
 
 
-def deskewed(rec: RecordHarmonics, delays) -> np.ndarray:
-    """The record's acceleration harmonics with per-channel delays removed."""
-    if not len(delays):
-        return rec.acceleration
-    h = np.arange(1, rec.acceleration.shape[1] + 1)
-    return rec.acceleration * np.exp(1j * np.outer(np.asarray(delays, float), 2 * np.pi * rec.f0 * h))
+def deskewed(rec: RecordHarmonics, delays, gains=()) -> np.ndarray:
+    """The record's acceleration harmonics with per-channel delays (s) and sensitivity factors (``gains``: each channel
+    reads g times its acceleration) removed."""
+    A = rec.acceleration
+    if len(delays):
+        h = np.arange(1, A.shape[1] + 1)
+        A = A * np.exp(1j * np.outer(np.asarray(delays, float), 2 * np.pi * rec.f0 * h))
+    if len(gains):
+        A = A / np.asarray(gains, float)[:, None]
+    return A
 
 
 class _Memo:
@@ -115,12 +119,12 @@ def memoised(enabled: bool = True):
 def identified_forces(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics) -> InverseHarmonics:
     """Contact forces of a record by inverse identification with the augmented model (memoised: the
     candidates that leave the structure, its damping and the channels as they are reuse it)."""
-    key = (model.structure_with(aug), model.damping, aug.extra_damping, tuple(aug.delays), id(rec))
+    key = (model.structure_with(aug), model.damping, aug.extra_damping, tuple(aug.delays), tuple(aug.gains), id(rec))
 
     def compute():
         fe = fe_model(model, aug)
         zeta = augmented_zeta(fe, model.damping, aug.extra_damping)
-        return inverse_harmonics(fe, zeta, rec.force, deskewed(rec, aug.delays), rec.f0), rec
+        return inverse_harmonics(fe, zeta, rec.force, deskewed(rec, aug.delays, aug.gains), rec.f0), rec
 
     return _FORCES.get(key, compute)
 
@@ -367,6 +371,15 @@ def _per_channel_theta(
     return theta
 
 
+def _held_gains(channel_gains, j: int) -> np.ndarray:
+    """The channel-gain candidate's theta (gain errors g - 1) from the random test's relative gains, or zeros where
+    they are not known for these j channels."""
+    g = None if channel_gains is None else np.asarray(channel_gains, dtype=float)
+    if g is None or g.size != j or not np.all(np.isfinite(g)) or np.any(g <= 0):
+        return np.zeros(j)
+    return g - 1.0
+
+
 def _least_squares_unit(
     run: _CandidateRuns, lo: np.ndarray, hi: np.ndarray, x0: np.ndarray, max_evaluations: int
 ) -> np.ndarray:
@@ -478,6 +491,7 @@ def calibrate(
     base: Augmentation = NONE,
     starts=(),
     channel_delays=None,
+    channel_gains=None,
 ) -> Calibration:
     """theta of ``cand`` minimising the calibration case's gap (friction law refitted at each theta);
     each simulation starts from the previous one's steady state (``start``: the model's own). ``base``:
@@ -485,6 +499,8 @@ def calibrate(
     more points (theta) a search over several parameters starts from if they are better than its scan's best.
     ``channel_delays``: the random test's per-channel delays (s), where known; a per-channel candidate that sets
     delays holds their common part (``_per_channel_theta``).
+    ``channel_gains``: the channels' gains relative to one another as the random test's residues show them
+    (``UpdatingResult.channel_gains``); the channel-gain candidate applies them as they are (``_held_gains``).
     The search compares harmonic-balance states (within 5e-4 of the integrator's orbit; ``POLISH_SEARCH`` set to
     True polishes each with the integrator); the optimum is evaluated again with the integrator's polish, so its gap
     and simulation are the reference's (same optimum within 1 %, a quarter to a third less diagnosis time, measured
@@ -494,7 +510,14 @@ def calibrate(
     if cand.per_channel:
         j = rec.acceleration.shape[0]
         sets_delays = channel_delays is not None and bool(cand.augmentation(np.ones(j)).delays)
-        theta = _per_channel_theta(run, cand, rec, max_evaluations, channel_delays if sets_delays else None)
+        if cand.augmentation(np.zeros(j)).gains:
+            # a channel's sensitivity is the same in every test: the random test's residues bind the channels' gains
+            # relative to one another (0.5-0.7 %), and the candidate applies them, searching nothing. Searched on the
+            # dual-sine records (every channel from zero) the gains were an amplitude scale that took up half of a
+            # normal dashpot's or viscous friction's gap (common gains of -4 to -6 %) and named a channel skew's
+            theta = _held_gains(channel_gains, j)
+        else:
+            theta = _per_channel_theta(run, cand, rec, max_evaluations, channel_delays if sets_delays else None)
     elif len(cand.parameters) == 1:
         theta = _scalar_theta(run, cand, max_evaluations)
     else:

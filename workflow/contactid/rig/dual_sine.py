@@ -22,7 +22,7 @@ from .effects import effect_magnitudes
 from .frontend import add_noise, anti_alias_decimate, delay_channels
 from ..harmonics import harmonic_amplitudes
 from .nonlinear import ContactParameters, ControlResult, DualSineSimulator, control_response, reduced_model
-from .structure import channel_delays, rig_structure, true_structure_config
+from .structure import channel_delays, channel_gains, rig_structure, true_structure_config
 
 log = logging.getLogger(__name__)
 
@@ -203,14 +203,17 @@ def _measured_record(
     rng: np.random.Generator,
 ) -> tuple[np.ndarray, np.ndarray]:
     """The force (N) and accelerations (m/s^2, (sensors, samples)) as the front end records them: channel delays
-    if that effect is on, anti-alias filtering and decimation to the sampling rate over the record, and sensor
-    noise (``noise_fraction`` of each channel's rms, from ``rng``)."""
+    and sensitivity errors if those effects are on, anti-alias filtering and decimation to the sampling rate over
+    the record, and sensor noise (``noise_fraction`` of each channel's rms, from ``rng``)."""
     q = sim.oversampling
     acc_sim = out["a"] @ sim.red.sensors.T  # (n, sensors)
     acc_sim = acc_sim.T
     delays = channel_delays(rig_cfg, acc_sim.shape[0])
     if delays is not None:
         acc_sim = delay_channels(acc_sim, delays, 1.0 / sim.dt)
+    gains = channel_gains(rig_cfg, acc_sim.shape[0])
+    if gains is not None:
+        acc_sim = acc_sim * np.asarray(gains)[:, None]
     acc = anti_alias_decimate(acc_sim, q)[:, margin // q : (margin + n_rec) // q]
     force = anti_alias_decimate(out["f"], q)[margin // q : (margin + n_rec) // q]
     force = add_noise(force, noise_fraction, rng)

@@ -76,6 +76,15 @@ EFFECTS = {
             1.0e-3,
         ),
         EffectSpec(
+            "channel_gain_error",
+            "1",
+            "sensitivity error of the acceleration channels (a calibration the analysis does not know): channel k "
+            "of n reads 1 + m (-1)^k (k + 1) / n times its acceleration",
+            0.03,
+            -0.5,
+            0.5,
+        ),
+        EffectSpec(
             "contact_separation",
             "1",
             "factor on every rig load case's target amplitudes A1, A2: the rig is driven hard enough to "

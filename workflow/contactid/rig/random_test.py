@@ -32,7 +32,8 @@ class RandomTestSettings:
     modal_damping_ratio: damping ratio (at damping_reference_hz, spread over the modes by damping_form,
     see ``rig.damping``); oversampling: internal
     integration rate over output rate; settle_s: discarded start-up time;
-    channel_delays_s: per-accelerometer sampling delay (effect channel_time_skew).
+    channel_delays_s: per-accelerometer sampling delay (effect channel_time_skew);
+    channel_gains: per-accelerometer sensitivity factor (effect channel_gain_error).
     """
 
     sampling_rate_hz: float = 5120.0
@@ -44,6 +45,7 @@ class RandomTestSettings:
     oversampling: int = 4
     settle_s: float = 2.0
     channel_delays_s: tuple | None = None
+    channel_gains: tuple | None = None
     damping_form: str = "modal"
     damping_reference_hz: float = 54.4
 
@@ -144,6 +146,8 @@ def simulate_random_test(model: FEModel, settings: RandomTestSettings, seed: int
 
     if s.channel_delays_s is not None:
         acc_sim = delay_channels(acc_sim, s.channel_delays_s, fs_sim)
+    if s.channel_gains is not None:
+        acc_sim = acc_sim * np.asarray(s.channel_gains)[:, None]
     force = anti_alias_decimate(f_sim, q)[n_settle : n_settle + n_out]
     acc = anti_alias_decimate(acc_sim, q)[:, n_settle : n_settle + n_out]
     rng_noise = generator(seed, "random_test/noise")
@@ -156,7 +160,7 @@ def simulate_random_test(model: FEModel, settings: RandomTestSettings, seed: int
 def settings_from_config(random_test_cfg, rig_cfg, n_channels: int = 3) -> RandomTestSettings:
     """RandomTestSettings from the ``random_test`` and ``rig`` config blocks (keys left out: the schema's defaults)."""
     from ..config import schema_defaults
-    from .structure import channel_delays
+    from .structure import channel_delays, channel_gains
 
     rt = {**schema_defaults("random_test"), **dict(random_test_cfg or {})}
     rig_defaults = schema_defaults("rig")
@@ -171,6 +175,7 @@ def settings_from_config(random_test_cfg, rig_cfg, n_channels: int = 3) -> Rando
         modal_damping_ratio=float(rig["modal_damping_ratio"]),
         oversampling=int(rig["oversampling"]),
         channel_delays_s=channel_delays(rig_cfg, n_channels),
+        channel_gains=channel_gains(rig_cfg, n_channels),
         damping_form=str(td["form"]),
         damping_reference_hz=float(td["reference_frequency_hz"]),
     )

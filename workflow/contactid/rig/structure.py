@@ -75,7 +75,16 @@ def channel_delays(rig_cfg: Mapping, n_channels: int):
     return tuple(m * (k + 1) / n_channels for k in range(n_channels))
 
 
-RANDOM_TEST_EFFECTS = ("transducer_mass_error", "channel_time_skew")
+def channel_gains(rig_cfg: Mapping, n_channels: int):
+    """Per-accelerometer sensitivity factors of the effect channel_gain_error, or None when off: channel k of n
+    reads 1 + m (-1)^k (k + 1) / n times its acceleration."""
+    m = effect_magnitudes(rig_cfg.get("effects"))["channel_gain_error"]
+    if not m:
+        return None
+    return tuple(1.0 + m * (-1) ** k * (k + 1) / n_channels for k in range(n_channels))
+
+
+RANDOM_TEST_EFFECTS = ("transducer_mass_error", "channel_time_skew", "channel_gain_error")
 
 
 def random_test_rig_config(rig_cfg: Mapping) -> dict:
