@@ -167,6 +167,8 @@ class UpdatingResult:
     # gain_sd is 0): reported, the structure is not multiplied by them
     channel_gains: tuple = ()
     channel_gain_sd: tuple = ()
+    # whether they lowered the nominal structure's chi^2 significantly (and so took part in the update's fit)
+    channel_gains_significant: bool = False
 
     @classmethod
     def from_summary(cls, summary: dict, params: StructureParameters) -> "UpdatingResult":
@@ -193,6 +195,7 @@ class UpdatingResult:
             float(summary.get("effective_factors", math.nan)),
             tuple(summary.get("channel_gains") or ()),
             tuple(summary.get("channel_gain_sd") or ()),
+            bool(summary.get("channel_gains_significant", False)),
         )
 
     def proposed_structure(self) -> StructureParameters:
@@ -265,6 +268,7 @@ class UpdatingResult:
             "effective_factors": self.effective_factors,
             "channel_gains": list(self.channel_gains),
             "channel_gain_sd": list(self.channel_gain_sd),
+            "channel_gains_significant": self.channel_gains_significant,
         }
 
 
@@ -442,12 +446,15 @@ def _posterior_identifiability(jacobian, sd, labels: list) -> tuple[np.ndarray, 
     return cov, ident
 
 
-def channel_gains_significant(params, names, f_id, f_sd, R_id, residue_accuracy, sd, gain_sd, confidence) -> bool:
-    """Whether the channels' gains relative to one another (``gain_basis``, prior sd ``gain_sd`` of their logs) lower
-    the nominal structure's chi^2 (k_t and k_n refitted) by more than chi^2_(j-1)(confidence): the residues call the
-    channels miscalibrated. Where they do not, the update is made without them: fitted always, they took part of a
-    structure's own misfit at the sensors (the compound benchmark's update of compound-14-s1 went from 16.2 % to 13.6 %
-    instead of 15.0 %, and its normal dashpot was no longer named)."""
+def channel_gains_significant(
+    params, names, f_id, f_sd, R_id, residue_accuracy, sd, gain_sd, confidence
+) -> tuple[bool, tuple, tuple]:
+    """(significant, gains, their sd): the channels' gains relative to one another (``gain_basis``, prior sd ``gain_sd``
+    of their logs) fitted with k_t and k_n on the nominal structure, the posterior sd of each one's log, and whether
+    they lower its chi^2 by more than chi^2_(j-1)(confidence): the residues call the channels miscalibrated. Where they
+    do not, the update is made without them: fitted always, they took part of a structure's own misfit at the sensors
+    (the compound benchmark's update of compound-14-s1 went from 16.2 % to 13.6 % instead of 15.0 %, and its normal
+    dashpot was no longer named)."""
     from scipy.stats import chi2  # here: scipy.stats takes 0.3 s to import
 
     j = R_id.shape[0]
@@ -456,10 +463,17 @@ def channel_gains_significant(params, names, f_id, f_sd, R_id, residue_accuracy,
     with_gains = _UpdatingProblem(params, names, f_id, f_sd, R_id, residue_accuracy, sd_g, j - 1)
     without = _UpdatingProblem(params, names, f_id, f_sd, R_id, residue_accuracy, sd, 0)
     free = np.array([True, True] + [False] * len(names) + [True] * (j - 1))
-    x_g, _ = with_gains.fit(x, free)
+    x_g, sol = with_gains.fit(x, free)
     x_0, _ = without.fit(x[: 2 + len(names)], free[: 2 + len(names)])
     drop = float(np.sum(without.data_residuals(x_0) ** 2) - np.sum(with_gains.data_residuals(x_g) ** 2))
-    return drop > float(chi2.ppf(confidence, j - 1))
+    B = gain_basis(j)
+    J = sol.jac  # of (data, prior) residuals in the free entries: k_t, k_n, the gains
+    try:
+        cov = np.linalg.inv(J.T @ J)[2:, 2:]
+    except np.linalg.LinAlgError:
+        cov = np.linalg.pinv(J.T @ J)[2:, 2:]
+    gains = tuple(float(v) for v in np.exp(B @ x_g[len(x_g) - (j - 1) :]))
+    return drop > float(chi2.ppf(confidence, j - 1)), gains, tuple(float(v) for v in np.sqrt(np.diag(B @ cov @ B.T)))
 
 
 def update_structure(
@@ -495,10 +509,13 @@ def update_structure(
     names = [str(f) for f in factors]
     sd = _prior_sds(names, contact_prior_sd, prior_sd)
     n_gains = R_id.shape[0] - 1 if R_id is not None and gain_sd > 0 and R_id.shape[0] > 1 else 0
-    if n_gains and not channel_gains_significant(
-        params, names, f_id, f_sd, R_id, residue_accuracy, sd, gain_sd, confidence
-    ):
-        n_gains = 0  # channels the residues call calibrated: the update as without the gains
+    significant, gains_alone = False, ((), ())
+    if n_gains:
+        significant, *gains_alone = channel_gains_significant(
+            params, names, f_id, f_sd, R_id, residue_accuracy, sd, gain_sd, confidence
+        )
+        if not significant:
+            n_gains = 0  # channels the residues do not call miscalibrated: the update as without the gains
     sd = np.concatenate([sd, np.full(n_gains, float(gain_sd))])
     x_nom = np.array([np.log(params.k_t), np.log(params.k_n)] + [0.0] * (len(names) + n_gains))
     problem = _UpdatingProblem(params, names, f_id, f_sd, R_id, residue_accuracy, sd, n_gains)
@@ -574,10 +591,11 @@ def update_structure(
         effective_factors=float(np.sum(weights)),
         channel_gains=tuple(float(v) for v in np.exp(gain_basis(n_gains + 1) @ x[len(x) - n_gains :]))
         if n_gains
-        else (),
+        else tuple(gains_alone[0]),
         channel_gain_sd=tuple(
             float(v) for v in np.sqrt(np.diag(gain_basis(n_gains + 1) @ gain_cov @ gain_basis(n_gains + 1).T))
         )
         if n_gains
-        else (),
+        else tuple(gains_alone[1]),
+        channel_gains_significant=bool(significant),
     )
