@@ -35,7 +35,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass, field
-from typing import Callable
+from typing import Callable, NamedTuple
 
 import numpy as np
 
@@ -446,12 +446,23 @@ def _posterior_identifiability(jacobian, sd, labels: list) -> tuple[np.ndarray, 
     return cov, ident
 
 
+class ChannelGainTest(NamedTuple):
+    """``channel_gains_significant``'s answer, with the two nominal fits (x of k_t, k_n, the factors at nominal and,
+    in ``x_with``, the gains) that ``update_structure`` starts from."""
+
+    significant: bool
+    gains: tuple
+    sd: tuple
+    x_with: np.ndarray
+    x_without: np.ndarray
+
+
 def channel_gains_significant(
     params, names, f_id, f_sd, R_id, residue_accuracy, sd, gain_sd, confidence
-) -> tuple[bool, tuple, tuple]:
-    """(significant, gains, their sd): the channels' gains relative to one another (``gain_basis``, prior sd ``gain_sd``
-    of their logs) fitted with k_t and k_n on the nominal structure, the posterior sd of each one's log, and whether
-    they lower its chi^2 by more than chi^2_(j-1)(confidence): the residues call the channels miscalibrated. Where they
+) -> ChannelGainTest:
+    """The channels' gains relative to one another (``gain_basis``, prior sd ``gain_sd`` of their logs) fitted with k_t
+    and k_n on the nominal structure, the posterior sd of each one's log, and whether they lower its chi^2 by more
+    than chi^2_(j-1)(confidence): the residues call the channels miscalibrated. Where they
     do not, the update is made without them: fitted always, they took part of a structure's own misfit at the sensors
     (the compound benchmark's update of compound-14-s1 went from 16.2 % to 13.6 % instead of 15.0 %, and its normal
     dashpot was no longer named)."""
@@ -473,7 +484,8 @@ def channel_gains_significant(
     except np.linalg.LinAlgError:
         cov = np.linalg.pinv(J.T @ J)[2:, 2:]
     gains = tuple(float(v) for v in np.exp(B @ x_g[len(x_g) - (j - 1) :]))
-    return drop > float(chi2.ppf(confidence, j - 1)), gains, tuple(float(v) for v in np.sqrt(np.diag(B @ cov @ B.T)))
+    gain_sd_post = tuple(float(v) for v in np.sqrt(np.diag(B @ cov @ B.T)))
+    return ChannelGainTest(drop > float(chi2.ppf(confidence, j - 1)), gains, gain_sd_post, x_g, x_0)
 
 
 def update_structure(
@@ -509,18 +521,21 @@ def update_structure(
     names = [str(f) for f in factors]
     sd = _prior_sds(names, contact_prior_sd, prior_sd)
     n_gains = R_id.shape[0] - 1 if R_id is not None and gain_sd > 0 and R_id.shape[0] > 1 else 0
-    significant, gains_alone = False, ((), ())
+    gain_test = None
     if n_gains:
-        significant, *gains_alone = channel_gains_significant(
+        gain_test = channel_gains_significant(
             params, names, f_id, f_sd, R_id, residue_accuracy, sd, gain_sd, confidence
         )
-        if not significant:
+        if not gain_test.significant:
             n_gains = 0  # channels the residues do not call miscalibrated: the update as without the gains
     sd = np.concatenate([sd, np.full(n_gains, float(gain_sd))])
     x_nom = np.array([np.log(params.k_t), np.log(params.k_n)] + [0.0] * (len(names) + n_gains))
     problem = _UpdatingProblem(params, names, f_id, f_sd, R_id, residue_accuracy, sd, n_gains)
     contact_only = np.array([True, True] + [False] * len(names) + [True] * n_gains)
-    x0, _ = problem.fit(x_nom, contact_only)  # the nominal structure with k_t, k_n refitted to the same data
+    if gain_test is None:
+        x0, _ = problem.fit(x_nom, contact_only)  # the nominal structure with k_t, k_n refitted to the same data
+    else:  # the same fit, made by the gains' test
+        x0 = gain_test.x_with if gain_test.significant else gain_test.x_without
     chi2_nominal = float(np.sum(problem.data_residuals(x0) ** 2))
     free = np.ones(x_nom.size, bool)
     x_start = x_nom.copy()
@@ -591,11 +606,11 @@ def update_structure(
         effective_factors=float(np.sum(weights)),
         channel_gains=tuple(float(v) for v in np.exp(gain_basis(n_gains + 1) @ x[len(x) - n_gains :]))
         if n_gains
-        else tuple(gains_alone[0]),
+        else (gain_test.gains if gain_test is not None else ()),
         channel_gain_sd=tuple(
             float(v) for v in np.sqrt(np.diag(gain_basis(n_gains + 1) @ gain_cov @ gain_basis(n_gains + 1).T))
         )
         if n_gains
-        else tuple(gains_alone[1]),
-        channel_gains_significant=bool(significant),
+        else (gain_test.sd if gain_test is not None else ()),
+        channel_gains_significant=gain_test is not None and gain_test.significant,
     )

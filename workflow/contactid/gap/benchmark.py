@@ -149,14 +149,12 @@ def refitted_magnitude(effect: str, parameters: Mapping | None) -> float | None:
     }
     if effect in direct:
         return float(parameters[direct[effect]])
-    if effect == "channel_time_skew":
+    if effect in ("channel_time_skew", "channel_gain_error"):
         d = np.array([parameters[k] for k in sorted(parameters, key=lambda k: int(k.rsplit("_", 1)[1]))])
         shape = np.arange(1, d.size + 1) / d.size
+        if effect == "channel_gain_error":
+            shape = shape * (-1.0) ** np.arange(d.size)
         return float(d @ shape / (shape @ shape))
-    if effect == "channel_gain_error":
-        g = np.array([parameters[k] for k in sorted(parameters, key=lambda k: int(k.rsplit("_", 1)[1]))])
-        shape = (-1.0) ** np.arange(g.size) * np.arange(1, g.size + 1) / g.size
-        return float(g @ shape / (shape @ shape))
     return None
 
 

@@ -1307,9 +1307,7 @@ def diagnose(
         workers,
         base_sims,
         channel_delays=None if channel_delays is None else np.asarray(channel_delays, dtype=float),
-        channel_gains=np.asarray(updating.channel_gains, dtype=float)
-        if updating is not None and len(getattr(updating, "channel_gains", ()) or ())
-        else None,
+        channel_gains=np.asarray(updating.channel_gains, dtype=float) if updating and updating.channel_gains else None,
     )
     # candidates: calibrate, predict the held-out cases (forked before the localisation runs numba's
     # parallel friction kernel in this process)
