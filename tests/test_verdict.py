@@ -786,6 +786,52 @@ def test_the_report_says_when_the_records_accepted_the_update():
     assert "random test alone" not in text
 
 
+def test_the_report_describes_the_base_models_update_and_the_channels_gains():
+    from contactid.gap.report import updating_paragraph
+
+    ident = {
+        "k_t": {"posterior_over_prior": 0.08, "bound_by_data": True, "posterior_sd": 0.24},
+        "stiffness_scale": {"posterior_over_prior": 0.18, "bound_by_data": True, "posterior_sd": 0.0092},
+        "tangential_lever_arm_scale": {"posterior_over_prior": 0.99, "bound_by_data": False, "posterior_sd": 0.099},
+    }
+    upd = {
+        "accepted": False,
+        "accepted_by": "",
+        "chi2_nominal": 0.4412,
+        "chi2_updated": 0.359,
+        "chi2_threshold": 9.08,
+        "effective_factors": 3.82,
+        "n_data": 12,
+        "factors": {"stiffness_scale": 1.0},
+        "proposal": {"factors": {"stiffness_scale": 1.0021}},
+        "records_test": {"heldout_gap_chain": 0.00298, "heldout_gap_updated": 0.00258, "record_scatter": 3.5e-5},
+        "identifiability": ident,
+        "channel_gains": [1.0014, 0.9996, 0.9989],
+        "channel_gain_sd": [0.0048, 0.0047, 0.0047],
+        "channel_gains_significant": False,
+    }
+    at_floor = {"remaining_gap": {"floor": 0.006}, "where": {"model_updating": upd}}
+    text = updating_paragraph(at_floor)
+    assert "nominal structure is kept" in text and "$\\times1.002$" in text  # the proposal, not the kept factors
+    assert "0.441" in text and "9.08" in text and "3.8 factors" in text
+    assert "lies at the identification's floor" in text and "$0.600$" in text
+    # what the random test binds (relative sd of the factor) and what it leaves at its prior; k_t is not a factor
+    assert "binds stiffness\\_scale ($\\pm$\\,$0.920$" in text and "leaves tangential\\_lever\\_arm\\_scale" in text
+    assert "k\\_t" not in text
+    assert "channel 1 $1.001$" in text and "channel 3 $0.9989$" in text and "fitted without them" in text
+    above = updating_paragraph({"remaining_gap": {"floor": 0.002}, "where": {"model_updating": upd}})
+    assert "does not shrink it by gap.min\\_reduction" in above
+    significant = {**upd, "channel_gains_significant": True, "accepted": True, "accepted_by": "random_test"}
+    significant["factors"] = {"stiffness_scale": 0.97}
+    text = updating_paragraph({"where": {"model_updating": significant}})
+    assert "The drop is significant" in text and "$\\times0.9700$" in text and "fitted with the update" in text
+    assert "nor did" not in text
+    by_records = {**significant, "accepted_by": "records", "chi2_threshold": None}
+    text = updating_paragraph({"where": {"model_updating": by_records}})
+    assert "no drop is significant" in text and "the dual-sine records accepted it" in text and "$0.258$" in text
+    assert updating_paragraph({"where": {}}) == ""  # updating off: no paragraph
+
+
 def test_a_step_names_the_candidates_the_records_cannot_tell_from_it():
     from contactid.gap.report import explanation_text
 
