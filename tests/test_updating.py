@@ -351,6 +351,10 @@ def test_channel_gains_are_the_measurement_chains_and_leave_the_structure_alone(
     # the summary keeps them
     again = UpdatingResult.from_summary(with_gains.summary(), nominal)
     assert again.channel_gains == with_gains.channel_gains
+    # the structure's factors alone cannot stand in for them: the gains are needed beyond the update without them
+    alone = with_gains.structure_alone
+    assert alone["gains_needed"] and alone["gains_drop"] > 3 * alone["gains_threshold"]
+    assert again.structure_alone == alone
     # a structure off and calibrated channels: the residues do not call the channels miscalibrated, the update is made
     # without gains and accepted
     truth = apply_factors(nominal, {"transducer_mass_scale": 1.3})
@@ -359,3 +363,31 @@ def test_channel_gains_are_the_measurement_chains_and_leave_the_structure_alone(
     assert upd.accepted and upd.factors["transducer_mass_scale"] == pytest.approx(1.3, rel=0.05)
     assert not upd.channel_gains_significant and with_gains.channel_gains_significant
     assert max(abs(np.log(upd.channel_gains))) < 0.01  # estimated all the same, near 1: what the candidate applies
+
+
+@pytest.mark.slow  # two updates with gains, one without (about 5 s)
+def test_a_clamp_the_gains_would_stand_in_for_is_offered_as_the_structure_alone(nominal):
+    # a rig whose clamp gives (2e5 N m/rad), its beam 3 % softer and its transducers 40 % heavy, channels calibrated:
+    # the nominal structure's residues call for channel gains (they move the sensors' residues as the clamp's shapes
+    # do) and under their prior the gains are cheaper than the clamp, so the update with them keeps the clamp rigid;
+    # without them, the structure's factors alone fit the data as well and find the clamp
+    truth = apply_factors(nominal, {"stiffness_scale": 0.97, "transducer_mass_scale": 1.4})
+    truth = truth.replace(clamp_rotational_stiffness=2.0e5)
+    f, R = modal_predictions(truth, 3)
+    upd = update_structure(nominal, f, 0.001 * f, R, residue_accuracy=0.01, gain_sd=0.03)
+    assert upd.channel_gains_significant and upd.factors["clamp_compliance_scale"] < 2.0
+    alone = upd.structure_alone
+    assert not alone["gains_needed"] and alone["gains_drop"] < alone["gains_threshold"] == pytest.approx(
+        5.991, abs=1e-3
+    )
+    without = upd.without_gains()
+    assert without.accepted and not without.channel_gains_significant and without.structure_alone is None
+    # the clamp's compliance against a rigid clamp (CLAMP_RIGID 1e8 N m/rad): 1e8 / 2e5 = 500
+    assert without.factors["clamp_compliance_scale"] == pytest.approx(500, rel=0.25)
+    assert without.factors["stiffness_scale"] == pytest.approx(0.97, abs=0.01)
+    assert without.structure.clamp_rotational_stiffness == pytest.approx(2.0e5, rel=0.25)
+    # the gains it reports are the nominal structure's, what the candidate channel_gain_error applies
+    assert without.channel_gains == tuple(alone["nominal_channel_gains"]) and len(without.channel_gains) == 3
+    # the summary of the update with gains keeps the alternative whole
+    again = UpdatingResult.from_summary(upd.summary(), nominal)
+    assert again.without_gains().structure == without.structure

@@ -830,6 +830,12 @@ def test_the_report_describes_the_base_models_update_and_the_channels_gains():
     text = updating_paragraph({"where": {"model_updating": by_records}})
     assert "no drop is significant" in text and "the dual-sine records accepted it" in text and "$0.258$" in text
     assert updating_paragraph({"where": {}}) == ""  # updating off: no paragraph
+    # gains the random test could not tell from the structure: what the records chose, and why
+    test = {"gains_drop": 0.059, "gains_threshold": 5.99, "heldout_gap_gains": 0.0207, "heldout_gap_structure": 0.0205}
+    chose = {**upd, "gains_versus_structure": {**test, "record_scatter": 3.4e-5, "gains_preferred": False}}
+    text = updating_paragraph({"where": {"model_updating": chose}})
+    assert "alone fit the random test as well" in text and "$2.07$" in text and "made without them" in text
+    assert "within their scatter" not in text
 
 
 def test_a_step_names_the_candidates_the_records_cannot_tell_from_it():
@@ -893,3 +899,58 @@ def test_the_two_transducer_mass_factors_that_moved_are_one_effect():
         V.updating_effect(factors, {**traded, "stiffness_scale": {"posterior_sd": 0.009, "profile_chi2_increase": 1.0}})
         is None
     )
+
+
+def test_the_records_call_for_the_channels_gains_only_where_they_shrink_the_gap_clearly():
+    from contactid.gap.verdict import records_prefer_gains
+
+    settings = {"separation": 1.5, "noise_factor": 2.0}
+    # measured: channels 3 % off read through their gains 0.62 %, the structure alone (a clamp 1500 x compliant)
+    # 14.4 %; a rig whose clamp gives, 2.07 % with the gains against 2.05 % without
+    assert records_prefer_gains(0.144, 0.0062, 3.6e-5, settings)
+    assert not records_prefer_gains(0.0205, 0.0207, 3.4e-5, settings)
+    assert not records_prefer_gains(0.0205, 0.0140, 3.4e-5, settings)  # smaller, but not by the separation factor
+    assert not records_prefer_gains(0.0030, 0.0019, 6e-4, settings)  # by the factor, but within the records' scatter
+    assert not records_prefer_gains(float("nan"), 0.001, 1e-5, settings)
+
+
+def test_the_records_choose_between_the_update_with_the_gains_and_the_structure_alone(monkeypatch):
+    from dataclasses import dataclass
+
+    import contactid.gap.diagnosis as diagnosis
+    import contactid.gap.pipeline as pipeline
+
+    settled = []
+
+    def settle(model, modal, calibration, fit_settings, settings, seed, upd, held_out):
+        settled.append(upd.label)
+        return f"model {upd.label}", upd
+
+    @dataclass
+    class Upd:  # what updated_model reads of an UpdatingResult
+        label: str
+        structure_alone: dict | None
+        channel_gains: tuple = (0.99, 1.0, 1.01)
+        gains_versus_structure: dict | None = None
+
+        def without_gains(self):
+            return Upd("alone", None, self.channel_gains)
+
+    monkeypatch.setattr(pipeline, "settled_update", settle)
+    alone = {"gains_needed": False, "gains_drop": 0.06, "gains_threshold": 5.99}
+    upd = Upd("gains", alone)
+    for preferred, chosen in ((False, "alone"), (True, "gains")):
+        settled.clear()
+        test = {"heldout_gap_gains": 0.02, "heldout_gap_structure": 0.02, "record_scatter": 1e-5}
+        monkeypatch.setattr(
+            diagnosis, "records_test_of_gains", lambda *a, p=preferred, t=test: {**t, "gains_preferred": p}
+        )
+        model, out = pipeline.updated_model(None, None, "cal", None, None, 1, upd, {"lc2": "rec"})
+        assert settled == ["gains", "alone"] and model == f"model {chosen}" and out.label == chosen
+        assert out.gains_versus_structure["gains_preferred"] is preferred
+        assert out.gains_versus_structure["gains_drop"] == 0.06
+    # gains the random test needs beyond the structure, or no records to ask: the update as it is, settled once
+    for upd2, held in ((Upd("gains", {**alone, "gains_needed": True}), {"lc2": "rec"}), (upd, None)):
+        settled.clear()
+        model, out = pipeline.updated_model(None, None, "cal", None, None, 1, upd2, held)
+        assert settled == ["gains"] and out is upd2

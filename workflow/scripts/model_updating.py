@@ -33,3 +33,15 @@ if upd is not None:
             "the channels' gains relative to one another on the residues (the measurement chain's): %s",
             ", ".join(f"{g:.4f} (sd {s:.4f})" for g, s in zip(upd.channel_gains, upd.channel_gain_sd)),
         )
+    if upd.structure_alone:
+        alone = upd.structure_alone
+        log.info(
+            "without the gains, the structure's factors alone: chi2 %.3g (%.3g with them, a drop of %.3g against %.3g: "
+            "%s); %s",
+            alone["chi2_updated"],
+            upd.chi2_updated,
+            alone["gains_drop"],
+            alone["gains_threshold"],
+            "the gains are needed" if alone["gains_needed"] else "the random test cannot tell, the records will choose",
+            ", ".join(f"{k} {v:.4g}" for k, v in ((alone.get("proposal") or alone)["factors"]).items()),
+        )

@@ -950,6 +950,43 @@ def records_test_of_update(
     return out
 
 
+def records_test_of_gains(
+    with_gains: IdentifiedModel,
+    gains,
+    structure_alone: IdentifiedModel,
+    held_out: Mapping[str, RecordHarmonics],
+    calibration: RecordHarmonics,
+    fit_settings: FitSettings,
+    settings: GapSettings,
+) -> dict:
+    """What the dual-sine records say where the random test cannot tell the accelerometer channels' gains from the
+    structure's factors (``UpdatingResult.structure_alone``): the held-out gap of the model updated with the gains,
+    read through them (``gains``, each channel's relative factor; the friction law refitted on the ``calibration``
+    record as the channels read it), against the model updated without them, and the records' scatter (the bootstrap's
+    sd of the latter's gap); ``gains_preferred`` by ``verdict.records_prefer_gains``."""
+    from .verdict import records_prefer_gains
+
+    H = settings.n_harmonics
+    cases = list(held_out)
+    HarmonicBalance.forget()
+    aug = Augmentation(gains=tuple(float(g) for g in gains))
+    _, read, _, _ = evaluate(with_gains, aug, calibration, fit_settings.bounds, H)
+    sims_gains = {c: evaluate(read, aug, held_out[c], None, H, refit=False)[2] for c in cases}
+    HarmonicBalance.forget()
+    sims_alone = {c: baseline(structure_alone, held_out[c], H)[1] for c in cases}
+    draws = heldout_gap_draws(held_out, cases, H, sims_alone, bootstrap_draws(held_out, cases, settings))
+    out = {
+        "heldout_gap_gains": heldout_gap_of(held_out, cases, H, sims_gains),
+        "heldout_gap_structure": heldout_gap_of(held_out, cases, H, sims_alone),
+        "record_scatter": float(np.std(draws)),
+        "cases": cases,
+    }
+    out["gains_preferred"] = records_prefer_gains(
+        out["heldout_gap_structure"], out["heldout_gap_gains"], out["record_scatter"], settings
+    )
+    return out
+
+
 def records_drift(records: Mapping[str, RecordHarmonics], H: int, thresholds: PlaceThresholds = DEFAULT_PLACE) -> bool:
     """Whether the records drift as the localisation's place tells it (``verdict.place``): the median over the
     records of the trend's size in standard errors (``record_drift``) above ``thresholds.drift_z``."""

@@ -179,6 +179,46 @@ def diagnosed_model(
 
 def updated_model(model, modal: xr.Dataset, calibration, fit_settings, settings, seed: int, upd=None, held_out=None):
     """The base model updated from the random test before the candidates (``structure_update``, or ``upd`` when
+    already computed): ``settled_update``. Where the accelerometer channels' gains took part in the update but the
+    random test cannot tell them from the structure's factors (``UpdatingResult.structure_alone``'s ``gains_needed``
+    false), both updates are settled and the ``held_out`` records choose (``diagnosis.records_test_of_gains``): the one
+    without the gains unless the records call for them; the test is kept in ``gains_versus_structure``. Returns (model
+    to diagnose, UpdatingResult or None when updating is off)."""
+    import logging
+
+    if upd is None:
+        upd = structure_update(model.structure, modal, settings)
+    if upd is None:
+        return model, None
+    alone = upd.structure_alone
+    if not alone or alone.get("gains_needed") or not held_out or calibration is None:
+        return settled_update(model, modal, calibration, fit_settings, settings, seed, upd, held_out)
+    from .diagnosis import records_test_of_gains
+
+    m_gains, u_gains = settled_update(model, modal, calibration, fit_settings, settings, seed, upd, held_out)
+    m_alone, u_alone = settled_update(
+        model, modal, calibration, fit_settings, settings, seed, upd.without_gains(), held_out
+    )
+    test = records_test_of_gains(m_gains, u_gains.channel_gains, m_alone, held_out, calibration, fit_settings, settings)
+    test.update(gains_drop=alone["gains_drop"], gains_threshold=alone["gains_threshold"])
+    logging.getLogger(__name__).info(
+        "model updating: the random test cannot tell the channels' gains from the structure's factors (chi^2 %.3g "
+        "lower with them, %.3g needed); held-out gap %.4g with the gains, %.4g without them (records' scatter %.2g): "
+        "the update %s them",
+        test["gains_drop"],
+        test["gains_threshold"],
+        test["heldout_gap_gains"],
+        test["heldout_gap_structure"],
+        test["record_scatter"],
+        "with" if test["gains_preferred"] else "without",
+    )
+    if test["gains_preferred"]:
+        return m_gains, dataclasses.replace(u_gains, gains_versus_structure=test)
+    return m_alone, dataclasses.replace(u_alone, gains_versus_structure=test)
+
+
+def settled_update(model, modal: xr.Dataset, calibration, fit_settings, settings, seed: int, upd=None, held_out=None):
+    """The base model updated from the random test before the candidates (``structure_update``, or ``upd`` when
     already computed), with the inverse identification and the friction fit redone on the calibration record
     (``calibration``: its RecordHarmonics). Returns (model to diagnose, UpdatingResult or None when updating is
     off); the model is the chain's own when the update is not accepted. An update the random test's chi^2 test did

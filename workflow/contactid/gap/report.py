@@ -386,8 +386,33 @@ def _channel_gains_text(upd: dict) -> str:
             r"; they lower the nominal structure's $\chi^2$ significantly and are fitted with the update"
             if upd.get("channel_gains_significant")
             else r"; within their scatter, so the update is fitted without them"
+            if not upd.get("gains_versus_structure")
+            else r"; they lower the nominal structure's $\chi^2$ significantly"
         )
-        + r". The channel-gain candidate applies them as they are."
+        + r". "
+        + _gains_versus_structure_text(upd.get("gains_versus_structure"))
+        + r"The channel-gain candidate applies them as they are."
+    )
+
+
+def _gains_versus_structure_text(test: dict | None) -> str:
+    """Where the random test could not tell the channels' gains from the structure's factors: what the dual-sine
+    records chose (``diagnosis.records_test_of_gains``)."""
+    if not test:
+        return ""
+    return (
+        r"But the structure's factors alone fit the random test as well ($\chi^2$ lower by "
+        + _fmt(_num(test.get("gains_drop")), 3)
+        + r" with the gains, "
+        + _fmt(_num(test.get("gains_threshold")), 3)
+        + r" needed), so the dual-sine records chose: held-out gap "
+        + _pct(test.get("heldout_gap_gains"))
+        + r" with the update read through the gains, "
+        + _pct(test.get("heldout_gap_structure"))
+        + r" with the structure alone (the records' scatter "
+        + _pct(test.get("record_scatter"))
+        + r"); the update is made "
+        + (r"with the gains. " if test.get("gains_preferred") else r"without them. ")
     )
 
 

@@ -260,6 +260,21 @@ def records_accept_update(gap_chain: float, gap_updated: float, scatter: float, 
     return explains_most(gap_chain, gap_updated, scatter, settings)
 
 
+def records_prefer_gains(gap_structure: float, gap_gains: float, scatter: float, settings) -> bool:
+    """Whether the dual-sine records call for the accelerometer channels' gains where the random test cannot tell
+    them from the structure's factors (``diagnosis.records_test_of_gains``): the model updated with the gains and read
+    through them leaves a held-out gap (``gap_gains``) below the structure-alone update's (``gap_structure``) by a
+    factor of ``separation`` and by more than noise_factor x the records' ``scatter``. Otherwise the structure is kept:
+    a rig's structure is off a few per cent everywhere, and the candidate ``channel_gain_error`` still applies the
+    gains on it."""
+    if not (np.isfinite(gap_structure) and np.isfinite(gap_gains)):
+        return False
+    return bool(
+        gap_structure >= _setting(settings, "separation") * gap_gains
+        and gap_structure - gap_gains > _setting(settings, "noise_factor") * scatter
+    )
+
+
 def records_carry_factor(gap_chain: float, alone: float, without: float, scatter: float, settings) -> bool:
     """Whether the dual-sine records put an accepted update on one factor: that factor's effect alone (held-out gap
     ``alone``) explains the chain's gap materially (``records_accept_update``) and the update without the factor
