@@ -384,6 +384,34 @@ def test_compound_items_are_seeded_and_balanced():
         assert abs(p["tangential_lever_arm"]) <= 0.08
 
 
+def test_half_the_compound_rigs_have_a_clamp_that_gives_and_the_rest_of_each_item_is_unchanged(default_config):
+    from contactid.gap.benchmark import CLAMP_STIFFNESS, RANGES, compound_config, compound_items
+
+    items = compound_items(20, [1, 2], default_config["seed"], RANGES)
+    clamps = [s["clamp_rotational_stiffness_nm_per_rad"] for s in items.values()]
+    given = [c for c in clamps if c is not None]
+    assert 12 <= len(given) <= 28 and all(CLAMP_STIFFNESS[0] <= c <= CLAMP_STIFFNESS[1] for c in given)
+    # drawn after every other draw: the items as they were before the clamp (measured at 2cd2e68: compound-14-s2)
+    spec = items["compound-14-s2"]
+    assert spec["damping_form"] == "stiffness_proportional" and set(spec["effects"]) == {
+        "channel_time_skew",
+        "normal_contact_damping",
+    }
+    assert spec["effects"]["normal_contact_damping"] == pytest.approx(593.0430028244796)
+    assert spec["perturbation"]["transducer_masses"] == pytest.approx(0.06998262793467908)
+    # the rig's true structure carries the clamp; the identification's structure stays rigid
+    name = next(n for n, s in items.items() if s["clamp_rotational_stiffness_nm_per_rad"])
+    cfg = compound_config(default_config, items[name])
+    true = cfg["rig"]["true_structure"]["clamp_rotational_stiffness_nm_per_rad"]
+    assert true == items[name]["clamp_rotational_stiffness_nm_per_rad"]
+    assert cfg["structure"].get("clamp_rotational_stiffness_nm_per_rad") is None
+    rigid = next(n for n, s in items.items() if not s["clamp_rotational_stiffness_nm_per_rad"])
+    assert (
+        "clamp_rotational_stiffness_nm_per_rad"
+        not in compound_config(default_config, items[rigid])["rig"]["true_structure"]
+    )
+
+
 def test_long_benchmark_items_are_scheduled_first():
     """The scheduler's order (gap_benchmark_item's priority): compound items with a drifting preload, then items whose
     contact opens, then the other compound items, the leave-outs, and the single effects last."""
