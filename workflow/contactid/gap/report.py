@@ -620,8 +620,10 @@ def compound_paragraph(c: dict) -> str:
     err = c["perturbation_only_median_abs_error"]
     return (
         "\n\\paragraph{Compound benchmark.} " + str(c["n"]) + r" rig data sets whose structure (E, transducer "
-        r"masses, tangential lever arm), normal law and damping form differ from the model's at random, with 0, 1 "
-        r"or 2 effects (" + ", ".join(f"{v} with {k}" for k, v in c["n_by_effect_count"].items()) + r"), diagnosed "
+        r"masses, tangential lever arm; on half of them a clamp that gives), normal law and damping form differ "
+        r"from the model's at random, with 0, 1 or 2 effects ("
+        + ", ".join(f"{v} with {k}" for k, v in c["n_by_effect_count"].items())
+        + r"), diagnosed "
         r"with model updating and scored on the additive explanation. Perturbation only: no contact effect named "
         r"in "
         + _pct(c["perturbation_only_no_contact_effect"])
