@@ -950,7 +950,7 @@ def test_the_records_choose_between_the_update_with_the_gains_and_the_structure_
 
     settled = []
 
-    def settle(model, modal, calibration, fit_settings, settings, seed, upd, held_out):
+    def settle(model, calibration, fit_settings, settings, seed, upd, held_out):
         settled.append(upd.label)
         return f"model {upd.label}", upd
 

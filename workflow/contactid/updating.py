@@ -214,9 +214,8 @@ class UpdatingResult:
         (``gap.pipeline.updated_model``)."""
         if self.structure_alone is None or self.nominal is None:
             raise ValueError("model updating: no update without the channel gains (the gains took no part in it)")
-        alone = {k: v for k, v in self.structure_alone.items() if k not in ("gains_drop", "gains_threshold")}
         return dataclasses.replace(
-            UpdatingResult.from_summary(alone, self.nominal),
+            UpdatingResult.from_summary(self.structure_alone, self.nominal),
             channel_gains=tuple(self.structure_alone.get("nominal_channel_gains", self.channel_gains)),
             channel_gain_sd=tuple(self.structure_alone.get("nominal_channel_gain_sd", self.channel_gain_sd)),
             channel_gains_significant=False,

@@ -179,11 +179,11 @@ def diagnosed_model(
 
 def updated_model(model, modal: xr.Dataset, calibration, fit_settings, settings, seed: int, upd=None, held_out=None):
     """The base model updated from the random test before the candidates (``structure_update``, or ``upd`` when
-    already computed): ``settled_update``. Where the accelerometer channels' gains took part in the update but the
-    random test cannot tell them from the structure's factors (``UpdatingResult.structure_alone``'s ``gains_needed``
-    false), both updates are settled and the ``held_out`` records choose (``diagnosis.records_test_of_gains``): the one
-    without the gains unless the records call for them; the test is kept in ``gains_versus_structure``. Returns (model
-    to diagnose, UpdatingResult or None when updating is off)."""
+    already computed), settled by ``settled_update``. Where the accelerometer channels' gains took part in the update
+    but the random test cannot tell them from the structure's factors (``UpdatingResult.structure_alone``'s
+    ``gains_needed`` false), both updates are settled and the ``held_out`` records choose
+    (``diagnosis.records_test_of_gains``): the one without the gains unless the records call for them; the test is kept
+    in ``gains_versus_structure``. Returns (model to diagnose, UpdatingResult or None when updating is off)."""
     import logging
 
     if upd is None:
@@ -192,13 +192,11 @@ def updated_model(model, modal: xr.Dataset, calibration, fit_settings, settings,
         return model, None
     alone = upd.structure_alone
     if not alone or alone.get("gains_needed") or not held_out or calibration is None:
-        return settled_update(model, modal, calibration, fit_settings, settings, seed, upd, held_out)
+        return settled_update(model, calibration, fit_settings, settings, seed, upd, held_out)
     from .diagnosis import records_test_of_gains
 
-    m_gains, u_gains = settled_update(model, modal, calibration, fit_settings, settings, seed, upd, held_out)
-    m_alone, u_alone = settled_update(
-        model, modal, calibration, fit_settings, settings, seed, upd.without_gains(), held_out
-    )
+    m_gains, u_gains = settled_update(model, calibration, fit_settings, settings, seed, upd, held_out)
+    m_alone, u_alone = settled_update(model, calibration, fit_settings, settings, seed, upd.without_gains(), held_out)
     test = records_test_of_gains(m_gains, u_gains.channel_gains, m_alone, held_out, calibration, fit_settings, settings)
     test.update(gains_drop=alone["gains_drop"], gains_threshold=alone["gains_threshold"])
     logging.getLogger(__name__).info(
@@ -217,22 +215,17 @@ def updated_model(model, modal: xr.Dataset, calibration, fit_settings, settings,
     return m_alone, dataclasses.replace(u_alone, gains_versus_structure=test)
 
 
-def settled_update(model, modal: xr.Dataset, calibration, fit_settings, settings, seed: int, upd=None, held_out=None):
-    """The base model updated from the random test before the candidates (``structure_update``, or ``upd`` when
-    already computed), with the inverse identification and the friction fit redone on the calibration record
-    (``calibration``: its RecordHarmonics). Returns (model to diagnose, UpdatingResult or None when updating is
-    off); the model is the chain's own when the update is not accepted. An update the random test's chi^2 test did
-    not accept (its ``proposal``) is accepted when the ``held_out`` records ({case: RecordHarmonics}, the load
-    cases other than the calibration case) show a held-out gap above the floor that the update explains materially
-    (``settings.updating_records_test``; ``diagnosis.records_test_of_update``); the result then says
-    ``accepted_by`` "records" and keeps the test in ``records_test``."""
+def settled_update(model, calibration, fit_settings, settings, seed: int, upd, held_out=None):
+    """The base model updated by ``upd`` (an UpdatingResult of the random test), with the inverse
+    identification and the friction fit redone on the calibration record (``calibration``: its RecordHarmonics).
+    Returns (model to diagnose, UpdatingResult); the model is the chain's own when the update is not accepted. An
+    update the random test's chi^2 test did not accept (its ``proposal``) is accepted when the ``held_out`` records
+    ({case: RecordHarmonics}, the load cases other than the calibration case) show a held-out gap above the floor
+    that the update explains materially (``settings.updating_records_test``; ``diagnosis.records_test_of_update``);
+    the result then says ``accepted_by`` "records" and keeps the test in ``records_test``."""
     import logging
 
     log = logging.getLogger(__name__)
-    if upd is None:
-        upd = structure_update(model.structure, modal, settings)
-    if upd is None:
-        return model, None
     if not upd.accepted:
         if upd.proposal is None or not held_out or not getattr(settings, "updating_records_test", False):
             log.info(

@@ -6,7 +6,7 @@ from __future__ import annotations
 import pandas as pd
 
 from ..latex import _fmt, plain_text as _t, tabular
-from .verdict import never_opens
+from .verdict import at_floor, never_opens
 
 
 def _bound_text(c: dict) -> str:
@@ -342,7 +342,7 @@ def _why_not(rt: dict, floor) -> str:
     """Why the dual-sine records did not accept an update: nothing above the floor to explain, or too little
     explained (``verdict.records_accept_update``)."""
     gap = rt.get("heldout_gap_chain")
-    if gap is not None and floor is not None and float(gap) < float(floor):
+    if gap is not None and floor is not None and at_floor(float(gap), {"min_gap": float(floor)}):
         return r": the nominal structure's gap lies at the identification's floor, gap.min\_gap " + _pct(floor)
     return r": the update does not shrink it by gap.min\_reduction beyond the records' scatter"
 
@@ -375,6 +375,12 @@ def _channel_gains_text(upd: dict) -> str:
     gains, sd = upd.get("channel_gains") or [], upd.get("channel_gain_sd") or []
     if not gains:
         return ""
+    if upd.get("channel_gains_significant"):
+        significance = r"; they lower the nominal structure's $\chi^2$ significantly and are fitted with the update"
+    elif upd.get("gains_versus_structure"):
+        significance = r"; they lower the nominal structure's $\chi^2$ significantly"
+    else:
+        significance = r"; within their scatter, so the update is fitted without them"
     return (
         r" The accelerometer channels' gains relative to one another (their logarithms sum to zero), read off the "
         r"random test's residues: "
@@ -382,13 +388,7 @@ def _channel_gains_text(upd: dict) -> str:
             f"channel {i + 1} ${_fmt(float(g), 4)}$" + (r" ($\pm$\," + _pct(s) + ")" if s is not None else "")
             for i, (g, s) in enumerate(zip(gains, list(sd) + [None] * (len(gains) - len(sd))))
         )
-        + (
-            r"; they lower the nominal structure's $\chi^2$ significantly and are fitted with the update"
-            if upd.get("channel_gains_significant")
-            else r"; within their scatter, so the update is fitted without them"
-            if not upd.get("gains_versus_structure")
-            else r"; they lower the nominal structure's $\chi^2$ significantly"
-        )
+        + significance
         + r". "
         + _gains_versus_structure_text(upd.get("gains_versus_structure"))
         + r"The channel-gain candidate applies them as they are."
