@@ -66,7 +66,9 @@ def reference_package():
             ["git", "archive", REFERENCE, "workflow/contactid"], cwd=ROOT, capture_output=True, check=True
         ).stdout
         with tarfile.open(fileobj=io.BytesIO(tar)) as t:
-            t.extractall(dest, filter="data")
+            # the "data" filter where this Python has it (3.11.4 and later); a git archive of our own tree otherwise
+            kw = {"filter": "data"} if hasattr(tarfile, "data_filter") else {}
+            t.extractall(dest, **kw)
         (dest / "workflow" / "contactid").rename(dest / "contactid_ref")
     sys.path.insert(0, str(dest))
     return importlib.import_module("contactid_ref")
