@@ -75,6 +75,9 @@ def _raw(n=256, **kw):
         (lambda ds: ds.assign(force=ds["force"].where(ds["time"] < 0.1)), "NaN"),
         (lambda ds: ds.assign(acceleration=ds["acceleration"].assign_attrs(units="g")), "convert to 'm/s\\^2'"),
         (lambda ds: ds.isel(time=slice(0, 4)), "only 4 samples"),
+        (lambda ds: ds.drop_vars("time"), "coordinate 'time' .* is missing"),
+        (lambda ds: ds.assign_attrs(sampling_rate_hz=1001.0), "not uniform .* samples from t0"),
+        (lambda ds: ds.assign_coords(time=ds["time"].assign_attrs(units="h")), "'time' has units 'h'"),
     ],
 )
 def test_bad_raw_files_get_clear_errors(tmp_path, mutate, message):
@@ -87,6 +90,32 @@ def test_bad_raw_files_get_clear_errors(tmp_path, mutate, message):
     with pytest.raises(RawDataError, match=message) as err:
         read_raw(path)
     assert str(path) in str(err.value)
+
+
+def test_raw_files_as_other_tools_write_them_read_as_the_format(tmp_path):
+    """Single precision (many DAQ exports), time in milliseconds, time as CF dates ("seconds since ..."): the same
+    record in double precision on the exact axis t0 + k / fs; a 128 s single-precision time axis (rounded to 7.6e-6 s,
+    4 % of a sample) too."""
+    fs, n = 5120.0, 16384
+    t = np.arange(n) / fs
+    rng = np.random.default_rng(3)
+    ref = raw_dataset(t, rng.normal(size=n), rng.normal(size=(3, n)), ["a1", "a2", "a3"], [0.55, 0.3, 0.05], fs)
+    single = ref.assign_coords(time=ref["time"].astype(np.float32))
+    single = single.assign(force=single["force"].astype(np.float32), acceleration=single["acceleration"].astype("f4"))
+    ms = ref.assign_coords(time=("time", 1e3 * t, {"units": "ms"}))
+    dates = ref.assign_coords(time=np.datetime64("2026-12-04T10:00:00") + np.round(t * 1e9).astype("timedelta64[ns]"))
+    long_ = ref.assign_coords(time=("time", (t + 128.0 - t[-1]).astype(np.float32), {"units": "s"}))
+    for name, ds in {"single": single, "ms": ms, "dates": dates, "long": long_}.items():
+        path = tmp_path / f"{name}.nc"
+        ds.to_netcdf(path, engine="netcdf4")
+        back = read_raw(path)
+        t0 = float(back["time"][0])
+        assert back["time"].dtype == np.float64 and back["time"].attrs["units"] == "s"
+        np.testing.assert_allclose(back["time"].values, t0 + np.arange(n) / fs, rtol=0, atol=1e-12 * (1 + abs(t0)))
+        assert back["force"].dtype == np.float64 == back["acceleration"].dtype
+        tol = 1e-7 if name == "single" else 0  # single precision rounds the samples, nothing else does
+        np.testing.assert_allclose(back["acceleration"].values, ref["acceleration"].values, rtol=tol, atol=tol * 10)
+        assert t0 == pytest.approx(128.0 - t[-1] if name == "long" else 0.0, abs=1e-5)
 
 
 def _imports_in_a_fresh_process(module: str, code: str, *args: str) -> bool:

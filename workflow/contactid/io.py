@@ -4,7 +4,8 @@ Raw format (shared by the rig, measured files and importers; see
 ``config/README.md``):
     force(time)               N
     acceleration(sensor, time) m/s^2
-    coords: time (s), sensor (names), position(sensor) (m from the clamp)
+    coords: time (s; ms, us or CF dates are converted, and the axis rebuilt as t0 + k / fs in float64),
+            sensor (names), position(sensor) (m from the clamp)
     global attribute sampling_rate_hz; dual-sine records add excitation_frequency_hz.
 """
 
@@ -194,6 +195,50 @@ def raw_dataset(
 
 _ACC_UNITS = {"m/s^2", "m/s2", "m s-2", "m/s**2"}
 _FORCE_UNITS = {"N", "newton"}
+# the time axis as other tools write it: its unit (absent: seconds, the format's), in seconds
+_TIME_UNITS = {
+    **dict.fromkeys(("s", "sec", "second", "seconds"), 1.0),
+    **dict.fromkeys(("ms", "millisecond", "milliseconds"), 1e-3),
+    **dict.fromkeys(("us", "microsecond", "microseconds"), 1e-6),
+}
+
+
+def _time_in_seconds(time: xr.DataArray, fail) -> np.ndarray:
+    """The time coordinate in seconds (float64): numbers in the unit their ``units`` attribute states (s, ms or us;
+    none: s), or dates and durations as xarray decodes CF units ("seconds since ...": seconds from the first
+    sample). ``fail(msg)`` raises the reader's error."""
+    v = time.values
+    if v.dtype.kind == "M":  # dates: the first sample is t = 0
+        return (v - v[0]).astype("timedelta64[ns]").astype(np.int64) * 1e-9
+    if v.dtype.kind == "m":
+        return v.astype("timedelta64[ns]").astype(np.int64) * 1e-9
+    if v.dtype.kind not in "fiu":
+        fail(f"coordinate 'time' holds values of type {v.dtype}; write seconds as numbers")
+    units = str(time.attrs.get("units", "s")).strip()
+    if units not in _TIME_UNITS:
+        fail(f"coordinate 'time' has units {units!r}; write seconds ('s'), or 'ms' or 'us'")
+    return np.asarray(v, dtype=np.float64) * _TIME_UNITS[units]
+
+
+def _uniform_time(t: np.ndarray, stored_dtype: np.dtype, fs: float, fail) -> np.ndarray:
+    """The record's time axis t0 + k / fs (float64), after checking that the file's times ``t`` (s) lie on it: within
+    a hundredth of a sample, or within twice what the file's number type resolves (float32 keeps 3.2 s to 1.2e-7 s,
+    128 s to 7.6e-6 s: 4 % of a sample at 5120 Hz). A time axis whose steps are not 1 / fs, or whose
+    sampling_rate_hz does not match it by a hundredth of a sample over the record, is refused: the harmonics are
+    read at fs."""
+    k = np.arange(t.size)
+    grid = t[0] + k / fs
+    resolution = 2 * np.finfo(stored_dtype).eps * float(np.max(np.abs(t))) if stored_dtype.kind == "f" else 0.0
+    off = np.abs(t - grid)
+    if off.size and float(np.max(off)) > max(0.01 / fs, resolution):
+        i = int(np.argmax(off))
+        steps = np.diff(t)
+        fail(
+            f"time steps are not uniform at 1/sampling_rate_hz = {1.0 / fs:g} s: sample {i} is at {t[i]:.9g} s, "
+            f"{off[i] * fs:.3g} samples from t0 + {i}/sampling_rate_hz (steps from {steps.min():g} to "
+            f"{steps.max():g} s); correct sampling_rate_hz or the time coordinate"
+        )
+    return grid
 
 
 def read_raw(
@@ -257,9 +302,12 @@ def read_raw(
     fs = float(ds.attrs["sampling_rate_hz"])
     if not fs > 0:
         fail(f"sampling_rate_hz = {fs}; must be positive")
-    dt = np.diff(ds["time"].values)
-    if dt.size and not np.allclose(dt, 1.0 / fs, rtol=1e-6, atol=0):
-        fail(f"time steps are not uniform at 1/sampling_rate_hz = {1.0 / fs:g} s")
+    if "time" not in ds.coords:
+        fail("coordinate 'time' (s, uniform steps of 1/sampling_rate_hz) is missing")
+    t = _uniform_time(_time_in_seconds(ds["time"], fail), ds["time"].dtype, fs, fail)
+    ds = ds.assign_coords(time=("time", t, {"units": "s", "long_name": "time"}))
+    for var in ("force", "acceleration"):  # single-precision files (many DAQ exports) computed in double
+        ds[var] = ds[var].astype(np.float64)
     if dual_sine:
         f0 = float(ds.attrs["excitation_frequency_hz"])
         if not f0 > 0:
