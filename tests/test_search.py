@@ -138,3 +138,47 @@ def test_a_model_through_a_wide_bracket_does_not_confirm_its_own_minimum(shape, 
     theta = residual_line_search(f, points, -0.4125, 1.05, 3.9e-3, 12)
     assert theta == pytest.approx(c, abs=0.01)
     assert len(points) <= 3 + 12
+
+
+class _QuadraticRuns:
+    """A calibration's runs (``refit._CandidateRuns``' interface) on a residual vector with its minimum at ``best``."""
+
+    def __init__(self, best, scale):
+        self.best, self.scale, self.thetas = best, scale, []
+
+    def residual(self, theta):
+        t = float(np.ravel(theta)[0])
+        self.thetas.append(t)
+        return np.array([(t - self.best) / self.scale, 0.01])
+
+    def __call__(self, theta):
+        return (float(np.linalg.norm(self.residual(theta))),)
+
+
+@pytest.mark.parametrize("best, expected", [(1500.0, 1500.0), (5000.0, 5000.0), (2.0e5, 3.0e4)])
+def test_a_refit_at_the_end_of_its_range_searches_on_within_the_parameters_domain(best, expected):
+    """A normal dashpot of 5000 s/m on the rig was refitted to the library range's 3000 and left a quarter of its gap
+    to a transducer mass; the range is widened threefold past the end the optimum reached (alpha: 0-3000 s/m, then
+    0-12000 and 0-30000, the domain) and searched again; an optimum inside the range is searched as before."""
+    from contactid.gap.candidates import LIBRARY
+    from contactid.gap.refit import _scalar_theta
+
+    run = _QuadraticRuns(best, 1000.0)
+    theta = _scalar_theta(run, LIBRARY["normal_contact_damping"], 12)
+    assert float(theta[0]) == pytest.approx(expected, abs=1e-3 * 3.0e4)
+    assert max(run.thetas) <= 3.0e4
+    assert (max(run.thetas) > 3000.0) == (best > 3000.0)  # the range is widened only where the optimum reached its end
+
+
+def test_a_parameters_range_widens_within_its_domain_and_covers_an_earlier_refit():
+    from contactid.gap.candidates import LIBRARY
+
+    alpha = LIBRARY["normal_contact_damping"].parameters[0]
+    assert alpha.extended(False, True).high == 12000.0 and alpha.extended(False, True).low == 0.0
+    assert alpha.extended(True, False) is None  # zero damping is the domain's end
+    joint = alpha.covering(5000.0)  # a first pass's refit beyond the library range, searched again in a joint refit
+    assert (joint.low, joint.high, joint.start) == (0.0, 12000.0, 5000.0)
+    assert alpha.covering(1e6).high == 3.0e4 and alpha.covering(1e6).start == 3.0e4
+    drift = LIBRARY["preload_drift"].parameters[0]
+    assert drift.extended(True, True).low == -0.9 and drift.extended(True, True).high == 3.5
+    assert LIBRARY["multi_asperity_friction"].parameters[0].extended(True, True) is None  # a share: 0-1 is all

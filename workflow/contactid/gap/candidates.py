@@ -13,7 +13,7 @@ candidate maps its parameter vector theta onto any combination of the Augmentati
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Callable
 
 import numpy as np
@@ -25,13 +25,36 @@ from .model import Augmentation
 class Parameter:
     """One parameter of a candidate: name, unit, search range [low, high], and where a search over
     several parameters starts (``start``; the middle of the range by default), for example the value
-    that leaves the identified model as it is."""
+    that leaves the identified model as it is. ``domain``: the widest range a one-parameter search widens [low, high]
+    to where its optimum ends at an end of the range (``extended``; None: the range is the parameter's whole domain),
+    so that an effect larger than its typical range is refitted, not cut at the range's end."""
 
     name: str
     unit: str
     low: float
     high: float
     start: float | None = None
+    domain: tuple[float, float] | None = None
+
+    def extended(self, at_low: bool, at_high: bool) -> "Parameter | None":
+        """The range widened past the ends an optimum reached (``at_low``, ``at_high``) by three times its span, within
+        ``domain``; None where the domain allows no wider range there."""
+        lo_d, hi_d = self.domain or (self.low, self.high)
+        span = self.high - self.low
+        low = max(lo_d, self.low - 3.0 * span) if at_low else self.low
+        high = min(hi_d, self.high + 3.0 * span) if at_high else self.high
+        return replace(self, low=low, high=high) if (low, high) != (self.low, self.high) else None
+
+    def covering(self, value: float) -> "Parameter":
+        """This parameter starting at ``value``, its range widened as ``extended`` widens it until it holds ``value``
+        (a refit that ended beyond the library's range, searched again in a joint refit)."""
+        p = self
+        while value < p.low or value > p.high:
+            wider = p.extended(value < p.low, value > p.high)
+            if wider is None:
+                break
+            p = wider
+        return replace(p, start=float(np.clip(value, p.low, p.high)))
 
     @property
     def off(self) -> float:
@@ -87,7 +110,7 @@ register(
     Candidate(
         "structural_damping",
         "extra modal damping of the beam's modes at test level",
-        (Parameter("extra_damping_ratio", "1", 0.0, 0.05),),
+        (Parameter("extra_damping_ratio", "1", 0.0, 0.05, domain=(0.0, 0.2)),),
         lambda th: Augmentation(extra_damping=float(th[0])),
         acts_on="structure_or_measurement",
     )
@@ -96,7 +119,7 @@ register(
     Candidate(
         "normal_contact_damping",
         "Hunt-Crossley damping of the normal contact, N (1 - alpha deta/dt)",
-        (Parameter("alpha", "s/m", 0.0, 3000.0),),
+        (Parameter("alpha", "s/m", 0.0, 3000.0, domain=(0.0, 3.0e4)),),
         lambda th: Augmentation(hunt_crossley=float(th[0])),
         acts_on="normal_contact",
     )
@@ -105,7 +128,7 @@ register(
     Candidate(
         "viscous_friction",
         "velocity-dependent friction, S + sigma_2 dxi/dt",
-        (Parameter("sigma_2", "N s/m", 0.0, 3000.0),),
+        (Parameter("sigma_2", "N s/m", 0.0, 3000.0, domain=(0.0, 1.0e5)),),
         lambda th: Augmentation(viscous=float(th[0])),
         acts_on="tangential_contact",
     )
@@ -123,7 +146,7 @@ register(
     Candidate(
         "transducer_mass_error",
         "every transducer mass wrong by the same factor 1 + m",
-        (Parameter("mass_error", "1", -0.9, 3.0),),
+        (Parameter("mass_error", "1", -0.9, 3.0, domain=(-0.9, 9.0)),),
         lambda th: Augmentation(mass_error=float(th[0])),
         acts_on="structure_or_measurement",
     )
@@ -156,7 +179,7 @@ register(
     Candidate(
         "preload_drift",
         "static normal preload drifting linearly over each record",
-        (Parameter("relative_drift", "1", -0.5, 0.5),),
+        (Parameter("relative_drift", "1", -0.5, 0.5, domain=(-0.9, 5.0)),),
         lambda th: Augmentation(preload_drift=float(th[0])),
         acts_on="non_stationary",
     )
@@ -209,13 +232,9 @@ def joint_candidate(new: Candidate, earlier, n_channels: int) -> tuple[Candidate
     def expand(c: Candidate, theta=None):
         params = c.parameters * (n_channels if c.per_channel else 1)
         if theta is None:  # the new effect starts off, at its own start where it gives one
-            return tuple(
-                Parameter(p.name, p.unit, p.low, p.high, start=p.off if p.start is None else p.start) for p in params
-            )
-        return tuple(
-            Parameter(p.name, p.unit, p.low, p.high, start=float(np.clip(t, p.low, p.high)))
-            for p, t in zip(params, np.atleast_1d(theta))
-        )
+            return tuple(replace(p, start=p.off if p.start is None else p.start) for p in params)
+        # an earlier step refitted beyond its library range (``Parameter.extended``): searched in a range holding it
+        return tuple(p.covering(float(t)) for p, t in zip(params, np.atleast_1d(theta)))
 
     parts = [expand(new)] + [expand(c, th) for c, th in earlier]
     sizes = np.cumsum([len(x) for x in parts])[:-1]

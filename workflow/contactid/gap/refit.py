@@ -13,7 +13,7 @@ from __future__ import annotations
 import contextlib
 import contextvars
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numba import njit
@@ -443,6 +443,20 @@ def _scalar_theta(run: _CandidateRuns, cand: Candidate, max_evaluations: int) ->
     off = np.array([p.off])
     if run(off)[0] < run(theta)[0]:
         theta = off
+    # an optimum at an end of the range that the parameter's domain goes beyond: the effect is larger than the
+    # library's typical range (a normal dashpot of 5000 s/m was refitted to the range's 3000 and left a quarter of its
+    # gap to a transducer mass): search again in the range widened there (``Parameter.extended``)
+    wider = p.extended(theta[0] - p.low <= xatol and not p.is_off(p.low), p.high - theta[0] <= xatol)
+    if wider is not None:
+        log.info(
+            "%s: refitted at the end of its range, %s = %.4g; searching %.4g-%.4g",
+            cand.name,
+            p.name,
+            theta[0],
+            wider.low,
+            wider.high,
+        )
+        return _scalar_theta(run, replace(cand, parameters=(wider,)), max_evaluations)
     return theta
 
 
