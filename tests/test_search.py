@@ -182,3 +182,25 @@ def test_a_parameters_range_widens_within_its_domain_and_covers_an_earlier_refit
     drift = LIBRARY["preload_drift"].parameters[0]
     assert drift.extended(True, True).low == -0.9 and drift.extended(True, True).high == 3.5
     assert LIBRARY["multi_asperity_friction"].parameters[0].extended(True, True) is None  # a share: 0-1 is all
+
+
+def test_channel_delays_beyond_the_librarys_range_are_searched_where_the_random_test_puts_them():
+    """A DAQ whose accelerometer channels lag the force by 0.4-0.8 ms (filter delays of other modules): the random
+    test's residue phases measure them, and the search holds their mean in a range that holds them (the library's
+    +-0.2 ms clipped them to 0.2 ms each, a common error of 0.4 ms)."""
+    from types import SimpleNamespace
+
+    from contactid.gap.candidates import LIBRARY
+    from contactid.gap.refit import _per_channel_theta
+
+    truth = np.array([4.0e-4, 6.0e-4, 8.0e-4])
+    P = np.eye(3) - np.ones((3, 3)) / 3
+
+    def run(theta):
+        return (float(np.linalg.norm(P @ (theta - truth)) / 1e-5) + 1e-3,)
+
+    rec = SimpleNamespace(acceleration=np.zeros((3, 9)))
+    common = truth + np.array([2e-6, -3e-6, 1e-6])
+    theta = _per_channel_theta(run, LIBRARY["channel_time_skew"], rec, 10, common)
+    assert np.mean(theta) == pytest.approx(np.mean(common), abs=1e-12)
+    np.testing.assert_allclose(theta, truth, atol=1e-5)

@@ -155,7 +155,7 @@ register(
     Candidate(
         "channel_time_skew",
         "each accelerometer channel late on the force by its own delay",
-        (Parameter("delay", "s", -2.0e-4, 2.0e-4),),
+        (Parameter("delay", "s", -2.0e-4, 2.0e-4, domain=(-2.0e-3, 2.0e-3)),),
         lambda th: Augmentation(delays=tuple(float(x) for x in th)),
         per_channel=True,
         acts_on="structure_or_measurement",

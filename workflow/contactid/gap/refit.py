@@ -347,6 +347,9 @@ def _per_channel_theta(
     p = cand.parameters[0]
     span = p.high - p.low
     if common is not None and np.size(common) == j and j > 1 and np.all(np.isfinite(common)):
+        # delays the random test measured beyond the library's range (a DAQ's filter delays): a range that holds them
+        p = p.covering(float(np.max(common))).covering(float(np.min(common)))
+        span = p.high - p.low
         x0 = np.clip(np.asarray(common, dtype=float), p.low, p.high)
         # an orthonormal basis of the channels' differences (the plane where the values sum to zero)
         B = np.linalg.qr(np.vstack([np.ones(j), np.eye(j)[: j - 1]]).T)[0][:, 1:]
