@@ -393,7 +393,7 @@ def simulate(
     else:
         sim.start_from_linear(coef, None, w)
         _, _, settled = sim.settle(coef, None, w, tol=tol, max_chunks=30)
-    result = _marched_result(sim, model, aug, rec, coef, w, H, n_per, record_periods, settled, grid)
+    result = _marched_result(sim, model, aug, rec, coef, w, H, n_per, record_periods, settled, grid, aperiodic=polish)
     if periodic is not None:
         result.extra.update({"Z": periodic.Z, "method": "harmonic_balance", "iterations": periodic.iterations})
     return result
@@ -476,7 +476,11 @@ def _marched_result(
     record_periods,
     settled,
     grid,
+    aperiodic: bool = True,
 ) -> SimResult:
+    """The integrator's record of the state it reached (``settled`` or not). ``aperiodic``: where it did not settle,
+    measure the share of the response that is not periodic (``extra["aperiodic"]``; read only for a candidate's
+    polished optimum, ``diagnosis.model_periodicity``: 15 ms a simulation, skipped in the searches)."""
     first = last = None
     if not settled and not aug.preload_drift:
         # the motion does not settle (impacts): average over as many periods as the record holds, as the
@@ -512,7 +516,7 @@ def _marched_result(
     }
     contact, means = _contact_harmonics(sig, t1, w, n_per, H)
     extra = {"means": means, "method": "time_marching"}
-    if not settled and not aug.preload_drift and np.all(np.isfinite(acc)):
+    if aperiodic and not settled and not aug.preload_drift and np.all(np.isfinite(acc)):
         # a response that does not settle: the share of it that is not periodic, as the records' (at their rate)
         q = max(1, int(round(1.0 / (sim.dt * rec.fs))))
         extra["aperiodic"] = aperiodic_share(acc[:, ::q], 1.0 / (q * sim.dt), rec.f0)
