@@ -26,7 +26,7 @@ from ..friction_parameters import fitted_parameters
 from ..harmonics import aperiodic_share, periodic_grid, periodic_harmonics
 from ..identification import damping_by_mode
 from ..parameters import StructureParameters, identified_structure
-from ..rig.nonlinear import ContactParameters, DualSineSimulator, reduced_model
+from ..rig.nonlinear import ContactParameters, DualSineSimulator, reduced_model, stable_oversampling
 from .records import RecordHarmonics
 
 
@@ -275,7 +275,7 @@ def simulator(model: IdentifiedModel, aug: Augmentation, fs: float, f0: float | 
         unilateral=aug.unilateral_exponent >= 1.0,
         regularization=model.regularization,
     )
-    q = max(int(model.oversampling), int(np.ceil(red.omega.max() / (1.6 * fs))))
+    q = stable_oversampling(red, fs, int(model.oversampling), viscous=aug.viscous)
     dt = 1.0 / (q * fs)
     if f0:
         dt = 1.0 / f0 / np.ceil(1.0 / (f0 * dt))

@@ -21,7 +21,14 @@ from .damping import rig_damping_ratios
 from .effects import effect_magnitudes
 from .frontend import add_noise, anti_alias_decimate, delay_channels
 from ..harmonics import harmonic_amplitudes
-from .nonlinear import ContactParameters, ControlResult, DualSineSimulator, control_response, reduced_model
+from .nonlinear import (
+    ContactParameters,
+    ControlResult,
+    DualSineSimulator,
+    control_response,
+    reduced_model,
+    stable_oversampling,
+)
 from .structure import channel_delays, channel_gains, rig_structure, true_structure_config
 
 log = logging.getLogger(__name__)
@@ -118,10 +125,10 @@ def build_simulator(
     zeta[red.beam_mode] += eff["structural_damping"]
     q = int(oversampling or settings["oversampling"])
     contact = contact_parameters(structure_cfg, rig_cfg)
-    # explicit central differences are stable for omega_max dt < 2: keep a margin (1.6) by oversampling more;
+    # explicit central differences: a margin on omega_max dt and on the viscous friction's rate (stable_oversampling);
     # a hardening normal law stiffens the normal shape: take its tangent where N reaches 3 N0
     stiffening = np.sqrt(normal_tangent_ratio(contact, red.k_n, 3.0))
-    q = max(q, int(np.ceil(stiffening * red.omega.max() / (1.6 * settings["sampling_rate_hz"]))))
+    q = stable_oversampling(red, settings["sampling_rate_hz"], q, stiffening, eff["viscous_friction"])
     sim = DualSineSimulator(red, contact, zeta, 1.0 / (q * settings["sampling_rate_hz"]))
     sim.oversampling = q
     return sim

@@ -64,6 +64,17 @@ class ReducedModel:
     k_n: float
 
 
+def stable_oversampling(red: ReducedModel, fs: float, q_min: int, stiffening: float = 1.0, viscous: float = 0.0) -> int:
+    """Integration steps per sample at ``fs`` (Hz), at least ``q_min``, at which the explicit central differences keep
+    a margin: omega_max dt <= 1.6 (omega_max (rad/s) times ``stiffening``, a hardening normal law's tangent ratio;
+    2 is the edge) and the viscous friction's rate sigma_2 |dxi/dq|^2 (1/s; ``viscous`` sigma_2 in N s/m), which a step
+    takes explicitly, times dt at most 1 (2 is the edge: the rig's records blew up at sigma_2 = 2e4 N s/m, rate x dt
+    1.96, with the default eight steps per sample)."""
+    q = max(int(q_min), int(np.ceil(stiffening * red.omega.max() / (1.6 * fs))))
+    rate = float(viscous) * float(red.xi @ red.xi)
+    return max(q, int(np.ceil(rate / fs)))
+
+
 def reduced_model(model: FEModel, n_modes: int, static_correction: bool = True) -> ReducedModel:
     """Basis of the lowest ``n_modes`` stuck modes plus the static responses to a unit tangential
     and a unit normal contact force and to the excitation (residual flexibility of the truncated
