@@ -116,3 +116,27 @@ def test_the_settings_records_left_empty_equal_the_schemas_defaults(default_conf
     assert GapSettings.from_config({}, 1, 25) == GapSettings.from_config(filled["gap"], 1, 25)
     assert fit_settings({}) == fit_settings(filled["friction"])
     assert random_test_settings({}, {}) == random_test_settings(filled["random_test"], filled["rig"])
+
+
+@pytest.mark.parametrize(
+    "change, message",
+    [
+        (
+            {"nonlinear": {"calibration_case": "lc9"}},
+            r"nonlinear\.calibration_case = 'lc9' is not a load case; name one",
+        ),
+        ({"load_cases": {"lc1": {"A1_m_per_s2": 14.0, "A2_m_per_s2": 34.0}}}, r"nonlinear\.figure_case = 'lc3' is not"),
+        ({"gap": {"candidates": ["normal_contact_damping", "teleportation"]}}, r"'teleportation' not in the candidate"),
+    ],
+)
+def test_a_case_or_candidate_the_config_does_not_have_is_named_before_anything_runs(default_config, change, message):
+    """Before, a calibration or figure case missing from load_cases stopped the DAG with a bare KeyError in an input
+    function, and an unknown gap candidate passed until the diagnosis ran."""
+    c = copy.deepcopy(default_config)
+    for block, values in change.items():
+        c[block] = {**c[block], **values} if block != "load_cases" else values
+    with pytest.raises(ConfigError, match=message):
+        check_config(c)
+    c["gap"] = {**c["gap"], "plugins": ["my_effects"]}  # a plugin may register its own names: checked by the rule
+    if "gap" in change:
+        check_config(c)

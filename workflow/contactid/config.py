@@ -264,6 +264,29 @@ def _load_case_errors(cfg: Mapping) -> list:
     return errors
 
 
+def _case_reference_errors(cfg: Mapping) -> list:
+    """nonlinear.calibration_case and nonlinear.figure_case name load cases; gap.candidates name the library's
+    candidates (the built-in ones; where gap.plugins add their own, their names are checked when the rule imports
+    them)."""
+    errors = []
+    cases = sorted(cfg.get("load_cases") or {})
+    for key in ("calibration_case", "figure_case"):
+        name = (cfg.get("nonlinear") or {}).get(key)
+        if name is not None and cases and name not in cases:
+            errors.append(f"nonlinear.{key} = {name!r} is not a load case; name one of {', '.join(cases)} (load_cases)")
+    gap = cfg.get("gap") or {}
+    if gap.get("candidates") is not None and not gap.get("plugins"):
+        from .gap.candidates import BUILTIN
+
+        unknown = [c for c in gap["candidates"] if c not in BUILTIN]
+        if unknown:
+            errors.append(
+                f"gap.candidates: {', '.join(map(repr, unknown))} not in the candidate library; name some of "
+                f"{', '.join(BUILTIN)}, or add your own module under gap.plugins"
+            )
+    return errors
+
+
 def _record_format_errors(cfg: Mapping) -> list:
     """A measured record in another format than netCDF has a complete channel map (``importers.record_spec``, for
     measured FRFs ``importers.frf_uff.frf_sensor_map``); a format other than netCDF is for measured records only,
@@ -324,6 +347,7 @@ def check_config(cfg: Mapping, source: str = "config/config.yaml") -> None:
         *_random_test_errors(cfg),
         *_stiction_bound_errors(cfg),
         *_load_case_errors(cfg),
+        *_case_reference_errors(cfg),
         *_record_format_errors(cfg),
         *_rig_errors(cfg),
     ]
