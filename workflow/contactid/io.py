@@ -196,7 +196,7 @@ def raw_dataset(
 _ACC_UNITS = {"m/s^2", "m/s2", "m s-2", "m/s**2"}
 _FORCE_UNITS = {"N", "newton"}
 # the time axis as other tools write it: its unit (absent: seconds, the format's), in seconds
-_TIME_UNITS = {
+TIME_UNITS = {
     **dict.fromkeys(("s", "sec", "second", "seconds"), 1.0),
     **dict.fromkeys(("ms", "millisecond", "milliseconds"), 1e-3),
     **dict.fromkeys(("us", "microsecond", "microseconds"), 1e-6),
@@ -215,9 +215,9 @@ def _time_in_seconds(time: xr.DataArray, fail) -> np.ndarray:
     if v.dtype.kind not in "fiu":
         fail(f"coordinate 'time' holds values of type {v.dtype}; write seconds as numbers")
     units = str(time.attrs.get("units", "s")).strip()
-    if units not in _TIME_UNITS:
+    if units not in TIME_UNITS:
         fail(f"coordinate 'time' has units {units!r}; write seconds ('s'), or 'ms' or 'us'")
-    return np.asarray(v, dtype=np.float64) * _TIME_UNITS[units]
+    return np.asarray(v, dtype=np.float64) * TIME_UNITS[units]
 
 
 def _uniform_time(t: np.ndarray, stored_dtype: np.dtype, fs: float, fail) -> np.ndarray:

@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Mapping
 
-from ..io import RawDataError
+from ..io import TIME_UNITS, RawDataError
 
 # physical units accepted per quantity, with the factor to SI (N, m/s^2)
 PHYSICAL = {
@@ -87,6 +87,7 @@ class ImportSpec:
     excitation_frequency_hz: float | None
     time_column: str | None
     where: str
+    time_units: str = "s"  # the CSV time column's unit: s, ms or us (contactid.io's time units)
 
     @property
     def force(self) -> ChannelSpec:
@@ -192,6 +193,9 @@ def import_spec(block: Mapping, where: str, fmt: str, file: str) -> ImportSpec:
     if dup:
         raise RawDataError(f"{where}: channel(s) {dup} are mapped twice; each role needs its own channel")
     tc = block.get("time_column")
+    tu = str(block.get("time_units", "s")).strip()
+    if tu not in TIME_UNITS:
+        raise RawDataError(f"{where}: time_units = {tu!r}; give s, ms or us (the unit of the time column)")
     return ImportSpec(
         fmt,
         str(file),
@@ -200,6 +204,7 @@ def import_spec(block: Mapping, where: str, fmt: str, file: str) -> ImportSpec:
         _positive_or_none(block, "excitation_frequency_hz", where),
         str(tc) if tc else None,
         where,
+        tu,
     )
 
 

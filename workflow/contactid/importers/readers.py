@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..io import RawDataError
+from ..io import TIME_UNITS, RawDataError
 from .channels import ImportSpec, check_file_unit
 
 
@@ -169,7 +169,7 @@ def read_csv(spec: ImportSpec) -> dict:
 
     dt = None
     if spec.time_column:
-        t = column(spec.time_column)
+        t = column(spec.time_column) * TIME_UNITS[spec.time_units]
         if t.size >= 2:
             steps = np.diff(t)
             dt = float(np.mean(steps))
