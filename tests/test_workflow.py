@@ -108,6 +108,7 @@ def test_invalid_measured_records_stop_only_their_case_and_say_why(tmp_path):
     ds.to_netcdf(proj / "measured" / "lc9.nc", engine="netcdf4")
     cfg = yaml.safe_load((proj / "config" / "config.yaml").read_text())
     cfg["load_cases"] = {c: {"source": "measured", "file": f"measured/{c}.nc"} for c in ("lc7", "lc8", "lc9")}
+    cfg["nonlinear"].update(calibration_case="lc9", figure_case="lc9")  # cases the config has (config.check_config)
     (proj / "config" / "config.yaml").write_text(yaml.safe_dump(cfg))
     res = snakemake(proj, "--keep-going", *[f"results/{c}/raw_check.nc" for c in ("lc7", "lc8", "lc9")])
     assert res.returncode != 0
@@ -134,6 +135,7 @@ def test_measured_case_with_wrong_unit_names_file(small_run, tmp_path):
     ds.to_netcdf(proj / "measured" / "lc7.nc", engine="netcdf4")
     cfg = yaml.safe_load((proj / "config" / "config.yaml").read_text())
     cfg["load_cases"] = {"lc7": {"source": "measured", "file": "measured/lc7.nc"}}
+    cfg["nonlinear"].update(calibration_case="lc7", figure_case="lc7")
     (proj / "config" / "config.yaml").write_text(yaml.safe_dump(cfg))
     res = snakemake(proj, "results/lc7/raw_check.nc")
     assert res.returncode != 0
