@@ -878,6 +878,19 @@ def heldout_gap_draws(records: Mapping[str, RecordHarmonics], cases, H: int, sim
     return np.array([heldout_gap_of(records, cases, H, sims_by_case, {c: boot[c][b] for c in cases}) for b in range(n)])
 
 
+def _gaps_and_scatter(
+    held_out: Mapping[str, RecordHarmonics], settings: GapSettings, sims: Mapping, scatter_of: str
+) -> dict:
+    """The held-out gap (``heldout_gap_of``) of each model's simulations ``sims`` {label: {case: SimResult}} as
+    ``heldout_gap_<label>``, and the records' scatter: the sd of model ``scatter_of``'s gap over the bootstrap of record
+    blocks (``bootstrap_draws``, the diagnosis's own stream). The two records' tests below weigh two models by it."""
+    H = settings.n_harmonics
+    cases = list(held_out)
+    draws = heldout_gap_draws(held_out, cases, H, sims[scatter_of], bootstrap_draws(held_out, cases, settings))
+    out = {f"heldout_gap_{label}": heldout_gap_of(held_out, cases, H, by_case) for label, by_case in sims.items()}
+    return {**out, "record_scatter": float(np.std(draws)), "cases": cases}
+
+
 def records_test_of_update(
     chain: IdentifiedModel,
     updated: IdentifiedModel,
@@ -904,13 +917,7 @@ def records_test_of_update(
     HarmonicBalance.forget()  # no Newton history from an earlier diagnosis in this process
     models = {"chain": chain, "updated": updated}
     sims = {label: {c: baseline(m, held_out[c], H)[1] for c in cases} for label, m in models.items()}
-    draws = heldout_gap_draws(held_out, cases, H, sims["chain"], bootstrap_draws(held_out, cases, settings))
-    out = {
-        "heldout_gap_chain": heldout_gap_of(held_out, cases, H, sims["chain"]),
-        "heldout_gap_updated": heldout_gap_of(held_out, cases, H, sims["updated"]),
-        "record_scatter": float(np.std(draws)),
-        "cases": cases,
-    }
+    out = _gaps_and_scatter(held_out, settings, sims, "chain")
     library = settings.candidates if settings.candidates is not None else tuple(LIBRARY)
     if calibration is not None and fit_settings is not None and "preload_drift" in library:
         if records_drift({c: held_out[c] for c in cases}, H, settings.place):
@@ -974,13 +981,7 @@ def records_test_of_gains(
     sims_gains = {c: evaluate(read, aug, held_out[c], None, H, refit=False)[2] for c in cases}
     HarmonicBalance.forget()
     sims_alone = {c: baseline(structure_alone, held_out[c], H)[1] for c in cases}
-    draws = heldout_gap_draws(held_out, cases, H, sims_alone, bootstrap_draws(held_out, cases, settings))
-    out = {
-        "heldout_gap_gains": heldout_gap_of(held_out, cases, H, sims_gains),
-        "heldout_gap_structure": heldout_gap_of(held_out, cases, H, sims_alone),
-        "record_scatter": float(np.std(draws)),
-        "cases": cases,
-    }
+    out = _gaps_and_scatter(held_out, settings, {"gains": sims_gains, "structure": sims_alone}, "structure")
     out["gains_preferred"] = records_prefer_gains(
         out["heldout_gap_structure"], out["heldout_gap_gains"], out["record_scatter"], settings
     )
