@@ -9,6 +9,7 @@ rule report_fragments:
         table3="results/tables/table3.csv",
         table4="results/tables/table4.csv",
         consistency="results/tables/paper_consistency.csv",
+        intervals="results/gap/friction_intervals.json",
     output:
         numbers="results/report/numbers.tex",
         setup="results/report/setup.tex",

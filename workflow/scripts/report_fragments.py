@@ -5,6 +5,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from contactid.gap.report import updated_law_note
 from contactid.latex import contact_fragment, data_checks_text, macros, report_values, setup_table, tabular
 from contactid.logs import setup_logging
 
@@ -65,7 +66,8 @@ Path(out.table4).write_text(
             "paper_value": "paper",
             "truth": "rig truth",
         },
-        "Friction-law parameters (paper, Table 4): working method with profile-likelihood intervals.",
+        "Friction-law parameters (paper, Table 4): working method with profile-likelihood intervals."
+        + updated_law_note(json.loads(Path(inp.intervals).read_text())),
         "tab:t4",
         intervals={"identified": ("interval_low", "interval_high")},
     )
