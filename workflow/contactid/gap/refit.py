@@ -416,10 +416,6 @@ def _least_squares_unit(
     return np.clip(res.x, 0.0, 1.0)
 
 
-# a one-parameter search's tolerance, a share of the parameter's range (EXPERIMENT)
-SCALAR_XATOL = 1e-4
-
-
 def _scalar_theta(run: _CandidateRuns, cand: Candidate, max_evaluations: int) -> np.ndarray:
     """theta (1,) of a one-parameter candidate: a scan of the range, the search between the best point's neighbours
     (``SEARCH``), and "off" where that is better."""
@@ -434,7 +430,7 @@ def _scalar_theta(run: _CandidateRuns, cand: Candidate, max_evaluations: int) ->
     p = cand.parameters[0]
     grid = p.low + (p.high - p.low) * np.array([0.0, 1 / 32, 1 / 8, 1 / 4, 1 / 2, 3 / 4, 1.0])
     best = min(range(1, 6), key=lambda i: run(np.array([grid[i]]))[0])
-    xatol = SCALAR_XATOL * (p.high - p.low)
+    xatol = 1e-3 * (p.high - p.low)
     trio = {float(grid[i]): run.residual(grid[i]) for i in (best - 1, best, best + 1)}
     if SEARCH.get() == "residual" and all(r is not None for r in trio.values()):
         x = residual_line_search(run.residual, trio, grid[best - 1], grid[best + 1], xatol, max_evaluations)
