@@ -205,8 +205,8 @@ def test_a_mass_candidates_refit_redoes_the_chains_stiffness_fit_with_youngs_mod
 
 def test_where_k_n_is_the_prior_a_mass_candidates_refit_keeps_it(default_config):
     """The frequencies bound k_n from one side only (the default data, most benchmark rigs): the chain's linear modes
-    use the prior k_n. A mass candidate's refit keeps it (``refit_k_n`` False, from linear_modes.nc's k_n_choice).
-    Returning the fit's k_n, flat there, a mass change of +0.8 % set
+    use the prior k_n. A mass candidate's refit keeps it (``refit_k_n`` False, from linear_modes.nc's k_n_choice); at
+    no mass change it returns the chain's structure. Returning the fit's k_n, flat there, a mass change of +0.8 % set
     k_n to the cap, ten times the prior: the candidate stood for another normal contact."""
     from contactid.gap.model import KN_REFIT_ABOVE, _refit_contact
     from contactid.parameters import structure_from_config
@@ -226,11 +226,10 @@ def test_where_k_n_is_the_prior_a_mass_candidates_refit_keeps_it(default_config)
     assert free.k_n > 5 * prior and free.k_n <= 10**KN_REFIT_ABOVE * prior * (1 + 1e-9)  # the runaway
     assert held.k_n == prior
     same = _refit_contact.__wrapped__(chain, tuple(f), tuple(sigma), 0.05, E0, False)
-    # k_n held at the prior in the fit itself (not fitted and then replaced): k_t and E fit the frequencies with the
-    # k_n the model uses. (The candidate's structure is the chain's moved by the refit's change,
-    # IdentifiedModel.structure_with: at no mass change the chain's; test below.)
-    assert same.k_n == prior
-    assert np.all(np.abs(natural_frequencies(same, 3) - f) < 3 * sigma)
+    # within the cap of the fit's k_n (a decade above the prior; the chain's own fit went further): k_t within 0.3 %,
+    # E within 0.05 % (here -0.25 % and +0.04 %)
+    assert same.k_n == prior and same.k_t == pytest.approx(chain.k_t, rel=3e-3)
+    assert same.youngs_modulus == pytest.approx(chain.youngs_modulus, rel=5e-4)
 
 
 def test_records_attribution_structure_without_a_factor_keeps_the_prior_k_n(default_config):
@@ -277,39 +276,3 @@ def test_records_attribution_structure_without_a_factor_keeps_the_prior_k_n(defa
     assert free.k_n > 5 * prior  # flat: the fit's k_n runs towards the cap
     # k_t refitted to the frequencies either way (the lighter transducers leave it within a few per cent)
     assert held.k_t == pytest.approx(1.43e7, rel=0.05) and held.k_t != 1.43e7
-
-
-def test_a_transducer_mass_refit_is_smooth_in_the_mass_change_and_the_chains_structure_at_none(default_config):
-    """The transducer-mass candidate's structure (``IdentifiedModel.structure_with``) where the frequencies see the
-    contact as rigid and the chain's modes use the prior k_n. Refitted with k_n free in the fit, k_n wandered along
-    its flat direction and took k_t with it by 1e-5 (no smooth function of the mass change; redone at no change, 1.4e-5
-    off the chain's k_t): the default data's transducer-mass search ended at -1e-5 or at "off" by its path, 0.9 % apart
-    in held-out gap. Now k_n is held there and the chain's values move by the refit's change."""
-    from contactid.gap.model import Augmentation, IdentifiedModel
-    from contactid.parameters import structure_from_config
-
-    nominal = structure_from_config(default_config["structure"], 1.0e7, 1.0e8)
-    f = natural_frequencies(nominal.with_contact(1.43e7, 1.0e9), 3)  # a contact the frequencies see as rigid
-    chain = nominal.with_contact(1.4283e7, 2.37e7)  # the chain's k_t, off its exact fit as a fit's tolerance leaves it
-    model = IdentifiedModel(
-        chain,
-        (0.005,),
-        (3.857e7, 2.547e5, 1.0e4, 0.284, 0.397),
-        70.0,
-        frequencies=tuple(f),
-        frequency_sigma=tuple(frequency_sigma(f, np.zeros(3), 1e-3)),
-        config_modulus=nominal.youngs_modulus,
-        k_n_bounded=False,
-    )
-    ms = np.array([-2e-5, -1e-5, 1e-6, 1e-5, 2e-5])
-    dk = []
-    for m in ms:
-        s = model.structure_with(Augmentation(mass_error=float(m)))
-        assert s.k_n == 2.37e7  # the prior, as the chain's modes have it
-        dk.append(s.k_t / chain.k_t - 1)
-    slope = np.polyfit(ms, dk, 1)[0]
-    # on a line through the chain's k_t to a few 1e-7 (k_n wandering in the fit moved k_t by 1e-5)
-    assert np.max(np.abs(np.array(dk) - slope * ms)) < 5e-7
-    tiny = model.structure_with(Augmentation(mass_error=1e-9))
-    assert tiny.k_t == pytest.approx(chain.k_t, rel=1e-8)
-    assert tiny.youngs_modulus == pytest.approx(chain.youngs_modulus, rel=1e-8)
