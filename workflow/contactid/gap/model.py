@@ -98,23 +98,16 @@ class IdentifiedModel:
         """The structure with the augmentation's changes; changed masses re-fit k_t and k_n to the identified
         natural frequencies, and Young's modulus with them where the chain's stiffness fit freed it (the linear
         chain's stiffness fit redone with the effect in the model, ``_refit_contact``); a changed shortening leaves
-        them (a second-order term: the linear chain does not see it).
-
-        The refit's change is applied to the chain's values (k_t, k_n and E times the refit with the masses changed
-        over the refit without), so that the structure tends to the chain's as the mass change vanishes. Redone
-        from the chain's own values, the refit ends a few 1e-5 from them (k_t 1.4e-5 lower on the default data),
-        and near resonance that moved the default data's held-out gap by 0.9 %: the transducer-mass search ended
-        at -1e-5 or at "off" depending on the path, the largest difference between the diagnosis and its
-        time-marching reference (benchmarks/gap_diagnosis.py)."""
+        them (a second-order term: the linear chain does not see it)."""
         p = self.structure
         if aug.shortening_change:
             p = p.replace(shortening_scale=p.shortening_scale * (1.0 + aug.shortening_change))
         if aug.mass_error:
             m = 1.0 + aug.mass_error
-            heavier = p.replace(
+            p = p.replace(
                 sensor_masses=tuple(m * x for x in p.sensor_masses), force_transducer_mass=m * p.force_transducer_mass
             )
-            p = _refit_change(p, self.refit_stiffness(heavier), self.refit_stiffness(p))
+            p = self.refit_stiffness(p)
         return p
 
     def refit_stiffness(self, structure: StructureParameters, free_modulus: bool = True) -> StructureParameters:
@@ -168,14 +161,6 @@ def identified_model(
     )
 
 
-def _refit_change(base: StructureParameters, changed: StructureParameters, unchanged: StructureParameters):
-    """``changed`` (a refit of a changed structure) with k_t, k_n and Young's modulus set to ``base``'s times the
-    refit's change, ``changed`` over ``unchanged`` (the same refit of ``base`` itself): equal to ``base``'s where
-    nothing changed (``IdentifiedModel.structure_with``)."""
-    p = changed.with_contact(base.k_t * changed.k_t / unchanged.k_t, base.k_n * changed.k_n / unchanged.k_n)
-    return p.replace(youngs_modulus=base.youngs_modulus * changed.youngs_modulus / unchanged.youngs_modulus)
-
-
 # how far above the chain's k_n a mass candidate's refit may take it (decades): see _refit_contact
 KN_REFIT_ABOVE = 1.0
 
@@ -202,7 +187,8 @@ def _refit_contact(
     at +30.5 % (docs/measurements.md, twenty-fifth session).
 
     ``refit_k_n`` False: where the frequencies bound k_n from one side only, the chain's linear modes use the prior
-    k_n, not the fit's; so does the refit, which holds k_n there and fits k_t (and E) alone. Returning the fit's k_n moved it to the cap, ten times the prior, at any mass change (+0.8 %
+    k_n, not the fit's; so does the refit (the fit is the chain's, k_n then set to the prior: at no mass change the
+    chain's structure). Returning the fit's k_n moved it to the cap, ten times the prior, at any mass change (+0.8 %
     on a compound benchmark item): the candidate then stood for a normal contact ten times stiffer, and explained
     61 % of what a preload drift left of a multi-asperity friction's gap.
 
@@ -218,36 +204,34 @@ def _refit_contact(
 
     f_id = np.asarray(frequencies)
     fmap = ContactFrequencyMap(params, len(f_id))
-    # k_n held where the chain's modes use the prior: the frequencies are flat in it there, and fitted along with k_t
-    # it wandered along that flat direction (2.3844e7-2.3857e7 for mass changes of +-1e-5), taking k_t and E with it
-    # by 1e-5: a refit that was not a smooth function of the masses (the transducer-mass search's jitter near zero)
-    x0 = np.log10([params.k_t, params.k_n] if refit_k_n else [params.k_t])
-    lo, hi = x0 - 2, x0 + ([2, KN_REFIT_ABOVE] if refit_k_n else [2])
+    x0 = np.log10([params.k_t, params.k_n])
+    lo, hi = x0 - 2, x0 + [2, KN_REFIT_ABOVE]
     weights = np.asarray(sigma, dtype=float) if len(sigma) == len(f_id) else f_id
 
     def contact(x):
-        return float(10.0 ** x[0]), (float(10.0 ** x[1]) if refit_k_n else params.k_n)
+        return float(10.0 ** x[0]), float(10.0 ** x[1])
 
-    result = contact
+    def result(x):  # k_n held where the chain's modes use the prior: the fit's k_n (flat there) is not used
+        return float(10.0 ** x[0]), (float(10.0 ** x[1]) if refit_k_n else params.k_n)
 
     if scale_sd > 0 and config_modulus > 0:
         ln_s0 = float(np.log(params.youngs_modulus / config_modulus))  # the current E over the config's
 
         def residuals(x):
-            r = (fmap(*contact(x), float(np.exp(x[-1]))) - f_id) / weights
-            return np.append(r, (ln_s0 + x[-1]) / scale_sd)
+            r = (fmap(*contact(x), float(np.exp(x[2]))) - f_id) / weights
+            return np.append(r, (ln_s0 + x[2]) / scale_sd)
 
         res = least_squares(
             residuals,
             [*x0, 0.0],
             bounds=([*lo, LN_SCALE_BOUNDS[0] - ln_s0], [*hi, LN_SCALE_BOUNDS[1] - ln_s0]),
-            x_scale=[*[0.1] * x0.size, 0.01],
+            x_scale=[0.1, 0.1, 0.01],
             xtol=1e-10,
             ftol=1e-12,
             **JACOBIAN,
         )
         p = params.with_contact(*result(res.x))
-        return p.replace(youngs_modulus=params.youngs_modulus * float(np.exp(res.x[-1])))
+        return p.replace(youngs_modulus=params.youngs_modulus * float(np.exp(res.x[2])))
     res = least_squares(
         lambda x: (fmap(*contact(x)) - f_id) / weights,
         x0,
