@@ -78,6 +78,7 @@ def _raw(n=256, **kw):
         (lambda ds: ds.drop_vars("time"), "coordinate 'time' .* is missing"),
         (lambda ds: ds.assign_attrs(sampling_rate_hz=1001.0), "not uniform .* samples from t0"),
         (lambda ds: ds.assign_coords(time=ds["time"].assign_attrs(units="h")), "'time' has units 'h'"),
+        (lambda ds: ds.assign_coords(position=ds["position"].assign_attrs(units="in")), "'position' has units 'in'"),
     ],
 )
 def test_bad_raw_files_get_clear_errors(tmp_path, mutate, message):
@@ -93,9 +94,9 @@ def test_bad_raw_files_get_clear_errors(tmp_path, mutate, message):
 
 
 def test_raw_files_as_other_tools_write_them_read_as_the_format(tmp_path):
-    """Single precision (many DAQ exports), time in milliseconds, time as CF dates ("seconds since ..."): the same
-    record in double precision on the exact axis t0 + k / fs; a 128 s single-precision time axis (rounded to 7.6e-6 s,
-    4 % of a sample) too."""
+    """Single precision (many DAQ exports), time in milliseconds, time as CF dates ("seconds since ..."), sensor
+    positions in mm written as a variable: the same record in double precision on the exact axis t0 + k / fs, positions
+    in m; a 128 s single-precision time axis (rounded to 7.6e-6 s, 4 % of a sample) too."""
     fs, n = 5120.0, 16384
     t = np.arange(n) / fs
     rng = np.random.default_rng(3)
@@ -105,7 +106,9 @@ def test_raw_files_as_other_tools_write_them_read_as_the_format(tmp_path):
     ms = ref.assign_coords(time=("time", 1e3 * t, {"units": "ms"}))
     dates = ref.assign_coords(time=np.datetime64("2026-12-04T10:00:00") + np.round(t * 1e9).astype("timedelta64[ns]"))
     long_ = ref.assign_coords(time=("time", (t + 128.0 - t[-1]).astype(np.float32), {"units": "s"}))
-    for name, ds in {"single": single, "ms": ms, "dates": dates, "long": long_}.items():
+    # sensor positions in mm, and written as a variable on 'sensor' instead of a coordinate
+    mm = ms.assign_coords(position=("sensor", 1e3 * ref["position"].values, {"units": "mm"})).reset_coords("position")
+    for name, ds in {"single": single, "ms": ms, "dates": dates, "long": long_, "mm": mm}.items():
         path = tmp_path / f"{name}.nc"
         ds.to_netcdf(path, engine="netcdf4")
         back = read_raw(path)
@@ -116,6 +119,8 @@ def test_raw_files_as_other_tools_write_them_read_as_the_format(tmp_path):
         tol = 1e-7 if name == "single" else 0  # single precision rounds the samples, nothing else does
         np.testing.assert_allclose(back["acceleration"].values, ref["acceleration"].values, rtol=tol, atol=tol * 10)
         assert t0 == pytest.approx(128.0 - t[-1] if name == "long" else 0.0, abs=1e-5)
+        np.testing.assert_allclose(back["position"].values, [0.55, 0.3, 0.05], rtol=1e-12)
+        assert "position" in back.coords and back["position"].attrs["units"] == "m"
 
 
 def _imports_in_a_fresh_process(module: str, code: str, *args: str) -> bool:

@@ -195,6 +195,7 @@ def raw_dataset(
 
 _ACC_UNITS = {"m/s^2", "m/s2", "m s-2", "m/s**2"}
 _FORCE_UNITS = {"N", "newton"}
+_POSITION_UNITS = {"m": 1.0, "cm": 1e-2, "mm": 1e-3}
 # the time axis as other tools write it: its unit (absent: seconds, the format's), in seconds
 TIME_UNITS = {
     **dict.fromkeys(("s", "sec", "second", "seconds"), 1.0),
@@ -270,6 +271,8 @@ def read_raw(
     if set(ds["acceleration"].dims) != {"sensor", "time"}:
         fail(f"'acceleration' must have dims ('sensor', 'time'), has {ds['acceleration'].dims}")
     ds["acceleration"] = ds["acceleration"].transpose("sensor", "time")
+    if "position" in ds.data_vars and ds["position"].dims == ("sensor",):
+        ds = ds.set_coords("position")  # written as a variable on 'sensor' (as some tools do): the same thing
     if "position" not in ds.coords:
         fail("coordinate 'position' (m from the clamp, on 'sensor') is missing")
     if "sampling_rate_hz" not in ds.attrs:
@@ -284,6 +287,17 @@ def read_raw(
         fail(f"'acceleration' has units {units_a!r}; convert to 'm/s^2' (1 g = 9.80665 m/s^2)")
     if ds["position"].dtype.kind not in "fiu" or not np.all(np.isfinite(ds["position"].values)):
         fail("coordinate 'position' must hold finite numbers (m from the clamp)")
+    units_x = str(ds["position"].attrs.get("units", "m")).strip()
+    if units_x not in _POSITION_UNITS:
+        fail(f"coordinate 'position' has units {units_x!r}; write metres ('m'), or 'cm' or 'mm'")
+    if units_x != "m":  # stated in cm or mm: converted, as the time axis is
+        ds = ds.assign_coords(
+            position=(
+                "sensor",
+                ds["position"].values * _POSITION_UNITS[units_x],
+                {**ds["position"].attrs, "units": "m"},
+            )
+        )
     try:
         fs_attr = float(ds.attrs["sampling_rate_hz"])
         f0_attr = float(ds.attrs.get("excitation_frequency_hz", 1.0))
