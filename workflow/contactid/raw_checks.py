@@ -190,21 +190,22 @@ def validate_dual_sine(raw: xr.Dataset, path: str, checks: Mapping) -> list[str]
         change = np.abs(last - first) / scale
         worst = int(np.argmax(change))
         if change[worst] > c["stationarity_tolerance"]:
-            steady = steady_drift(first[worst], middle[worst], last[worst])
-            if not steady or change[worst] > c["drift_tolerance"]:
+            failed = (
+                f"{path}: channel {name}: stationarity check failed: the amplitude at {(1, 3)[worst]} w "
+                f"changes by {change[worst]:.3g} between the record's first and last thirds "
+            )
+            if not steady_drift(first[worst], middle[worst], last[worst]):
                 raise RawDataError(
-                    f"{path}: channel {name}: stationarity check failed: the amplitude at {(1, 3)[worst]} w "
-                    f"changes by {change[worst]:.3g} between the record's first and last thirds "
-                    + (
-                        f"(raw_checks.stationarity_tolerance = {c['stationarity_tolerance']}), not as a steady drift "
-                        "(its change from the first third to the middle one and on to the last differ more than "
-                        "twofold, as a transient's or an unsettled motion's do); record after the transient has died "
-                        "out, or raise the tolerance"
-                        if not steady
-                        else f"steadily, beyond raw_checks.drift_tolerance = {c['drift_tolerance']}; record a shorter "
-                        "test, or raise the tolerance to diagnose the drift (the gap diagnosis can model a drifting "
-                        "preload)"
-                    )
+                    failed + f"(raw_checks.stationarity_tolerance = {c['stationarity_tolerance']}), not as a steady "
+                    "drift (its change from the first third to the middle one and on to the last differ more than "
+                    "twofold, as a transient's or an unsettled motion's do); record after the transient has died out, "
+                    "or raise the tolerance"
+                )
+            if change[worst] > c["drift_tolerance"]:
+                raise RawDataError(
+                    failed + f"steadily, beyond raw_checks.drift_tolerance = {c['drift_tolerance']}; record a shorter "
+                    "test, or raise the tolerance to diagnose the drift (the gap diagnosis can model a drifting "
+                    "preload)"
                 )
             warnings.append(
                 f"{name}: amplitude at {(1, 3)[worst]} w drifts steadily by {change[worst]:.3g} over the record "
