@@ -204,3 +204,39 @@ def test_channel_delays_beyond_the_librarys_range_are_searched_where_the_random_
     theta = _per_channel_theta(run, LIBRARY["channel_time_skew"], rec, 10, common)
     assert np.mean(theta) == pytest.approx(np.mean(common), abs=1e-12)
     np.testing.assert_allclose(theta, truth, atol=1e-5)
+
+
+@pytest.mark.parametrize("best, expected", [(-1.07e-5, 0.0), (2.0e-3, 0.0), (0.02, 0.02), (-0.05, -0.05)])
+def test_an_optimum_the_search_cannot_tell_from_off_is_off(best, expected):
+    """The transducer-mass search on the effect-free default data ended at -1.07e-5 in one diagnosis and at "off" in
+    the other (its tolerance is 1e-3 of the range, 3.9e-3): any mass change refits the stiffness, which moves k_t by
+    1e-5, and the two held-out gaps stood 0.88 % apart. An optimum within the tolerance of "off" is "off"; one beyond
+    it is kept."""
+    from contactid.gap.candidates import LIBRARY
+    from contactid.gap.refit import _scalar_theta
+
+    run = _QuadraticRuns(best, 0.01)
+    theta = _scalar_theta(run, LIBRARY["transducer_mass_error"], 12)
+    assert float(theta[0]) == pytest.approx(expected, abs=1e-3 * 3.9 if expected else 0.0)
+
+
+def test_channel_delays_the_search_cannot_tell_from_zero_are_zero():
+    """The default data's channel delays came out at 0.01-0.26 us in one diagnosis (tolerance 0.4 us, 1e-3 of the
+    range) and at zero in the other, held-out gaps 5.4 % apart: every channel within the tolerance is zero; a
+    channel beyond it keeps every channel's value (the search starts from the random test's delays)."""
+    from types import SimpleNamespace
+
+    from contactid.gap.candidates import LIBRARY
+    from contactid.gap.refit import _per_channel_theta
+
+    rec = SimpleNamespace(acceleration=np.zeros((3, 9)))
+    for truth, zero in (([1e-8, 1.1e-7, -2.6e-7], True), ([1e-8, 1.1e-7, -2.6e-6], False)):
+        truth = np.array(truth)
+
+        def run(theta, truth=truth):
+            return (float(np.linalg.norm(theta - truth) / 1e-5) + 1e-3,)
+
+        theta = _per_channel_theta(run, LIBRARY["channel_time_skew"], rec, 10, truth)  # the random test's delays
+        assert np.all(theta == 0.0) == zero
+        if not zero:
+            np.testing.assert_allclose(theta, truth, atol=4e-7)
