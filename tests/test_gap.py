@@ -245,15 +245,16 @@ def test_candidates_in_two_processes_equal_the_serial_ones(hc_data, hc_diagnosis
 @pytest.mark.slow
 def test_a_diagnosis_does_not_depend_on_what_ran_before_it(hc_data, hc_diagnosis):
     """Run again in the same process (after other diagnoses left their Newton history), a diagnosis gives the same
-    numbers to the last digit, every searched state polished too (that setting is the most sensitive to it: a
-    second run ended its searches elsewhere, held-out gaps 1.6 % apart, before each diagnosis forgot that history)."""
-    polished = _diagnose(hc_data, TWO, polish_searches=True)
+    numbers to the last digit, with every searched state polished (the default, the setting most sensitive to it:
+    a second run ended its searches elsewhere, held-out gaps 1.6 % apart, before each diagnosis forgot that history)
+    and with the periodic states alone in the searches."""
+    periodic = _diagnose(hc_data, TWO, polish_searches=False)
     again = _diagnose(hc_data, TWO)
     assert [r["heldout_gap_after"] for r in again.ranking] == [r["heldout_gap_after"] for r in hc_diagnosis.ranking]
     assert [r["calibration_gap"] for r in again.ranking] == [r["calibration_gap"] for r in hc_diagnosis.ranking]
-    polished_again = _diagnose(hc_data, TWO, polish_searches=True)
-    assert [r["heldout_gap_after"] for r in polished_again.ranking] == [
-        r["heldout_gap_after"] for r in polished.ranking
+    periodic_again = _diagnose(hc_data, TWO, polish_searches=False)
+    assert [r["heldout_gap_after"] for r in periodic_again.ranking] == [
+        r["heldout_gap_after"] for r in periodic.ranking
     ]
 
 
@@ -648,15 +649,18 @@ def test_a_benchmark_item_not_diagnosed_still_gets_its_files_and_figures(tmp_pat
 @pytest.mark.slow
 def test_polish_searches_setting_polishes_every_searched_state(hc_data, monkeypatch):
     """gap.polish_searches reaches the candidate's search (as an argument of the task, so that a worker process sees
-    it too): every state compared is polished; by default only the optimum is."""
+    it too): every state compared is polished (the default); set false, only the optimum is."""
     from contactid.gap import refit
     from contactid.gap.diagnosis import GapSettings, _candidate_task
     from contactid.gap.refit import POLISH_SEARCH, baseline
 
     cfg, model, records, _ = hc_data
     fit = settings_from_config(cfg["friction"])
-    settings = GapSettings.from_config({**cfg["gap"], "polish_searches": True}, 0, 25)
-    assert settings.polish_searches and not GapSettings.from_config(cfg["gap"], 0, 25).polish_searches
+    settings = GapSettings.from_config(cfg["gap"], 0, 25)
+    assert (
+        settings.polish_searches
+        and not GapSettings.from_config({**cfg["gap"], "polish_searches": False}, 0, 25).polish_searches
+    )
     base = {c: baseline(model, records[c], 9)[1] for c in records}
     seen = []
     evaluate = refit.evaluate
@@ -679,7 +683,7 @@ def test_polish_searches_setting_polishes_every_searched_state(hc_data, monkeypa
     _candidate_task(("viscous_friction", {**common, "polish_searches": True}))
     assert len(seen) > 3 and all(seen) and not POLISH_SEARCH.get()
     seen.clear()
-    _candidate_task(("viscous_friction", common))
+    _candidate_task(("viscous_friction", {**common, "polish_searches": False}))
     assert len(seen) > 3 and seen.count(True) == 1  # the optimum alone
 
 

@@ -105,7 +105,7 @@ class GapSettings:
     updating_records_test: bool = True  # the records may accept an update the random test's chi^2 did not
     updating_gain_sd: float = 0.03  # prior sd of ln of each channel's sensitivity on the residues (0: calibrated)
     joint_refit: bool = True  # the explanation's later steps refit the earlier steps' parameters with theirs
-    polish_searches: bool = False  # every searched state polished by the integrator (refit.POLISH_SEARCH)
+    polish_searches: bool = True  # every searched state polished by the integrator (refit.POLISH_SEARCH)
     pair_lookahead: float = 3.0  # where no candidate shrinks a gap above this many min_gap materially, try a pair
     retry_unmoved: bool = False  # later passes also try the candidates whose refit alone left them off
     place: PlaceThresholds = DEFAULT_PLACE  # the localisation's thresholds (gap.place)
@@ -646,8 +646,8 @@ def _candidate(
 
 
 def _candidate_task(task):
-    """(name, common): ``_candidate(name, **common)``, every searched state polished by the integrator where
-    ``common["polish_searches"]`` says so (``refit.polished_searches``: set here, in the process that runs the
+    """(name, common): ``_candidate(name, **common)``, every searched state polished by the integrator unless
+    ``common["polish_searches"]`` is False (``refit.polished_searches``: set here, in the process that runs the
     candidate, since a worker does not inherit the caller's context). Each candidate starts without Newton history
     (``HarmonicBalance.forget``): which worker runs which candidate after which depends on timing, and a candidate
     that started from another's last Jacobian ended elsewhere where its calibration gap is flat (the default data's
@@ -655,7 +655,7 @@ def _candidate_task(task):
     name, common = task
     common = dict(common)
     HarmonicBalance.forget()
-    with polished_searches(common.pop("polish_searches", False)):
+    with polished_searches(common.pop("polish_searches", True)):
         return _candidate(name, **common)
 
 

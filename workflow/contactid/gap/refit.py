@@ -260,11 +260,11 @@ def evaluate(
 
 
 # True: every state of a calibration search polished by the integrator, so that the search sees the reference's gaps
-# (to its settling tolerance): held-out gaps within 0.02-0.9 % of the time-marching diagnosis's on
-# benchmarks/gap_diagnosis.py's four data sets, against 0.9-16 % with the periodic states alone (the default: same
-# verdicts and, but for ties, rankings; the searches stop elsewhere in flat calibration gaps), for 20-75 % more
+# (to its settling tolerance): held-out gaps within 0.01-0.08 % of the time-marching diagnosis's on
+# benchmarks/gap_diagnosis.py's four data sets, against 2.4-8.6 % with the periodic states alone (False here: same
+# verdicts and, but for near ties, rankings; the searches stop elsewhere in flat calibration gaps), for 25-90 % more
 # diagnosis time (a contact that may open marches from the linear state then, as the reference does). The gap
-# setting polish_searches sets it for a diagnosis.
+# setting polish_searches (true by default) sets it for a diagnosis.
 POLISH_SEARCH = contextvars.ContextVar("polish_search", default=False)
 
 
