@@ -215,6 +215,7 @@ def gap_inputs(wildcards):
         "updating": "results/gap/model_updating.json",
     }
     inputs["raw"] = [raw_record(c) for c in load_cases()]
+    inputs.update(gap_floor_input())
     inputs["checks"] = [
         f"results/{c}/raw_check.nc" for c in load_cases()
     ]  # a record that fails validation stops the gap
@@ -229,6 +230,21 @@ def gap_outputs():
     return ["results/gap/diagnosis.json", "results/gap/gap.nc", "results/gap/friction_intervals.json"] + [
         f"results/gap/gap_{v}.png" for v in GAP_VIEWS
     ]
+
+
+def measured_floor():
+    """Whether gap.min_gap is measured (``auto``: rule gap_floor) rather than given."""
+    return config["gap"].get("min_gap") == "auto"
+
+
+def gap_floor_input(wildcards=None):
+    """The measured floor of the held-out gap where gap.min_gap is auto (results/gap/floor.json), else nothing."""
+    return {"floor": "results/gap/floor.json"} if measured_floor() else {}
+
+
+def benchmark_floor_input(wildcards=None):
+    """The blind benchmark's measured floor where gap.min_gap is auto (results/gap_benchmark/floor.json)."""
+    return {"floor": "results/gap_benchmark/floor.json"} if measured_floor() else {}
 
 
 def benchmark_base_config():

@@ -8,6 +8,43 @@ rule gap:
         gap_outputs(),
 
 
+rule gap_floor:
+    """The identification's own floor of the held-out gap at the records' drive, where gap.min_gap is auto: the rig
+    without effects, the identified friction law as its truth, identified again (results/gap/floor.json)."""
+    input:
+        fit="results/friction/friction_fit.nc",
+        calibration=raw_record(calibration_case()),
+    output:
+        "results/gap/floor.json",
+    params:
+        code=CODE_DIGEST,
+        config=benchmark_base_config(),
+    threads: 1
+    conda:
+        "../envs/contactid.yaml"
+    log:
+        "logs/gap_floor.log",
+    script:
+        "../scripts/gap_floor.py"
+
+
+rule gap_benchmark_floor:
+    """The blind benchmark's floor of the held-out gap where gap.min_gap is auto: the configured rig without
+    effects at its configured drive, identified (results/gap_benchmark/floor.json)."""
+    output:
+        "results/gap_benchmark/floor.json",
+    params:
+        code=CODE_DIGEST,
+        config=benchmark_base_config(),
+    threads: 1
+    conda:
+        "../envs/contactid.yaml"
+    log:
+        "logs/gap_benchmark/floor.log",
+    script:
+        "../scripts/gap_floor.py"
+
+
 rule model_updating:
     """Structural updating from the random test's modal data before the gap candidates (results/gap/model_updating.json)."""
     input:
@@ -18,7 +55,9 @@ rule model_updating:
     params:
         code=CODE_DIGEST,
         structure=config["structure"],
-        gap=config["gap"],
+        # its block alone: the contact forces and the friction fit read the update, and another gap setting
+        # (gap.min_gap, the candidates) reran them
+        model_updating=config["gap"]["model_updating"],
         seed=config["seed"],
         n_harmonics=config["nonlinear"]["n_harmonics"],
     threads: 1
@@ -123,6 +162,8 @@ rule gap_figures:
 
 rule gap_benchmark_item:
     """One blind-benchmark item: rig records with a hidden effect, the chain's identification and the gap diagnosis, scored against the hidden truth."""
+    input:
+        unpack(benchmark_floor_input),
     output:
         item="results/gap_benchmark/items/{item}.json",
         diagnosis="results/gap_benchmark/items/{item}/diagnosis.json",
@@ -206,6 +247,7 @@ rule gap_ladder:
     """The detection ladder: every effect at a tenth, a third and the whole of its typical magnitude, scored where
     its held-out gap exceeds twice gap.min_gap (results/gap_benchmark/ladder.json)."""
     input:
+        unpack(benchmark_floor_input),
         rows=expand("results/gap_benchmark/items/{item}.json", item=list(ladder_items())),
     output:
         "results/gap_benchmark/ladder.json",

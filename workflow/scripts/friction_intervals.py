@@ -3,6 +3,7 @@
 import json
 
 from contactid.gap.diagnosis import GapSettings
+from contactid.gap.floor import resolved_gap_config
 from contactid.gap.pipeline import workflow_models
 from contactid.gap.uncertainty import friction_uncertainty
 from contactid.io import write_text
@@ -12,7 +13,9 @@ log = setup_logging(snakemake.log[0])
 p = snakemake.params
 inp = snakemake.input
 K = int(p.n_harmonics)
-settings = GapSettings.from_config(p.gap, int(p.seed), K)
+# gap.min_gap: auto reads the floor the rule gap_floor measured
+gap = resolved_gap_config(p.gap, json.load(open(inp.floor)) if "floor" in inp.keys() else None)
+settings = GapSettings.from_config(gap, int(p.seed), K)
 records, fit_settings, modal, _, model, upd = workflow_models(
     p.structure, inp, p.cases, p.calibration_case, K, p.friction, settings, int(p.seed)
 )

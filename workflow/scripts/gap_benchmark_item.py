@@ -5,15 +5,19 @@ import json
 import numba
 
 from contactid.gap.benchmark import run_item
+from contactid.gap.floor import resolved_gap_config
 from contactid.gap.output import _clean
 from contactid.io import write_text
 from contactid.logs import setup_logging
 
 log = setup_logging(snakemake.log[0])
 numba.set_num_threads(max(1, min(int(snakemake.threads), numba.config.NUMBA_NUM_THREADS)))
+config = dict(snakemake.params.config)
+if "floor" in snakemake.input.keys():  # gap.min_gap: auto: the floor rule gap_benchmark_floor measured
+    config["gap"] = resolved_gap_config(config["gap"], json.load(open(snakemake.input.floor)))
 row = run_item(
     snakemake.params.spec,
-    snakemake.params.config,
+    config,
     {"diagnosis": snakemake.output.diagnosis, "dataset": snakemake.output.dataset},
 )
 row["item"] = snakemake.wildcards.item

@@ -1,9 +1,11 @@
 """Rule gap_diagnosis: the identified model against every load case's raw record (issue 7)."""
 
+import json
 import time
 
 from contactid.gap.candidates import load_plugins
 from contactid.gap.diagnosis import GapSettings, diagnose, linear_stage, prepare_workers, random_test_delays
+from contactid.gap.floor import resolved_gap_config
 from contactid.gap.pipeline import workflow_models
 from contactid.gap.output import diagnosis_json, gap_dataset
 from contactid.io import load_dataset, provenance, write_dataset, write_text
@@ -15,7 +17,9 @@ inp = snakemake.input
 t0 = time.perf_counter()
 load_plugins(p.gap.get("plugins"))
 K = int(p.n_harmonics)
-settings = GapSettings.from_config(p.gap, int(p.seed), K)
+# gap.min_gap: auto reads the floor the rule gap_floor measured
+gap = resolved_gap_config(p.gap, json.load(open(inp.floor)) if "floor" in inp.keys() else None)
+settings = GapSettings.from_config(gap, int(p.seed), K)
 workers = int(snakemake.resources.workers)
 prepare_workers(workers)  # before the friction fit after updating starts numba's threads
 records, fit_settings, modal, chain_model, model, updating = workflow_models(
@@ -50,5 +54,8 @@ prov = provenance(
 ds = gap_dataset(diag, records, settings.n_harmonics)
 ds.attrs.update(prov)
 write_dataset(ds, snakemake.output.dataset)
-write_text(snakemake.output.diagnosis, diagnosis_json(diag, {"seconds": seconds, "provenance": prov}))
+extra = {"seconds": seconds, "provenance": prov}
+if "floor" in inp.keys():
+    extra["measured_floor"] = json.load(open(inp.floor))
+write_text(snakemake.output.diagnosis, diagnosis_json(diag, extra))
 log.info("verdict %s: %s (%.1f s)", diag.verdict, diag.reason, seconds)

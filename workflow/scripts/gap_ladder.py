@@ -9,7 +9,10 @@ from contactid.logs import setup_logging
 
 log = setup_logging(snakemake.log[0])
 rows = [json.load(open(path)) for path in snakemake.input.rows]
-result = ladder_score(rows, float(snakemake.params.floor))
+floor = snakemake.params.floor  # gap.min_gap; auto: the one rule gap_benchmark_floor measured
+if "floor" in snakemake.input.keys():
+    floor = json.load(open(snakemake.input.floor))["min_gap"]
+result = ladder_score(rows, float(floor))
 write_text(snakemake.output[0], json.dumps(_clean(result), indent=2))
 log.info(
     "detection ladder: %d items, %d detectable (held-out gap above twice the floor); named in %s, refitted "

@@ -2,6 +2,7 @@
 
 import json
 
+from contactid.config import with_defaults
 from contactid.gap.diagnosis import GapSettings
 from contactid.gap.pipeline import structure_update
 from contactid.io import load_dataset, write_text
@@ -11,7 +12,9 @@ from contactid.parameters import identified_structure
 log = setup_logging(snakemake.log[0])
 p = snakemake.params
 modes = load_dataset(snakemake.input.modes)
-settings = GapSettings.from_config(p.gap, int(p.seed), int(p.n_harmonics))
+# the update reads gap.model_updating alone (the rule's params): the block's siblings at their defaults
+gap = {**with_defaults({"gap": {}})["gap"], "model_updating": p.model_updating}
+settings = GapSettings.from_config(gap, int(p.seed), int(p.n_harmonics))
 structure = identified_structure(p.structure, modes)
 upd = structure_update(structure, load_dataset(snakemake.input.modal), settings)
 summary = {"enabled": upd is not None, **(upd.summary() if upd is not None else {})}

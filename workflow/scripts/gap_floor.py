@@ -1,0 +1,33 @@
+"""Rules gap_floor and gap_benchmark_floor: the identification's own floor of the held-out gap (gap.min_gap: auto).
+
+gap_floor: at the calibration record's drive, with the identified friction law as the rig's truth.
+gap_benchmark_floor: at the configured drive, with the configured rig's law (the benchmark items' rig).
+"""
+
+import json
+
+from contactid.config import with_defaults
+from contactid.friction_parameters import fitted_parameters
+from contactid.gap.floor import identification_floor
+from contactid.gap.records import record_harmonics
+from contactid.io import load_dataset, read_raw, write_text
+from contactid.logs import setup_logging
+
+log = setup_logging(snakemake.log[0])
+cfg = with_defaults(snakemake.params.config)
+inp = snakemake.input
+if "fit" in inp.keys():  # the configured data: the calibration record's drive, the identified law
+    fit = load_dataset(inp.fit)
+    friction, regularization = fitted_parameters(fit), str(fit.attrs["regularization"])
+    raw = read_raw(inp.calibration, dual_sine=True)
+    rec = record_harmonics(raw, cfg["nonlinear"]["calibration_case"], int(cfg["nonlinear"]["n_harmonics"]))
+    f0, fs, n = rec.f0, rec.fs, int(raw.sizes["time"])
+else:  # the blind benchmark's items: the configured rig, its law and its drive
+    truth = cfg["rig"]["truth"]["friction"]
+    friction = [truth[k] for k in ("e_f_n_per_m", "k_c_per_m", "e_t_n_per_m", "kappa", "mu")]
+    regularization = truth["regularization"]
+    f0 = float(cfg["rig"]["dual_sine"]["excitation_frequency_hz"])
+    fs = float(cfg["random_test"]["sampling_rate_hz"])
+    n = int(cfg["rig"]["dual_sine"]["record_samples"])
+floor = identification_floor(cfg, friction, regularization, f0, fs, n, int(cfg["seed"]))
+write_text(snakemake.output[0], json.dumps(floor, indent=2))
