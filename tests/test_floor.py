@@ -58,3 +58,14 @@ def test_the_floor_follows_the_drive():
     assert 0.0002 < above["floor"] < 0.3 * near["floor"]
     assert near["min_gap"] == pytest.approx(FLOOR_FACTOR * near["floor"])
     assert set(near["by_case"]) == {"lc2", "lc3"} and near["calibration_case"] == "lc1"
+
+
+def test_the_report_says_the_floor_was_measured_and_what_it_is():
+    from contactid.gap.report import explanation_text, measured_floor_text
+
+    left = {"heldout_gap": 0.0005, "share": 1.0, "floor": 0.001, "at_floor": True, "place": "contact"}
+    diag = {"explanation": [], "remaining_gap": {**left, "min_reduction": 0.5}}
+    assert measured_floor_text(diag) == "" and "measured" not in explanation_text(diag)
+    diag["measured_floor"] = {"floor": 0.0005, "min_gap": 0.001, "factor": 2.0, "drive_hz": 60.0}
+    text = explanation_text(diag)
+    assert "measured for these records" in text and "$60.00$~Hz" in text and "0.05" in text

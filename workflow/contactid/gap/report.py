@@ -153,7 +153,24 @@ def explanation_text(diag: dict) -> str:
             )
             + r"; Fig.~\ref{fig:gap_explanation}."
         )
-    return text
+    return text + measured_floor_text(diag)
+
+
+def measured_floor_text(diag: dict) -> str:
+    """Where gap.min_gap is measured (auto, ``gap.floor``): what the rig without effects left at the records' drive."""
+    m = diag.get("measured_floor")
+    if not m:
+        return ""
+    return (
+        r" The floor gap.min\_gap is measured for these records (gap.min\_gap: auto): the rig without effects, the "
+        r"identified friction law as its truth, driven at $"
+        + _fmt(m["drive_hz"], 4)
+        + r"$~Hz and identified by the chain, leaves a held-out gap of "
+        + _pct(m["floor"])
+        + r"; gap.min\_gap is $"
+        + _fmt(m["factor"], 2)
+        + r"$ times it."
+    )
 
 
 def updated_law_note(intervals: dict | None) -> str:
