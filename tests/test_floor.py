@@ -34,16 +34,20 @@ def test_the_floors_rig_is_the_model_without_any_effect_at_the_records_drive():
     assert cfg["rig"]["effects"] == {"viscous_friction": 300.0}  # the caller's config is left as it was
 
 
-def test_auto_is_resolved_from_the_measured_floor_and_refused_without_it():
-    from contactid.gap.diagnosis import GapSettings
-
-    gap = {**_cfg()["gap"], "min_gap": "auto"}
+def test_the_measured_floor_replaces_min_gap_where_one_was_measured():
+    gap = _cfg()["gap"]
+    assert gap["measure_floor"] is True and gap["min_gap"] == 0.006
     assert resolved_gap_config(gap, {"min_gap": 0.001})["min_gap"] == 0.001
-    assert resolved_gap_config({**gap, "min_gap": 0.004}, None)["min_gap"] == 0.004
-    with pytest.raises(ValueError, match="gap.min_gap is 'auto' but no measured floor"):
-        resolved_gap_config(gap, None)
-    with pytest.raises(ValueError, match="resolved_gap_config"):
-        GapSettings.from_config(gap, 0, 25)
+    assert resolved_gap_config(gap, None)["min_gap"] == 0.006
+    # one load case: nothing held out, nothing measured (identification_floor says why), min_gap stands
+    assert resolved_gap_config(gap, {"floor": None, "min_gap": None, "reason": "no load case"})["min_gap"] == 0.006
+
+
+def test_one_load_case_measures_no_floor():
+    cfg = _cfg()
+    cfg["load_cases"] = {"lc1": cfg["load_cases"]["lc1"]}
+    out = identification_floor(cfg, TRUTH, "none", 54.375, 5120.0, 16384, int(cfg["seed"]))
+    assert out["floor"] is None and out["min_gap"] is None and "lc1" in out["reason"]
 
 
 @pytest.mark.slow  # the rig (random test and three load cases) and the chain twice (about 12 s)

@@ -498,12 +498,12 @@ def test_no_table_cell_prints_more_digits_than_its_interval_supports(default_run
             assert cells[1] == "$0$", f"Table 8 {name}: {cells[1]} is lost in its interval"
 
 
-def test_a_measured_floor_runs_only_the_floor_and_the_gaps_jobs(default_run, tmp_path):
-    """gap.min_gap: auto adds the floor's rule (the rig without effects at the records' drive) before the diagnosis
-    and the friction intervals, which then run again; nothing upstream of the friction fit runs."""
+def test_a_given_floor_reruns_the_gaps_jobs_without_the_floors(default_run, tmp_path):
+    """gap.measure_floor false (min_gap as given): the floor's rule is left out; the diagnosis and the friction
+    intervals run again, nothing upstream of them (the model update reads its own block alone)."""
     cfg = yaml.safe_load((default_run / "config" / "config.yaml").read_text())
-    cfg["gap"]["min_gap"] = "auto"
-    alt = tmp_path / "auto_floor.yaml"  # a dry run: the shared project stays untouched
+    cfg["gap"]["measure_floor"] = False
+    alt = tmp_path / "given_floor.yaml"  # a dry run: the shared project stays untouched
     alt.write_text(yaml.safe_dump(cfg))
     res = snakemake(default_run, "--configfile", str(alt), "-n", "--quiet", "rules")
     assert res.returncode == 0, res.stderr[-3000:]
@@ -513,5 +513,6 @@ def test_a_measured_floor_runs_only_the_floor_and_the_gaps_jobs(default_run, tmp
         for line in out.splitlines()
         if len(line.split()) == 2 and line.split()[1].isdigit()
     }
-    assert jobs.get("gap_floor") == 1 and jobs.get("gap_diagnosis") == 1 and jobs.get("friction_intervals") == 1
-    assert "friction_fit" not in jobs and "rig_dual_sine" not in jobs and "gap_benchmark_floor" not in jobs
+    assert jobs.get("gap_diagnosis") == 1 and jobs.get("friction_intervals") == 1 and "gap_floor" not in jobs
+    assert "friction_fit" not in jobs and "model_updating" not in jobs and "rig_dual_sine" not in jobs
+    assert (default_run / "results" / "gap" / "floor.json").exists()  # the default run measured it

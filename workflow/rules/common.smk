@@ -233,17 +233,17 @@ def gap_outputs():
 
 
 def measured_floor():
-    """Whether gap.min_gap is measured (``auto``: rule gap_floor) rather than given."""
-    return config["gap"].get("min_gap") == "auto"
+    """Whether gap.min_gap is measured (gap.measure_floor: rule gap_floor) rather than given."""
+    return bool(config["gap"].get("measure_floor", True))
 
 
 def gap_floor_input(wildcards=None):
-    """The measured floor of the held-out gap where gap.min_gap is auto (results/gap/floor.json), else nothing."""
+    """The measured floor of the held-out gap where gap.measure_floor (results/gap/floor.json), else nothing."""
     return {"floor": "results/gap/floor.json"} if measured_floor() else {}
 
 
 def benchmark_floor_input(wildcards=None):
-    """The blind benchmark's measured floor where gap.min_gap is auto (results/gap_benchmark/floor.json)."""
+    """The blind benchmark's measured floor where gap.measure_floor (results/gap_benchmark/floor.json)."""
     return {"floor": "results/gap_benchmark/floor.json"} if measured_floor() else {}
 
 

@@ -9,7 +9,7 @@ rule gap:
 
 
 rule gap_floor:
-    """The identification's own floor of the held-out gap at the records' drive, where gap.min_gap is auto: the rig
+    """The identification's own floor of the held-out gap at the records' drive, where gap.measure_floor: the rig
     without effects, the identified friction law as its truth, identified again (results/gap/floor.json)."""
     input:
         fit="results/friction/friction_fit.nc",
@@ -29,7 +29,7 @@ rule gap_floor:
 
 
 rule gap_benchmark_floor:
-    """The blind benchmark's floor of the held-out gap where gap.min_gap is auto: the configured rig without
+    """The blind benchmark's floor of the held-out gap where gap.measure_floor: the configured rig without
     effects at its configured drive, identified (results/gap_benchmark/floor.json)."""
     output:
         "results/gap_benchmark/floor.json",

@@ -13,7 +13,7 @@ log = setup_logging(snakemake.log[0])
 p = snakemake.params
 inp = snakemake.input
 K = int(p.n_harmonics)
-# gap.min_gap: auto reads the floor the rule gap_floor measured
+# gap.measure_floor: min_gap from the floor the rule gap_floor measured
 gap = resolved_gap_config(p.gap, json.load(open(inp.floor)) if "floor" in inp.keys() else None)
 settings = GapSettings.from_config(gap, int(p.seed), K)
 records, fit_settings, modal, _, model, upd = workflow_models(

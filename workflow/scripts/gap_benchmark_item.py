@@ -13,7 +13,7 @@ from contactid.logs import setup_logging
 log = setup_logging(snakemake.log[0])
 numba.set_num_threads(max(1, min(int(snakemake.threads), numba.config.NUMBA_NUM_THREADS)))
 config = dict(snakemake.params.config)
-if "floor" in snakemake.input.keys():  # gap.min_gap: auto: the floor rule gap_benchmark_floor measured
+if "floor" in snakemake.input.keys():  # gap.measure_floor: the floor rule gap_benchmark_floor measured
     config["gap"] = resolved_gap_config(config["gap"], json.load(open(snakemake.input.floor)))
 row = run_item(
     snakemake.params.spec,

@@ -17,7 +17,7 @@ inp = snakemake.input
 t0 = time.perf_counter()
 load_plugins(p.gap.get("plugins"))
 K = int(p.n_harmonics)
-# gap.min_gap: auto reads the floor the rule gap_floor measured
+# gap.measure_floor: min_gap from the floor the rule gap_floor measured
 gap = resolved_gap_config(p.gap, json.load(open(inp.floor)) if "floor" in inp.keys() else None)
 settings = GapSettings.from_config(gap, int(p.seed), K)
 workers = int(snakemake.resources.workers)

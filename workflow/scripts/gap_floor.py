@@ -1,4 +1,4 @@
-"""Rules gap_floor and gap_benchmark_floor: the identification's own floor of the held-out gap (gap.min_gap: auto).
+"""Rules gap_floor and gap_benchmark_floor: the identification's own floor of the held-out gap (gap.measure_floor).
 
 gap_floor: at the calibration record's drive, with the identified friction law as the rig's truth.
 gap_benchmark_floor: at the configured drive, with the configured rig's law (the benchmark items' rig).

@@ -9,9 +9,9 @@ from contactid.logs import setup_logging
 
 log = setup_logging(snakemake.log[0])
 rows = [json.load(open(path)) for path in snakemake.input.rows]
-floor = snakemake.params.floor  # gap.min_gap; auto: the one rule gap_benchmark_floor measured
+floor = snakemake.params.floor  # gap.min_gap, or with gap.measure_floor the one rule gap_benchmark_floor measured
 if "floor" in snakemake.input.keys():
-    floor = json.load(open(snakemake.input.floor))["min_gap"]
+    floor = json.load(open(snakemake.input.floor))["min_gap"] or floor
 result = ladder_score(rows, float(floor))
 write_text(snakemake.output[0], json.dumps(_clean(result), indent=2))
 log.info(

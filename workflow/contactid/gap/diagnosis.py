@@ -60,16 +60,6 @@ from .verdict import verdict as _verdict
 log = logging.getLogger(__name__)
 
 
-def _min_gap(value) -> float:
-    """gap.min_gap as a number; ``auto`` must have been resolved first (``floor.resolved_gap_config``)."""
-    if value == "auto":
-        raise ValueError(
-            "gap.min_gap 'auto' is the floor the rule gap_floor measures (results/gap/floor.json); resolve it with "
-            "contactid.gap.floor.resolved_gap_config before building GapSettings, or give gap.min_gap a number"
-        )
-    return float(value)
-
-
 @dataclass(frozen=True)
 class GapSettings:
     """n_harmonics: harmonics compared (gap); identification_harmonics: K of the inverse
@@ -135,7 +125,7 @@ class GapSettings:
             n_harmonics=int(g["n_harmonics"]),
             identification_harmonics=int(n_harmonics_id),
             candidates=tuple(cands) if cands is not None else None,
-            min_gap=_min_gap(g["min_gap"]),
+            min_gap=float(g["min_gap"]),
             min_reduction=float(g["min_reduction"]),
             separation=float(g["separation"]),
             noise_factor=float(g["noise_factor"]),

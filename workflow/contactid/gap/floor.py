@@ -5,12 +5,13 @@ leaves on records without any unmodelled effect. That floor depends on the drive
 54.4 Hz (the value 0.006 was set as about twice it), 0.05 % at 60 Hz, where a viscous friction of 300 N s/m raised
 the held-out gap to 0.46 % and stayed below the fixed floor (docs/measurements.md, thirty-fifth session).
 
-``gap.min_gap: auto`` measures it: the rig, with no effect, its nominal structure and damping (none of
+``gap.measure_floor`` (true by default) measures it: the rig, with no effect, its nominal structure and damping (none of
 ``rig.true_structure``, ``rig.true_damping``, nor a cubic normal law) and the identified friction law as its truth,
 is driven at the calibration record's frequency, sampling rate and length and at the configured load cases'
 response levels (seeded by the config's seed); the chain identifies the model from those records (random test,
 linear chain, the friction law's fit on the calibration case) and the identified model's held-out gap on the other
-cases is the floor. ``min_gap`` is then ``FLOOR_FACTOR`` times it.
+cases is the floor. ``min_gap`` is then ``FLOOR_FACTOR`` times it. Where there is no held-out case (one load case),
+nothing is measured and ``gap.min_gap`` stands.
 """
 
 from __future__ import annotations
@@ -58,7 +59,6 @@ def floor_rig_config(cfg: Mapping, friction, regularization: str, f0: float, fs:
     rig["dual_sine"]["record_samples"] = int(n_samples)
     out["random_test"]["sampling_rate_hz"] = float(fs)
     out["random_test"]["source"] = "rig"
-    out["gap"]["min_gap"] = 0.0  # not read here; a number, as the schema's defaults expect
     return with_defaults(out)
 
 
@@ -77,11 +77,9 @@ def identification_floor(
     cases = sorted(rig_cfg["load_cases"], key=lambda c: int(c[2:]) if c[2:].isdigit() else c)
     cal = rig_cfg["nonlinear"]["calibration_case"]
     held = [c for c in cases if c != cal]
-    if not held:
-        raise ValueError(
-            "gap.min_gap: auto needs a held-out load case besides the calibration case "
-            f"{cal!r} (load_cases: {cases}); give gap.min_gap a number instead"
-        )
+    if not held:  # nothing to hold out: no floor to measure, gap.min_gap stands
+        log.info("floor: no load case besides the calibration case %s; gap.min_gap as configured", cal)
+        return {"floor": None, "min_gap": None, "reason": f"no load case besides the calibration case {cal}"}
     log.info(
         "floor: the rig without effects at %.4g Hz (%d samples at %.6g Hz), the identified law as its truth; "
         "making the records of %s",
@@ -123,14 +121,9 @@ def identification_floor(
 
 
 def resolved_gap_config(gap: Mapping, floor: Mapping | None) -> dict:
-    """The gap settings with ``min_gap`` a number: ``gap``'s own, or with ``min_gap: auto`` the measured floor's
-    (``floor``: ``identification_floor``'s result, results/gap/floor.json)."""
+    """The gap settings with ``min_gap`` the measured floor's (``floor``: ``identification_floor``'s result,
+    results/gap/floor.json) where one was measured, else ``gap``'s own."""
     out = dict(gap)
-    if out.get("min_gap") == "auto":
-        if floor is None:
-            raise ValueError(
-                "gap.min_gap is 'auto' but no measured floor was given (results/gap/floor.json, rule gap_floor); "
-                "give gap.min_gap a number, or run the workflow's gap_floor rule first"
-            )
+    if floor is not None and floor.get("min_gap") is not None:
         out["min_gap"] = float(floor["min_gap"])
     return out

@@ -157,12 +157,13 @@ def explanation_text(diag: dict) -> str:
 
 
 def measured_floor_text(diag: dict) -> str:
-    """Where gap.min_gap is measured (auto, ``gap.floor``): what the rig without effects left at the records' drive."""
+    """Where gap.min_gap is measured (gap.measure_floor, ``gap.floor``): what the rig without effects left at the
+    records' drive."""
     m = diag.get("measured_floor")
-    if not m:
+    if not m or m.get("floor") is None:
         return ""
     return (
-        r" The floor gap.min\_gap is measured for these records (gap.min\_gap: auto): the rig without effects, the "
+        r" The floor gap.min\_gap is measured for these records (gap.measure\_floor): the rig without effects, the "
         r"identified friction law as its truth, driven at $"
         + _fmt(m["drive_hz"], 4)
         + r"$~Hz and identified by the chain, leaves a held-out gap of "
