@@ -73,3 +73,25 @@ def test_the_report_says_the_floor_was_measured_and_what_it_is():
     diag["measured_floor"] = {"floor": 0.0005, "min_gap": 0.001, "factor": 2.0, "drive_hz": 60.0}
     text = explanation_text(diag)
     assert "measured for these records" in text and "$60.00$~Hz" in text and "0.05" in text
+
+
+def test_a_measured_cases_response_levels_are_read_from_its_record():
+    """A measured load case gives no response targets in its config block: the floor's rig takes them from the record,
+    the driving point's amplitudes at w and 3w, read at the sensor nearest the excitation (0.55 m: the first of
+    sensors at 0.30, 0.55 and 0.05 m in this file's order)."""
+    import numpy as np
+    import xarray as xr
+
+    from contactid.gap.floor import response_targets
+
+    fs, f0, n = 5120.0, 54.375, 8192
+    t = np.arange(n) / fs
+    w = 2 * np.pi * f0
+    amp = {0.30: (9.0, 20.0), 0.55: (14.0, 34.0), 0.05: (2.0, 5.0)}  # sensor position: (A at w, A at 3w), m/s^2
+    acc = np.array([a1 * np.sin(w * t + 0.3) + a3 * np.cos(3 * w * t - 1.0) for a1, a3 in amp.values()])
+    raw = xr.Dataset(
+        {"force": ("time", 5.0 * np.sin(w * t)), "acceleration": (("sensor", "time"), acc)},
+        attrs={"sampling_rate_hz": fs, "excitation_frequency_hz": f0},
+    )
+    got = response_targets(raw, list(amp), 0.55)
+    assert got["A1_m_per_s2"] == pytest.approx(14.0, rel=1e-9) and got["A2_m_per_s2"] == pytest.approx(34.0, rel=1e-9)

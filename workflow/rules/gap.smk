@@ -14,11 +14,13 @@ rule gap_floor:
     input:
         fit="results/friction/friction_fit.nc",
         calibration=raw_record(calibration_case()),
+        raw=[raw_record(c) for c in load_cases()],
     output:
         "results/gap/floor.json",
     params:
         code=CODE_DIGEST,
         config=benchmark_base_config(),
+        cases=load_cases(),
     threads: 1
     conda:
         "../envs/contactid.yaml"

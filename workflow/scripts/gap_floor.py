@@ -8,7 +8,7 @@ import json
 
 from contactid.config import with_defaults
 from contactid.friction_parameters import fitted_parameters
-from contactid.gap.floor import identification_floor
+from contactid.gap.floor import identification_floor, response_targets
 from contactid.gap.records import record_harmonics
 from contactid.io import load_dataset, read_raw, write_text
 from contactid.logs import setup_logging
@@ -19,6 +19,14 @@ inp = snakemake.input
 if "fit" in inp.keys():  # the configured data: the calibration record's drive, the identified law
     fit = load_dataset(inp.fit)
     friction, regularization = fitted_parameters(fit), str(fit.attrs["regularization"])
+    st = cfg["structure"]
+    for case, path in zip(snakemake.params.cases, inp.raw):
+        lc = cfg["load_cases"][case]
+        if "A1_m_per_s2" not in lc or "A2_m_per_s2" not in lc:  # a measured case: its levels from its record
+            cfg["load_cases"][case] = response_targets(
+                read_raw(path, dual_sine=True), st["sensors"]["positions_m"], st["excitation_position_m"]
+            )
+            log.info("floor: %s's response levels from its record: %s", case, cfg["load_cases"][case])
     raw = read_raw(inp.calibration, dual_sine=True)
     rec = record_harmonics(raw, cfg["nonlinear"]["calibration_case"], int(cfg["nonlinear"]["n_harmonics"]))
     f0, fs, n = rec.f0, rec.fs, int(raw.sizes["time"])

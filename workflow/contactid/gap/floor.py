@@ -5,13 +5,14 @@ leaves on records without any unmodelled effect. That floor depends on the drive
 54.4 Hz (the value 0.006 was set as about twice it), 0.05 % at 60 Hz, where a viscous friction of 300 N s/m raised
 the held-out gap to 0.46 % and stayed below the fixed floor (docs/measurements.md, thirty-fifth session).
 
-``gap.measure_floor`` (true by default) measures it: the rig, with no effect, its nominal structure and damping (none of
-``rig.true_structure``, ``rig.true_damping``, nor a cubic normal law) and the identified friction law as its truth,
-is driven at the calibration record's frequency, sampling rate and length and at the configured load cases'
-response levels (seeded by the config's seed); the chain identifies the model from those records (random test,
-linear chain, the friction law's fit on the calibration case) and the identified model's held-out gap on the other
-cases is the floor. ``min_gap`` is then ``FLOOR_FACTOR`` times it. Where there is no held-out case (one load case),
-nothing is measured and ``gap.min_gap`` stands.
+``gap.measure_floor`` (true by default) measures it: the rig, with no effect, its nominal structure and damping
+(none of ``rig.true_structure``, ``rig.true_damping``, nor a cubic normal law) and the identified friction law as
+its truth, is driven at the calibration record's frequency, sampling rate and length and at the load cases' response
+levels (the configured ones; a measured case's read from its record, ``response_targets``; seeded by the config's
+seed); the chain identifies the model from those records (random test, linear chain, the friction law's fit on the
+calibration case) and the identified model's held-out gap on the other cases is the floor. ``min_gap`` is then
+``FLOOR_FACTOR`` times it. Where there is no held-out case (one load case), nothing is measured and ``gap.min_gap``
+stands.
 """
 
 from __future__ import annotations
@@ -60,6 +61,19 @@ def floor_rig_config(cfg: Mapping, friction, regularization: str, f0: float, fs:
     out["random_test"]["sampling_rate_hz"] = float(fs)
     out["random_test"]["source"] = "rig"
     return with_defaults(out)
+
+
+def response_targets(raw, positions, excitation_position: float, n_harmonics: int = 3) -> dict:
+    """A load case's response levels as the rig's response control takes them ({"A1_m_per_s2", "A2_m_per_s2"}: the
+    driving point's acceleration amplitudes at w and 3w), read from a dual-sine record at the sensor nearest the
+    excitation (m; ``positions`` the sensors', m): a measured case's levels, which its config block does not give."""
+    import numpy as np
+
+    from .records import record_harmonics
+
+    rec = record_harmonics(raw, "record", max(3, int(n_harmonics)))
+    s = int(np.argmin(np.abs(np.asarray(positions, dtype=float) - float(excitation_position))))
+    return {"A1_m_per_s2": float(abs(rec.acceleration[s, 0])), "A2_m_per_s2": float(abs(rec.acceleration[s, 2]))}
 
 
 def identification_floor(
