@@ -95,3 +95,14 @@ def test_a_measured_cases_response_levels_are_read_from_its_record():
     )
     got = response_targets(raw, list(amp), 0.55)
     assert got["A1_m_per_s2"] == pytest.approx(14.0, rel=1e-9) and got["A2_m_per_s2"] == pytest.approx(34.0, rel=1e-9)
+
+
+def test_the_report_says_why_a_floor_was_not_measured():
+    from contactid.gap.report import measured_floor_text
+
+    diag = {
+        "remaining_gap": {"floor": 0.006},
+        "measured_floor": {"floor": None, "min_gap": None, "reason": "no load case besides the calibration case lc1"},
+    }
+    text = measured_floor_text(diag)
+    assert "not measured" in text and "lc1" in text and "0.6" in text

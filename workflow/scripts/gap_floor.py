@@ -5,6 +5,7 @@ gap_benchmark_floor: at the configured drive, with the configured rig's law (the
 """
 
 import json
+import math
 
 from contactid.config import with_defaults
 from contactid.friction_parameters import fitted_parameters
@@ -37,5 +38,14 @@ else:  # the blind benchmark's items: the configured rig, its law and its drive
     f0 = float(cfg["rig"]["dual_sine"]["excitation_frequency_hz"])
     fs = float(cfg["random_test"]["sampling_rate_hz"])
     n = int(cfg["rig"]["dual_sine"]["record_samples"])
-floor = identification_floor(cfg, friction, regularization, f0, fs, n, int(cfg["seed"]))
+try:
+    floor = identification_floor(cfg, friction, regularization, f0, fs, n, int(cfg["seed"]))
+except (ValueError, FloatingPointError, ArithmeticError, RuntimeError) as exc:  # the rig or the chain could not
+    # make or identify these records (a law the rig cannot drive to the levels, say): the diagnosis goes on with the
+    # configured gap.min_gap, and says why
+    log.warning("floor: not measured (%s); gap.min_gap as configured", exc)
+    floor = {"floor": None, "min_gap": None, "reason": f"not measured: {exc}"}
+if floor["floor"] is not None and not math.isfinite(floor["floor"]):
+    log.warning("floor: the rig's records gave a held-out gap of %s; gap.min_gap as configured", floor["floor"])
+    floor = {**floor, "floor": None, "min_gap": None, "reason": "the floor's rig records were not finite"}
 write_text(snakemake.output[0], json.dumps(floor, indent=2))

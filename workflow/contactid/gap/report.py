@@ -160,8 +160,17 @@ def measured_floor_text(diag: dict) -> str:
     """Where gap.min_gap is measured (gap.measure_floor, ``gap.floor``): what the rig without effects left at the
     records' drive."""
     m = diag.get("measured_floor")
-    if not m or m.get("floor") is None:
+    if not m:
         return ""
+    if m.get("floor") is None:
+        left = diag.get("remaining_gap") or {}
+        return (
+            r" The floor was not measured for these records ("
+            + _t(str(m.get("reason", "")))
+            + r"): gap.min\_gap is the configured "
+            + _pct(left.get("floor"))
+            + "."
+        )
     return (
         r" The floor gap.min\_gap is measured for these records (gap.measure\_floor): the rig without effects, the "
         r"identified friction law as its truth, driven at $"
