@@ -253,6 +253,15 @@ def test_default_records_meet_table2(default_run):
         assert tr["N_min_n"] > 0 and tr["max_S_over_mu_N"] > 0.99
 
 
+def _planned_jobs(res) -> dict:
+    """{rule: job count} of a dry run's job table (``snakemake -n --quiet rules``)."""
+    return {
+        line.split()[0]: int(line.split()[1])
+        for line in (res.stdout + res.stderr).splitlines()
+        if len(line.split()) == 2 and line.split()[1].isdigit()
+    }
+
+
 def test_new_load_case_runs_only_its_jobs(default_run, tmp_path):
     cfg = yaml.safe_load((default_run / "config" / "config.yaml").read_text())
     cfg["load_cases"]["lc4"] = {"A1_m_per_s2": 12.0, "A2_m_per_s2": 30.0}
@@ -260,12 +269,7 @@ def test_new_load_case_runs_only_its_jobs(default_run, tmp_path):
     alt.write_text(yaml.safe_dump(cfg))
     res = snakemake(default_run, "--configfile", str(alt), "-n", "--quiet", "rules")
     assert res.returncode == 0, res.stderr[-3000:]
-    out = res.stdout + res.stderr
-    jobs = {
-        line.split()[0]: int(line.split()[1])
-        for line in out.splitlines()
-        if len(line.split()) == 2 and line.split()[1].isdigit()
-    }
+    jobs = _planned_jobs(res)
     assert jobs.get("rig_dual_sine") == 1 and jobs.get("raw_check") == 1
     assert "rig_random_test" not in jobs and "frf" not in jobs and "stiction_stiffness" not in jobs
     assert "friction_fit" not in jobs  # the calibration fit stays; lc4 is validated with it
@@ -507,12 +511,7 @@ def test_a_given_floor_reruns_the_gaps_jobs_without_the_floors(default_run, tmp_
     alt.write_text(yaml.safe_dump(cfg))
     res = snakemake(default_run, "--configfile", str(alt), "-n", "--quiet", "rules")
     assert res.returncode == 0, res.stderr[-3000:]
-    out = res.stdout + res.stderr
-    jobs = {
-        line.split()[0]: int(line.split()[1])
-        for line in out.splitlines()
-        if len(line.split()) == 2 and line.split()[1].isdigit()
-    }
+    jobs = _planned_jobs(res)
     assert jobs.get("gap_diagnosis") == 1 and jobs.get("friction_intervals") == 1 and "gap_floor" not in jobs
     assert "friction_fit" not in jobs and "model_updating" not in jobs and "rig_dual_sine" not in jobs
     assert (default_run / "results" / "gap" / "floor.json").exists()  # the default run measured it

@@ -3,7 +3,7 @@
 import json
 
 from contactid.gap.diagnosis import GapSettings
-from contactid.gap.floor import resolved_gap_config
+from contactid.gap.floor import read_floor, resolved_gap_config
 from contactid.gap.pipeline import workflow_models
 from contactid.gap.uncertainty import friction_uncertainty
 from contactid.io import write_text
@@ -14,7 +14,8 @@ p = snakemake.params
 inp = snakemake.input
 K = int(p.n_harmonics)
 # gap.measure_floor: min_gap from the floor the rule gap_floor measured
-gap = resolved_gap_config(p.gap, json.load(open(inp.floor)) if "floor" in inp.keys() else None)
+floor = read_floor(inp)
+gap = resolved_gap_config(p.gap, floor)
 settings = GapSettings.from_config(gap, int(p.seed), K)
 records, fit_settings, modal, _, model, upd = workflow_models(
     p.structure, inp, p.cases, p.calibration_case, K, p.friction, settings, int(p.seed)

@@ -5,7 +5,7 @@ import json
 import numba
 
 from contactid.gap.benchmark import run_item
-from contactid.gap.floor import resolved_gap_config
+from contactid.gap.floor import read_floor, resolved_gap_config
 from contactid.gap.output import _clean
 from contactid.io import write_text
 from contactid.logs import setup_logging
@@ -13,8 +13,8 @@ from contactid.logs import setup_logging
 log = setup_logging(snakemake.log[0])
 numba.set_num_threads(max(1, min(int(snakemake.threads), numba.config.NUMBA_NUM_THREADS)))
 config = dict(snakemake.params.config)
-if "floor" in snakemake.input.keys():  # gap.measure_floor: the floor rule gap_benchmark_floor measured
-    config["gap"] = resolved_gap_config(config["gap"], json.load(open(snakemake.input.floor)))
+# gap.measure_floor: min_gap from the floor the rule gap_benchmark_floor measured
+config["gap"] = resolved_gap_config(config["gap"], read_floor(snakemake.input))
 row = run_item(
     snakemake.params.spec,
     config,

@@ -1,11 +1,10 @@
 """Rule gap_diagnosis: the identified model against every load case's raw record (issue 7)."""
 
-import json
 import time
 
 from contactid.gap.candidates import load_plugins
 from contactid.gap.diagnosis import GapSettings, diagnose, linear_stage, prepare_workers, random_test_delays
-from contactid.gap.floor import resolved_gap_config
+from contactid.gap.floor import read_floor, resolved_gap_config
 from contactid.gap.pipeline import workflow_models
 from contactid.gap.output import diagnosis_json, gap_dataset
 from contactid.io import load_dataset, provenance, write_dataset, write_text
@@ -18,7 +17,8 @@ t0 = time.perf_counter()
 load_plugins(p.gap.get("plugins"))
 K = int(p.n_harmonics)
 # gap.measure_floor: min_gap from the floor the rule gap_floor measured
-gap = resolved_gap_config(p.gap, json.load(open(inp.floor)) if "floor" in inp.keys() else None)
+floor = read_floor(inp)
+gap = resolved_gap_config(p.gap, floor)
 settings = GapSettings.from_config(gap, int(p.seed), K)
 workers = int(snakemake.resources.workers)
 prepare_workers(workers)  # before the friction fit after updating starts numba's threads
@@ -55,7 +55,7 @@ ds = gap_dataset(diag, records, settings.n_harmonics)
 ds.attrs.update(prov)
 write_dataset(ds, snakemake.output.dataset)
 extra = {"seconds": seconds, "provenance": prov}
-if "floor" in inp.keys():
-    extra["measured_floor"] = json.load(open(inp.floor))
+if floor is not None:
+    extra["measured_floor"] = floor
 write_text(snakemake.output.diagnosis, diagnosis_json(diag, extra))
 log.info("verdict %s: %s (%.1f s)", diag.verdict, diag.reason, seconds)

@@ -3,15 +3,15 @@
 import json
 
 from contactid.gap.benchmark import ladder_score
+from contactid.gap.floor import read_floor, resolved_gap_config
 from contactid.gap.output import _clean
 from contactid.io import write_text
 from contactid.logs import setup_logging
 
 log = setup_logging(snakemake.log[0])
 rows = [json.load(open(path)) for path in snakemake.input.rows]
-floor = snakemake.params.floor  # gap.min_gap, or with gap.measure_floor the one rule gap_benchmark_floor measured
-if "floor" in snakemake.input.keys():
-    floor = json.load(open(snakemake.input.floor))["min_gap"] or floor
+# gap.min_gap, or with gap.measure_floor the one rule gap_benchmark_floor measured
+floor = resolved_gap_config({"min_gap": snakemake.params.floor}, read_floor(snakemake.input))["min_gap"]
 result = ladder_score(rows, float(floor))
 write_text(snakemake.output[0], json.dumps(_clean(result), indent=2))
 log.info(

@@ -18,6 +18,7 @@ stands.
 from __future__ import annotations
 
 import copy
+import json
 import logging
 import time
 from typing import Mapping
@@ -88,7 +89,7 @@ def identification_floor(
 
     t0 = time.perf_counter()
     rig_cfg = floor_rig_config(cfg, friction, regularization, f0, fs, n_samples)
-    cases = sorted(rig_cfg["load_cases"], key=lambda c: int(c[2:]) if c[2:].isdigit() else c)
+    cases = list(rig_cfg["load_cases"])
     cal = rig_cfg["nonlinear"]["calibration_case"]
     held = [c for c in cases if c != cal]
     if not held:  # nothing to hold out: no floor to measure, gap.min_gap stands
@@ -106,7 +107,7 @@ def identification_floor(
     model = identify(rig_cfg, recs["random_test"], recs[cal])[0]
     H = int(rig_cfg["gap"]["n_harmonics"])
     K = int(rig_cfg["nonlinear"]["n_harmonics"])
-    records = {c: record_harmonics(recs[c], c, K) for c in cases}
+    records = {c: record_harmonics(recs[c], c, K) for c in held}
     sims = {c: baseline(model, records[c], H)[1] for c in held}
     by_case = {c: heldout_gap_of(records, [c], H, sims) for c in held}
     floor = heldout_gap_of(records, held, H, sims)
@@ -132,6 +133,12 @@ def identification_floor(
         "control_converged": {c: int(v) for c, v in converged.items()},
         "seconds": float(seconds),
     }
+
+
+def read_floor(inputs) -> dict | None:
+    """The measured floor a rule was given (its input ``floor``, results/gap/floor.json or the benchmark's), or None
+    where gap.measure_floor is off."""
+    return json.loads(open(inputs.floor).read()) if "floor" in inputs.keys() else None
 
 
 def resolved_gap_config(gap: Mapping, floor: Mapping | None) -> dict:
