@@ -106,3 +106,20 @@ def test_the_report_says_why_a_floor_was_not_measured():
     }
     text = measured_floor_text(diag)
     assert "not measured" in text and "lc1" in text and "0.6" in text
+
+
+def test_a_rule_reads_its_measured_floor_or_none(tmp_path):
+    """The rules that take the measured floor read it through one function; without the input (gap.measure_floor off)
+    the configured min_gap stands, as the ladder's scoring and the diagnosis resolve it."""
+    import json
+
+    from contactid.gap.floor import read_floor
+
+    class Inputs(dict):
+        __getattr__ = dict.__getitem__
+
+    path = tmp_path / "floor.json"
+    path.write_text(json.dumps({"floor": 0.0005, "min_gap": 0.001}))
+    assert read_floor(Inputs(floor=str(path)))["min_gap"] == 0.001 and read_floor(Inputs()) is None
+    assert resolved_gap_config({"min_gap": 0.006}, read_floor(Inputs(floor=str(path))))["min_gap"] == 0.001
+    assert resolved_gap_config({"min_gap": 0.006}, read_floor(Inputs()))["min_gap"] == 0.006
