@@ -565,6 +565,26 @@ def calibrate(
     )
 
 
+def held(
+    model: IdentifiedModel,
+    cand: Candidate,
+    rec: RecordHarmonics,
+    settings: FitSettings,
+    n_harmonics: int,
+    theta,
+    start: SimResult | None = None,
+    base: Augmentation = NONE,
+) -> Calibration:
+    """``cand`` at ``theta`` measured elsewhere (channel delays: the random test's residue phases), not searched: the
+    friction law refitted to the calibration case's forces with it, the simulation polished by the integrator."""
+    run = _CandidateRuns(model, cand, rec, settings.bounds, n_harmonics, start, base)
+    theta = np.atleast_1d(np.asarray(theta, dtype=float))
+    g, m2, sim, misfit, aug = run(theta, polish=True)
+    return Calibration(
+        cand.name, theta, np.asarray(m2.friction), g, m2, aug, run.evaluations, misfit, sim, ((cand.name, theta),)
+    )
+
+
 def baseline(model: IdentifiedModel, rec: RecordHarmonics, n_harmonics: int) -> tuple[float, SimResult]:
     """The identified model as the chain left it (no effect, no refit) on one record."""
     g, _, sim, _ = evaluate(model, NONE, rec, None, n_harmonics, refit=False)

@@ -127,7 +127,7 @@ def explanation_text(diag: dict) -> str:
             + _updating_note(s, diag)
             + _law_note(s)
             + _periodicity_note(s, periodicity)
-            + r" (refitted: "
+            + (r" (held where the random test measured it, not refitted: " if s.get("held") else r" (refitted: ")
             + ", ".join(f"{_t(k)} $= {_fmt(v, 3)}$" for k, v in s["parameters"].items())
             + r") takes the held-out gap from "
             + _pct(s["heldout_gap_before"])
