@@ -562,6 +562,39 @@ def test_the_waterfall_starts_where_the_explanation_starts_and_its_labels_fit():
     assert labels[2].endswith("(92 %)")
 
 
+def test_a_held_step_that_widens_the_gap_is_drawn_and_said_as_held():
+    """A channel skew held at the random test's delays widens the gap (it exposes the dashpot it masked); the waterfall
+    draws its bar upward in orange, both bars joined, and the report says it was held, not refitted."""
+    from contactid.gap.figures import waterfall_bars
+    from contactid.gap.report import explanation_text
+
+    steps = [
+        {
+            "effect": "channel_time_skew",
+            "parameters": {"delay_0": 1.07e-5, "delay_1": 1.96e-5, "delay_2": 2.92e-5},
+            "heldout_gap_before": 0.0256,
+            "heldout_gap_after": 0.0397,
+            "share": (0.0256**2 - 0.0397**2) / 0.0256**2,
+            "held": True,
+        },
+        {
+            "effect": "normal_contact_damping",
+            "parameters": {"alpha": 423.0},
+            "heldout_gap_before": 0.0397,
+            "heldout_gap_after": 0.0038,
+            "share": (0.0397**2 - 0.0038**2) / 0.0256**2,
+        },
+    ]
+    diag = _synthetic_diagnosis(steps, "normal_contact_damping", 0.0038)
+    labels, bottoms, heights, colors = waterfall_bars(diag)
+    assert colors[1:3] == ["tab:orange", "tab:green"] and "(held)" in labels[1]
+    assert bottoms[1] + heights[1] == pytest.approx(2.56) and bottoms[1] == pytest.approx(3.97)
+    assert bottoms[2] + heights[2] == pytest.approx(3.97)
+    text = explanation_text(diag)
+    assert "channel\\_time\\_skew (held where the random test measured it, not refitted: " in text
+    assert "normal\\_contact\\_damping (refitted: " in text
+
+
 def test_a_winner_near_the_floor_keeps_its_reduction_readable(monkeypatch):
     """The ranking's reduction label sits inside its bar in white; a bar too short to hold it (a winner that takes
     the gap to the floor) gets it beside its whisker in black (it was white on white, clipped to "-9")."""

@@ -330,7 +330,8 @@ WATERFALL_LABEL_WIDTH = 14  # characters per line of a waterfall bar's label (fi
 def waterfall_bars(diag: dict) -> tuple[list, list, list, list]:
     """The waterfall's bars (labels, bottoms, heights in %, colours): the held-out gap the explanation starts from
     (the chain's identified model, before a model update that is its first step), what each step removes (labelled
-    with its share of the gap's power) and what remains."""
+    with its share of the gap's power; orange where a step widens it: an effect held where the random test measured it
+    exposes one it masked, which the next step takes) and what remains."""
     import textwrap
 
     steps = diag.get("explanation") or []
@@ -345,11 +346,11 @@ def waterfall_bars(diag: dict) -> tuple[list, list, list, list]:
 
     labels, bottoms, heights, colors = ["identified\nmodel"], [0.0], [100 * before], ["0.5"]
     for s in steps:
-        law = " (never opens)" if never_opens(s) else ""
+        law = " (never opens)" if never_opens(s) else " (held)" if s.get("held") else ""
         labels.append(f"{wrap('+ ' + _name(s['effect']) + law)}\n({100 * _num(s['share']):.0f} %)")
         bottoms.append(100 * _num(s["heldout_gap_after"]))
         heights.append(100 * (_num(s["heldout_gap_before"]) - _num(s["heldout_gap_after"])))
-        colors.append("tab:green")
+        colors.append("tab:green" if heights[-1] >= 0 else "tab:orange")
     remaining = _num(left.get("heldout_gap", before))
     labels.append("remaining\n" + wrap(f"({_name(left.get('place', diag['where'].get('place', '?')))})"))
     bottoms.append(0.0)
