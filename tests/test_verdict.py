@@ -986,6 +986,14 @@ def test_the_records_call_for_the_channels_gains_only_where_they_shrink_the_gap_
     assert not records_prefer_gains(0.0205, 0.0140, 3.4e-5, settings)  # smaller, but not by the separation factor
     assert not records_prefer_gains(0.0030, 0.0019, 6e-4, settings)  # by the factor, but within the records' scatter
     assert not records_prefer_gains(float("nan"), 0.001, 1e-5, settings)
+    # the structure alone widening the chain's own gap is contradicted by the records: channels 3 % off apart beside a
+    # normal dashpot on a perturbed rig, 13.09 % against the chain's 11.87 % and the gains' 11.94 %
+    assert records_prefer_gains(0.1309, 0.1194, 5.4e-5, settings, gap_chain=0.1187)
+    assert not records_prefer_gains(0.1309, 0.1194, 5.4e-5, settings)  # without the chain's gap: the factor rule
+    # a structure alone that shrinks the chain's gap keeps the factor rule (the clamp rig); nor do the gains win where
+    # they leave more than the structure alone, however wide the chain's gap
+    assert not records_prefer_gains(0.0205, 0.0140, 3.4e-5, settings, gap_chain=0.0300)
+    assert not records_prefer_gains(0.0205, 0.0207, 3.4e-5, settings, gap_chain=0.0150)
 
 
 def test_the_records_choose_between_the_update_with_the_gains_and_the_structure_alone(monkeypatch):
@@ -1015,14 +1023,18 @@ def test_the_records_choose_between_the_update_with_the_gains_and_the_structure_
     upd = Upd("gains", alone)
     for preferred, chosen in ((False, "alone"), (True, "gains")):
         settled.clear()
-        test = {"heldout_gap_gains": 0.02, "heldout_gap_structure": 0.02, "record_scatter": 1e-5}
+        test = {"heldout_gap_gains": 0.02, "heldout_gap_structure": 0.02, "heldout_gap_chain": 0.02}
+        test["record_scatter"] = 1e-5
         monkeypatch.setattr(
-            diagnosis, "records_test_of_gains", lambda *a, p=preferred, t=test: {**t, "gains_preferred": p}
+            diagnosis,
+            "records_test_of_gains",
+            lambda *a, p=preferred, t=test, **kw: {**t, "gains_preferred": p, "chain": kw.get("chain")},
         )
-        model, out = pipeline.updated_model(None, None, "cal", None, None, 1, upd, {"lc2": "rec"})
+        model, out = pipeline.updated_model("chain", None, "cal", None, None, 1, upd, {"lc2": "rec"})
         assert settled == ["gains", "alone"] and model == f"model {chosen}" and out.label == chosen
         assert out.gains_versus_structure["gains_preferred"] is preferred
         assert out.gains_versus_structure["gains_drop"] == 0.06
+        assert out.gains_versus_structure["chain"] == "chain"  # the model not updated is weighed too
     # gains the random test needs beyond the structure, or no records to ask: the update as it is, settled once
     for upd2, held in ((Upd("gains", {**alone, "gains_needed": True}), {"lc2": "rec"}), (upd, None)):
         settled.clear()

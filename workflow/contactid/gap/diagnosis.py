@@ -1000,12 +1000,14 @@ def records_test_of_gains(
     calibration: RecordHarmonics,
     fit_settings: FitSettings,
     settings: GapSettings,
+    chain: IdentifiedModel | None = None,
 ) -> dict:
     """What the dual-sine records say where the random test cannot tell the accelerometer channels' gains from the
     structure's factors (``UpdatingResult.structure_alone``): the held-out gap of the model updated with the gains,
     read through them (``gains``, each channel's relative factor; the friction law refitted on the ``calibration``
     record as the channels read it), against the model updated without them, and the records' scatter (the bootstrap's
-    sd of the latter's gap); ``gains_preferred`` by ``verdict.records_prefer_gains``."""
+    sd of the latter's gap); with ``chain`` (the model not updated) its gap too, ``heldout_gap_chain``;
+    ``gains_preferred`` by ``verdict.records_prefer_gains``."""
     from .verdict import records_prefer_gains
 
     H = settings.n_harmonics
@@ -1016,9 +1018,16 @@ def records_test_of_gains(
     sims_gains = {c: evaluate(read, aug, held_out[c], None, H, refit=False)[2] for c in cases}
     HarmonicBalance.forget()
     sims_alone = {c: baseline(structure_alone, held_out[c], H)[1] for c in cases}
-    out = _gaps_and_scatter(held_out, settings, {"gains": sims_gains, "structure": sims_alone}, "structure")
+    sims = {"gains": sims_gains, "structure": sims_alone}
+    if chain is not None:
+        sims["chain"] = {c: baseline(chain, held_out[c], H)[1] for c in cases}
+    out = _gaps_and_scatter(held_out, settings, sims, "structure")
     out["gains_preferred"] = records_prefer_gains(
-        out["heldout_gap_structure"], out["heldout_gap_gains"], out["record_scatter"], settings
+        out["heldout_gap_structure"],
+        out["heldout_gap_gains"],
+        out["record_scatter"],
+        settings,
+        out.get("heldout_gap_chain"),
     )
     return out
 

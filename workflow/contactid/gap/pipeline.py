@@ -197,16 +197,19 @@ def updated_model(model, modal: xr.Dataset, calibration, fit_settings, settings,
 
     m_gains, u_gains = settled_update(model, calibration, fit_settings, settings, seed, upd, held_out)
     m_alone, u_alone = settled_update(model, calibration, fit_settings, settings, seed, upd.without_gains(), held_out)
-    test = records_test_of_gains(m_gains, u_gains.channel_gains, m_alone, held_out, calibration, fit_settings, settings)
+    test = records_test_of_gains(
+        m_gains, u_gains.channel_gains, m_alone, held_out, calibration, fit_settings, settings, chain=model
+    )
     test.update(gains_drop=alone["gains_drop"], gains_threshold=alone["gains_threshold"])
     logging.getLogger(__name__).info(
         "model updating: the random test cannot tell the channels' gains from the structure's factors (chi^2 %.3g "
-        "lower with them, %.3g needed); held-out gap %.4g with the gains, %.4g without them (records' scatter %.2g): "
-        "the update %s them",
+        "lower with them, %.3g needed); held-out gap %.4g with the gains, %.4g without them, %.4g not updated "
+        "(records' scatter %.2g): the update %s them",
         test["gains_drop"],
         test["gains_threshold"],
         test["heldout_gap_gains"],
         test["heldout_gap_structure"],
+        test["heldout_gap_chain"],
         test["record_scatter"],
         "with" if test["gains_preferred"] else "without",
     )
