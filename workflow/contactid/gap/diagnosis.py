@@ -811,35 +811,42 @@ def explain(
             break
         best = min(gaps, key=gaps.get)  # ties: library order
         chosen = [(best, results[best], gaps[best], indistinguishable(gaps, best, settings))]
+
+        def pair_on(first_name, res_first, gap_first, alts_first, results2):
+            # (gap, first step, second step) of the pass ``results2`` on top of a first half, where its best leaves
+            # less than the first half alone and than the pass's best, beyond the scatter, and explains materially
+            gaps2 = finite_gaps(results2, [n for n in results2 if n != first_name])
+            best2 = min(gaps2, key=gaps2.get) if gaps2 else None
+            if best2 is None or not (
+                gaps2[best2] < min(gaps[best], gap_first) - beyond_scatter
+                and explains_materially(gap, gaps2[best2], scatter, settings)
+            ):
+                return None
+            second = (best2, results2[best2], gaps2[best2], indistinguishable(gaps2, best2, settings))
+            return gaps2[best2], (first_name, res_first, gap_first, alts_first), second
+
+        # seeds (before any step): a pair on an effect held where the random test measured it adds no parameter the
+        # records fit, so it competes with the pass's best alone as well as with its pair
+        seeds = []
+        if seeded is not None and not steps:
+            for seed, (res_seed, res2) in seeded(list(remaining)).items():
+                pair = pair_on(seed, res_seed, heldout_gap(res_seed[1]), [], res2)
+                if pair is not None:
+                    seeds.append(pair)
+        pairs = list(seeds)
         if not explains_materially(gap, gaps[best], scatter, settings):
             lookahead = settings.pair_lookahead
             if not (lookahead and gap > lookahead * settings.min_gap):
                 break
-            # first halves: the pass's best where it shrinks the gap beyond the scatter, then any seeds offered
-            firsts = []
+            # the pass's best as a first half, where it shrinks the gap beyond the scatter
             others = [n for n in remaining if n != best and (later is None or n in later)]
             if others and gaps[best] < gap - beyond_scatter:
-                firsts.append((best, chosen[0][1], gaps[best], chosen[0][3], next_pass(others, results[best][0])))
-            if seeded is not None and not steps:
-                for seed, (res_seed, res2) in seeded(list(remaining)).items():
-                    firsts.append((seed, res_seed, heldout_gap(res_seed[1]), [], res2))
-            pairs = []
-            for first_name, res_first, gap_first, alts_first, results2 in firsts:
-                gaps2 = finite_gaps(results2, [n for n in results2 if n != first_name])
-                best2 = min(gaps2, key=gaps2.get) if gaps2 else None
-                if best2 is not None and (
-                    gaps2[best2] < min(gaps[best], gap_first) - beyond_scatter
-                    and explains_materially(gap, gaps2[best2], scatter, settings)
-                ):
-                    pairs.append(
-                        (
-                            gaps2[best2],
-                            (first_name, res_first, gap_first, alts_first),
-                            (best2, results2[best2], gaps2[best2], indistinguishable(gaps2, best2, settings)),
-                        )
-                    )
+                pair = pair_on(best, chosen[0][1], gaps[best], chosen[0][3], next_pass(others, results[best][0]))
+                if pair is not None:
+                    pairs.insert(0, pair)
             if not pairs:
                 break
+        if pairs:
             _, first_step, second_step = min(pairs, key=lambda p: p[0])
             held_step = first_step[0] if first_step[0] != best else None
             log.info(
