@@ -810,6 +810,10 @@ def test_a_skew_held_at_the_random_tests_delays_seeds_the_pair_that_explains_wha
     steps, left, tried = _explain(first, [on_viscous], 0.1294, 1e-4, on, seeds=seeds)
     assert [s["effect"] for s in steps] == ["viscous_friction"] and left == 0.0231
     assert [t[0] for t in tried] == ["seeded", "viscous_friction"]  # the seeds once: none in the second pass
+    # gap.pair_lookahead 0 tries no pair, seeded or not
+    good = {"channel_time_skew": (0.14, {"structural_damping": 0.0040, "viscous_friction": 0.0252})}
+    steps, _, tried = _explain(first, [on_viscous], 0.1294, 1e-4, {**on, "pair_lookahead": 0.0}, seeds=good)
+    assert [s["effect"] for s in steps] == ["viscous_friction"] and all(t[0] != "seeded" for t in tried)
 
 
 def test_contact_opens_tells_a_separating_law_from_a_stiffer_closed_one():

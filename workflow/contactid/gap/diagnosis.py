@@ -784,11 +784,13 @@ def explain(
     it beyond the records' scatter but not materially, the next pass is tried on top of it: two effects that each
     leave most of the gap may together explain it (a preload drift and a normal dashpot, 36 % and 24 % alone); the
     pair is added when together they shrink it materially and the second shrinks it further beyond the scatter.
-    Before any step, ``seeded(remaining)`` ({seed: (its result, the next pass on top of it)}, or None) offers more
-    first halves of a pair: an effect measured elsewhere and held there (the random test's channel delays), which
-    alone may widen the gap by exposing a second effect it masks (a channel skew of 10-30 us and a normal dashpot of
-    400 s/m: the dashpot refitted to zero, the skew searched away from its delays; held at them, the dashpot took 2.54
-    to 0.44 %). The pair that leaves the least is added.
+    Before any step (and unless the lookahead is 0), ``seeded(remaining)`` ({seed: (its result, the next pass on top
+    of it)}, or None) offers more first halves of a pair: an effect measured elsewhere and held there (the random
+    test's channel delays), which alone may widen the gap by exposing a second effect it masks (a channel skew of 10-30
+    us and a normal dashpot of 400 s/m: the dashpot refitted to zero, the skew searched away from its delays; held at
+    them, the dashpot took 2.54 to 0.44 %). Held, it adds no parameter the records fit, so its pair competes with the
+    pass's best alone as well: it is added where it leaves less than that best and than the seed alone, beyond the
+    scatter, and explains materially. The pair that leaves the least is added.
 
     first: {name: (calibration, sims, residuals)} of the first pass; heldout_gap(sims) the held-out gap of a
     model's simulations; later: the candidates tried after the first pass (``verdict.retried``; None: all);
@@ -828,7 +830,7 @@ def explain(
         # seeds (before any step): a pair on an effect held where the random test measured it adds no parameter the
         # records fit, so it competes with the pass's best alone as well as with its pair
         seeds = []
-        if seeded is not None and not steps:
+        if seeded is not None and not steps and settings.pair_lookahead:
             for seed, (res_seed, res2) in seeded(list(remaining)).items():
                 pair = pair_on(seed, res_seed, heldout_gap(res_seed[1]), [], res2)
                 if pair is not None:
