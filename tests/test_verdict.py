@@ -810,8 +810,12 @@ def test_a_skew_held_at_the_random_tests_delays_seeds_the_pair_that_explains_wha
     steps, left, tried = _explain(first, [on_viscous], 0.1294, 1e-4, on, seeds=seeds)
     assert [s["effect"] for s in steps] == ["viscous_friction"] and left == 0.0231
     assert [t[0] for t in tried] == ["seeded", "viscous_friction"]  # the seeds once: none in the second pass
-    # gap.pair_lookahead 0 tries no pair, seeded or not
     good = {"channel_time_skew": (0.14, {"structural_damping": 0.0040, "viscous_friction": 0.0252})}
+    # the seed's step is marked held also where the searched skew is the pass's best
+    skew_best = {"channel_time_skew": 0.0231, "structural_damping": 0.11}
+    steps, _, _ = _explain(skew_best, [{"viscous_friction": 0.0039}], before=0.1294, settings=on, seeds=good)
+    assert [s["effect"] for s in steps] == ["channel_time_skew", "structural_damping"] and steps[0].get("held")
+    # gap.pair_lookahead 0 tries no pair, seeded or not
     steps, _, tried = _explain(first, [on_viscous], 0.1294, 1e-4, {**on, "pair_lookahead": 0.0}, seeds=good)
     assert [s["effect"] for s in steps] == ["viscous_friction"] and all(t[0] != "seeded" for t in tried)
 

@@ -814,9 +814,10 @@ def explain(
         best = min(gaps, key=gaps.get)  # ties: library order
         chosen = [(best, results[best], gaps[best], indistinguishable(gaps, best, settings))]
 
-        def pair_on(first_name, res_first, gap_first, alts_first, results2):
-            # (gap, first step, second step) of the pass ``results2`` on top of a first half, where its best leaves
-            # less than the first half alone and than the pass's best, beyond the scatter, and explains materially
+        def pair_on(first_name, res_first, gap_first, alts_first, results2, held_first=False):
+            # (gap, first step, second step, whether the first is held) of the pass ``results2`` on top of a first
+            # half, where its best leaves less than the first half alone and than the pass's best, beyond the scatter,
+            # and explains materially
             gaps2 = finite_gaps(results2, [n for n in results2 if n != first_name])
             best2 = min(gaps2, key=gaps2.get) if gaps2 else None
             if best2 is None or not (
@@ -825,14 +826,14 @@ def explain(
             ):
                 return None
             second = (best2, results2[best2], gaps2[best2], indistinguishable(gaps2, best2, settings))
-            return gaps2[best2], (first_name, res_first, gap_first, alts_first), second
+            return gaps2[best2], (first_name, res_first, gap_first, alts_first), second, held_first
 
         # seeds (before any step): a pair on an effect held where the random test measured it adds no parameter the
         # records fit, so it competes with the pass's best alone as well as with its pair
         seeds = []
         if seeded is not None and not steps and settings.pair_lookahead:
             for seed, (res_seed, res2) in seeded(list(remaining)).items():
-                pair = pair_on(seed, res_seed, heldout_gap(res_seed[1]), [], res2)
+                pair = pair_on(seed, res_seed, heldout_gap(res_seed[1]), [], res2, held_first=True)
                 if pair is not None:
                     seeds.append(pair)
         pairs = list(seeds)
@@ -849,8 +850,8 @@ def explain(
             if not pairs:
                 break
         if pairs:
-            _, first_step, second_step = min(pairs, key=lambda p: p[0])
-            held_step = first_step[0] if first_step[0] != best else None
+            _, first_step, second_step, held_first = min(pairs, key=lambda p: p[0])
+            held_step = first_step[0] if held_first else None
             log.info(
                 "explanation: %s alone leaves %.4g of %.4g, with %s %.4g: the pair is added",
                 first_step[0],
