@@ -553,16 +553,21 @@ def calibrate(
         theta = _scalar_theta(run, cand, max_evaluations)
     else:
         theta = _simplex_theta(run, cand, max_evaluations, starts)
-    g, m2, sim, misfit, aug = run(theta, polish=True)
-    if not np.isfinite(g):  # nothing in the range could be simulated: the effect off
+    cal = _calibration_at(run, theta)
+    if not np.isfinite(cal.gap):  # nothing in the range could be simulated: the effect off
         theta = (
             np.array([p.off for p in cand.parameters]) if not cand.per_channel else np.zeros_like(np.atleast_1d(theta))
         )
-        g, m2, sim, misfit, aug = run(theta, polish=True)
+        cal = _calibration_at(run, theta)
+    return cal
+
+
+def _calibration_at(run: _CandidateRuns, theta) -> Calibration:
+    """The Calibration of ``run``'s candidate at ``theta``: its simulation polished by the integrator."""
     theta = np.atleast_1d(theta)
-    return Calibration(
-        cand.name, theta, np.asarray(m2.friction), g, m2, aug, run.evaluations, misfit, sim, ((cand.name, theta),)
-    )
+    g, m2, sim, misfit, aug = run(theta, polish=True)
+    name = run.cand.name
+    return Calibration(name, theta, np.asarray(m2.friction), g, m2, aug, run.evaluations, misfit, sim, ((name, theta),))
 
 
 def held(
@@ -578,11 +583,7 @@ def held(
     """``cand`` at ``theta`` measured elsewhere (channel delays: the random test's residue phases), not searched: the
     friction law refitted to the calibration case's forces with it, the simulation polished by the integrator."""
     run = _CandidateRuns(model, cand, rec, settings.bounds, n_harmonics, start, base)
-    theta = np.atleast_1d(np.asarray(theta, dtype=float))
-    g, m2, sim, misfit, aug = run(theta, polish=True)
-    return Calibration(
-        cand.name, theta, np.asarray(m2.friction), g, m2, aug, run.evaluations, misfit, sim, ((cand.name, theta),)
-    )
+    return _calibration_at(run, np.asarray(theta, dtype=float))
 
 
 def baseline(model: IdentifiedModel, rec: RecordHarmonics, n_harmonics: int) -> tuple[float, SimResult]:
