@@ -5,6 +5,7 @@
 import os
 import sys
 
+from snakemake.exceptions import WorkflowError
 from snakemake.utils import min_version, validate
 
 min_version("9.0")
@@ -22,7 +23,13 @@ sys.path.insert(0, os.path.join(workflow.basedir, "workflow"))
 configfile: "config/config.yaml"
 
 
-from contactid.config import numbers_written_as_text
+from contactid.config import duplicate_key_errors, numbers_written_as_text
+
+# a key given twice in a config file (a second `lc2:`) is kept last by every YAML reader, silently: refused, with
+# the file and lines (the config file and every --configfile merged over it)
+_duplicates = [e for _path in workflow.configfiles for e in duplicate_key_errors(_path)]
+if _duplicates:
+    raise WorkflowError("config: duplicate keys:\n  - " + "\n  - ".join(_duplicates))
 
 # 4e-05 is text to YAML 1.1 (4.0e-05 is a number): such values where the schema wants a number are read as numbers
 for _key, _value in numbers_written_as_text(config, "workflow/schemas/config.schema.yaml"):

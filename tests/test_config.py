@@ -140,3 +140,120 @@ def test_a_case_or_candidate_the_config_does_not_have_is_named_before_anything_r
     c["gap"] = {**c["gap"], "plugins": ["my_effects"]}  # a plugin may register its own names: checked by the rule
     if "gap" in change:
         check_config(c)
+
+
+# ------------------------------------------------------------------------------------------
+# measured files and the config files themselves (contactid.measured_files, config.duplicate_key_errors)
+# ------------------------------------------------------------------------------------------
+
+
+def _measured(cfg, tmp_path, names=("lc1", "lc2")):
+    for c in names:
+        (tmp_path / f"{c}.nc").write_bytes(c.encode())
+    cfg["load_cases"] = {c: {"source": "measured", "file": str(tmp_path / f"{c}.nc")} for c in names}
+    cfg["nonlinear"].update(calibration_case=names[0], figure_case=names[0])
+    return cfg
+
+
+def test_a_measured_file_that_does_not_exist_is_refused_naming_key_and_near_names(default_config, tmp_path):
+    cfg = _measured(copy.deepcopy(default_config), tmp_path)
+    check_config(cfg)
+    cfg["load_cases"]["lc2"]["file"] = str(tmp_path / "lc_2.nc")
+    with pytest.raises(ConfigError, match=r"load_cases\.lc2\.file = .*lc_2\.nc': does not exist") as err:
+        check_config(cfg)
+    assert "did you mean" in str(err.value) and "lc2.nc" in str(err.value)
+    # relative paths from the project directory (root); no root: not looked at (a config checked elsewhere)
+    cfg["load_cases"]["lc2"]["file"] = "lc2.nc"
+    check_config(cfg, root=tmp_path)
+    with pytest.raises(ConfigError, match=r"load_cases\.lc2\.file = 'lc2\.nc': does not exist"):
+        check_config(cfg, root=tmp_path / "elsewhere")
+    check_config(cfg, root=None)
+    # a CSV's sidecar too
+    cfg["load_cases"]["lc2"] = {"source": "measured", "format": "csv", "file": str(tmp_path / "lc2.nc")}
+    with pytest.raises(ConfigError, match=r"load_cases\.lc2\.sidecar = .*lc2\.yaml': does not exist"):
+        check_config(cfg)
+
+
+def test_two_records_on_one_file_are_refused_unless_asked_for(default_config, tmp_path):
+    cfg = _measured(copy.deepcopy(default_config), tmp_path)
+    cfg["load_cases"]["lc2"]["file"] = str(tmp_path / "." / "lc1.nc")  # the same file, written otherwise
+    with pytest.raises(ConfigError, match=r"load_cases\.lc2\.file = .* is the file load_cases\.lc1\.file reads"):
+        check_config(cfg)
+    cfg["load_cases"]["lc2"]["allow_shared_file"] = True
+    check_config(cfg)
+    cfg["random_test"] = {"source": "measured", "file": str(tmp_path / "lc1.nc")}
+    with pytest.raises(ConfigError, match="load_cases.lc1.file = .* is the file random_test.file reads"):
+        check_config(cfg)
+
+
+def test_duplicate_keys_are_named_with_their_lines(tmp_path):
+    from contactid.config import duplicate_key_errors
+
+    f = tmp_path / "c.yaml"
+    f.write_text(
+        "seed: 1\nload_cases:\n  lc2: {file: a.nc}\n  lc3: {file: b.nc}\n  lc2: {file: b.nc}\n"
+        "x: &a {k: 1}\ny:\n  <<: *a\n  k: 2\n"
+    )
+    assert duplicate_key_errors(f) == [
+        f"{f}:5: key 'lc2' repeats line 3 (YAML keeps the last silently); remove or rename one"
+    ]
+    f.write_text("seed: 1\nseed: 2\n")
+    assert len(duplicate_key_errors(f)) == 1
+    assert duplicate_key_errors(Path(__file__).resolve().parents[1] / "config" / "config.yaml") == []
+
+
+def test_an_overlay_merges_as_snakemake_merges_it():
+    from contactid.config import merged_over
+
+    base = {"a": {"b": 1, "c": [1, 2]}, "d": 1}
+    assert merged_over(base, {"a": {"c": [3]}, "e": {"f": 1}}) == {"a": {"b": 1, "c": [3]}, "d": 1, "e": {"f": 1}}
+    assert base == {"a": {"b": 1, "c": [1, 2]}, "d": 1}  # untouched
+
+
+def test_a_file_digest_follows_its_content_not_its_modification_time(tmp_path):
+    import os
+    import time
+
+    from contactid.measured_files import file_sha256, measured_digests
+
+    rec, cache = tmp_path / "lc1.nc", tmp_path / "cache" / "digests.json"
+    rec.write_bytes(b"first record")
+    d1 = file_sha256(rec, cache)
+    assert d1 == file_sha256(rec) and cache.exists()
+    st = os.stat(rec)
+    time.sleep(0.01)
+    rec.write_bytes(b"other record")  # same size, then its modification time set back, as `cp -p` does
+    os.utime(rec, ns=(st.st_atime_ns, st.st_mtime_ns))
+    assert os.stat(rec).st_mtime_ns == st.st_mtime_ns and os.stat(rec).st_size == st.st_size
+    assert file_sha256(rec, cache) == file_sha256(rec) != d1
+    # only measured files get a digest: the workflow's own records are tracked by their rules
+    assert measured_digests([str(rec), "data/raw/lc2.nc"], {str(rec)}, cache) == {str(rec): file_sha256(rec)}
+
+
+def test_check_config_reads_an_overlay_as_the_snakefile_does(tmp_path):
+    """`contactid check-config overlay.yaml` merges it over config/config.yaml (as `snakemake --configfile` does);
+    --alone checks the file by itself; a duplicate key or a missing measured file fails, naming it."""
+    import subprocess
+    import sys
+
+    root = Path(__file__).resolve().parents[1]
+
+    def run(*args):
+        return subprocess.run(
+            [sys.executable, "-m", "contactid", "check-config", *args], cwd=root, capture_output=True, text=True
+        )
+
+    overlay = tmp_path / "overlay.yaml"
+    overlay.write_text("frf: {segment_length: 4096}\n")
+    out = run(str(overlay))
+    assert out.returncode == 0 and f"{overlay} (over config/config.yaml): valid" in out.stdout
+    out = run(str(overlay), "--alone")
+    assert out.returncode == 1 and "'structure' is a required property" in out.stdout
+    overlay.write_text(
+        f"random_test: {{source: measured, file: {tmp_path / 'random_test.nc'}}}\nfrf: {{segment_length: 4096}}\n"
+    )
+    out = run(str(overlay))
+    assert out.returncode == 1 and "random_test.file = " in out.stdout and "does not exist" in out.stdout
+    overlay.write_text("frf: {segment_length: 4096}\nfrf: {segment_length: 8192}\n")
+    out = run(str(overlay))
+    assert out.returncode == 1 and f"{overlay}:2: key 'frf' repeats line 1" in out.stdout

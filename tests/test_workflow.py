@@ -153,6 +153,42 @@ def test_gap_runs_on_a_directory_of_raw_files_alone(measured_run):
     assert d["verdict"] == "none" and [r["effect"] for r in d["ranking"]] == ["viscous_friction"]
 
 
+def test_measured_files_are_inputs_by_their_content(measured_run, tmp_path):
+    """On a project that has run: a config whose measured file does not exist stops snakemake before any job, naming
+    the key and the path, and the results stand as they were; a record replaced by another with the same size and
+    modification time (cp -p, rsync -a, a restored backup) plans its import and everything after it again; a key
+    written twice in a --configfile is refused with its lines."""
+    import os
+
+    proj = copy_project(measured_run[0], tmp_path / "proj")
+    summary = proj / "results" / "summary.json"
+    before = (summary.read_bytes(), summary.stat().st_mtime_ns)
+    assert "Nothing to be done" in snakemake(proj, "-n").stdout
+    cfg = project_config(proj)
+    (tmp_path / "typo.yaml").write_text(
+        yaml.safe_dump({"load_cases": {"lc3": {**cfg["load_cases"]["lc3"], "file": "measured/lc_3.csv"}}})
+    )
+    for target in ((), ("gap",)):
+        res = snakemake(proj, *target, "--configfile", str(tmp_path / "typo.yaml"))
+        assert res.returncode != 0
+        assert "load_cases.lc3.file = 'measured/lc_3.csv': does not exist" in res.stderr + res.stdout
+        assert "did you mean 'measured/lc3.csv'" in res.stderr + res.stdout
+    assert (summary.read_bytes(), summary.stat().st_mtime_ns) == before
+    csv = proj / "measured" / "lc3.csv"
+    st = csv.stat()
+    text = csv.read_text().splitlines()
+    csv.write_text("\n".join(text[:1] + text[2:] + text[1:2]) + "\n")  # the same bytes in another order
+    os.utime(csv, ns=(st.st_atime_ns, st.st_mtime_ns))
+    assert csv.stat().st_size == st.st_size and csv.stat().st_mtime_ns == st.st_mtime_ns
+    plan = snakemake(proj, "-n", "--quiet", "rules").stdout
+    for rule in ("import_csv", "raw_check", "contact_forces", "gap_diagnosis", "summary"):
+        assert rule in plan, (rule, plan)
+    assert "import_uff58_frf" not in plan  # the random test did not change
+    (tmp_path / "dup.yaml").write_text("gap: {candidates: [viscous_friction]}\ngap: {candidates: []}\n")
+    res = snakemake(proj, "-n", "--configfile", str(tmp_path / "dup.yaml"))
+    assert res.returncode != 0 and f"{tmp_path / 'dup.yaml'}:2: key 'gap' repeats line 1" in res.stderr
+
+
 def test_report_of_measured_records_says_no_truth_is_known(measured_run):
     """Every record measured: the report compiles, says there is no truth, and prints no empty truth column."""
     proj, _ = measured_run

@@ -7,42 +7,70 @@ compile-kernels  numba's kernels compiled into the workflow's cache ahead of its
 """
 
 import argparse
+import os
 import sys
 
 
 def check_config_main(argv) -> int:
-    """Validate a config file as the Snakefile does (schema with its defaults, then the cross-field checks);
-    print what is wrong (key and how to fix it) or that it is valid. Returns 1 when it is not."""
+    """Validate a config file as the Snakefile reads it: merged over the base config (config/config.yaml, as
+    `snakemake --configfile FILE` merges it; the base itself, or a file with --alone, is checked alone), duplicate
+    keys, the schema with its defaults, the cross-field checks and the measured files (relative paths from the
+    current directory, the project's); print what is wrong (key and how to fix it) or that it is valid. Returns 1
+    when it is not."""
     import jsonschema
     import yaml
 
-    from .config import SCHEMA, ConfigError, _load_schema, check_config, numbers_written_as_text, with_defaults
+    from .config import (
+        SCHEMA,
+        ConfigError,
+        _load_schema,
+        check_config,
+        duplicate_key_errors,
+        merged_over,
+        numbers_written_as_text,
+        with_defaults,
+    )
 
     parser = argparse.ArgumentParser(prog="contactid check-config", description=check_config_main.__doc__)
     parser.add_argument("config", nargs="?", default="config/config.yaml", help="the config file (YAML)")
+    parser.add_argument("--base", default="config/config.yaml", help="the config the file is merged over")
+    parser.add_argument("--alone", action="store_true", help="check the file alone, not merged over the base")
     args = parser.parse_args(argv)
-    try:
-        with open(args.config) as fh:
-            cfg = yaml.safe_load(fh) or {}
-    except (OSError, yaml.YAMLError) as exc:
-        print(f"{args.config}: cannot be read: {exc}")
-        return 1
+    alone = args.alone or os.path.realpath(args.config) == os.path.realpath(args.base)
+    files = [args.config] if alone else [args.base, args.config]
+    cfg = {}
+    for path in files:
+        try:
+            with open(path) as fh:
+                part = yaml.safe_load(fh) or {}
+            duplicates = duplicate_key_errors(path)
+        except (OSError, yaml.YAMLError) as exc:
+            print(f"{path}: cannot be read: {exc}")
+            return 1
+        if duplicates:
+            print("\n".join(duplicates))
+            return 1
+        if not isinstance(part, dict):
+            print(f"{path}: must hold keys at its top level (a YAML mapping)")
+            return 1
+        cfg = merged_over(cfg, part)
+    name = args.config if alone else f"{args.config} (over {args.base})"
     for key, value in numbers_written_as_text(cfg, SCHEMA):
-        print(f"{args.config}: {key}: read as the number {value!r} (write exponents with a decimal point: 4.0e-05)")
+        print(f"{name}: {key}: read as the number {value!r} (write exponents with a decimal point: 4.0e-05)")
     filled = with_defaults(cfg)
     errors = sorted(
         jsonschema.Draft202012Validator(_load_schema(SCHEMA)).iter_errors(filled), key=lambda e: list(e.path)
     )
     for e in errors:
-        print(f"{args.config}: {'.'.join(str(p) for p in e.path) or '(top level)'}: {e.message}")
+        print(f"{name}: {'.'.join(str(p) for p in e.path) or '(top level)'}: {e.message}")
     if errors:
         return 1
     try:
-        check_config(filled, args.config)
+        check_config(filled, name)
     except ConfigError as exc:
         print(exc)
         return 1
-    print(f"{args.config}: valid ({len(filled.get('load_cases', {}))} load cases)")
+    print(f"{name}: valid ({len(filled.get('load_cases', {}))} load cases)")
     return 0
 
 

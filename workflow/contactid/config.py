@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import copy
 import functools
+import os
 import re
 from pathlib import Path
 from typing import Mapping
@@ -120,6 +121,54 @@ def numbers_written_as_text(cfg: dict, schema) -> list:
         node[last] = value
         changed.append((".".join(str(k) for k in err.absolute_path), value))
     return changed
+
+
+def duplicate_key_errors(path: str | os.PathLike) -> list[str]:
+    """Every key a YAML mapping of the file at ``path`` gives twice (YAML readers keep the last silently: a second
+    ``lc2:`` would replace the first load case), as "file:line: key 'k' (under a.b) repeats line m"."""
+    import yaml
+
+    errors = []
+
+    class _Loader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):
+        pass
+
+    def construct_mapping(loader, node, deep=False):
+        seen = {}
+        for key_node, _ in node.value:
+            if key_node.tag == "tag:yaml.org,2002:merge":
+                continue
+            key = loader.construct_object(key_node, deep=True)
+            try:
+                first = seen.get(key)
+            except TypeError:  # an unhashable key: the reader's own error follows
+                continue
+            if first is not None:
+                errors.append(
+                    f"{path}:{key_node.start_mark.line + 1}: key {key!r} repeats line {first} (YAML keeps the last "
+                    "silently); remove or rename one"
+                )
+            else:
+                seen[key] = key_node.start_mark.line + 1
+        return loader.construct_mapping_plain(node, deep=deep)
+
+    _Loader.construct_mapping_plain = _Loader.construct_mapping
+    _Loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, construct_mapping)
+    with open(path) as fh:
+        yaml.load(fh, Loader=_Loader)
+    return errors
+
+
+def merged_over(base: Mapping, overlay: Mapping) -> dict:
+    """``overlay`` merged over ``base`` as Snakemake merges a --configfile over the Snakefile's configfile: blocks
+    key by key, recursively; any other value (a list, a number) replaced whole."""
+    out = copy.deepcopy(dict(base))
+    for key, value in overlay.items():
+        if isinstance(value, Mapping) and isinstance(out.get(key), Mapping):
+            out[key] = merged_over(out[key], value)
+        else:
+            out[key] = copy.deepcopy(value)
+    return out
 
 
 def _true_structure_errors(structure: Mapping, changes: Mapping, path: str = "rig.true_structure") -> list:
@@ -337,11 +386,16 @@ def _rig_errors(cfg: Mapping) -> list:
     return errors
 
 
-def check_config(cfg: Mapping, source: str = "config/config.yaml") -> None:
+def check_config(cfg: Mapping, source: str = "config/config.yaml", root: str | os.PathLike | None = ".") -> None:
     """Raise :class:`ConfigError` on cross-field inconsistencies of ``cfg`` (its left-out keys at the schema's
-    defaults, ``with_defaults``)."""
+    defaults, ``with_defaults``) and, with ``root`` (the project directory relative paths are taken from; None:
+    not looked at), on measured files that do not exist or that two records share (``measured_files``)."""
+    from .measured_files import missing_file_errors, shared_file_errors
+
     cfg = with_defaults(cfg)
+    files = [*missing_file_errors(cfg, root), *shared_file_errors(cfg, root)] if root is not None else []
     errors = [
+        *files,
         *_sensor_errors(cfg["structure"]),
         *_mode_count_errors(cfg),
         *_random_test_errors(cfg),

@@ -372,6 +372,32 @@ def data_checks_text(summary: Mapping) -> str:
     return "\n".join(line for line in lines if line) + "\n"
 
 
+def records_alert_text(summary: Mapping) -> str:
+    """The report's first-page notice of records that disagree with each other or with the identified model
+    (summary.json's ``records_check``, rule record_checks): each record named with the likely cause and its fix;
+    empty (a comment) where every record agrees."""
+    findings = (summary.get("records_check") or {}).get("findings") or []
+    if not findings:
+        return "% every record agrees with the others and with the identified model (rule record_checks)\n"
+    hard = any(f.get("signature") for f in findings)
+    lines = [
+        r"\begin{center}\fbox{\begin{minipage}{0.94\linewidth}",
+        r"\textbf{Check the records first.} "
+        + (
+            "These records disagree with the others or with the identified model in a way a units factor, a sign "
+            "or a channel order explains; the numbers below that use them are not to be trusted until they are "
+            r"corrected, and the gap diagnosis looks for no effect (verdict records\_disagree):"
+            if hard
+            else "These records disagree grossly with the identified model, for a cause the checks do not name:"
+        ),
+        r"\begin{itemize}",
+        *[rf"\item {plain_text(f['message'])}" for f in findings],
+        r"\end{itemize}",
+        r"\end{minipage}}\end{center}",
+    ]
+    return "\n".join(lines) + "\n"
+
+
 TEX_SYMBOLS = {"k_t": "$k_t$", "k_n": "$k_n$", "S": "$S$"}  # the model checks' symbols in LaTeX
 
 

@@ -262,3 +262,17 @@ def model_form_summary(intervals: Mapping) -> dict:
         "confidence": par["confidence"],
         **{n: {"value": v["value"], "interval": v["interval"]} for n, v in par.items() if n != "confidence"},
     }
+
+
+def records_check_summary(check: Mapping, data_warnings: dict) -> dict:
+    """`records_check` of summary.json from record_checks.json (``gap.record_checks.records_check``): passed, the
+    findings and each case's gap to the identified model; each finding's message is added to ``data_warnings`` under
+    its record (in place), so that every warning about a record is in one list."""
+    for f in check.get("findings", []):
+        data_warnings.setdefault(f["record"], []).append(f"records check ({f['check']}): {f['message']}")
+    return {
+        "passed": bool(check.get("passed", True)),
+        "findings": list(check.get("findings", [])),
+        "heldout_gap_to_model": dict(check.get("gaps", {})),
+        "calibration_case": check.get("calibration_case"),
+    }

@@ -3,10 +3,24 @@
 from snakemake.utils import Paramspace
 
 from contactid.config import check_config
+from contactid.measured_files import measured_digests, measured_records, record_files
 from contactid.studies import noise_study_table
 from contactid.rig.structure import random_test_rig_config
 
-check_config(config)
+# the schema's cross-field checks, and the measured files: a path that does not exist (or two records on one file)
+# stops the run here, before any job, naming the config key
+check_config(config, "config (" + " over ".join(map(str, workflow.configfiles)) + ")")
+
+# every measured file (and CSV sidecar) the config names: the rules that read one take its sha256 as a parameter
+# (records_digest), so that a record replaced by another, whatever its modification time, reruns what it fed
+MEASURED_FILES = {path for _, block in measured_records(config) for _, path in record_files(block)}
+
+
+def records_digest(paths):
+    """{path: sha256} of the measured files among ``paths`` (one or a list; the rig's and imported records are
+    tracked by their own rules): a parameter of each rule that reads a measured file."""
+    return measured_digests(paths, MEASURED_FILES, os.path.join(".snakemake", "contactid", "measured-digests.json"))
+
 
 # The chain from the raw records to the gap diagnosis is the workflow's critical path: its jobs go first
 # whenever a core is free (the linear chain, which everything waits for, before the dual-sine rigs), and the
@@ -157,6 +171,7 @@ def summary_inputs(wildcards):
     if load_cases():
         inputs["fit"] = "results/friction/friction_fit.nc"
         inputs["friction_intervals"] = "results/gap/friction_intervals.json"
+        inputs["record_checks"] = "results/gap/record_checks.json"
     for c, path in truth_records().items():
         inputs[f"truth_{c}"] = path
     return inputs

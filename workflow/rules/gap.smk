@@ -19,6 +19,7 @@ rule gap_floor:
         "results/gap/floor.json",
     params:
         code=CODE_DIGEST,
+        records=records_digest([raw_record(c) for c in load_cases()]),
         config=benchmark_base_config(),
         cases=load_cases(),
     threads: 1
@@ -81,6 +82,7 @@ rule friction_intervals:
         "results/gap/friction_intervals.json",
     params:
         code=CODE_DIGEST,
+        records=records_digest([raw_record(c) for c in load_cases()]),
         structure=config["structure"],
         gap=config["gap"],
         friction=config["friction"],
@@ -102,11 +104,13 @@ rule gap_diagnosis:
     priority: CRITICAL_PATH
     input:
         unpack(gap_inputs),
+        record_checks="results/gap/record_checks.json",
     output:
         diagnosis="results/gap/diagnosis.json",
         dataset="results/gap/gap.nc",
     params:
         code=CODE_DIGEST,
+        records=records_digest([raw_record(c) for c in load_cases()]),
         structure=config["structure"],
         gap=config["gap"],
         friction=config["friction"],
@@ -278,3 +282,30 @@ rule gap_report_fragment:
         "logs/gap_report_fragment.log",
     script:
         "../scripts/gap_report_fragment.py"
+
+
+rule record_checks:
+    """The load cases' records against each other (accelerance at the drive) and against the identified model's prediction at each record's measured force: a units factor, a flipped sign, a swapped channel or a gross disagreement, named with its fix (results/gap/record_checks.json)."""
+    priority: CRITICAL_PATH
+    input:
+        modes="results/linear/linear_modes.nc",
+        modal="results/linear/modal.nc",
+        fit="results/friction/friction_fit.nc",
+        raw=[raw_record(c) for c in load_cases()],
+        checks=[f"results/{c}/raw_check.nc" for c in load_cases()],
+    output:
+        "results/gap/record_checks.json",
+    params:
+        code=CODE_DIGEST,
+        records=records_digest([raw_record(c) for c in load_cases()]),
+        structure=config["structure"],
+        thresholds=config["gap"]["record_checks"],
+        n_harmonics=config["nonlinear"]["n_harmonics"],
+        calibration_case=calibration_case(),
+        cases=load_cases(),
+    conda:
+        "../envs/contactid.yaml"
+    log:
+        "logs/record_checks.log",
+    script:
+        "../scripts/record_checks.py"

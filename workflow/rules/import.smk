@@ -17,6 +17,7 @@ for _fmt in ("uff58", "tdms", "csv"):
             record=import_pattern(_fmt),
         params:
             code=CODE_DIGEST,
+            records=lambda wc: records_digest(list(import_inputs(wc).values())),
             block=lambda wc: record_block(wc.record),
             where=lambda wc: wc.record if wc.record == "random_test" else f"load_cases.{wc.record}",
         conda:

@@ -15,6 +15,7 @@ if random_test_is_frf_file():
             frf="results/linear/frf.nc",
         params:
             code=CODE_DIGEST,
+            records=records_digest(config["random_test"]["file"]),
             block=config["random_test"],
             structure=config["structure"],
             band_hz=config["modal"]["band_hz"],
@@ -39,6 +40,7 @@ else:
             frf="results/linear/frf.nc",
         params:
             code=CODE_DIGEST,
+            records=records_digest(random_test_raw()),
             frf=config["frf"],
             structure=config["structure"],
             blocks=config["modal"]["uncertainty_blocks"],

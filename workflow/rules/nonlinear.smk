@@ -10,6 +10,7 @@ rule raw_check:
         check="results/{case}/raw_check.nc",
     params:
         code=CODE_DIGEST,
+        records=lambda wc: records_digest(raw_record(wc.case)),
         structure=config["structure"],
         checks=config["raw_checks"],
         n_harmonics=config["nonlinear"]["n_harmonics"],
@@ -32,6 +33,7 @@ rule generalized_coordinates:
         gc="results/{case}/generalized_coordinates.nc",
     params:
         code=CODE_DIGEST,
+        records=lambda wc: records_digest(raw_record(wc.case)),
         nonlinear=config["nonlinear"],
     conda:
         "../envs/contactid.yaml"
@@ -52,6 +54,7 @@ rule nonlinear_modes:
         nnm="results/{case}/nonlinear_modes.nc",
     params:
         code=CODE_DIGEST,
+        records=lambda wc: records_digest(raw_record(wc.case)),
         structure=config["structure"],
         nonlinear=config["nonlinear"],
     conda:
@@ -73,6 +76,7 @@ rule reduced_model:
         reduced="results/{case}/reduced_model.nc",
     params:
         code=CODE_DIGEST,
+        records=lambda wc: records_digest(raw_record(wc.case)),
         structure=config["structure"],
         nonlinear=config["nonlinear"],
     conda:
@@ -92,6 +96,7 @@ rule contact_forces:
         forces="results/{case}/contact_forces.nc",
     params:
         code=CODE_DIGEST,
+        records=lambda wc: records_digest(raw_record(wc.case)),
         structure=config["structure"],
         nonlinear=config["nonlinear"],
     conda:
@@ -115,6 +120,7 @@ rule harmonic_study:
         table=report("results/studies/harmonic_count.csv", caption="../report/harmonic_study.rst", category="Studies"),
     params:
         code=CODE_DIGEST,
+        records=records_digest(raw_record(calibration_case())),
         structure=config["structure"],
         counts=config["nonlinear"]["harmonic_study"],
     conda:

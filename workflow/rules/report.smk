@@ -19,6 +19,7 @@ rule report_fragments:
         consistency="results/report/consistency.tex",
         contact="results/report/contact.tex",
         datachecks="results/report/datachecks.tex",
+        alerts="results/report/alerts.tex",
     params:
         code=CODE_DIGEST,
         structure=config["structure"],

@@ -1,11 +1,14 @@
 """Rule gap_diagnosis: the identified model against every load case's raw record (issue 7)."""
 
+import dataclasses
+import json
 import time
 
 from contactid.gap.candidates import load_plugins
 from contactid.gap.diagnosis import GapSettings, diagnose, linear_stage, prepare_workers, random_test_delays
 from contactid.gap.floor import read_floor, resolved_gap_config
 from contactid.gap.pipeline import workflow_models
+from contactid.gap.record_checks import diagnosis_outcome
 from contactid.gap.output import diagnosis_json, gap_dataset
 from contactid.io import load_dataset, provenance, write_dataset, write_text
 from contactid.logs import setup_logging
@@ -39,6 +42,11 @@ diag = diagnose(
     updating=updating,
     channel_delays=random_test_delays(frf, modal),
 )
+# records that contradict each other or the model by a units factor, a sign or a channel order: no effect is looked for
+with open(inp.record_checks) as fh:
+    record_check = json.load(fh)
+verdict, reason, explanation = diagnosis_outcome(diag.verdict, diag.reason, diag.explanation, record_check)
+diag = dataclasses.replace(diag, verdict=verdict, reason=reason, explanation=explanation)
 seconds = time.perf_counter() - t0
 prov = provenance(
     "gap_diagnosis",
@@ -54,7 +62,7 @@ prov = provenance(
 ds = gap_dataset(diag, records, settings.n_harmonics)
 ds.attrs.update(prov)
 write_dataset(ds, snakemake.output.dataset)
-extra = {"seconds": seconds, "provenance": prov}
+extra = {"seconds": seconds, "provenance": prov, "records_check": record_check}
 if floor is not None:
     extra["measured_floor"] = floor
 write_text(snakemake.output.diagnosis, diagnosis_json(diag, extra))

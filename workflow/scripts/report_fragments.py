@@ -6,7 +6,15 @@ from pathlib import Path
 import pandas as pd
 
 from contactid.gap.report import updated_law_note
-from contactid.latex import contact_fragment, data_checks_text, macros, report_values, setup_table, tabular
+from contactid.latex import (
+    contact_fragment,
+    data_checks_text,
+    macros,
+    records_alert_text,
+    report_values,
+    setup_table,
+    tabular,
+)
 from contactid.logs import setup_logging
 
 setup_logging(snakemake.log[0])
@@ -20,6 +28,7 @@ Path(out.numbers).write_text(
 )
 Path(out.setup).write_text(setup_table(snakemake.params.structure))
 Path(out.datachecks).write_text(data_checks_text(summary))
+Path(out.alerts).write_text(records_alert_text(summary))
 Path(out.table1).write_text(
     tabular(
         pd.read_csv(inp.table1),

@@ -11,6 +11,7 @@ from contactid.reporting import (
     linear_summary,
     load_case_summary,
     model_form_summary,
+    records_check_summary,
 )
 
 log = setup_logging(snakemake.log[0])
@@ -34,6 +35,9 @@ summary["model_checks"] = model_checks(stiction.attrs, stiction.sizes["mode"], N
 if "friction_intervals" in inp.keys():
     with open(inp.friction_intervals) as fh:
         summary["friction"]["model_form_intervals"] = model_form_summary(json.load(fh))
+if "record_checks" in inp.keys():  # the records against each other and the identified model (rule record_checks)
+    with open(inp.record_checks) as fh:
+        summary["records_check"] = records_check_summary(json.load(fh), summary["data_warnings"])
 with open(snakemake.output.summary, "w") as fh:
     json.dump(summary, fh, indent=2, sort_keys=True, default=lambda o: o.item() if hasattr(o, "item") else str(o))
 log.info("summary of %s written to %s", ", ".join(summary), snakemake.output.summary)

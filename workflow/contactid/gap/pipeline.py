@@ -329,3 +329,24 @@ def _refitted(model, structure, calibration, fit_settings, seed: int):
         label="friction fit after updating",
     )
     return m2.with_friction(fit.params)
+
+
+def workflow_record_checks(structure_cfg: Mapping, inputs, cases, calibration_case: str, n_harmonics: int, thresholds):
+    """The records' check (``record_checks.records_check``) from the workflow's files: ``inputs`` names modes, modal,
+    fit and raw (the load cases' records, in the order of ``cases``); the prediction is the chain's identified model
+    (not updated) at each record's measured force."""
+    from ..io import load_dataset, read_raw
+    from .model import NONE, identified_model, simulate
+    from .record_checks import accelerance_levels, model_evidence, records_check
+
+    model = identified_model(
+        structure_cfg, load_dataset(inputs.modes), load_dataset(inputs.modal), load_dataset(inputs.fit)
+    )
+    H = int(n_harmonics)
+    evidence, harmonics = {}, {}
+    for case, path in zip(cases, inputs.raw):
+        rec = record_harmonics(read_raw(path, dual_sine=True), case, H)
+        sim = simulate(model, NONE, rec)
+        evidence[case] = model_evidence(case, rec.sensors, rec.acceleration[:, :H], sim.acceleration[:, :H])
+        harmonics[case] = {"acceleration": rec.acceleration, "force": rec.force}
+    return records_check(accelerance_levels(harmonics), evidence, calibration_case, thresholds)

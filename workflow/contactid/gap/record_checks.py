@@ -1,0 +1,326 @@
+"""Plausibility of the records against each other and against the identified model: a units factor, a flipped sign,
+a swapped channel, a gross disagreement.
+
+Each record passed its own checks (``raw_checks``); these look at what no single record shows. Evidence first (pure
+numbers from the records and the identified model's predictions at each record's measured force), then the
+decisions, each a small pure function of the evidence and a threshold, applied in a fixed order, every one recorded
+in the trace:
+
+* ``level_tests`` (before identification, the records alone): each load case's accelerance at its drive (every
+  sensor's harmonic over the force's, at w and 3 w) against the other cases'. Cases of one rig driven at one
+  frequency differ by their level's nonlinearity, a few tens of per cent; a case a units factor away from the
+  others (9.81 for g, 1000 for mm/s^2 or kN) was written in other units than its label says.
+* ``model_tests`` (after identification): each case's record against the identified model's prediction at the
+  record's measured force. The calibration case fits by construction; a held-out case of the same rig leaves a gap
+  of the same order. A record that is a scaled, sign-flipped or channel-permuted copy of its prediction (the
+  transformation leaves a small part of the gap) is a units, sign or channel-map error, named with its factor.
+
+A finding is a message naming the record, the likely cause and the fix. It goes to the console, ``summary.json``'s
+``data_warnings``, the report's first page, and the gap diagnosis, whose verdict becomes ``records_disagree``: no
+unmodelled effect is to be looked for in records that disagree with each other in this way.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+from typing import Mapping
+
+import numpy as np
+
+# factors between units a vibration record is written in by mistake, and what each means
+UNIT_FACTORS = (
+    (9.80665, "accelerations in g labelled m/s^2 (or the force in kgf labelled N)"),
+    (1000.0, "accelerations in mm/s^2 labelled m/s^2, or the force in kN or mN"),
+    (100.0, "accelerations in cm/s^2 labelled m/s^2"),
+    (4.448222, "the force in lbf labelled N"),
+    (0.3048, "accelerations in ft/s^2 labelled m/s^2"),
+)
+
+
+@dataclass(frozen=True)
+class Thresholds:
+    """The tests' limits (config ``gap.record_checks``).
+
+    level_factor: a case's accelerance this many times off the cases' median (or its inverse) is named;
+    explained_share: a transformation (scale, sign, channel order) explains a disagreement when it leaves at most
+    this share of the gap; gross_ratio, signature_gap: a held-out case leaving more than gross_ratio times the
+    calibration case's gap and more than signature_gap is looked at for a transformation; gross_gap: beyond it (and
+    gross_ratio times the calibration case's) with none, a gross disagreement of unknown cause; unit_tolerance: a factor
+    within this relative distance of a units factor is named as that factor."""
+
+    level_factor: float = 3.0
+    explained_share: float = 0.35
+    gross_ratio: float = 10.0
+    signature_gap: float = 0.05
+    gross_gap: float = 0.3
+    unit_tolerance: float = 0.15
+
+    @classmethod
+    def from_config(cls, block: Mapping | None) -> "Thresholds":
+        return cls(**{k: float(v) for k, v in dict(block or {}).items() if k in cls.__dataclass_fields__})
+
+
+# -------------------------------------------------------------------------------------------------------------------
+# evidence
+# -------------------------------------------------------------------------------------------------------------------
+
+
+def accelerance_levels(checks: Mapping[str, Mapping]) -> dict:
+    """{case: (j, 2) complex accelerance at w and 3 w} of every sensor from the records' harmonics ``checks``
+    {case: {"acceleration": (j, H) complex, "force": (H,) complex}} (raw_check.nc's amplitudes and phases)."""
+    out = {}
+    for case, c in checks.items():
+        A, F = np.asarray(c["acceleration"]), np.asarray(c["force"])
+        hs = [h for h in (0, 2) if h < F.size and abs(F[h]) > 0]
+        out[case] = np.stack([A[:, h] / F[h] for h in hs], axis=1)
+    return out
+
+
+def _ls_scale(pred: np.ndarray, meas: np.ndarray) -> complex:
+    """The complex factor a minimising |a pred - meas|."""
+    den = np.vdot(pred, pred)
+    return complex(np.vdot(pred, meas) / den) if abs(den) > 0 else 0j
+
+
+def _rel(a: np.ndarray, b: np.ndarray) -> float:
+    return float(np.linalg.norm(a - b) / max(np.linalg.norm(b), 1e-300))
+
+
+@dataclass(frozen=True)
+class ModelEvidence:
+    """One record against the identified model's prediction at its measured force (harmonics 1..H of every sensor):
+    the gap; the common complex factor of prediction onto record and the gap it leaves; each sensor's factor and gap;
+    the channel permutation that fits best (sensor order) and the gap it leaves."""
+
+    case: str
+    sensors: tuple
+    gap: float
+    scale: complex
+    gap_scaled: float
+    sensor_scale: tuple
+    sensor_gap: tuple
+    permutation: tuple
+    gap_permuted: float
+
+
+def model_evidence(case: str, sensors, measured: np.ndarray, predicted: np.ndarray) -> ModelEvidence:
+    """``measured`` and ``predicted``: (j, H) complex accelerations of one record and of the model at its force."""
+    A, P = np.asarray(measured), np.asarray(predicted)
+    a = _ls_scale(P.ravel(), A.ravel())
+    per = [_ls_scale(P[i], A[i]) for i in range(A.shape[0])]
+    gaps = [_rel(P[i], A[i]) for i in range(A.shape[0])]
+    best, best_gap = tuple(range(A.shape[0])), _rel(P, A)
+    if A.shape[0] <= 6:  # at most 720 orders; beyond that the channel-map test is left out
+        for perm in itertools.permutations(range(A.shape[0])):
+            g = _rel(P[list(perm)], A)
+            if g < best_gap - 1e-12:
+                best, best_gap = perm, g
+    return ModelEvidence(
+        case,
+        tuple(sensors),
+        _rel(P, A),
+        a,
+        _rel(a * P, A),
+        tuple(per),
+        tuple(gaps),
+        best,
+        best_gap,
+    )
+
+
+# -------------------------------------------------------------------------------------------------------------------
+# decisions
+# -------------------------------------------------------------------------------------------------------------------
+
+
+def named_factor(factor: float, tol: float) -> str:
+    """A magnitude ratio (record over expectation) and what it most likely means: the units factor it is near, either
+    way, or a sensitivity."""
+    for f, meaning in UNIT_FACTORS:
+        for value, inverse in ((f, False), (1.0 / f, True)):
+            if abs(factor / value - 1.0) <= tol:
+                return f"{factor:.3g} times (near {'1/' if inverse else ''}{f:g}: likely {meaning})"
+    return f"{factor:.3g} times (likely a wrong sensitivity or gain in the channel map)"
+
+
+def _near_units(factor: float, tol: float) -> bool:
+    return any(abs(factor * f - 1.0) <= tol or abs(factor / f - 1.0) <= tol for f, _ in UNIT_FACTORS)
+
+
+def _trace(test: str, value: float, threshold: float, passed: bool, case: str) -> dict:
+    return {"test": test, "case": case, "value": float(value), "threshold": float(threshold), "passed": bool(passed)}
+
+
+def _finding(case: str, check: str, message: str, signature: bool) -> dict:
+    """``signature``: the cause is a transformation of the record (units, sign, channel order), not a guess."""
+    return {"record": case, "check": check, "message": message, "signature": signature}
+
+
+def level_tests(levels: Mapping[str, np.ndarray], th: Thresholds) -> tuple[list, list]:
+    """Each case's accelerance (``accelerance_levels``) against the median of every case's: (findings, trace). Needs
+    three cases to say which one is off; with two, a ratio beyond the limit names both. A units factor is named within
+    twice ``unit_tolerance`` here: the cases' own accelerances differ by their levels' nonlinearity."""
+    findings, trace = [], []
+    cases = list(levels)
+    if len(cases) < 2:
+        return findings, trace
+    for case in cases:
+        others = [c for c in cases if c != case]
+        # the median of every case (its own included: one case off cannot move it) or, with two, the other case
+        ref = np.median(np.abs(np.stack([levels[c] for c in (cases if len(cases) > 2 else others)])), axis=0)
+        factor = float(np.exp(np.median(np.log(np.abs(levels[case]) / ref))))  # over sensors and both harmonics
+        off = max(factor, 1.0 / factor)
+        passed = off <= th.level_factor
+        trace.append(_trace("accelerance_level_against_other_cases", off, th.level_factor, passed, case))
+        if not passed:
+            who = case if len(cases) > 2 else f"{case} or {others[0]}"
+            findings.append(
+                _finding(
+                    case,
+                    "accelerance_level",
+                    f"{who}: its accelerations over its force at the drive are "
+                    f"{named_factor(factor, 2 * th.unit_tolerance)} those of the other load cases "
+                    f"({', '.join(others)}); check the record's units and sensitivities (force and accelerations) "
+                    "against its channel map",
+                    True,
+                )
+            )
+    return findings, trace
+
+
+def model_tests(evidence: Mapping[str, ModelEvidence], calibration_case: str, th: Thresholds) -> tuple[list, list]:
+    """Each held-out record against the model's prediction at its force. Where its gap exceeds ``gross_ratio`` times
+    the calibration case's and ``signature_gap``, in this order: a common factor that explains the disagreement
+    (leaves at most ``explained_share`` of it) and is a units factor, a factor beyond 2 or a flipped sign; a channel
+    order that explains it (the channel map); one sensor off by its own factor while the others agree (its
+    sensitivity or sign). With none of these, a gap beyond ``gross_ratio`` times the calibration case's and
+    ``gross_gap`` is a gross disagreement of unknown cause (no signature: the verdict is not taken from it). Returns
+    (findings, trace)."""
+    findings, trace = [], []
+    cal = evidence.get(calibration_case)
+    base = cal.gap if cal is not None else 0.0
+    for case, ev in evidence.items():
+        if case == calibration_case:
+            continue
+        limit = max(th.gross_ratio * base, th.signature_gap)
+        disagrees = ev.gap > limit
+        trace.append(_trace("gap_against_calibration", ev.gap, limit, not disagrees, case))
+        if not disagrees:
+            continue
+        head = (
+            f"{case}: the record disagrees with the identified model's prediction at its measured force ({ev.gap:.1%}"
+        )
+        head += f" against {base:.2%} on the calibration case {calibration_case})"
+        finding = _signature(ev, th, head, trace)
+        if finding is None and ev.gap > max(th.gross_ratio * base, th.gross_gap):
+            finding = _finding(
+                case,
+                "gross",
+                f"{head}: the records disagree with the model grossly, and no units factor, sign or channel order "
+                "explains it; check units, signs and the channel map, and whether the structure changed between tests "
+                "(an effect the candidate library does not hold)",
+                False,
+            )
+        if finding is not None:
+            findings.append(finding)
+    return findings, trace
+
+
+def _signature(ev: ModelEvidence, th: Thresholds, head: str, trace: list) -> dict | None:
+    """The first transformation of the record that explains its disagreement with the prediction, as a finding."""
+    case, n = ev.case, len(ev.sensors)
+    mag, phase = abs(ev.scale), float(np.degrees(abs(np.angle(ev.scale))))
+    left = ev.gap_scaled / ev.gap
+    big = max(mag, 1.0 / max(mag, 1e-300))
+    explained = left <= th.explained_share and (phase > 135.0 or big >= 2.0 or _near_units(mag, th.unit_tolerance))
+    trace.append(_trace("common_factor_explains", left, th.explained_share, not explained, case))
+    if explained:
+        parts = []
+        if big >= 1.5:
+            parts.append(f"its accelerations are {named_factor(mag, th.unit_tolerance)} the prediction")
+        if phase > 135.0:
+            parts.append("of opposite sign (the force's or every accelerometer's sign is flipped)")
+        return _finding(
+            case, "units_or_sign", f"{head}: {' and '.join(parts)}; correct the record or its channel map", True
+        )
+    left = ev.gap_permuted / ev.gap
+    reordered = ev.permutation != tuple(range(n)) and left <= th.explained_share
+    trace.append(_trace("channel_order_explains", left, th.explained_share, not reordered, case))
+    if reordered:
+        moved = [
+            f"{ev.sensors[i]} holds what is predicted at {ev.sensors[p]}"
+            for i, p in enumerate(ev.permutation)
+            if i != p
+        ]
+        return _finding(
+            case,
+            "channel_map",
+            f"{head}: with its channels reordered it leaves {ev.gap_permuted:.1%} ({'; '.join(moved)}): the channel "
+            "map is likely swapped; correct the sensor order or positions",
+            True,
+        )
+    gaps = np.asarray(ev.sensor_gap)
+    if n < 2:
+        return None
+    worst = int(np.argmax(gaps))
+    a = ev.sensor_scale[worst]
+    rest = float(np.max(np.delete(gaps, worst)))
+    off = max(abs(a), 1.0 / max(abs(a), 1e-300))
+    alone = rest <= 0.5 * gaps[worst] and (off >= 1.3 or abs(np.angle(a)) > np.radians(135.0))
+    trace.append(_trace("one_channel_explains", rest / gaps[worst], 0.5, not alone, case))
+    if not alone:
+        return None
+    if abs(np.angle(a)) > np.radians(135.0):
+        what = "with the opposite sign" + (f", {named_factor(abs(a), th.unit_tolerance)}" if off >= 1.3 else "")
+    else:
+        what = named_factor(abs(a), th.unit_tolerance)
+    return _finding(
+        case,
+        "one_channel",
+        f"{head}: channel {ev.sensors[worst]} reads {what} its prediction while the others agree; correct that "
+        "channel's sensitivity or sign",
+        True,
+    )
+
+
+def records_check(
+    levels: Mapping[str, np.ndarray], evidence: Mapping[str, ModelEvidence], calibration_case: str, th: Thresholds
+) -> dict:
+    """The whole check: {"passed", "findings": [{record, check, message, signature}], "trace": [...], "gaps": {case:
+    gap}}; ``passed`` is False where a finding has a signature (a units factor, a sign, a channel order: the records,
+    not the model, are wrong)."""
+    f1, t1 = level_tests(levels, th)
+    f2, t2 = model_tests(evidence, calibration_case, th)
+    return {
+        "passed": not any(f["signature"] for f in f1 + f2),
+        "findings": f1 + f2,
+        "trace": t1 + t2,
+        "gaps": {c: e.gap for c, e in evidence.items()},
+        "calibration_case": calibration_case,
+    }
+
+
+# the gap diagnosis's verdict where a record fails with a signature (contract: an effect name, "none", or this)
+RECORDS_DISAGREE = "records_disagree"
+
+
+def diagnosis_outcome(verdict: str, reason: str, explanation: list, check: Mapping) -> tuple[str, str, list]:
+    """The gap diagnosis's (verdict, reason, explanation) given the records' check: where a record fails with a
+    signature (units, sign, channel order), verdict ``records_disagree``, the reason naming each such record and its
+    fix, and no explanation (no effect is to be looked for in records that contradict each other); a gross
+    disagreement of unknown cause is said first in the reason, the verdict kept; otherwise unchanged."""
+    hard = [f for f in check.get("findings", []) if f.get("signature")]
+    soft = [f for f in check.get("findings", []) if not f.get("signature")]
+    if hard:
+        worst = max((check.get("gaps") or {}).get(f["record"], 0.0) for f in hard)
+        said = "; ".join(f["message"] for f in hard)
+        return (
+            RECORDS_DISAGREE,
+            f"the records disagree with the model grossly ({worst:.0%} held out): check units, signs, channel map. "
+            + said,
+            [],
+        )
+    if soft:
+        return verdict, "; ".join(f["message"] for f in soft) + ". Diagnosis: " + reason, explanation
+    return verdict, reason, explanation
