@@ -112,3 +112,15 @@ def test_the_level_test_names_the_case_off_by_a_units_factor():
         "lc1 or lc3" in f["message"] or "lc3 or lc1" in f["message"]
         for f in records_check(accelerance_levels(two), {}, "lc1", Thresholds())["findings"]
     )
+
+
+def test_the_benchmark_counts_the_checks_false_alarms():
+    from contactid.gap.benchmark import records_check_score
+
+    rows = [
+        {"records_check": {"passed": True, "findings": []}},
+        {"records_check": {"passed": False, "findings": ["units_or_sign"]}},
+        {"records_check": {"passed": True, "findings": ["gross"]}},
+        {"failed": "the rig's records of lc2 are not finite"},
+    ]
+    assert records_check_score(rows) == {"items": 3, "false_alarms": 1, "gross_warnings": 1}

@@ -2,7 +2,7 @@
 
 import json
 
-from contactid.gap.benchmark import confusion_figure, score
+from contactid.gap.benchmark import confusion_figure, records_check_score, score
 from contactid.gap.output import _clean
 from contactid.io import write_text
 from contactid.logs import setup_logging
@@ -10,6 +10,8 @@ from contactid.logs import setup_logging
 log = setup_logging(snakemake.log[0])
 rows = [json.load(open(path)) for path in snakemake.input.rows]
 result = score(rows)
+# the records' check (rule record_checks) on records that are all right: its false alarms
+result["records_check"] = records_check_score(rows)
 # one line per item: the single-effect items' shrink, the compound items' effects and explanation, a failure's reason
 KEYS = {
     "blind": ("shrink_true",),
@@ -28,7 +30,7 @@ result["items"] = [
             "kind",
             "verdict",
             "seconds",
-            *(("failed",) if r.get("failed") else ("heldout_gap_before", *KEYS[r["kind"]])),
+            *(("failed",) if r.get("failed") else ("heldout_gap_before", "records_check", *KEYS[r["kind"]])),
         )
     }
     for r in rows

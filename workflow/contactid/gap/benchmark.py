@@ -401,6 +401,7 @@ def run_item(spec: Mapping, cfg: Mapping, outputs: Mapping | None = None) -> dic
     diag = item.diag
     if outputs:
         write_item_diagnosis(outputs, spec, item, n_harmonics)
+    records_check = _records_check(cfg, item)
     if spec["kind"] == "compound":
         row = compound_row(spec, cfg, effects, item, converged, t_rig)
         log.info(
@@ -411,7 +412,7 @@ def run_item(spec: Mapping, cfg: Mapping, outputs: Mapping | None = None) -> dic
             100 * row["friction_errors"]["mu"],
             time.perf_counter() - t0,
         )
-        return row
+        return {**row, "records_check": records_check}
     expected = "none" if spec["kind"] == "leave_out" else (spec["effect"] or "none")
     log.info(
         "benchmark item (%s): %s -> verdict %s (expected %s: %s), %.1f s in all",
@@ -422,7 +423,34 @@ def run_item(spec: Mapping, cfg: Mapping, outputs: Mapping | None = None) -> dic
         "right" if diag.verdict == expected else "wrong",
         time.perf_counter() - t0,
     )
-    return blind_row(spec, item, converged, t_rig)
+    return {**blind_row(spec, item, converged, t_rig), "records_check": records_check}
+
+
+def _records_check(cfg: Mapping, item: ItemDiagnosis) -> dict:
+    """The records' check (rule record_checks) of an item's records against its chain model: every rig record is
+    right, so a finding with a signature is a false alarm of the check ({passed, checks named})."""
+    from .pipeline import records_check_of
+    from .record_checks import Thresholds
+
+    out = records_check_of(
+        item.chain_model,
+        item.records,
+        cfg["nonlinear"]["calibration_case"],
+        int(cfg["nonlinear"]["n_harmonics"]),
+        Thresholds.from_config(cfg["gap"]["record_checks"]),
+    )
+    return {"passed": out["passed"], "findings": [f["check"] for f in out["findings"]]}
+
+
+def records_check_score(rows: list) -> dict:
+    """How often the records' check called the benchmark's (right) records wrong: findings with a signature (false
+    alarms, which would make the verdict records_disagree) and gross warnings, over the items it ran on."""
+    ran = [r["records_check"] for r in rows if isinstance(r.get("records_check"), Mapping)]
+    return {
+        "items": len(ran),
+        "false_alarms": sum(not c["passed"] for c in ran),
+        "gross_warnings": sum("gross" in c["findings"] for c in ran),
+    }
 
 
 def score(rows: list) -> dict:

@@ -332,21 +332,31 @@ def _refitted(model, structure, calibration, fit_settings, seed: int):
 
 
 def workflow_record_checks(structure_cfg: Mapping, inputs, cases, calibration_case: str, n_harmonics: int, thresholds):
-    """The records' check (``record_checks.records_check``) from the workflow's files: ``inputs`` names modes, modal,
-    fit and raw (the load cases' records, in the order of ``cases``); the prediction is the chain's identified model
-    (not updated) at each record's measured force."""
+    """The records' check (``records_check_of``) from the workflow's files: ``inputs`` names modes, modal, fit and raw
+    (the load cases' records, in the order of ``cases``); the prediction is the chain's identified model (not
+    updated)."""
     from ..io import load_dataset, read_raw
-    from .model import NONE, identified_model, simulate
-    from .record_checks import accelerance_levels, model_evidence, records_check
+    from .model import identified_model
 
     model = identified_model(
         structure_cfg, load_dataset(inputs.modes), load_dataset(inputs.modal), load_dataset(inputs.fit)
     )
     H = int(n_harmonics)
-    evidence, harmonics = {}, {}
-    for case, path in zip(cases, inputs.raw):
-        rec = record_harmonics(read_raw(path, dual_sine=True), case, H)
+    records = {c: record_harmonics(read_raw(path, dual_sine=True), c, H) for c, path in zip(cases, inputs.raw)}
+    return records_check_of(model, records, calibration_case, H, thresholds)
+
+
+def records_check_of(model, records: Mapping, calibration_case: str, n_harmonics: int, thresholds) -> dict:
+    """``record_checks.records_check`` of the records' harmonics ``records`` {case: RecordHarmonics}: their
+    accelerances at the drive, and each against ``model``'s prediction at its measured force (harmonics
+    1..``n_harmonics``)."""
+    from .model import NONE, simulate
+    from .record_checks import accelerance_levels, model_evidence, records_check
+
+    H = int(n_harmonics)
+    evidence = {}
+    for case, rec in records.items():
         sim = simulate(model, NONE, rec)
         evidence[case] = model_evidence(case, rec.sensors, rec.acceleration[:, :H], sim.acceleration[:, :H])
-        harmonics[case] = {"acceleration": rec.acceleration, "force": rec.force}
-    return records_check(accelerance_levels(harmonics), evidence, calibration_case, thresholds)
+    levels = accelerance_levels({c: {"acceleration": r.acceleration, "force": r.force} for c, r in records.items()})
+    return records_check(levels, evidence, calibration_case, thresholds)
