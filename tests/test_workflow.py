@@ -186,7 +186,7 @@ def test_measured_files_are_inputs_by_their_content(measured_run, tmp_path):
     assert "import_uff58_frf" not in plan  # the random test did not change
     (tmp_path / "dup.yaml").write_text("gap: {candidates: [viscous_friction]}\ngap: {candidates: []}\n")
     res = snakemake(proj, "-n", "--configfile", str(tmp_path / "dup.yaml"))
-    assert res.returncode != 0 and f"{tmp_path / 'dup.yaml'}:2: key 'gap' repeats line 1" in res.stderr
+    assert res.returncode != 0 and f"{tmp_path / 'dup.yaml'}:2: key 'gap' repeats line 1" in res.stderr + res.stdout
 
 
 def test_report_of_measured_records_says_no_truth_is_known(measured_run):

@@ -279,12 +279,22 @@ def read_raw(
         fail("global attribute 'sampling_rate_hz' is missing")
     if dual_sine and "excitation_frequency_hz" not in ds.attrs:
         fail("global attribute 'excitation_frequency_hz' is missing (required for dual-sine records)")
-    units_f = ds["force"].attrs.get("units")
-    if units_f not in _FORCE_UNITS:
-        fail(f"'force' has units {units_f!r}; convert to 'N'")
-    units_a = ds["acceleration"].attrs.get("units")
-    if units_a not in _ACC_UNITS:
-        fail(f"'acceleration' has units {units_a!r}; convert to 'm/s^2' (1 g = 9.80665 m/s^2)")
+    imported = (
+        "or import the file with a channel map stating the units it stores (config/README.md, Importing measured files)"
+    )
+    for var, main, accepted, other, convert in (
+        ("force", "N", _FORCE_UNITS, "kN, lbf or volts", "convert to 'N'"),
+        ("acceleration", "m/s^2", _ACC_UNITS, "g, mm/s^2 or volts", "convert to 'm/s^2' (1 g = 9.80665 m/s^2)"),
+    ):
+        units = ds[var].attrs.get("units")
+        if units is None or (isinstance(units, str) and not units.strip()):
+            also = ", ".join(repr(u) for u in sorted(accepted - {main}))
+            fail(
+                f"'{var}' has no units attribute; state the units: units = '{main}' (also read: {also}); a record in "
+                f"{other} must be converted first, {imported}"
+            )
+        if not (isinstance(units, str) and units in accepted):
+            fail(f"'{var}' has units {units!r}; {convert}, {imported}")
     if ds["position"].dtype.kind not in "fiu" or not np.all(np.isfinite(ds["position"].values)):
         fail("coordinate 'position' must hold finite numbers (m from the clamp)")
     units_x = str(ds["position"].attrs.get("units", "m")).strip()

@@ -1,5 +1,8 @@
-"""Checks of a dual-sine raw record before identification: its harmonic content at the
-excitation frequency and its stationarity (first against last third of the record)."""
+"""Checks of raw records before identification: a dual-sine record's harmonic content at the excitation frequency
+and its stationarity (first against last third of the record), and the validation of dual-sine and random-test records
+(dead channels, clipping, the sampling rate and excitation frequency, offsets, stationarity, length, coherence), each
+check a small function of the record's numbers whose thresholds follow from the physics and statistics of the records
+(the constants below) or from the config's raw_checks."""
 
 from __future__ import annotations
 
@@ -9,7 +12,7 @@ import numpy as np
 import xarray as xr
 
 from .io import RawDataError
-from .harmonics import harmonic_content
+from .harmonics import harmonic_amplitudes, harmonic_content, synthesize
 
 
 def driving_point_index(raw: xr.Dataset, excitation_position_m: float, path: str, tol_m: float = 1e-3) -> int:
@@ -87,6 +90,35 @@ def check_settings(checks: Mapping | None) -> dict:
 # no force (N) or acceleration (m/s^2) of a vibration test comes near this: a larger value is a scaling error
 PHYSICAL_LIMIT = 1.0e9
 
+# The checks' thresholds, from the physics and statistics of the records (none is a setting):
+# - a bin of a record's spectrum stands LINE_FACTOR times above the spectrum's median (its noise floor) only where a
+#   line is: white noise's bins are Rayleigh distributed, with the median 1.18 times the scale, and one exceeds ten
+#   medians with probability exp(-69) (none of a million bins by chance);
+LINE_FACTOR = 10.0
+# - a harmonic's least-squares amplitude (or a mean) beyond LINE_SNR standard errors of the channel's noise is real:
+#   noise alone reaches it with probability exp(-12.5) = 4e-6 (a mean: 6e-7);
+LINE_SNR = 5.0
+# - no accelerometer on the driven beam responds at the drive's lines with less than DEAD_LEVEL of another's: the
+#   modes' shapes rise from the clamp as (x / L)^2, so only a sensor within about a millimetre of the clamp would;
+#   a channel that far below its peers is flat but for noise or crosstalk;
+DEAD_LEVEL = 1e-6
+# - a declared excitation frequency is the drive's rounded or nominal value, a few per cent off at most: a record whose
+#   lines sit further off is read as a wrong sampling rate (another acquisition rate, a resampled export); the
+#   message names both fixes either way;
+RATE_FACTOR_LIMIT = 0.05
+# - a flat top is clipping where the signal's continuation (a quadratic through the samples either side of it) runs
+#   beyond the held value by more than CLIP_EXCESS times the channel's sample-to-sample scatter (the same
+#   continuation's robust residual at every sample: noise, quantisation and curvature together); a clean periodic
+#   record's repeated peak, a sample the continuation meets within its scatter, is not;
+CLIP_EXCESS = 5.0
+# - the value at a clipped channel's limit collects every sample beyond it: it recurs CLIP_SPIKE times as often as the
+#   values next to it, which no unclipped record's extreme does (``flat_tops``).
+CLIP_SPIKE = 4.0
+# - a piezoelectric transducer holds no mean, and a periodic motion's acceleration has none over whole periods: a mean
+#   beyond LINE_SNR standard errors is an offset, worth a warning from OFFSET_SHARE of the channel's drive line
+#   (or, in a random test, of its rms) on (a smaller one is harmless and common).
+OFFSET_SHARE = 0.01
+
 
 def _channels(raw: xr.Dataset, path: str = "record"):
     """(name, samples) of the force and every accelerometer, after the magnitude check."""
@@ -102,8 +134,38 @@ def _channels(raw: xr.Dataset, path: str = "record"):
     yield from chans
 
 
+def _unit(k: int) -> str:
+    """The unit of channel ``k`` of ``_channels`` (the force first)."""
+    return "N" if k == 0 else "m/s^2"
+
+
+def _dead_fix(k: int) -> str:
+    """What a dead channel ``k`` of ``_channels`` is and what to do."""
+    if k == 0:
+        return (
+            "a dead force transducer, its cable or a channel not recorded; check the transducer and its cable "
+            "(the identification needs the force)"
+        )
+    return (
+        "a dead sensor, cable or a channel not recorded; check the sensor and its cable, or remove it from the "
+        "record and from structure.sensors"
+    )
+
+
+def flat_channel_check(channels, path: str) -> None:
+    """Refuse a channel of ``channels`` ([(name, samples)], from ``_channels``: the force first) whose samples are all
+    equal: nothing was recorded on it (no clipping, frequency or harmonic means anything there)."""
+    for k, (name, x) in enumerate(channels):
+        if x.size and float(np.ptp(x)) == 0.0:
+            raise RawDataError(
+                f"{path}: channel {name}: dead-channel check failed: channel {name} is flat (all samples equal to "
+                f"{x[0]:.6g} {_unit(k)}): {_dead_fix(k)}"
+            )
+
+
 def samples_at_limit(x: np.ndarray) -> int:
-    """How many samples sit at the channel's largest or smallest value (a flat top: clipping)."""
+    """How many samples sit at the channel's largest or smallest value (not all of them clipped: a clean periodic
+    record repeats its peak sample every period; ``flat_tops`` tells)."""
     span = float(np.ptp(x))
     if span == 0.0:
         return x.size
@@ -111,35 +173,114 @@ def samples_at_limit(x: np.ndarray) -> int:
     return int(max(np.sum(x >= x.max() - tol), np.sum(x <= x.min() + tol)))
 
 
-def clipping_warnings(channels, path: str, clip_samples: int, drive: str) -> list[str]:
-    """Refuse a clipped channel of ``channels`` ([(name, samples)], from ``_channels``) when
-    ``clip_samples`` samples sit at its extreme value; warn from half that many."""
-    warnings = []
-    for name, x in channels:
-        at = samples_at_limit(x)
-        if at >= clip_samples:
-            raise RawDataError(
-                f"{path}: channel {name}: clipping check failed: {at} samples sit at the range limit "
-                f"({x.max():.6g} / {x.min():.6g}); raw_checks.clip_samples = {clip_samples}. "
-                f"Lower the input range's gain or the {drive} and record again"
+_SIDE = 3  # samples either side of a flat top through which its continuation is drawn
+
+
+def _continuation_scatter(x: np.ndarray, tol: float) -> float:
+    """The channel's sample-to-sample scatter: the robust rms (1.4826 median absolute value) of each sample less the
+    quadratic through the ``_SIDE`` samples either side of it, over the samples off its extreme values (within
+    ``tol``: a clipped channel's flat tops, which the quadratic meets exactly, left out)."""
+    if x.size < 2 * _SIDE + 1:
+        return 0.0
+    u = np.r_[-_SIDE:0, 1 : _SIDE + 1].astype(float)
+    kernel = np.zeros(2 * _SIDE + 1)
+    kernel[u.astype(int) + _SIDE] = np.linalg.pinv(np.vander(u, 3, increasing=True))[0]  # the quadratic at u = 0
+    centre = x[_SIDE:-_SIDE]
+    residual = np.abs(centre - np.correlate(x, kernel, mode="valid"))
+    off = (centre < x.max() - tol) & (centre > x.min() + tol)
+    return 1.4826 * float(np.median(residual[off] if off.any() else residual))
+
+
+def flat_tops(x: np.ndarray, unit: str = "") -> tuple[int, str]:
+    """Clipping of one channel: (how many samples are held at its largest or smallest value, the evidence, in
+    ``unit``).
+
+    A clipped channel holds samples at the range limit where the signal went on beyond it, seen two ways:
+    - the limit's value collects every sample beyond it: it occurs more than ``CLIP_SPIKE`` times as often as each of
+      the three values just below it (plus one). A record with noise repeats no value, a clean periodic record repeats
+      each of its values once a period, the peak as often as its neighbours, and a quantised sine's top step holds at
+      most about 2.4 times the samples of the step below it (its arcsine distribution);
+    - a run at the limit (gaps of up to two samples below it bridged) that the signal's continuation, the quadratic
+      through the ``_SIDE`` samples either side of it, exceeds by ``CLIP_EXCESS`` times the channel's
+      sample-to-sample scatter: a flat top. A clean periodic record's peak, repeated at the same phase every period
+      (one or two samples, the neighbours below), is met by that continuation within the scatter."""
+    span = float(np.ptp(x))
+    if span == 0.0 or x.size < 2 * _SIDE + 2:
+        return 0, ""
+    tol = 1e-9 * span  # values this close are one value (a periodic record's repeats differ by rounding)
+    q = np.round((x - x.min()) / tol).astype(np.int64)
+    counts = np.unique(q, return_counts=True)[1]
+    scatter = None
+    held, evidence = 0, ""
+    for sign in (1.0, -1.0):
+        y = sign * x
+        limit = float(y.max())
+        at = np.flatnonzero(q == (q.max() if sign > 0 else 0))
+        if at.size < 2:
+            continue
+        inwards = counts[::-1] if sign > 0 else counts  # the values' counts from this limit inwards
+        n_limit = at.size
+        most = int(inwards[1:4].max()) if inwards.size > 1 else 0
+        if n_limit > CLIP_SPIKE * (most + 1):
+            side_held = n_limit
+            side_evidence = (
+                f"the limit's value occurs {n_limit} times, each of the three just below it at most {most} times"
             )
-        if at >= max(2, clip_samples // 2):
-            warnings.append(f"{name}: {at} samples at the range limit (clipping check: {clip_samples})")
+        else:
+            if scatter is None:
+                scatter = max(_continuation_scatter(x, tol), 1e-12 * span)
+            side_held, worst = 0, 0.0
+            for top in np.split(at, np.flatnonzero(np.diff(at) > 3) + 1):
+                i, j = int(top[0]), int(top[-1])
+                if i < _SIDE or j + _SIDE >= y.size:
+                    continue  # at the record's edge: no continuation on one side
+                u = np.r_[i - _SIDE : i, j + 1 : j + 1 + _SIDE]
+                c = (i + j) / 2
+                coef = np.polyfit(u - c, y[u], 2)
+                excess = float(np.max(np.polyval(coef, np.arange(i, j + 1) - c))) - limit
+                if excess > CLIP_EXCESS * scatter:
+                    side_held += top.size
+                    worst = max(worst, excess)
+            side_evidence = (
+                f"the signal's continuation runs up to {worst:.3g}{' ' + unit if unit else ''} beyond it, "
+                f"{worst / scatter:.3g} times the channel's sample-to-sample scatter"
+            )
+        if side_held > held:
+            evidence = side_evidence
+        held += side_held
+    return held, evidence
+
+
+def clipping_warnings(channels, path: str, clip_samples: int, drive: str) -> list[str]:
+    """Refuse a clipped channel of ``channels`` ([(name, samples)], from ``_channels``) when ``clip_samples``
+    samples are held at its range limit in flat tops (``flat_tops``); warn from half that many."""
+    warnings = []
+    for k, (name, x) in enumerate(channels):
+        held, evidence = flat_tops(x, _unit(k))
+        if held >= clip_samples:
+            raise RawDataError(
+                f"{path}: channel {name}: clipping check failed: {held} samples sit at the range limit "
+                f"({x.max():.6g} / {x.min():.6g} {_unit(k)}), held there ({evidence}); raw_checks.clip_samples = "
+                f"{clip_samples}. Lower the input range's gain or the {drive} and record again"
+            )
+        if held >= max(2, clip_samples // 2):
+            warnings.append(f"{name}: {held} samples held at the range limit (clipping check: {clip_samples})")
     return warnings
 
 
-def recovered_frequency(x: np.ndarray, fs: float, declared_hz: float) -> tuple[float, int]:
-    """The excitation frequency found in a record: the strongest spectral line of ``x`` (Hann
-    window), refined by maximising the windowed DFT magnitude, divided by its harmonic number h of
-    the declared frequency. Returns (frequency in Hz, h)."""
-    from scipy.optimize import minimize_scalar
-
-    n = x.size
-    w = np.hanning(n)
-    y = (x - x.mean()) * w
+def _spectrum(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The Hann-windowed, mean-free record and its DFT magnitude (no DC bin)."""
+    y = (x - x.mean()) * np.hanning(x.size)
     spec = np.abs(np.fft.rfft(y))
     spec[0] = 0.0
-    k = int(np.argmax(spec))
+    return y, spec
+
+
+def _refine(y: np.ndarray, fs: float, k: int) -> float:
+    """The frequency (Hz) near bin ``k`` at which the windowed record ``y``'s DFT magnitude peaks."""
+    from scipy.optimize import minimize_scalar
+
+    n = y.size
     t = np.arange(n) / fs
     df = fs / n
 
@@ -152,34 +293,176 @@ def recovered_frequency(x: np.ndarray, fs: float, declared_hz: float) -> tuple[f
         method="bounded",
         options={"xatol": 1e-7 * max(k, 1) * df},
     )
-    h = max(1, int(round(res.x / declared_hz)))
-    return float(res.x / h), h
+    return float(res.x)
 
 
-def validate_dual_sine(raw: xr.Dataset, path: str, checks: Mapping) -> list[str]:
-    """Clipping, excitation frequency and stationarity of a dual-sine record; raises RawDataError on
-    the first failure, returns the warnings."""
-    c = check_settings(checks)
-    fs = float(raw.attrs["sampling_rate_hz"])
-    f0 = float(raw.attrs["excitation_frequency_hz"])
-    n = raw.sizes["time"]
-    duration = n / fs
-    channels = list(_channels(raw, path))
-    warnings = clipping_warnings(channels, path, c["clip_samples"], "excitation")
-    f_rec, h = recovered_frequency(np.asarray(raw["force"].values, float), fs, f0)
-    drift_cycles = abs(f_rec - f0) * duration
-    if h not in (1, 2, 3) or drift_cycles > c["frequency_tolerance_cycles"]:
+def _line_at(spec: np.ndarray, bin_: float, floor: float) -> float:
+    """The magnitude of the line at (fractional) bin ``bin_`` of ``spec``: the largest bin within one of it where
+    it stands ``LINE_FACTOR`` times above ``floor`` and twice above the bins three away on both sides (a line's
+    main lobe, not another line's leakage, which falls off steadily); else 0."""
+    j0 = int(round(bin_))
+    if j0 < 1 or j0 + 1 >= spec.size:
+        return 0.0
+    j = j0 - 1 + int(np.argmax(spec[j0 - 1 : j0 + 2]))
+    around = max(spec[j - 3] if j >= 3 else 0.0, spec[j + 3] if j + 3 < spec.size else 0.0)
+    return float(spec[j]) if spec[j] >= LINE_FACTOR * floor and spec[j] >= 2.0 * around else 0.0
+
+
+def excitation_lines(x: np.ndarray, fs: float, declared_hz: float) -> dict:
+    """The dual-sine excitation a force record shows: its strongest spectral line (Hann window, refined by maximising
+    the windowed DFT magnitude) and whether it is the record's w or 3 w, by the line standing out at three times it
+    or at a third of it (the stronger of the two where both do). Returns ``frequency_hz`` (the record's w),
+    ``harmonic`` (1 or 3: the strongest line's), ``strongest_hz``, ``paired`` (the other line found) and
+    ``line_to_floor`` (the strongest bin against the spectrum's median). With no partner line the strongest is taken
+    as the 3 w of the declared frequency when within ``RATE_FACTOR_LIMIT`` of it, else as w."""
+    y, spec = _spectrum(x)
+    df = fs / x.size
+    floor = float(np.median(spec[1:])) if spec.size > 1 else 0.0
+    k = int(np.argmax(spec))
+    f_a = _refine(y, fs, k)
+    above, below = _line_at(spec, 3 * f_a / df, floor), _line_at(spec, f_a / 3 / df, floor)
+    if below > 0.0 and below >= above:
+        h = 3
+    elif above > 0.0:
+        h = 1
+    else:
+        h = 3 if abs(f_a / (3 * declared_hz) - 1.0) <= RATE_FACTOR_LIMIT else 1
+    return {
+        "frequency_hz": f_a / h,
+        "harmonic": h,
+        "strongest_hz": f_a,
+        "paired": bool(above > 0.0 or below > 0.0),
+        "line_to_floor": float(spec[k] / floor) if floor > 0.0 else np.inf,
+    }
+
+
+def recovered_frequency(x: np.ndarray, fs: float, declared_hz: float) -> tuple[float, int]:
+    """The excitation frequency found in a dual-sine record (``excitation_lines``): (frequency in Hz, the harmonic
+    number, 1 or 3, of the record's strongest line)."""
+    lines = excitation_lines(x, fs, declared_hz)
+    return float(lines["frequency_hz"]), int(lines["harmonic"])
+
+
+def excitation_frequency_check(force: np.ndarray, fs: float, f0: float, path: str, tolerance_cycles: float) -> list:
+    """Refuse a force record with no excitation line, one whose lines sit at r f0 and 3 r f0 (a wrong sampling rate or
+    excitation frequency), or one whose excitation drifts more than ``tolerance_cycles`` cycles from the declared
+    ``f0`` over the record; warn from half the tolerance."""
+    lines = excitation_lines(force, fs, f0)
+    if lines["line_to_floor"] < LINE_FACTOR:
+        raise RawDataError(
+            f"{path}: channel force: excitation check failed: the force shows no spectral line (its strongest bin is "
+            f"{lines['line_to_floor']:.3g} times the spectrum's median, a line stands {LINE_FACTOR:g} times above "
+            "it): a dead force transducer, its cable, or a drive that was off; check the transducer, its cable and "
+            "the shaker's amplifier"
+        )
+    f_rec, h = lines["frequency_hz"], lines["harmonic"]
+    r = f_rec / f0
+    if abs(r - 1.0) > RATE_FACTOR_LIMIT:
+        if lines["paired"]:
+            seen = f"the record's lines are at {f_rec:.6g} and {3 * f_rec:.6g} Hz"
+        else:
+            seen = (
+                f"the record's one line is at {lines['strongest_hz']:.6g} Hz (taken as its {'3 w' if h == 3 else 'w'})"
+            )
+        raise RawDataError(
+            f"{path}: channel force: sampling rate check failed: {seen}, {r:.4g} times the declared "
+            f"excitation_frequency_hz = {f0:g} Hz and 3 f0 = {3 * f0:g} Hz: sampling_rate_hz ({fs:g}) is likely "
+            f"{r:.4g} times the true rate ({fs / r:.5g} Hz), or excitation_frequency_hz {1 / r:.4g} times the true "
+            f"one ({f_rec:.6g} Hz); correct the one that is wrong"
+        )
+    drift_cycles = abs(f_rec - f0) * force.size / fs
+    if drift_cycles > tolerance_cycles:
         raise RawDataError(
             f"{path}: channel force: excitation frequency check failed: the record's excitation is at "
             f"{f_rec:.6g} Hz (strongest line at harmonic {h}), the file declares {f0:.6g} Hz, "
             f"{drift_cycles:.3g} cycles apart over the record (raw_checks.frequency_tolerance_cycles = "
-            f"{c['frequency_tolerance_cycles']}); correct excitation_frequency_hz"
+            f"{tolerance_cycles}); correct excitation_frequency_hz"
         )
-    if drift_cycles > 0.5 * c["frequency_tolerance_cycles"]:
-        warnings.append(
+    if drift_cycles > 0.5 * tolerance_cycles:
+        return [
             f"force: excitation at {f_rec:.6g} Hz against {f0:.6g} Hz declared ({drift_cycles:.3g} cycles "
             "over the record)"
-        )
+        ]
+    return []
+
+
+def drive_lines(x: np.ndarray, fs: float, f0: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each row's amplitudes at w and 3 w (k, 2), its mean (k,) and its noise (k,: the rms of what the mean and the
+    harmonics of f0 below 0.45 fs, the first 50 at most, leave), fitted together by least squares over the whole
+    record (partial periods included)."""
+    x = np.atleast_2d(np.asarray(x, dtype=float))
+    n = x.shape[1]
+    t = np.arange(n) / fs
+    H = max(3, min(50, int(0.45 * fs / f0)))
+    c = harmonic_amplitudes(x.T, t, 2 * np.pi * f0, range(1, H + 1)).T  # (k, H)
+    periodic = synthesize(c, f0, t)
+    mean = np.mean(x - periodic, axis=1)
+    left = x - periodic - mean[:, None]
+    noise = np.sqrt(np.sum(left**2, axis=1) / max(n - 2 * H - 1, 1))
+    return np.abs(c[:, [0, 2]]), mean, noise
+
+
+def dead_channel_check(names, lines: np.ndarray, noise: np.ndarray, n: int, path: str) -> None:
+    """Refuse a channel that records no response at the drive's lines: an accelerometer whose larger line (w or 3 w,
+    ``lines`` (k, 2), the force's first) is below ``DEAD_LEVEL`` of the strongest accelerometer's, or any channel
+    whose lines do not stand ``LINE_SNR`` standard errors out of its own ``noise`` (rms, over ``n`` samples)."""
+    level = lines.max(axis=1)
+    acc = level[1:]
+    top = 1 + int(np.argmax(acc)) if acc.size else 0
+    for k, name in enumerate(names):
+        if k > 0 and level[k] < DEAD_LEVEL * level[top]:
+            raise RawDataError(
+                f"{path}: channel {name}: dead-channel check failed: channel {name} is flat but for noise "
+                f"({noise[k]:.3g} m/s^2 rms): its response at w and 3 w, {level[k]:.3g} m/s^2, is "
+                f"{level[k] / level[top]:.2g} of the strongest accelerometer's ({names[top]}, {level[top]:.3g} "
+                f"m/s^2), and no accelerometer on the driven beam responds with less than {DEAD_LEVEL:g} of "
+                f"another's: {_dead_fix(k)}"
+            )
+        se = noise[k] * np.sqrt(2.0 / n)
+        if level[k] < LINE_SNR * se:
+            raise RawDataError(
+                f"{path}: channel {name}: dead-channel check failed: its lines at w and 3 w ({level[k]:.3g} "
+                f"{_unit(k)}) do not stand out of its noise ({noise[k]:.3g} {_unit(k)} rms, {LINE_SNR:g} standard "
+                f"errors of a line: {LINE_SNR * se:.3g} {_unit(k)}): it records noise, not the test: {_dead_fix(k)}"
+            )
+
+
+def _offset_text(k: int) -> str:
+    """What an offset on channel ``k`` of ``_channels`` (the force first) is and what to check."""
+    what = "a transducer" if k == 0 else "an accelerometer"
+    zero = "the charge amplifier's" if k == 0 else "the charge amplifier's or signal conditioner's"
+    return f"{what} offset or drift (harmless to the identification, which uses the harmonics; check {zero} zero)"
+
+
+def offset_warnings(names, mean: np.ndarray, reference: np.ndarray, noise: np.ndarray, n: int, what) -> list[str]:
+    """Warnings for channels whose ``mean`` stands ``LINE_SNR`` standard errors (``noise`` rms over ``n`` samples) out
+    of zero and exceeds ``OFFSET_SHARE`` of ``reference`` (its drive line, or its rms), named ``what[k]``."""
+    out = []
+    for k, name in enumerate(names):
+        m = float(mean[k])
+        if abs(m) > LINE_SNR * noise[k] / np.sqrt(n) and abs(m) > OFFSET_SHARE * reference[k]:
+            out.append(
+                f"{name}: mean {m:.3g} {_unit(k)}, {abs(m) / reference[k]:.2g} of its {what[k]}: {_offset_text(k)}"
+            )
+    return out
+
+
+def validate_dual_sine(raw: xr.Dataset, path: str, checks: Mapping) -> list[str]:
+    """Dead channels, clipping, the sampling rate and excitation frequency, offsets and stationarity of a dual-sine
+    record; raises RawDataError on the first failure, returns the warnings."""
+    c = check_settings(checks)
+    fs = float(raw.attrs["sampling_rate_hz"])
+    f0 = float(raw.attrs["excitation_frequency_hz"])
+    n = raw.sizes["time"]
+    channels = list(_channels(raw, path))
+    flat_channel_check(channels, path)
+    warnings = clipping_warnings(channels, path, c["clip_samples"], "excitation")
+    warnings += excitation_frequency_check(channels[0][1], fs, f0, path, c["frequency_tolerance_cycles"])
+    names = [name for name, _ in channels]
+    lines, mean, noise = drive_lines(np.array([x for _, x in channels]), fs, f0)
+    dead_channel_check(names, lines, noise, n, path)
+    which = ["amplitude at " + ("w" if a >= b else "3 w") for a, b in lines]
+    warnings += offset_warnings(names, mean, lines.max(axis=1), noise, n, which)
     third = n // 3
     for name, x in channels:
         whole = np.abs(harmonic_content(x, fs, f0, (1, 3)))
@@ -229,11 +512,28 @@ def steady_drift(first: float, middle: float, last: float) -> bool:
 
 
 def validate_random_test(raw: xr.Dataset, path: str, checks: Mapping, segment_length: int, blocks: int) -> list[str]:
-    """Clipping, record length and frequency resolution of the random test (before the FRF)."""
+    """Dead channels, clipping, offsets, record length and frequency resolution of the random test (before the FRF;
+    a sensor that records noise alone is refused by the coherence check after it)."""
     c = check_settings(checks)
     fs = float(raw.attrs["sampling_rate_hz"])
     n = raw.sizes["time"]
-    warnings = clipping_warnings(list(_channels(raw, path)), path, c["clip_samples"], "force level")
+    channels = list(_channels(raw, path))
+    flat_channel_check(channels, path)
+    warnings = clipping_warnings(channels, path, c["clip_samples"], "force level")
+    names = [name for name, _ in channels]
+    rms = np.array([float(np.std(x)) for _, x in channels])
+    if rms.size > 1:
+        top = 1 + int(np.argmax(rms[1:]))
+        for k in range(1, rms.size):
+            if rms[k] < DEAD_LEVEL * rms[top]:
+                raise RawDataError(
+                    f"{path}: channel {names[k]}: dead-channel check failed: channel {names[k]} is flat but for "
+                    f"noise: its rms response, {rms[k]:.3g} m/s^2, is {rms[k] / rms[top]:.2g} of the strongest "
+                    f"accelerometer's ({names[top]}, {rms[top]:.3g} m/s^2), and no accelerometer on the driven beam "
+                    f"responds with less than {DEAD_LEVEL:g} of another's: {_dead_fix(k)}"
+                )
+    mean = np.array([float(np.mean(x)) for _, x in channels])
+    warnings += offset_warnings(names, mean, rms, rms, n, ["rms"] * len(names))
     need = 2 * segment_length * blocks
     if n < need:
         raise RawDataError(
