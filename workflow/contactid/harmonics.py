@@ -8,13 +8,24 @@ from __future__ import annotations
 
 import numpy as np
 
+ARRAY_LIMIT_BYTES = 256 << 20
+"""The most memory (bytes, 256 MiB) one work array of this module sized by a record may take: the least-squares
+design matrix of ``harmonic_amplitudes`` (samples x (2 harmonics + 1), with its two complex powers) and the phase
+matrix of ``synthesize`` (harmonics x samples, complex). ``aperiodic_share`` fits every harmonic below 0.45 fs, so its
+design matrix grows with the square of the samples per period: 12 MiB on the project's records (174 periods of 94
+samples), 14 GiB on two million samples at 1000 samples per period. Past the limit the work is done in blocks of
+samples below it (the normal equations summed block by block, the synthesis block by block: the same numbers to
+rounding), where a least squares by SVD is needed (fewer than two periods, aliased or repeated harmonics) refused
+with ``io.WorkLimitError``."""
 
-def harmonic_amplitudes(signal: np.ndarray, t: np.ndarray, w: float, harmonics) -> np.ndarray:
-    """Complex amplitudes c_h of signal ~ mean + sum_h Im(c_h exp(i h w t)) by least squares
-    (t in s, w in rad/s; valid on any window, whole number of periods or not). ``signal`` (n,) or (n, k): k
-    signals sampled at the same times, solved together (c of shape (H, k))."""
-    harmonics = [int(h) for h in harmonics]
-    t = np.asarray(t, dtype=float)
+
+def _design_row_bytes(n_columns: int) -> int:
+    """Memory (bytes) per sample of ``harmonic_amplitudes``' design matrix and its complex powers."""
+    return 8 * int(n_columns) + 32
+
+
+def _design(t: np.ndarray, w: float, harmonics: list) -> np.ndarray:
+    """The least-squares design matrix [1, sin(h w t), cos(h w t)...] (t.size, 1 + 2 len(harmonics))."""
     # e^{i h w t} by powers of e^{i w t} (about h machine epsilons of error, a tenth of the cost of sin and cos)
     X = np.empty((t.size, 1 + 2 * len(harmonics)))
     X[:, 0] = 1.0
@@ -24,19 +35,54 @@ def harmonic_amplitudes(signal: np.ndarray, t: np.ndarray, w: float, harmonics) 
         zh = zh * z
         for k in (k for k, hk in enumerate(harmonics) if hk == h):
             X[:, 1 + 2 * k], X[:, 2 + 2 * k] = zh.imag, zh.real
+    return X
+
+
+def harmonic_amplitudes(signal: np.ndarray, t: np.ndarray, w: float, harmonics) -> np.ndarray:
+    """Complex amplitudes c_h of signal ~ mean + sum_h Im(c_h exp(i h w t)) by least squares
+    (t in s, w in rad/s; valid on any window, whole number of periods or not). ``signal`` (n,) or (n, k): k
+    signals sampled at the same times, solved together (c of shape (H, k)). Memory within ``ARRAY_LIMIT_BYTES``."""
+    harmonics = [int(h) for h in harmonics]
+    t = np.asarray(t, dtype=float)
+    n_columns = 1 + 2 * len(harmonics)
     span = t[-1] - t[0] if t.size > 1 else 0.0
     periods = span * w / (2 * np.pi)
     # the highest harmonic's phase advance per sample, against pi (Nyquist: its sine column would vanish)
     top = max(harmonics, default=0) * w * span / max(t.size - 1, 1)
-    if periods >= 2.0 and t.size > 4 * X.shape[1] and len(set(harmonics)) == len(harmonics) and top < 0.9 * np.pi:
-        # two periods or more of distinct harmonics below Nyquist: the columns are near orthogonal (condition about
-        # 1.4), so the normal equations are as accurate as an SVD (1e-16) at a third of its cost; otherwise the
-        # SVD least squares (a repeated or aliased harmonic: the minimum-norm solution, as before)
+    normal = periods >= 2.0 and t.size > 4 * n_columns and len(set(harmonics)) == len(harmonics) and top < 0.9 * np.pi
+    rows = max(1, ARRAY_LIMIT_BYTES // _design_row_bytes(n_columns))
+    if t.size <= rows:
+        X = _design(t, w, harmonics)
+        if normal:
+            # two periods or more of distinct harmonics below Nyquist: the columns are near orthogonal (condition
+            # about 1.4), so the normal equations are as accurate as an SVD (1e-16) at a third of its cost; otherwise
+            # the SVD least squares (a repeated or aliased harmonic: the minimum-norm solution, as before)
+            import scipy.linalg
+
+            coef = scipy.linalg.solve(X.T @ X, X.T @ signal, assume_a="pos", check_finite=False)
+        else:
+            coef = np.linalg.lstsq(X, signal, rcond=None)[0]
+    elif normal:  # a design matrix past the limit: the normal equations summed over blocks of samples
         import scipy.linalg
 
-        coef = scipy.linalg.solve(X.T @ X, X.T @ signal, assume_a="pos", check_finite=False)
+        signal = np.asarray(signal)
+        XtX = np.zeros((n_columns, n_columns))
+        Xty = np.zeros((n_columns,) + signal.shape[1:], dtype=np.result_type(signal, float))
+        for first in range(0, t.size, rows):
+            X = _design(t[first : first + rows], w, harmonics)
+            XtX += X.T @ X
+            Xty += X.T @ signal[first : first + rows]
+        coef = scipy.linalg.solve(XtX, Xty, assume_a="pos", check_finite=False)
     else:
-        coef = np.linalg.lstsq(X, signal, rcond=None)[0]
+        from .io import WorkLimitError
+
+        raise WorkLimitError(
+            f"harmonic analysis: a least squares of {len(harmonics)} harmonics on {t.size} samples "
+            f"({periods:.3g} periods) needs {t.size * _design_row_bytes(n_columns) / 2**20:.4g} MiB, above the limit "
+            f"of {ARRAY_LIMIT_BYTES / 2**20:g} MiB (contactid.harmonics.ARRAY_LIMIT_BYTES), and it cannot be done in "
+            "blocks (fewer than two periods, or harmonics repeated or above the Nyquist frequency): check the record's "
+            "sampling_rate_hz and excitation_frequency_hz"
+        )
     # Im(c e^{i h w t}) = Re(c) sin + Im(c) cos
     return coef[1::2] + 1j * coef[2::2]
 
@@ -102,7 +148,14 @@ def synthesize(coef: np.ndarray, f0: float, t: np.ndarray, derivative: int = 0) 
     h = np.arange(1, coef.shape[1] + 1)
     w = 2 * np.pi * f0
     factor = (1j * h * w) ** derivative
-    return np.imag((coef * factor) @ np.exp(1j * np.outer(h * w, t)))
+    t = np.asarray(t, dtype=float)
+    block = max(1, ARRAY_LIMIT_BYTES // (24 * h.size))  # samples whose phases (real) and exponentials (complex) fit
+    if t.size <= block:
+        return np.imag((coef * factor) @ np.exp(1j * np.outer(h * w, t)))
+    return np.concatenate(  # past ``ARRAY_LIMIT_BYTES``: block by block
+        [np.imag((coef * factor) @ np.exp(1j * np.outer(h * w, t[i : i + block]))) for i in range(0, t.size, block)],
+        axis=-1,
+    )
 
 
 def periodic_grid(coef: np.ndarray, f0: float, m: int, derivative: int = 0) -> np.ndarray:

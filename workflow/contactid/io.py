@@ -60,6 +60,13 @@ class RawDataError(ValueError):
     """A raw record that does not follow the documented format."""
 
 
+class WorkLimitError(RawDataError):
+    """A computation refused because its memory, sized by a record or by a model identified from one, would pass a
+    stated limit (``rig.nonlinear.MAX_STEPS_PER_SAMPLE``, ``rig.nonlinear.WORK_LIMIT_BYTES``): the message says what
+    is too large, the limit, which record or model quantity made it so and the likely cause (most often a record
+    read in the wrong units or at the wrong sampling rate, whose identified model is then impossible)."""
+
+
 def file_digest(path: str | os.PathLike) -> str:
     """sha256 of a file's bytes (hex)."""
     h = hashlib.sha256()

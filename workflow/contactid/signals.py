@@ -6,6 +6,20 @@ from dataclasses import dataclass
 
 import numpy as np
 
+ARRAY_LIMIT_BYTES = 256 << 20
+"""The most memory (bytes, 256 MiB) the Welch segments' spectra of ``h1_frf`` may take at once: a longer record's
+segments are transformed and averaged in batches that stay below it (the same spectra, their means to rounding),
+so the FRF's memory does not grow with the record. A single segment past it (``frf.segment_length`` x the channels:
+some 2.8 million samples of four channels) is refused with ``io.WorkLimitError``. The project's random test (128 s at
+5120 Hz, segments of 65536 samples, four channels) takes 76 MiB, the foreign records' (60 s at 5400 Hz, 32768
+samples) 36 MiB: both in one batch, as before."""
+
+
+def _segment_bytes(n_channels: int, segment_length: int) -> int:
+    """Memory (bytes) of one segment's work in ``segment_spectra``: the detrended, windowed copy (8 bytes a sample)
+    and its one-sided spectrum (16 bytes a bin) of every channel."""
+    return int(n_channels) * (8 * int(segment_length) + 16 * (int(segment_length) // 2 + 1))
+
 
 @dataclass(frozen=True)
 class FRFEstimate:
@@ -71,12 +85,39 @@ def h1_frf(
         raise ValueError(f"FRF segment length {segment_length} exceeds the record length {n} samples")
     noverlap = int(round(overlap * segment_length))
     step = segment_length - noverlap
-    spectra = segment_spectra(np.vstack([force, responses]), segment_length, step, window)
-    F, X = spectra[0], spectra[1:]
-    gff = np.mean(F.real**2 + F.imag**2, axis=0)
-    gfx = np.mean(np.conj(F)[None] * X, axis=1)
-    gxx = np.mean(X.real**2 + X.imag**2, axis=1)
+    x = np.vstack([force, responses])
+    n_seg = 1 + (n - segment_length) // step
+    per_segment = _segment_bytes(x.shape[0], segment_length)
+    if per_segment > ARRAY_LIMIT_BYTES:
+        from .io import WorkLimitError
+
+        raise WorkLimitError(
+            f"FRF: one Welch segment of {segment_length} samples (frf.segment_length; "
+            f"{sampling_rate_hz / segment_length:.3g} Hz resolution at {sampling_rate_hz:g} Hz) of {x.shape[0]} "
+            f"channels needs {per_segment / 2**20:.4g} MiB, "
+            f"above the limit of {ARRAY_LIMIT_BYTES / 2**20:g} MiB (contactid.signals.ARRAY_LIMIT_BYTES): give a "
+            "shorter frf.segment_length, or check the record's sampling_rate_hz"
+        )
+    batch = max(1, ARRAY_LIMIT_BYTES // per_segment)
+    if n_seg <= batch:
+        spectra = segment_spectra(x, segment_length, step, window)
+        F, X = spectra[0], spectra[1:]
+        gff = np.mean(F.real**2 + F.imag**2, axis=0)
+        gfx = np.mean(np.conj(F)[None] * X, axis=1)
+        gxx = np.mean(X.real**2 + X.imag**2, axis=1)
+    else:  # a long record: its segments in batches below the limit, the spectra's sums accumulated
+        n_bin = segment_length // 2 + 1
+        gff, gfx, gxx = np.zeros(n_bin), np.zeros((x.shape[0] - 1, n_bin), complex), np.zeros((x.shape[0] - 1, n_bin))
+        for first in range(0, n_seg, batch):
+            last = min(n_seg, first + batch)
+            part = x[:, first * step : (last - 1) * step + segment_length]
+            spectra = segment_spectra(part, segment_length, step, window)
+            F, X = spectra[0], spectra[1:]
+            gff += np.sum(F.real**2 + F.imag**2, axis=0)
+            gfx += np.sum(np.conj(F)[None] * X, axis=1)
+            gxx += np.sum(X.real**2 + X.imag**2, axis=1)
+        gff, gfx, gxx = gff / n_seg, gfx / n_seg, gxx / n_seg
     h1 = gfx / np.where(gff > 0, gff, np.inf)
     coh = np.abs(gfx) ** 2 / np.where(gff * gxx > 0, gff * gxx, np.inf)
     f = np.fft.rfftfreq(segment_length, 1.0 / sampling_rate_hz)
-    return FRFEstimate(f, h1, coh, int(spectra.shape[1]))
+    return FRFEstimate(f, h1, coh, int(n_seg))

@@ -2,7 +2,9 @@
 
 import json
 
-from contactid.io import load_dataset, provenance, read_raw, write_dataset
+import numpy as np
+
+from contactid.io import RawDataError, load_dataset, provenance, read_raw, write_dataset
 from contactid.logs import fmt, setup_logging
 from contactid.nonlinear_chain import contact_forces_dataset
 from contactid.parameters import identified_structure
@@ -20,18 +22,73 @@ if "updating" in inp.keys():  # the structures the random test allows (model upd
     if upd["enabled"]:
         nominal = identified_structure(snakemake.params.structure, modes)
         structures = UpdatingResult.from_summary(upd, nominal).posterior_structures()
-ds = contact_forces_dataset(
-    read_raw(inp.raw, dual_sine=True),
-    load_dataset(inp.reduced),
-    modes,
-    load_dataset(inp.modal),
-    load_dataset(inp.stiction),
-    snakemake.params.structure,
-    K,
-    truth,
-    float(nl["observability_limit"]),
-    structures,
-)
+
+
+def nonfinite_fields(datasets: dict) -> list[str]:
+    """``file: variable`` of every variable holding a non-finite number among the inputs: where a NaN came from (an
+    open interval end is inf by design: k_n's, which the chain closes itself, is left out)."""
+    out = []
+    for path, data in datasets.items():
+        for name, var in data.data_vars.items():
+            values = np.asarray(var.values)
+            if values.dtype.kind in "fc" and not np.all(np.isfinite(values)) and name != "k_n_interval":
+                out.append(f"{path}: {name}")
+    return out
+
+
+raw = read_raw(inp.raw, dual_sine=True)
+reduced, modal, stiction = load_dataset(inp.reduced), load_dataset(inp.modal), load_dataset(inp.stiction)
+inputs = {inp.raw: raw, inp.reduced: reduced, inp.modes: modes, inp.modal: modal, inp.stiction: stiction}
+# the stiffness intervals' ends are structures the chain assembles (_stiffness_interval_spreads): an open upper end of
+# k_t (inf: the random test does not bound it) would give a NaN stiffness matrix; k_n's open end is closed there
+if not np.all(np.isfinite(stiction["k_t_interval"].values)):
+    raise RawDataError(
+        f"contact forces of {inp.raw}: {inp.stiction}'s k_t_interval is {stiction['k_t_interval'].values.tolist()} N/m "
+        f"(k_t = {float(stiction['k_t']):.4g} N/m; the random test's natural frequencies do not bound the tangential "
+        "contact stiffness from both sides), and the contact forces' spread over it needs both ends. Check the "
+        "random test (its sampling rate and units) and the structure's description; the stiffness fit's log "
+        "(logs/stiction_stiffness.log) says how far its frequencies are from the structure's"
+    )
+try:
+    ds = contact_forces_dataset(
+        raw,
+        reduced,
+        modes,
+        modal,
+        stiction,
+        snakemake.params.structure,
+        K,
+        truth,
+        float(nl["observability_limit"]),
+        structures,
+    )
+except (ValueError, np.linalg.LinAlgError) as exc:  # a NaN in a matrix: scipy's check, or a solver that fails on it
+    bad = nonfinite_fields(inputs)
+    if isinstance(exc, RawDataError) or not (bad or "infs or NaNs" in str(exc)):
+        raise
+    raise RawDataError(
+        f"contact forces of {inp.raw}: the inverse identification failed on infs or NaNs ({type(exc).__name__}: "
+        f"{exc}); "
+        + (
+            "non-finite inputs: " + "; ".join(bad)
+            if bad
+            else "every input is finite, so the identified structure itself (k_t, k_n, the structures the model "
+            f"updating allows in {inp.updating if 'updating' in inp.keys() else 'none'}) makes it singular"
+        )
+        + ". Check the random test (its sampling rate and units) and the linear chain's logs"
+    ) from exc
+bad = [
+    name
+    for name, var in ds.data_vars.items()
+    if np.asarray(var.values).dtype.kind in "fc" and not np.all(np.isfinite(var.values))
+]
+if bad:
+    raise RawDataError(
+        f"contact forces of {inp.raw}: the identified {', '.join(bad)} hold infs or NaNs (not written to "
+        f"{snakemake.output.forces}); non-finite inputs: "
+        + ("; ".join(nonfinite_fields(inputs)) or "none")
+        + ". Check the random test (its sampling rate and units) and the linear chain's logs"
+    )
 if not ds.attrs["eta_observable"]:
     log.warning(
         "eta moves by %.0f %% across the linear chain's stiffness intervals and by %.0f %% across the "

@@ -25,8 +25,17 @@ from ..beam_model import assemble
 from ..friction_parameters import fitted_parameters
 from ..harmonics import aperiodic_share, periodic_grid, periodic_harmonics
 from ..identification import damping_by_mode
+from ..io import WorkLimitError
 from ..parameters import StructureParameters, identified_structure
-from ..rig.nonlinear import ContactParameters, DualSineSimulator, reduced_model, stable_oversampling
+from ..rig.nonlinear import (
+    WORK_LIMIT_BYTES,
+    ContactParameters,
+    DualSineSimulator,
+    gib,
+    record_bytes,
+    reduced_model,
+    stable_oversampling,
+)
 from .records import RecordHarmonics
 
 
@@ -255,6 +264,17 @@ def fe_model(model: IdentifiedModel, aug: Augmentation = NONE):
     return _reduced(model.structure_with(aug), model.n_modes)[0]
 
 
+# what a model too stiff to integrate (``simulator``) says of its origin
+IMPLAUSIBLE_MODEL = (
+    "No pin has such a contact stiffness: the model's stiffnesses and masses come from the random test (the stiffness "
+    "fit on its natural frequencies, results/linear/stiction.nc, then the model updating on its FRFs' amplitudes, "
+    "results/gap/model_updating.json). Likely causes: the random test's accelerations in other units than declared "
+    "(in g read as m/s^2 its FRFs are 9.81 x low, which the model updating takes for masses and stiffnesses far off: "
+    "a random test of the paper's rig read so gave k_n = 2.5e19 N/m instead of 2.5e7) or wrong channel sensitivities; "
+    "check the random test's units and sensitivities, then its sampling rate"
+)
+
+
 def simulator(model: IdentifiedModel, aug: Augmentation, fs: float, f0: float | None = None) -> DualSineSimulator:
     """The reduced identified model with the augmentation, ready to integrate (step as the rig's,
     shortened to a whole number of steps per period of ``f0`` when given)."""
@@ -275,7 +295,11 @@ def simulator(model: IdentifiedModel, aug: Augmentation, fs: float, f0: float | 
         unilateral=aug.unilateral_exponent >= 1.0,
         regularization=model.regularization,
     )
-    q = stable_oversampling(red, fs, int(model.oversampling), viscous=aug.viscous)
+    try:
+        q = stable_oversampling(red, fs, int(model.oversampling), viscous=aug.viscous)
+    except WorkLimitError as exc:  # the identified model is too stiff to integrate
+        cause = "" if aug.viscous and "viscous" in str(exc) else f". {IMPLAUSIBLE_MODEL}"
+        raise WorkLimitError(f"gap diagnosis, the identified model: {exc}{cause}") from exc
     dt = 1.0 / (q * fs)
     if f0:
         dt = 1.0 / f0 / np.ceil(1.0 / (f0 * dt))
@@ -366,6 +390,7 @@ def simulate(
     n_per = int(round(2 * np.pi / w / sim.dt))
     periodic = None
     n_hb = min(n_per // 4, hb_harmonics or H)  # the balance's harmonics
+    _check_work(sim, rec, n_per, n_hb, max(int(record_periods), rec.periods), method == "harmonic_balance")
     # a contact that may open (unilateral law) is non-smooth: its periodic orbit need not be unique or attract,
     # so a harmonic-balance start could land the integrator on another orbit than the reference's; such a
     # model starts from the linear state, as the reference does (measured: the blind benchmark's
@@ -397,6 +422,42 @@ def simulate(
     if periodic is not None:
         result.extra.update({"Z": periodic.Z, "method": "harmonic_balance", "iterations": periodic.iterations})
     return result
+
+
+def _check_work(sim: DualSineSimulator, rec: RecordHarmonics, n_per: int, n_hb: int, periods: int, hb: bool) -> None:
+    """Refuse (``io.WorkLimitError``) a simulation whose harmonic-balance grid (``n_per`` points, ``n_hb``
+    harmonics) or whose stored record (``periods`` periods of ``n_per`` steps, what an unsettled response or a drifting
+    preload integrates) would pass ``rig.nonlinear.WORK_LIMIT_BYTES``, before anything is allocated; the message says
+    whether the model's step (its steps per sample) or the record (its samples per period, its periods) makes it so."""
+    from ..rig.harmonic_balance import grid_bytes
+
+    n = sim.red.omega.size
+    needs = {"the record's simulation": record_bytes(periods * n_per, n, state=False)}
+    if hb:
+        needs["the harmonic balance"] = grid_bytes(n_per, n_hb, n)
+    what, need = max(needs.items(), key=lambda kv: kv[1])
+    if need <= WORK_LIMIT_BYTES:
+        return
+    q = getattr(sim, "oversampling", 1)
+    per_sample = rec.fs / rec.f0
+    head = (
+        f"gap diagnosis of {rec.case}: {what} needs {gib(need)} ({n_per} steps per period of {rec.f0:g} Hz: "
+        f"{q} steps per sample x {per_sample:.6g} samples per period at {rec.fs:g} Hz"
+        + (f"; {periods} periods" if what == "the record's simulation" else "")
+        + f"), above the limit of {gib(WORK_LIMIT_BYTES)} (contactid.rig.nonlinear.WORK_LIMIT_BYTES): "
+    )
+    if q > 64:  # eight times the default oversampling: the model's stiffness, not the record, makes the steps
+        from ..rig.nonlinear import stiffest_mode
+
+        raise WorkLimitError(
+            head + f"the identified model's stiffest mode, at {stiffest_mode(sim.red)}, asks for {q} steps per "
+            f"sample. {IMPLAUSIBLE_MODEL}"
+        )
+    raise WorkLimitError(
+        head + f"the record has {per_sample:.6g} samples per period of its excitation and {rec.periods} periods; "
+        "check its sampling_rate_hz and excitation_frequency_hz (a sampling rate in other units, or an excitation "
+        "frequency far below the record's rate), or give a shorter record"
+    )
 
 
 def _periodic_state(sim: DualSineSimulator, coef, w, H, n_per, start):

@@ -64,15 +64,112 @@ class ReducedModel:
     k_n: float
 
 
+# Bounded work. The integrator's step follows the model's stiffest mode (``stable_oversampling``), and a model
+# identified from a record read in the wrong units can have one at GHz: the gap diagnosis of a random test whose
+# accelerations were in g read as m/s^2 had a normal-contact mode at 3.1 GHz and asked for 2.3 million steps per
+# sample, a 30.6 GiB harmonic-balance grid for one period. These limits turn that into an error that names the
+# quantity, the limit and the likely cause, before anything is allocated.
+MAX_STEPS_PER_SAMPLE = 1024
+"""The most integration steps per record sample ``stable_oversampling`` gives (the model's stiffest mode up to
+1024 x 1.6 / (2 pi) = 261 times the sampling rate). Legitimate models need 8 (the default oversampling; 9 after the
+gap diagnosis' mass refits, ``gap.model.KN_REFIT_ABOVE``), 79 (the viscous-friction candidate at the end of its
+domain, 1e5 N s/m, at 5120 Hz) and 169 (the project's structure with k_n at the stiffness fit's upper search bound,
+1e11 N/m, at 5120 Hz: a 219 kHz mode): the limit leaves six times the largest. Past it a ``WorkLimitError`` names
+the mode, the contact spring that makes it and the likely cause (a contact stiffness no pin can have, identified from
+a record read in the wrong units)."""
+
+WORK_LIMIT_BYTES = 1 << 30
+"""The most memory (bytes, 1 GiB) one simulation's stored signals (``DualSineSimulator.run``, ``record_bytes``) or
+one harmonic-balance grid (``rig.harmonic_balance.grid_bytes``) may take. With the job's own memory (the largest job
+of a run on the foreign records peaked at 0.75 GiB) and the copies the callers make of a stored record (a sixth of
+it), no job passes about 2.5 GiB, below the 4 GiB a job may use. Legitimate work stays far below it (estimates by
+those two functions): the rig's dual-sine record (16384 samples, eight steps each, with its margins) 89 MB; the gap
+diagnosis' harmonic balance of a 54 Hz record at 5400 Hz (800 points, 18 harmonics) 4.6 MB, and the longest record
+it integrates on the project's rig (174 periods of 754 steps) 44 MB; a record at 51.2 kHz driven at 10 Hz (41000
+steps per period) 0.2-0.3 GiB. Past it a ``WorkLimitError``."""
+
+
+def _work_limit_error(message: str):
+    from ..io import WorkLimitError  # here: this module is imported where xarray is not needed
+
+    return WorkLimitError(message)
+
+
+def gib(n_bytes: float) -> str:
+    """A memory size for a message ("30.6 GiB", "12 MiB")."""
+    return f"{n_bytes / 2**30:.3g} GiB" if n_bytes >= 2**30 else f"{n_bytes / 2**20:.3g} MiB"
+
+
+def frequency_text(f_hz: float) -> str:
+    """A frequency for a message, in Hz, kHz, MHz or GHz."""
+    for unit, scale in (("GHz", 1e9), ("MHz", 1e6), ("kHz", 1e3)):
+        if abs(f_hz) >= scale:
+            return f"{f_hz / scale:.3g} {unit}"
+    return f"{f_hz:.4g} Hz"
+
+
+def record_bytes(n_steps: int, n_r: int, state: bool = True) -> int:
+    """Memory (bytes) of ``DualSineSimulator.run``'s stored signals over ``n_steps`` steps of a reduced model of
+    ``n_r`` coordinates, with the coordinates and velocities (``state``) or without: measured 313 (336 with them)
+    bytes per step at n_r = 11, 16 (10 + n_r (1 + 2 state)) bytes bound it (the stored arrays and the temporaries)."""
+    return int(n_steps) * 16 * (10 + int(n_r) * (3 if state else 1))
+
+
+def stiffest_mode(red: ReducedModel) -> str:
+    """The reduced model's stiffest mode in words: its frequency and, where a contact spring carries most of its
+    strain energy (k eta_i^2 / omega_i^2 of the mass-normalised mode), which spring and its stiffness."""
+    i = int(np.argmax(red.omega))
+    w2 = max(float(red.omega[i]) ** 2, 1e-300)
+    shares = {
+        "normal": float(red.k_n) * float(red.eta[i]) ** 2 / w2,
+        "tangential": float(red.k_t) * float(red.xi[i]) ** 2 / w2,
+    }
+    name = max(shares, key=shares.get)
+    text = f"{frequency_text(red.omega[i] / (2 * np.pi))}"
+    if shares[name] > 0.5:
+        k = red.k_n if name == "normal" else red.k_t
+        other = ("k_t", red.k_t) if name == "normal" else ("k_n", red.k_n)
+        sym = "k_n" if name == "normal" else "k_t"
+        text += (
+            f", the {name} contact's mode (its spring {sym} = {k:.3g} N/m carries {100 * min(shares[name], 1.0):.0f} % "
+            f"of the mode's strain energy; {other[0]} = {other[1]:.3g} N/m)"
+        )
+    else:
+        text += f" (k_t = {red.k_t:.3g} N/m, k_n = {red.k_n:.3g} N/m)"
+    return text
+
+
 def stable_oversampling(red: ReducedModel, fs: float, q_min: int, stiffening: float = 1.0, viscous: float = 0.0) -> int:
     """Integration steps per sample at ``fs`` (Hz), at least ``q_min``, at which the explicit central differences keep
     a margin: omega_max dt <= 1.6 (omega_max (rad/s) times ``stiffening``, a hardening normal law's tangent ratio;
     2 is the edge) and the viscous friction's rate sigma_2 |dxi/dq|^2 (1/s; ``viscous`` sigma_2 in N s/m), which a step
     takes explicitly, times dt at most 1 (2 is the edge: the rig's records blew up at sigma_2 = 2e4 N s/m, rate x dt
-    1.96, with the default eight steps per sample)."""
-    q = max(int(q_min), int(np.ceil(stiffening * red.omega.max() / (1.6 * fs))))
+    1.96, with the default eight steps per sample).
+
+    Raises ``io.WorkLimitError`` past ``MAX_STEPS_PER_SAMPLE``, naming the stiffest mode (and the contact spring
+    that makes it) or the viscous rate."""
+    q_mode = int(np.ceil(stiffening * red.omega.max() / (1.6 * fs)))
     rate = float(viscous) * float(red.xi @ red.xi)
-    return max(q, int(np.ceil(rate / fs)))
+    q_rate = int(np.ceil(rate / fs))
+    q = max(int(q_min), q_mode, q_rate)
+    if q > MAX_STEPS_PER_SAMPLE:
+        if q_mode >= q_rate:
+            f_max = float(red.omega.max()) / (2 * np.pi)
+            what = (
+                f"the model's stiffest mode is at {stiffest_mode(red)}, {f_max / fs:.3g} x the sampling rate {fs:g} Hz"
+                + (f" (x {stiffening:.3g}, the normal law's hardening)" if stiffening != 1.0 else "")
+            )
+        else:
+            what = (
+                f"the viscous friction's rate sigma_2 |dxi/dq|^2 = {rate:.3g} 1/s (sigma_2 = {viscous:.3g} N s/m) is "
+                f"{rate / fs:.3g} x the sampling rate {fs:g} Hz"
+            )
+        raise _work_limit_error(
+            f"{what}: the explicit integration would need {q} steps per sample, above the limit of "
+            f"{MAX_STEPS_PER_SAMPLE} (contactid.rig.nonlinear.MAX_STEPS_PER_SAMPLE; a legitimate model needs 8 to "
+            "about 170)"
+        )
+    return q
 
 
 def reduced_model(model: FEModel, n_modes: int, static_correction: bool = True) -> ReducedModel:
@@ -525,6 +622,16 @@ class DualSineSimulator:
         coef = force_coefficients(F1, F3)
         n_store = 0 if store_from is None else n_steps - store_from
         n_r = self.red.omega.size
+        need = record_bytes(n_store, n_r, state)
+        if need > WORK_LIMIT_BYTES:
+            per_period = 2 * np.pi / (float(w) * self.dt) if w else float("nan")
+            raise _work_limit_error(
+                f"time integration: storing {n_store} steps ({n_store / per_period:.4g} periods of "
+                f"{per_period:.6g} steps, dt = {self.dt:.3g} s, {getattr(self, 'oversampling', '?')} steps per sample) "
+                f"of a {n_r}-coordinate model needs {gib(need)}, above the limit of {gib(WORK_LIMIT_BYTES)} "
+                "(contactid.rig.nonlinear.WORK_LIMIT_BYTES): a record this long, or a model this stiff "
+                f"(its stiffest mode at {stiffest_mode(self.red)}), is beyond what one job simulates"
+            )
         out = {k: np.empty(n_store) for k in ("S", "N", "xi", "eta", "f", "dxi", "deta")}
         out_a = np.empty((n_store, n_r))
         out_z = np.empty((n_store if state else 0, n_r))
