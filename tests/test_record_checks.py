@@ -100,7 +100,10 @@ def test_the_level_test_names_the_case_off_by_a_units_factor():
     rng = np.random.default_rng(0)
     F = np.array([2.0, 0.1, 1.0, 0.0])
     base = rng.normal(size=(3, 4)) + 1j * rng.normal(size=(3, 4))
-    checks = {c: {"acceleration": base * (1 + 0.1 * k) * F, "force": F} for k, c in enumerate(("lc1", "lc2", "lc3"))}
+    checks = {
+        c: {"f0": 54.0, "acceleration": base * (1 + 0.1 * k) * F, "force": F}
+        for k, c in enumerate(("lc1", "lc2", "lc3"))
+    }
     assert records_check(accelerance_levels(checks), {}, "lc1", Thresholds())["passed"]
     checks["lc3"]["acceleration"] = checks["lc3"]["acceleration"] / 9.80665
     out = records_check(accelerance_levels(checks), {}, "lc1", Thresholds())
@@ -124,3 +127,18 @@ def test_the_benchmark_counts_the_checks_false_alarms():
         {"failed": "the rig's records of lc2 are not finite"},
     ]
     assert records_check_score(rows) == {"items": 3, "false_alarms": 1, "gross_warnings": 1}
+
+
+def test_cases_driven_at_other_frequencies_are_not_compared_by_level():
+    """The accelerance of one structure changes with the drive frequency: a case at 60 Hz is not compared with cases
+    at 54 Hz, and alone at its frequency it is not looked at."""
+    from contactid.gap.record_checks import same_drive_groups
+
+    F = np.array([2.0, 0.1, 1.0])
+    A = np.ones((3, 3), complex)
+    checks = {"lc1": {"f0": 54.0}, "lc2": {"f0": 54.1}, "lc3": {"f0": 60.0}, "lc4": {"f0": 54.05}}
+    for k, c in enumerate(checks):
+        checks[c].update(acceleration=A * (10.0 if c == "lc3" else 1.0 + 0.01 * k) * F, force=F)
+    levels = accelerance_levels(checks)
+    assert same_drive_groups(levels) == [["lc1", "lc4", "lc2"], ["lc3"]]
+    assert records_check(levels, {}, "lc1", Thresholds())["findings"] == []

@@ -358,5 +358,7 @@ def records_check_of(model, records: Mapping, calibration_case: str, n_harmonics
     for case, rec in records.items():
         sim = simulate(model, NONE, rec)
         evidence[case] = model_evidence(case, rec.sensors, rec.acceleration[:, :H], sim.acceleration[:, :H])
-    levels = accelerance_levels({c: {"acceleration": r.acceleration, "force": r.force} for c, r in records.items()})
+    levels = accelerance_levels(
+        {c: {"f0": r.f0, "acceleration": r.acceleration, "force": r.force} for c, r in records.items()}
+    )
     return records_check(levels, evidence, calibration_case, thresholds)

@@ -67,14 +67,30 @@ class Thresholds:
 
 
 def accelerance_levels(checks: Mapping[str, Mapping]) -> dict:
-    """{case: (j, 2) complex accelerance at w and 3 w} of every sensor from the records' harmonics ``checks``
-    {case: {"acceleration": (j, H) complex, "force": (H,) complex}} (raw_check.nc's amplitudes and phases)."""
+    """{case: (f0 in Hz, (j, 2) complex accelerance at w and 3 w)} of every sensor from the records' harmonics
+    ``checks`` {case: {"f0": Hz, "acceleration": (j, H) complex, "force": (H,) complex}}."""
     out = {}
     for case, c in checks.items():
         A, F = np.asarray(c["acceleration"]), np.asarray(c["force"])
         hs = [h for h in (0, 2) if h < F.size and abs(F[h]) > 0]
-        out[case] = np.stack([A[:, h] / F[h] for h in hs], axis=1)
+        out[case] = (float(c["f0"]), np.stack([A[:, h] / F[h] for h in hs], axis=1))
     return out
+
+
+# load cases driven within this relative distance of each other's frequency are compared by their accelerance
+SAME_DRIVE = 0.005
+
+
+def same_drive_groups(levels: Mapping[str, tuple]) -> list[list[str]]:
+    """The cases of ``levels`` (``accelerance_levels``) grouped by drive frequency (within ``SAME_DRIVE``): the
+    accelerance of one structure depends on the frequency, so only cases driven alike are compared."""
+    groups: list[list[str]] = []
+    for case in sorted(levels, key=lambda c: levels[c][0]):
+        if groups and abs(levels[case][0] / levels[groups[-1][0]][0] - 1.0) <= SAME_DRIVE:
+            groups[-1].append(case)
+        else:
+            groups.append([case])
+    return groups
 
 
 def _ls_scale(pred: np.ndarray, meas: np.ndarray) -> complex:
@@ -157,10 +173,21 @@ def _finding(case: str, check: str, message: str, signature: bool) -> dict:
     return {"record": case, "check": check, "message": message, "signature": signature}
 
 
-def level_tests(levels: Mapping[str, np.ndarray], th: Thresholds) -> tuple[list, list]:
-    """Each case's accelerance (``accelerance_levels``) against the median of every case's: (findings, trace). Needs
-    three cases to say which one is off; with two, a ratio beyond the limit names both. A units factor is named within
-    twice ``unit_tolerance`` here: the cases' own accelerances differ by their levels' nonlinearity."""
+def level_tests(levels: Mapping[str, tuple], th: Thresholds) -> tuple[list, list]:
+    """Each case's accelerance (``accelerance_levels``) against the median of every case's driven at its frequency
+    (``same_drive_groups``): (findings, trace). Needs three cases to say which one is off; with two, a ratio beyond
+    the limit names both. A units factor is named within twice ``unit_tolerance`` here: the cases' own accelerances
+    differ by their levels' nonlinearity."""
+    findings, trace = [], []
+    for cases in same_drive_groups(levels):
+        f, t = _level_group({c: levels[c][1] for c in cases}, th)
+        findings += f
+        trace += t
+    return findings, trace
+
+
+def _level_group(levels: Mapping[str, np.ndarray], th: Thresholds) -> tuple[list, list]:
+    """``level_tests`` on cases driven at one frequency ({case: (j, 2) accelerance})."""
     findings, trace = [], []
     cases = list(levels)
     if len(cases) < 2:
