@@ -275,3 +275,32 @@ def test_an_offset_is_a_warning_not_a_refusal():
         "a1: mean 1.5 m/s^2, 0.045 of its amplitude at 3 w: an accelerometer offset or drift (harmless to the "
         "identification, which uses the harmonics; check the charge amplifier's or signal conditioner's zero)",
     ]
+
+
+def test_a_driving_point_accelerance_of_the_wrong_sign_is_a_warning():
+    """A passive structure's driving-point accelerance is positive-imaginary at its resonances (residues phi_d^2 > 0);
+    the force's sign flipped makes it negative there: a warning naming the driving point and its resonances. A
+    sensor off the driving point may have either sign."""
+    import xarray as xr
+
+    from contactid.raw_checks import driving_point_sign_warnings
+
+    f = np.linspace(1.0, 500.0, 4000)
+    w = 2 * np.pi * f
+    shapes = np.array([[1.0, 0.8, -0.6], [0.5, -0.7, 0.9]])  # (sensor, mode); sensor 0 at the driving point
+    wr = 2 * np.pi * np.array([50.0, 160.0, 320.0])
+    H = sum(
+        -(w**2) * np.outer(shapes[:, r] * shapes[0, r], 1 / (wr[r] ** 2 - w**2 + 0.02j * w * wr[r])) for r in range(3)
+    )
+
+    def frf(h):
+        return xr.Dataset(
+            {"h1_real": (("sensor", "frequency"), h.real), "h1_imag": (("sensor", "frequency"), h.imag)},
+            coords={"frequency": f, "sensor": ["a1", "a2"], "position": ("sensor", [0.55, 0.3])},
+        )
+
+    assert driving_point_sign_warnings(frf(H), 0.55, (20.0, 450.0)) == []
+    (msg,) = driving_point_sign_warnings(frf(-H), 0.55, (20.0, 450.0))
+    assert msg.startswith("a1 (driving point)") and "50.04 Hz, 160.1 Hz, 320.3 Hz" in msg and "sign is flipped" in msg
+    assert driving_point_sign_warnings(frf(-H), 0.30, (20.0, 450.0)) == []  # a2 is no driving point: not judged
+    assert driving_point_sign_warnings(frf(-H), 0.40, (20.0, 450.0)) == []  # no sensor at the driving point

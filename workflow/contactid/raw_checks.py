@@ -551,6 +551,36 @@ def validate_random_test(raw: xr.Dataset, path: str, checks: Mapping, segment_le
     return warnings
 
 
+def driving_point_sign_warnings(frf: xr.Dataset, excitation_position_m: float, band_hz) -> list[str]:
+    """The driving point's accelerance is positive-imaginary at its resonances for any passive structure (its residues
+    are phi_d^2 > 0: H = i phi_d^2 / (2 zeta) at resonance). Negative there, at most of its strongest peaks in
+    ``band_hz``, the force's or the driving-point accelerometer's sign is flipped: a warning (the linear chain reads
+    the modes' magnitudes and is not affected; the same channels of the dual-sine records are worth checking). No
+    sensor at the driving point (within 1 mm): nothing to say."""
+    pos = np.asarray(frf["position"].values, float) if "position" in frf.coords else np.array([])
+    if pos.size == 0 or np.min(np.abs(pos - excitation_position_m)) > 1e-3:
+        return []
+    d = int(np.argmin(np.abs(pos - excitation_position_m)))
+    f = frf["frequency"].values
+    h = frf["h1_real"].values[d] + 1j * frf["h1_imag"].values[d]
+    idx = np.where((f >= band_hz[0]) & (f <= band_hz[1]))[0]
+    if idx.size < 3:
+        return []
+    mag = np.abs(h)
+    peaks = [i for i in idx[1:-1] if mag[i] > mag[i - 1] and mag[i] >= mag[i + 1] and mag[i] > 0.05 * mag[idx].max()]
+    peaks = sorted(sorted(peaks, key=lambda i: -mag[i])[:3])
+    negative = [i for i in peaks if h[i].imag < 0]
+    if not peaks or 2 * len(negative) <= len(peaks):
+        return []
+    at = ", ".join(f"{f[i]:.4g} Hz" for i in negative)
+    return [
+        f"{frf['sensor'].values[d]} (driving point): the accelerance's imaginary part is negative at the resonances "
+        f"{at}, where a passive structure's is positive: the force's or this accelerometer's sign is flipped; the "
+        "linear chain reads the modes' magnitudes and is not affected, but check the same channels' signs in the "
+        "dual-sine records"
+    ]
+
+
 def validate_coherence(frf: xr.Dataset, band_hz, path: str, checks: Mapping) -> tuple[dict, list[str]]:
     """Share of the FRF lines in ``band_hz`` whose coherence reaches raw_checks.min_coherence, per
     channel; raises RawDataError when a channel's share is below raw_checks.coherence_fraction."""

@@ -8,7 +8,12 @@ import json
 from contactid.io import provenance, read_raw, write_dataset
 from contactid.linear_chain import check_sensor_layout, frf_dataset
 from contactid.logs import fmt, setup_logging
-from contactid.raw_checks import check_settings, validate_coherence, validate_random_test
+from contactid.raw_checks import (
+    check_settings,
+    driving_point_sign_warnings,
+    validate_coherence,
+    validate_random_test,
+)
 
 log = setup_logging(snakemake.log[0])
 p = snakemake.params
@@ -21,6 +26,7 @@ warnings = validate_random_test(raw, path, checks, seg, int(p.blocks))
 ds = frf_dataset(raw, seg, float(p.frf["overlap"]), p.frf["window"], int(p.blocks))
 shares, coherence_warnings = validate_coherence(ds, p.band_hz, path, checks)
 warnings += coherence_warnings
+warnings += driving_point_sign_warnings(ds, float(p.structure["excitation_position_m"]), p.band_hz)
 ds.attrs["warnings"] = json.dumps(warnings)
 ds.attrs["coherence_share"] = json.dumps(shares)
 ds.attrs.update(
