@@ -142,3 +142,16 @@ def test_cases_driven_at_other_frequencies_are_not_compared_by_level():
     levels = accelerance_levels(checks)
     assert same_drive_groups(levels) == [["lc1", "lc4", "lc2"], ["lc3"]]
     assert records_check(levels, {}, "lc1", Thresholds())["findings"] == []
+
+
+def test_records_whose_force_sign_is_flipped_everywhere_are_named_through_the_calibration_case():
+    """Every record's force flipped (one acquisition's sign error): the model fitted to the calibration record cannot
+    reproduce it either, so the held-out records are no worse than it; a calibration gap beyond gross_gap is looked
+    at too, and a sign that explains it is named."""
+    P = _prediction()
+    ev = {c: model_evidence(c, SENSORS, -0.8 * _noisy(P, 0.3, seed=k), P) for k, c in enumerate(("lc1", "lc2"))}
+    out = records_check({}, ev, "lc1", Thresholds())
+    assert not out["passed"]
+    assert {f["record"] for f in out["findings"]} == {"lc1", "lc2"}
+    (cal,) = [f for f in out["findings"] if f["record"] == "lc1"]
+    assert "does not reproduce even its calibration record" in cal["message"] and "opposite sign" in cal["message"]
