@@ -120,6 +120,65 @@ def test_invalid_measured_records_stop_only_their_case_and_say_why(tmp_path):
     assert (proj / "results/lc9/raw_check.nc").exists()  # the valid case went on
 
 
+# each odd record as a measured load case of one project, checked in one run (--keep-going): (defect, what the rule's
+# log must say, whether the record is refused); the checks' own tests are in tests/test_raw_checks.py
+ODD_RECORDS = {
+    "lc4": ("dead channel", ["channel a2: dead-channel check failed", "dead sensor, cable"], True),
+    "lc5": ("sampling rate and time axis doubled", ["sampling rate check failed", "2 times the declared"], True),
+    "lc6": ("no units attribute", ["'acceleration' has no units attribute; state the units"], True),
+    "lc7": ("noise-free (a simulator's)", [], False),
+    "lc8": ("force offset 2 N", ["force: mean 2", "offset or drift"], False),
+}
+
+
+def _odd_record(case):
+    from test_importers import dual_sine
+
+    ds = dual_sine(noise=0.0 if case == "lc7" else 0.005)
+    if case == "lc4":
+        ds["acceleration"].values[1] = 0.0
+    elif case == "lc5":
+        ds.attrs["sampling_rate_hz"] = 2 * ds.attrs["sampling_rate_hz"]
+        ds = ds.assign_coords(time=("time", ds["time"].values / 2, ds["time"].attrs))
+    elif case == "lc6":
+        del ds["acceleration"].attrs["units"]
+    elif case == "lc8":
+        ds["force"].values[:] += 2.0
+    return ds
+
+
+def test_odd_records_are_refused_or_warned_with_the_cause_that_fits(tmp_path):
+    """Odd measured records, each a load case of one project: a refused record stops its own case (exit status not
+    0, no dataset, the log naming the cause and the fix), an accepted one is checked with its warnings in the dataset,
+    and a result computed before stays as it was."""
+    proj = make_project(tmp_path)
+    (proj / "measured").mkdir()
+    for case in ODD_RECORDS:
+        _odd_record(case).to_netcdf(proj / "measured" / f"{case}.nc", engine="netcdf4")
+    cfg = yaml.safe_load((proj / "config" / "config.yaml").read_text())
+    cfg["load_cases"] = {c: {"source": "measured", "file": f"measured/{c}.nc"} for c in ODD_RECORDS}
+    cfg["nonlinear"].update(calibration_case="lc7", figure_case="lc7")
+    (proj / "config" / "config.yaml").write_text(yaml.safe_dump(cfg))
+    earlier = proj / "results" / "lc4" / "contact_forces.nc"  # a result of an earlier run of the same case
+    earlier.parent.mkdir(parents=True)
+    earlier.write_bytes(b"computed before")
+    stamp = earlier.stat().st_mtime_ns
+    res = snakemake(proj, "--keep-going", *[f"results/{c}/raw_check.nc" for c in ODD_RECORDS])
+    assert res.returncode != 0
+    for case, (defect, words, refused) in ODD_RECORDS.items():
+        log = (proj / "logs" / f"raw_check_{case}.log").read_text()
+        assert (proj / "results" / case / "raw_check.nc").exists() != refused, (defect, log)
+        assert "clipping" not in log, (defect, log)
+        if not refused:
+            import xarray as xr
+
+            warnings = json.loads(xr.load_dataset(proj / "results" / case / "raw_check.nc").attrs["warnings"])
+            log = "\n".join(warnings)
+        for w in words:
+            assert w in log, (defect, w, log)
+    assert earlier.read_bytes() == b"computed before" and earlier.stat().st_mtime_ns == stamp
+
+
 # ----------------------------------------------------------------------------------------------
 # on the small config: against the shared small run
 # ----------------------------------------------------------------------------------------------
