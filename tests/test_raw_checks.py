@@ -304,3 +304,38 @@ def test_a_driving_point_accelerance_of_the_wrong_sign_is_a_warning():
     assert msg.startswith("a1 (driving point)") and "50.04 Hz, 160.1 Hz, 320.3 Hz" in msg and "sign is flipped" in msg
     assert driving_point_sign_warnings(frf(-H), 0.30, (20.0, 450.0)) == []  # a2 is no driving point: not judged
     assert driving_point_sign_warnings(frf(-H), 0.40, (20.0, 450.0)) == []  # no sensor at the driving point
+
+
+def test_a_record_far_from_the_random_tests_level_is_refused_naming_units():
+    """The accelerance at the drive against the random test's FRF: within the factor any contact state gives
+    (slip moves and damps a resonance) it passes, whichever way; 1000 times off (mm/s^2 labelled m/s^2) it is refused
+    before identification, whose inverse problem would overflow on it."""
+    import xarray as xr
+
+    from contactid.raw_checks import LEVEL_FACTOR_LIMIT, frf_level_check
+
+    f = np.linspace(1.0, 500.0, 500)
+    frf = xr.Dataset(
+        {
+            "h1_real": (("sensor", "frequency"), np.full((2, f.size), 3.0)),
+            "h1_imag": (("sensor", "frequency"), 4.0 * np.ones((2, f.size))),
+        },
+        coords={"frequency": f, "sensor": ["a1", "a2"], "position": ("sensor", [0.55, 0.3])},
+    )
+
+    def check(factor):
+        amp = np.array([[5.0, 0.1, 5.0], [5.0, 0.1, 5.0], [1.0, 1.0, 1.0]]) * factor  # |H| = 5 at w and 3 w
+        return xr.Dataset(
+            {
+                "acceleration_amplitude": (("sensor", "harmonic"), amp),
+                "force_amplitude": ("harmonic", np.array([1.0, 0.0, 1.0])),
+            },
+            coords={"sensor": ["a1", "a2", "a9"], "position": ("sensor", [0.55, 0.3, 0.1]), "harmonic": [1, 2, 3]},
+            attrs={"excitation_frequency_hz": 54.0},
+        )
+
+    for factor in (1.0, 0.3, 3.0, 0.9 * LEVEL_FACTOR_LIMIT, 1.1 / LEVEL_FACTOR_LIMIT):
+        assert frf_level_check(check(factor), frf, "lc1.nc") == pytest.approx(factor)
+    for factor in (1000.0, 1e-3):
+        with pytest.raises(RawDataError, match=r"lc1.nc: level check failed: .* (1e\+03|0\.001) times .*mm/s\^2"):
+            frf_level_check(check(factor), frf, "lc1.nc")

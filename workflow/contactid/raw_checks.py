@@ -61,7 +61,16 @@ def dual_sine_check_dataset(raw: xr.Dataset, structure_cfg: Mapping, path: str, 
                 {"units": "1", "long_name": "driving-point harmonic change, last vs first third"},
             ),
         },
-        coords={"sensor": raw["sensor"].values, "harmonic": h, "excitation_harmonic": [1, 3]},
+        coords={
+            "sensor": raw["sensor"].values,
+            "position": (
+                "sensor",
+                np.asarray(raw["position"].values, float),
+                {"units": "m", "long_name": "distance from the clamp"},
+            ),
+            "harmonic": h,
+            "excitation_harmonic": [1, 3],
+        },
         attrs={
             "A1_m_per_s2": float(np.abs(c_acc[i, 0])),
             "A2_m_per_s2": float(np.abs(c_acc[i, 2])) if max_harmonic >= 3 else np.nan,
@@ -549,6 +558,50 @@ def validate_random_test(raw: xr.Dataset, path: str, checks: Mapping, segment_le
             f"{c['max_frf_resolution_hz']}; raise frf.segment_length (and the record length)"
         )
     return warnings
+
+
+# a dual-sine record's accelerance at its drive (every sensor, at w and 3 w; the median of their magnitudes) lies
+# within this factor of the random test's FRF at the same frequencies for any contact state: slip and separation
+# move a resonance and damp it, which changes the accelerance near it a few times (0.3 and 2.5 on the other
+# simulator's records), not fifty; beyond it the record is in other units than its label (mm/s^2: 1000) and its
+# identification would overflow
+LEVEL_FACTOR_LIMIT = 50.0
+
+
+def frf_level_check(check: xr.Dataset, frf: xr.Dataset, path: str) -> float:
+    """Refuse a dual-sine record (its ``dual_sine_check_dataset``) whose accelerance at the drive is more than
+    ``LEVEL_FACTOR_LIMIT`` times off the random test's FRF (either way); returns the factor (the median over the
+    sensors both files hold, matched by position within 1 mm, and harmonics 1 and 3), or nan where they share no
+    sensor or the FRF does not reach 3 f0."""
+    f0 = float(check.attrs["excitation_frequency_hz"])
+    f = frf["frequency"].values
+    h = frf["h1_real"].values + 1j * frf["h1_imag"].values
+    pos_frf = np.asarray(frf["position"].values, float) if "position" in frf.coords else np.array([])
+    pos_rec = np.asarray(check["position"].values, float) if "position" in check.coords else np.array([])
+    ratios = []
+    for j, x in enumerate(pos_rec):
+        if pos_frf.size == 0 or np.min(np.abs(pos_frf - x)) > 1e-3:
+            continue
+        s = int(np.argmin(np.abs(pos_frf - x)))
+        for k in (0, 2):
+            if k >= check.sizes["harmonic"] or not f[0] <= (k + 1) * f0 <= f[-1]:
+                continue
+            force = float(check["force_amplitude"].values[k])
+            model = abs(np.interp((k + 1) * f0, f, h[s].real) + 1j * np.interp((k + 1) * f0, f, h[s].imag))
+            if force > 0 and model > 0:
+                ratios.append(float(check["acceleration_amplitude"].values[j, k]) / force / model)
+    if not ratios:
+        return float("nan")
+    factor = float(np.exp(np.median(np.log(np.maximum(ratios, 1e-300)))))
+    if max(factor, 1.0 / factor) > LEVEL_FACTOR_LIMIT:
+        raise RawDataError(
+            f"{path}: level check failed: the record's accelerations over its force at the drive are {factor:.3g} "
+            f"times the random test's FRF at the same frequencies (the median over sensors at w and 3 w), beyond the "
+            f"factor {LEVEL_FACTOR_LIMIT:g} any contact state stays within: the accelerations or the force are in "
+            "other units than their labels (1000: mm/s^2 or kN; 100: cm/s^2; 9.81: g) or a sensitivity is wrong; "
+            "correct the record or its channel map"
+        )
+    return factor
 
 
 def driving_point_sign_warnings(frf: xr.Dataset, excitation_position_m: float, band_hz) -> list[str]:

@@ -6,6 +6,7 @@ rule raw_check:
     priority: CRITICAL_PATH
     input:
         raw=lambda wc: raw_record(wc.case),
+        frf="results/linear/frf.nc",
     output:
         check="results/{case}/raw_check.nc",
     params:

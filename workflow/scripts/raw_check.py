@@ -5,10 +5,10 @@ a message naming the file, the channel, the check and the measured value; warnin
 
 import json
 
-from contactid.io import provenance, read_raw, write_dataset
+from contactid.io import load_dataset, provenance, read_raw, write_dataset
 from contactid.linear_chain import check_sensor_layout
 from contactid.logs import setup_logging
-from contactid.raw_checks import check_settings, dual_sine_check_dataset, validate_dual_sine
+from contactid.raw_checks import check_settings, dual_sine_check_dataset, frf_level_check, validate_dual_sine
 
 log = setup_logging(snakemake.log[0])
 p = snakemake.params
@@ -21,8 +21,12 @@ raw = read_raw(
 check_sensor_layout(raw, p.structure, path)
 warnings = validate_dual_sine(raw, path, checks)
 ds = dual_sine_check_dataset(raw, p.structure, path, max_h)
+# the record's level against the random test's FRF: a record in other units than its label stops here
+ds.attrs["level_factor_to_frf"] = frf_level_check(ds, load_dataset(snakemake.input.frf), path)
 ds.attrs["warnings"] = json.dumps(warnings)
-ds.attrs.update(provenance("raw_check", {"checks": checks, "n_harmonics": p.n_harmonics}, {"raw": path}))
+ds.attrs.update(
+    provenance("raw_check", {"checks": checks, "n_harmonics": p.n_harmonics}, {"raw": path, "frf": snakemake.input.frf})
+)
 write_dataset(ds, snakemake.output.check)
 for w in warnings:
     log.warning("%s: %s", path, w)
