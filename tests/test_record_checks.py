@@ -155,3 +155,23 @@ def test_records_whose_force_sign_is_flipped_everywhere_are_named_through_the_ca
     assert {f["record"] for f in out["findings"]} == {"lc1", "lc2"}
     (cal,) = [f for f in out["findings"] if f["record"] == "lc1"]
     assert "does not reproduce even its calibration record" in cal["message"] and "opposite sign" in cal["message"]
+
+
+def test_a_response_the_model_overpredicts_at_one_level_is_no_units_error():
+    """A contact that opens at the highest level (the blind benchmark's contact-separation items): the record's
+    response is a fifth of the model's prediction, a common factor explains most of the gap, but the record's
+    accelerance among its peers is as theirs: the model, not the record, is off (a gross warning, the verdict kept).
+    The same factor near 1/9.81 that the peers show too is the record's units."""
+    P = _prediction()
+    levels = {c: (54.0, np.ones((3, 2), complex) * (1.0 + 0.05 * k)) for k, c in enumerate(("lc1", "lc2", "lc3"))}
+    ev = {
+        "lc1": model_evidence("lc1", SENSORS, _noisy(P, 0.01), P),
+        "lc3": model_evidence("lc3", SENSORS, 0.2 * _noisy(P, 0.1), P),
+    }
+    out = records_check(levels, ev, "lc1", Thresholds())
+    assert out["passed"] and [f["check"] for f in out["findings"]] == ["gross"]
+    ev["lc3"] = model_evidence("lc3", SENSORS, _noisy(P, 0.02) / 9.80665, P)
+    assert records_check(levels, ev, "lc1", Thresholds())["passed"]  # the peers do not show it: not the record's
+    levels["lc3"] = (54.0, levels["lc3"][1] / 9.80665)
+    out = records_check(levels, ev, "lc1", Thresholds())
+    assert not out["passed"] and {f["check"] for f in out["findings"]} == {"accelerance_level", "units_or_sign"}

@@ -12,8 +12,11 @@ in the trace:
   others (9.81 for g, 1000 for mm/s^2 or kN) was written in other units than its label says.
 * ``model_tests`` (after identification): each case's record against the identified model's prediction at the
   record's measured force. The calibration case fits by construction; a held-out case of the same rig leaves a gap
-  of the same order. A record that is a scaled, sign-flipped or channel-permuted copy of its prediction (the
-  transformation leaves a small part of the gap) is a units, sign or channel-map error, named with its factor.
+  of the same order. A record that is a sign-flipped, units-scaled or channel-permuted copy of its prediction (the
+  transformation leaves a small part of the gap) is a sign, units or channel-map error, named with its factor. A
+  units factor counts only where the record's level among its peers shows it too: a contact that opens at one
+  level makes the model overpredict that record several times, and the record's level among its peers is then as
+  theirs (the blind benchmark's contact-separation items).
 
 A finding is a message naming the record, the likely cause and the fix. It goes to the console, ``summary.json``'s
 ``data_warnings``, the report's first page, and the gap diagnosis, whose verdict becomes ``records_disagree``: no
@@ -173,34 +176,37 @@ def _finding(case: str, check: str, message: str, signature: bool) -> dict:
     return {"record": case, "check": check, "message": message, "signature": signature}
 
 
+def level_factors(levels: Mapping[str, tuple]) -> dict:
+    """{case: its accelerance over the median of its drive group's (``same_drive_groups``; the geometric median over
+    sensors and harmonics)} for every case that shares its drive with another; with two, each over the other."""
+    out = {}
+    for cases in same_drive_groups(levels):
+        if len(cases) < 2:
+            continue
+        for case in cases:
+            others = [c for c in cases if c != case]
+            # the median of every case (its own included: one case off cannot move it) or, with two, the other case
+            ref = np.median(np.abs(np.stack([levels[c][1] for c in (cases if len(cases) > 2 else others)])), axis=0)
+            out[case] = float(np.exp(np.median(np.log(np.abs(levels[case][1]) / ref))))
+    return out
+
+
 def level_tests(levels: Mapping[str, tuple], th: Thresholds) -> tuple[list, list]:
     """Each case's accelerance (``accelerance_levels``) against the median of every case's driven at its frequency
-    (``same_drive_groups``): (findings, trace). Needs three cases to say which one is off; with two, a ratio beyond
-    the limit names both. A units factor is named within twice ``unit_tolerance`` here: the cases' own accelerances
-    differ by their levels' nonlinearity."""
+    (``level_factors``): (findings, trace). Needs three cases at a drive to say which one is off; with two, a ratio
+    beyond the limit names both. A units factor is named within twice ``unit_tolerance`` here: the cases' own
+    accelerances differ by their levels' nonlinearity."""
     findings, trace = [], []
+    factors = level_factors(levels)
     for cases in same_drive_groups(levels):
-        f, t = _level_group({c: levels[c][1] for c in cases}, th)
-        findings += f
-        trace += t
-    return findings, trace
-
-
-def _level_group(levels: Mapping[str, np.ndarray], th: Thresholds) -> tuple[list, list]:
-    """``level_tests`` on cases driven at one frequency ({case: (j, 2) accelerance})."""
-    findings, trace = [], []
-    cases = list(levels)
-    if len(cases) < 2:
-        return findings, trace
-    for case in cases:
-        others = [c for c in cases if c != case]
-        # the median of every case (its own included: one case off cannot move it) or, with two, the other case
-        ref = np.median(np.abs(np.stack([levels[c] for c in (cases if len(cases) > 2 else others)])), axis=0)
-        factor = float(np.exp(np.median(np.log(np.abs(levels[case]) / ref))))  # over sensors and both harmonics
-        off = max(factor, 1.0 / factor)
-        passed = off <= th.level_factor
-        trace.append(_trace("accelerance_level_against_other_cases", off, th.level_factor, passed, case))
-        if not passed:
+        for case in (c for c in cases if c in factors):
+            factor = factors[case]
+            others = [c for c in cases if c != case]
+            off = max(factor, 1.0 / factor)
+            passed = off <= th.level_factor
+            trace.append(_trace("accelerance_level_against_other_cases", off, th.level_factor, passed, case))
+            if passed:
+                continue
             who = case if len(cases) > 2 else f"{case} or {others[0]}"
             findings.append(
                 _finding(
@@ -216,13 +222,17 @@ def _level_group(levels: Mapping[str, np.ndarray], th: Thresholds) -> tuple[list
     return findings, trace
 
 
-def model_tests(evidence: Mapping[str, ModelEvidence], calibration_case: str, th: Thresholds) -> tuple[list, list]:
+def model_tests(
+    evidence: Mapping[str, ModelEvidence], calibration_case: str, th: Thresholds, levels: Mapping | None = None
+) -> tuple[list, list]:
     """Each record against the model's prediction at its force. A held-out record is looked at where its gap exceeds
     ``gross_ratio`` times the calibration case's and ``signature_gap``; any record, the calibration case's included,
     where it exceeds ``gross_gap`` (a model that leaves that much on the record it was fitted to has failed on it,
     and the held-out records are then no worse than it).
     Looked at, in this order: a common factor that explains the disagreement (leaves at most ``explained_share`` of
-    it) and is a units factor, a factor beyond 2 or a flipped sign; a channel order that explains it (the channel
+    it) and is a flipped sign, or a units factor that the record's level among its peers (``levels``, from
+    ``level_factors``) shows too (a factor of any other size, or one the peers do not show, is the model's: an effect
+    it lacks at that level); a channel order that explains it (the channel
     map); one sensor off by its own factor while the others agree (its sensitivity or sign). With none of these, a
     gap beyond ``gross_gap`` (and, held out, ``gross_ratio`` times the calibration case's) is a gross disagreement of
     unknown cause (no signature: the verdict is not taken from it). Returns (findings, trace)."""
@@ -248,7 +258,7 @@ def model_tests(evidence: Mapping[str, ModelEvidence], calibration_case: str, th
                 f"{case}: the record disagrees with the identified model's prediction at its measured force "
                 f"({ev.gap:.1%} against {base:.2%} on the calibration case {calibration_case})"
             )
-        finding = _signature(ev, th, head, trace)
+        finding = _signature(ev, th, head, trace, (levels or {}).get(case))
         if finding is None and ev.gap > (th.gross_gap if own else max(th.gross_ratio * base, th.gross_gap)):
             finding = _finding(
                 case,
@@ -263,17 +273,23 @@ def model_tests(evidence: Mapping[str, ModelEvidence], calibration_case: str, th
     return findings, trace
 
 
-def _signature(ev: ModelEvidence, th: Thresholds, head: str, trace: list) -> dict | None:
-    """The first transformation of the record that explains its disagreement with the prediction, as a finding."""
+def _signature(ev: ModelEvidence, th: Thresholds, head: str, trace: list, level: float | None) -> dict | None:
+    """The first transformation of the record that explains its disagreement with the prediction, as a finding;
+    ``level``: the record's accelerance over its peers' (``level_factors``), None where it has none."""
     case, n = ev.case, len(ev.sensors)
     mag, phase = abs(ev.scale), float(np.degrees(abs(np.angle(ev.scale))))
     left = ev.gap_scaled / ev.gap
     big = max(mag, 1.0 / max(mag, 1e-300))
-    explained = left <= th.explained_share and (phase > 135.0 or big >= 2.0 or _near_units(mag, th.unit_tolerance))
+    # a units factor is the record's, not the model's, where the record's accelerance against the other cases'
+    # (``level``, where other cases share its drive) is off by about the same factor: an effect the model lacks
+    # (a contact that opens at one level) moves the prediction, not the record's level among its peers
+    corroborated = level is None or abs(np.log(level / max(mag, 1e-300))) < np.log(2.0)
+    units = _near_units(mag, th.unit_tolerance) and corroborated
+    explained = left <= th.explained_share and (phase > 135.0 or units)
     trace.append(_trace("common_factor_explains", left, th.explained_share, not explained, case))
     if explained:
         parts = []
-        if big >= 1.5:
+        if units and big >= 1.5:
             parts.append(f"its accelerations are {named_factor(mag, th.unit_tolerance)} the prediction")
         if phase > 135.0:
             parts.append("of opposite sign (the force's or every accelerometer's sign is flipped)")
@@ -327,7 +343,7 @@ def records_check(
     gap}}; ``passed`` is False where a finding has a signature (a units factor, a sign, a channel order: the records,
     not the model, are wrong)."""
     f1, t1 = level_tests(levels, th)
-    f2, t2 = model_tests(evidence, calibration_case, th)
+    f2, t2 = model_tests(evidence, calibration_case, th, level_factors(levels))
     return {
         "passed": not any(f["signature"] for f in f1 + f2),
         "findings": f1 + f2,
