@@ -175,3 +175,21 @@ def test_a_response_the_model_overpredicts_at_one_level_is_no_units_error():
     levels["lc3"] = (54.0, levels["lc3"][1] / 9.80665)
     out = records_check(levels, ev, "lc1", Thresholds())
     assert not out["passed"] and {f["check"] for f in out["findings"]} == {"accelerance_level", "units_or_sign"}
+
+
+def test_a_factor_the_peers_see_only_partly_is_no_units_error():
+    """Contact separation at one level: the model overpredicts the record 9 times and its peers see it 1.8 times
+    lower than theirs: not the record's units. Without peers a factor counts within a third of the tolerance of a
+    units factor: 9.0 does not (8 % off 9.81), 9.75 does."""
+    P = _prediction()
+    one = np.ones((3, 2), complex)
+    levels = {"lc1": (54.0, one), "lc2": (54.0, one), "lc3": (54.0, one / 1.8)}
+    ev = {
+        "lc1": model_evidence("lc1", SENSORS, _noisy(P, 0.01), P),
+        "lc3": model_evidence("lc3", SENSORS, _noisy(P, 0.05) / 9.0, P),
+    }
+    assert records_check(levels, ev, "lc1", Thresholds())["passed"]
+    alone = {"lc1": levels["lc1"], "lc3": (60.0, one)}  # lc3 alone at its drive: no peer
+    assert records_check(alone, ev, "lc1", Thresholds())["passed"]
+    ev["lc3"] = model_evidence("lc3", SENSORS, _noisy(P, 0.05) / 9.75, P)
+    assert not records_check(alone, ev, "lc1", Thresholds())["passed"]
