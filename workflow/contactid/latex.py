@@ -388,7 +388,9 @@ def records_alert_text(summary: Mapping) -> str:
             "or a channel order explains; the numbers below that use them are not to be trusted until they are "
             r"corrected, and the gap diagnosis looks for no effect (verdict records\_disagree):"
             if hard
-            else "These records disagree grossly with the identified model, for a cause the checks do not name:"
+            else "These records disagree grossly with the identified model in a way no units factor, sign or channel "
+            "order explains (an effect it lacks at their level, which the gap section looks for, or a structure that "
+            "changed between tests):"
         ),
         r"\begin{itemize}",
         *[rf"\item {plain_text(f['message'])}" for f in findings],

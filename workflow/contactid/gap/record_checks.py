@@ -264,8 +264,8 @@ def model_tests(
                 case,
                 "gross",
                 f"{head}: the records disagree with the model grossly, and no units factor, sign or channel order "
-                "explains it; check units, signs and the channel map, and whether the structure changed between tests "
-                "(an effect the candidate library does not hold)",
+                "explains it: an effect the identified model lacks at this level (the gap diagnosis looks for it), or "
+                "a structure that changed between tests; if neither, check units, signs and the channel map",
                 False,
             )
         if finding is not None:
