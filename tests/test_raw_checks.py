@@ -336,6 +336,6 @@ def test_a_record_far_from_the_random_tests_level_is_refused_naming_units():
 
     for factor in (1.0, 0.3, 3.0, 0.9 * LEVEL_FACTOR_LIMIT, 1.1 / LEVEL_FACTOR_LIMIT):
         assert frf_level_check(check(factor), frf, "lc1.nc") == pytest.approx(factor)
-    for factor in (1000.0, 1e-3):
-        with pytest.raises(RawDataError, match=r"lc1.nc: level check failed: .* (1e\+03|0\.001) times .*mm/s\^2"):
+    for factor, units in ((1000.0, "mm/s\\^2"), (1e-3, "force in mN")):
+        with pytest.raises(RawDataError, match=rf"lc1.nc: level check failed: .* (1e\+03|0\.001) times .*{units}"):
             frf_level_check(check(factor), frf, "lc1.nc")

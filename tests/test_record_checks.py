@@ -193,3 +193,15 @@ def test_a_factor_the_peers_see_only_partly_is_no_units_error():
     assert records_check(alone, ev, "lc1", Thresholds())["passed"]
     ev["lc3"] = model_evidence("lc3", SENSORS, _noisy(P, 0.05) / 9.75, P)
     assert not records_check(alone, ev, "lc1", Thresholds())["passed"]
+
+
+def test_a_units_factor_names_its_direction():
+    """One table for every check (contactid.units_factors): a record 1/9.81 times off is in g labelled m/s^2, 1000
+    times off in mm/s^2 (or its force in kN), 1/1000 its force in mN; 4.5 (lbf's 4.448) is no units factor here."""
+    from contactid.units_factors import units_error
+
+    assert "g labelled m/s^2" in units_error(0.102, 0.15)[1]
+    assert "mm/s^2" in units_error(980.0, 0.15)[1] and units_error(980.0, 0.15)[0] == 1000.0
+    assert "mN" in units_error(1.1e-3, 0.15)[1]
+    assert units_error(4.5, 0.15) is None and units_error(0.102, 0.15)[0] == pytest.approx(1 / 9.80665)
+    assert units_error(0.125, 0.15) is None and units_error(0.125, 0.3) is not None

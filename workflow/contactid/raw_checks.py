@@ -568,6 +568,15 @@ def validate_random_test(raw: xr.Dataset, path: str, checks: Mapping, segment_le
 LEVEL_FACTOR_LIMIT = 50.0
 
 
+def _units_cause(factor: float) -> str:
+    """What a record ``factor`` times off its expected level most likely has (``units_factors``)."""
+    from .units_factors import units_error
+
+    hit = units_error(factor, 0.3)  # the level against the stuck FRF scatters by the contact's state
+    what = f"likely {hit[1]} (a factor {hit[0]:.4g})" if hit else "other units than the labels"
+    return f"{what}, or a wrong sensitivity"
+
+
 def frf_level_check(check: xr.Dataset, frf: xr.Dataset, path: str) -> float:
     """Refuse a dual-sine record (its ``dual_sine_check_dataset``) whose accelerance at the drive is more than
     ``LEVEL_FACTOR_LIMIT`` times off the random test's FRF (either way); returns the factor (the median over the
@@ -597,9 +606,8 @@ def frf_level_check(check: xr.Dataset, frf: xr.Dataset, path: str) -> float:
         raise RawDataError(
             f"{path}: level check failed: the record's accelerations over its force at the drive are {factor:.3g} "
             f"times the random test's FRF at the same frequencies (the median over sensors at w and 3 w), beyond the "
-            f"factor {LEVEL_FACTOR_LIMIT:g} any contact state stays within: the accelerations or the force are in "
-            "other units than their labels (1000: mm/s^2 or kN; 100: cm/s^2; 9.81: g) or a sensitivity is wrong; "
-            "correct the record or its channel map"
+            f"factor {LEVEL_FACTOR_LIMIT:g} any contact state stays within: {_units_cause(factor)}; correct the "
+            "record or its channel map"
         )
     return factor
 

@@ -513,19 +513,12 @@ def amplitude_ratio(params: StructureParameters, residue_abs, k_t: float, k_n: f
 
 def amplitude_message(ratio: float, source: str) -> str:
     """The stiffness step's refusal of a random test whose FRF amplitudes are ``ratio`` times the structure's."""
+    from .units_factors import units_error
+
     causes = []
-    for factor, what in (
-        (
-            1 / 9.80665,
-            "accelerations in g read as m/s^2 (multiply them by 9.80665, or give the unit g in an imported file's "
-            "channel map)",
-        ),
-        (9.80665, "accelerations in m/s^2 declared as g"),
-        (1000.0, "the force in kN read as N, or the accelerations in mm/s^2 read as m/s^2"),
-        (1e-3, "the force in mN read as N"),
-    ):
-        if abs(np.log(ratio / factor)) < np.log(1.15):
-            causes.append(f"{what}: a factor {factor:.4g}")
+    hit = units_error(ratio, 0.15)
+    if hit is not None:
+        causes.append(f"{hit[1]}: a factor {hit[0]:.4g}")
     causes.append("wrong sensitivities of the acceleration or force channels (the same factor on every channel)")
     causes.append("the structure's masses (structure: density, dimensions, block, transducer and sensor masses)")
     return (

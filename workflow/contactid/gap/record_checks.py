@@ -31,14 +31,7 @@ from typing import Mapping
 
 import numpy as np
 
-# factors between units a vibration record is written in by mistake, and what each means (the metric ones: a factor
-# of 4.448 (lbf) or 3.28 (ft) is as near what an effect the model lacks does to a prediction, 4-5 times at a level
-# where a contact opens)
-UNIT_FACTORS = (
-    (9.80665, "accelerations in g labelled m/s^2 (or the force in kgf labelled N)"),
-    (1000.0, "accelerations in mm/s^2 labelled m/s^2, or the force in kN or mN"),
-    (100.0, "accelerations in cm/s^2 labelled m/s^2"),
-)
+from ..units_factors import near_units, units_error
 
 
 @dataclass(frozen=True)
@@ -155,16 +148,17 @@ def model_evidence(case: str, sensors, measured: np.ndarray, predicted: np.ndarr
 
 def named_factor(factor: float, tol: float) -> str:
     """A magnitude ratio (record over expectation) and what it most likely means: the units factor it is near, either
-    way, or a sensitivity."""
-    for f, meaning in UNIT_FACTORS:
-        for value, inverse in ((f, False), (1.0 / f, True)):
-            if abs(factor / value - 1.0) <= tol:
-                return f"{factor:.3g} times (near {'1/' if inverse else ''}{f:g}: likely {meaning})"
+    way (``units_factors``), or a sensitivity."""
+    hit = units_error(factor, tol)
+    if hit is not None:
+        value, meaning = hit
+        near = f"1/{1 / value:g}" if value < 1 else f"{value:g}"
+        return f"{factor:.3g} times (near {near}: likely {meaning})"
     return f"{factor:.3g} times (likely a wrong sensitivity or gain in the channel map)"
 
 
 def _near_units(factor: float, tol: float) -> bool:
-    return any(abs(factor * f - 1.0) <= tol or abs(factor / f - 1.0) <= tol for f, _ in UNIT_FACTORS)
+    return near_units(factor, tol)
 
 
 def _trace(test: str, value: float, threshold: float, passed: bool, case: str) -> dict:
