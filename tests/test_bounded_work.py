@@ -173,7 +173,13 @@ def test_amplitudes_in_g_are_refused_by_the_stiffness_step_and_true_ones_pass(fo
     with pytest.raises(RawDataError) as err:
         refuse_unreachable(params, ds, st, "rt.nc", 5400.0, residue_abs=residues / 9.80665)
     msg = str(err.value)
-    for words in ("random test rt.nc", "0.104 times", "accelerations in g labelled m/s^2", "AMPLITUDE_FACTOR_LIMIT", "sensitivities"):
+    for words in (
+        "random test rt.nc",
+        "0.104 times",
+        "accelerations in g labelled m/s^2",
+        "AMPLITUDE_FACTOR_LIMIT",
+        "sensitivities",
+    ):
         assert words in msg, words
 
 
