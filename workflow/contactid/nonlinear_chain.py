@@ -188,17 +188,13 @@ def _stiffness_interval_spreads(
     model: FEModel, modal: xr.Dataset, stiction: xr.Dataset, k_t: float, k_n: float, record, n_harmonics: int
 ) -> dict:
     """{"k_n" | "k_t": {quantity: NRMSE}}: how far S, N_dyn, xi and eta move between the two ends of the linear
-    chain's stiffness interval (N/m) of k_n and of k_t (an open upper end, of either: 10 x the larger of the
-    stiffness and the lower end), the other stiffness held; ``record``: (force, acceleration, fs, f0) of
-    ``_record``."""
+    chain's stiffness interval (N/m) of k_n (an open upper end: 10 x the larger of k_n and the lower end) and of k_t,
+    the other stiffness held; ``record``: (force, acceleration, fs, f0) of ``_record``."""
     force, acc, fs, f0 = record
-
-    def closed(key, k):
-        lo, hi = (float(v) for v in stiction[key].values)
-        return lo, hi if np.isfinite(hi) else 10 * max(k, lo)
-
+    lo_n, hi_n = (float(v) for v in stiction["k_n_interval"].values)
+    hi_n = hi_n if np.isfinite(hi_n) else 10 * max(k_n, lo_n)
     spreads = {}
-    for name, (a, b) in {"k_n": closed("k_n_interval", k_n), "k_t": closed("k_t_interval", k_t)}.items():
+    for name, (a, b) in {"k_n": (lo_n, hi_n), "k_t": tuple(float(v) for v in stiction["k_t_interval"].values)}.items():
         res = []
         for val in (a, b):
             ch = {"k_t": val, "k_n": k_n} if name == "k_t" else {"k_t": k_t, "k_n": val}
