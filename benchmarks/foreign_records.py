@@ -14,8 +14,6 @@ Usage: .venv/bin/python benchmarks/foreign_records.py [SET ...]   (default: ever
 """
 
 import json
-import shutil
-import subprocess
 import sys
 from pathlib import Path
 
@@ -23,7 +21,8 @@ import numpy as np
 import yaml
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from independent_rig import contact_scores  # the same scores as the other simulator's check
+from common import measured_project, run_gap_summary
+from independent_rig import contact_scores
 
 ROOT = Path(__file__).resolve().parents[1]
 CACHE = ROOT / "benchmarks" / "cache"
@@ -36,20 +35,11 @@ def project(name: str, folder: Path) -> Path:
     absolute), as `snakemake --configfile` would read it."""
     from contactid.config import merged_over
 
-    proj = CACHE / "foreign" / "projects" / name
-    if proj.exists():
-        shutil.rmtree(proj)
-    proj.mkdir(parents=True)
-    shutil.copy(ROOT / "Snakefile", proj / "Snakefile")
-    shutil.copytree(ROOT / "workflow", proj / "workflow", ignore=shutil.ignore_patterns("__pycache__", "*.egg-info"))
-    shutil.copytree(ROOT / "paper", proj / "paper")
     overlay = yaml.safe_load((folder / "config.yaml").read_text())
     for block in [overlay["random_test"], *overlay["load_cases"].values()]:
         block["file"] = str((ROOT / block["file"]).resolve())
     cfg = merged_over(yaml.safe_load((ROOT / "config" / "config.yaml").read_text()), overlay)
-    (proj / "config").mkdir()
-    (proj / "config" / "config.yaml").write_text(yaml.safe_dump(cfg, sort_keys=False))
-    return proj
+    return measured_project(CACHE / "foreign" / "projects" / name, cfg)
 
 
 def score(name: str, proj: Path, folder: Path) -> dict:
@@ -134,16 +124,7 @@ def main():
             raise SystemExit(f"benchmarks/foreign_records.py: unknown set {name!r}; give any of {', '.join(sets)}")
         folder = FOREIGN / name
         proj = project(name, folder)
-        print(f"{name}: snakemake gap summary in {proj}", flush=True)
-        run = subprocess.run(
-            [str(ROOT / ".venv" / "bin" / "snakemake"), "-c2", "gap", "summary"],
-            cwd=proj,
-            capture_output=True,
-            text=True,
-        )
-        if run.returncode:
-            print(run.stdout[-3000:], run.stderr[-3000:])
-            raise SystemExit(f"{name}: the workflow failed (log in {proj}/.snakemake/log)")
+        run_gap_summary(name, proj)
         rows.append(score(name, proj, folder))
         report(rows[-1])
     CACHE.mkdir(parents=True, exist_ok=True)

@@ -19,13 +19,13 @@ Usage: .venv/bin/python benchmarks/independent_rig.py [SET ...]   (default: ever
 
 import json
 import os
-import shutil
 import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
 import yaml
+from common import measured_project, run_gap_summary
 
 ROOT = Path(__file__).resolve().parents[1]
 CACHE = ROOT / "benchmarks" / "cache"
@@ -53,19 +53,10 @@ def generate(name: str) -> Path:
 
 def project(name: str, folder: Path) -> Path:
     """A project whose random test and load cases are the data set's files, read as measured records."""
-    proj = DATA / "projects" / name
-    if proj.exists():
-        shutil.rmtree(proj)
-    proj.mkdir(parents=True)
-    shutil.copy(ROOT / "Snakefile", proj / "Snakefile")
-    shutil.copytree(ROOT / "workflow", proj / "workflow", ignore=shutil.ignore_patterns("__pycache__", "*.egg-info"))
-    shutil.copytree(ROOT / "paper", proj / "paper")
     cfg = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
     cfg["random_test"] = {**cfg["random_test"], "source": "measured", "file": str(folder / "random_test.nc")}
     cfg["load_cases"] = {c: {"source": "measured", "file": str(folder / f"{c}.nc")} for c in CASES}
-    (proj / "config").mkdir()
-    (proj / "config" / "config.yaml").write_text(yaml.safe_dump(cfg, sort_keys=False))
-    return proj
+    return measured_project(DATA / "projects" / name, cfg)
 
 
 def _harmonics(x: np.ndarray, t: np.ndarray, f0: float, n: int = 5) -> np.ndarray:
@@ -169,16 +160,7 @@ def main():
             raise SystemExit(f"benchmarks/independent_rig.py: unknown data set {name!r}; give any of {', '.join(SETS)}")
         folder = generate(name)
         proj = project(name, folder)
-        print(f"{name}: snakemake gap summary in {proj}", flush=True)
-        run = subprocess.run(
-            [str(ROOT / ".venv" / "bin" / "snakemake"), "-c2", "gap", "summary"],
-            cwd=proj,
-            capture_output=True,
-            text=True,
-        )
-        if run.returncode:
-            print(run.stdout[-3000:], run.stderr[-3000:])
-            raise SystemExit(f"{name}: the workflow failed (log in {proj}/.snakemake/log)")
+        run_gap_summary(name, proj)
         rows.append(score(name, proj, folder))
         report(rows[-1])
     (CACHE / "independent_rig.json").write_text(json.dumps(rows, indent=2, default=float))
