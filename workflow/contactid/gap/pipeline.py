@@ -127,12 +127,10 @@ def workflow_models(
     and ``diagnosed_model``'s chain model, model to diagnose and UpdatingResult or None)."""
     import json
 
-    from ..io import load_dataset, read_raw
+    from ..io import load_dataset
 
     modal = load_dataset(inputs.modal)
-    records = {
-        c: record_harmonics(read_raw(path, dual_sine=True), c, n_harmonics) for c, path in zip(cases, inputs.raw)
-    }
+    records = workflow_records(inputs.raw, cases, n_harmonics)
     fit_settings = settings_from_config(friction_cfg)
     with open(inputs.updating) as fh:
         upd_summary = json.load(fh)
@@ -335,15 +333,22 @@ def workflow_record_checks(structure_cfg: Mapping, inputs, cases, calibration_ca
     """The records' check (``records_check_of``) from the workflow's files: ``inputs`` names modes, modal, fit and raw
     (the load cases' records, in the order of ``cases``); the prediction is the chain's identified model (not
     updated)."""
-    from ..io import load_dataset, read_raw
+    from ..io import load_dataset
     from .model import identified_model
 
     model = identified_model(
         structure_cfg, load_dataset(inputs.modes), load_dataset(inputs.modal), load_dataset(inputs.fit)
     )
-    H = int(n_harmonics)
-    records = {c: record_harmonics(read_raw(path, dual_sine=True), c, H) for c, path in zip(cases, inputs.raw)}
-    return records_check_of(model, records, calibration_case, H, thresholds)
+    records = workflow_records(inputs.raw, cases, n_harmonics)
+    return records_check_of(model, records, calibration_case, n_harmonics, thresholds)
+
+
+def workflow_records(paths, cases, n_harmonics: int) -> dict:
+    """{case: RecordHarmonics} of the load cases' dual-sine records ``paths`` (in the order of ``cases``), harmonics
+    1..``n_harmonics``: what the gap's rules compare the model with."""
+    from ..io import read_raw
+
+    return {c: record_harmonics(read_raw(path, dual_sine=True), c, int(n_harmonics)) for c, path in zip(cases, paths)}
 
 
 def records_check_of(model, records: Mapping, calibration_case: str, n_harmonics: int, thresholds) -> dict:
