@@ -13,6 +13,8 @@ import re
 from pathlib import Path
 from typing import Mapping
 
+from .measured_files import record_blocks
+
 # the one home of every default: the schema's ``default``s (every optional block defaults to {}, so that its keys'
 # defaults fill in where the block is left out); the Snakefile's validation fills them into the workflow's config,
 # ``with_defaults`` into a config used outside Snakemake
@@ -341,9 +343,7 @@ def _record_format_errors(cfg: Mapping) -> list:
     measured FRFs ``importers.frf_uff.frf_sensor_map``); a format other than netCDF is for measured records only,
     and FRFs (uff58_frf) are for the random test only."""
     errors = []
-    for where, block in [("random_test", cfg["random_test"])] + [
-        (f"load_cases.{c}", lc) for c, lc in (cfg.get("load_cases") or {}).items()
-    ]:
+    for where, block in record_blocks(cfg):
         fmt = block.get("format", "netcdf")
         if fmt == "uff58_frf" and where != "random_test":
             errors.append(

@@ -16,12 +16,16 @@ from pathlib import Path
 from typing import Iterator, Mapping
 
 
-def measured_records(cfg: Mapping) -> Iterator[tuple[str, Mapping]]:
-    """(config key, block) of every record the config reads from a file: the random test and each load case whose
-    ``source`` is measured."""
+def record_blocks(cfg: Mapping) -> list[tuple[str, Mapping]]:
+    """(config key, block) of every record the config names: the random test, then each load case."""
     blocks = [("random_test", cfg.get("random_test") or {})]
-    blocks += [(f"load_cases.{c}", lc or {}) for c, lc in (cfg.get("load_cases") or {}).items()]
-    for where, block in blocks:
+    return blocks + [(f"load_cases.{c}", lc or {}) for c, lc in (cfg.get("load_cases") or {}).items()]
+
+
+def measured_records(cfg: Mapping) -> Iterator[tuple[str, Mapping]]:
+    """(config key, block) of every record the config reads from a file (``record_blocks`` whose ``source`` is
+    measured, with a ``file``)."""
+    for where, block in record_blocks(cfg):
         if block.get("source", "rig") == "measured" and block.get("file"):
             yield where, block
 
