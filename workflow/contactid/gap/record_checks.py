@@ -54,7 +54,8 @@ class Thresholds:
 
     @classmethod
     def from_config(cls, block: Mapping | None) -> "Thresholds":
-        return cls(**{k: float(v) for k, v in dict(block or {}).items() if k in cls.__dataclass_fields__})
+        """From the ``gap.record_checks`` block (keys left out: the defaults), as ``verdict.PlaceThresholds``."""
+        return cls(**{k: float(v) for k, v in (block or {}).items()})
 
 
 # -------------------------------------------------------------------------------------------------------------------
