@@ -123,7 +123,8 @@ def model_evidence(case: str, sensors, measured: np.ndarray, predicted: np.ndarr
     a = _ls_scale(P.ravel(), A.ravel())
     per = [_ls_scale(P[i], A[i]) for i in range(A.shape[0])]
     gaps = [_rel(P[i], A[i]) for i in range(A.shape[0])]
-    best, best_gap = tuple(range(A.shape[0])), _rel(P, A)
+    gap = _rel(P, A)
+    best, best_gap = tuple(range(A.shape[0])), gap
     if A.shape[0] <= 6:  # at most 720 orders; beyond that the channel-map test is left out
         for perm in itertools.permutations(range(A.shape[0])):
             g = _rel(P[list(perm)], A)
@@ -132,7 +133,7 @@ def model_evidence(case: str, sensors, measured: np.ndarray, predicted: np.ndarr
     return ModelEvidence(
         case,
         tuple(sensors),
-        _rel(P, A),
+        gap,
         a,
         _rel(a * P, A),
         tuple(per),
@@ -156,10 +157,6 @@ def named_factor(factor: float, tol: float) -> str:
         near = f"1/{1 / value:g}" if value < 1 else f"{value:g}"
         return f"{factor:.3g} times (near {near}: likely {meaning})"
     return f"{factor:.3g} times (likely a wrong sensitivity or gain in the channel map)"
-
-
-def _near_units(factor: float, tol: float) -> bool:
-    return near_units(factor, tol)
 
 
 def _trace(test: str, value: float, threshold: float, passed: bool, case: str) -> dict:
@@ -280,10 +277,10 @@ def _signature(ev: ModelEvidence, th: Thresholds, head: str, trace: list, level:
     # the model lacks (a contact that opens at one level) moves the prediction, not the record's level among its
     # peers (the blind benchmark's contact-separation items: the prediction 4-5 times the record, near 1/4.448)
     if level is None:  # no peer to ask: the factor alone, within a third of the tolerance
-        units = _near_units(mag, th.unit_tolerance / 3.0)
+        units = near_units(mag, th.unit_tolerance / 3.0)
     else:  # the peers see the record off beyond level_factor, by about the same factor
         units = (
-            _near_units(mag, th.unit_tolerance)
+            near_units(mag, th.unit_tolerance)
             and max(level, 1.0 / level) > th.level_factor
             and abs(np.log(level / max(mag, 1e-300))) < np.log(1.0 + 2.0 * th.unit_tolerance)
         )
