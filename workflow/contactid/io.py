@@ -130,6 +130,18 @@ def content_digest(ds: xr.Dataset) -> str:
     return h.hexdigest()
 
 
+def nonfinite_variables(datasets: Mapping[str, xr.Dataset], skip=()) -> list[str]:
+    """``label: variable`` of every real or complex variable of ``datasets`` {label: dataset} that holds a NaN or an
+    infinite number (variables named in ``skip`` left out): where a NaN came from."""
+    out = []
+    for label, data in datasets.items():
+        for name, var in data.data_vars.items():
+            values = np.asarray(var.values)
+            if name not in skip and values.dtype.kind in "fc" and not np.all(np.isfinite(values)):
+                out.append(f"{label}: {name}")
+    return out
+
+
 def write_dataset(ds: xr.Dataset, path: str | os.PathLike) -> None:
     """Write ``ds`` whole or not at all: to a temporary file beside ``path``,
     then renamed over it. Every data variable must carry ``units`` and

@@ -530,3 +530,26 @@ def amplitude_message(ratio: float, source: str) -> str:
         "results/linear/stiction.nc is not written. Likely causes, most likely first: "
         + "; ".join(f"({i + 1}) {c}" for i, c in enumerate(causes))
     )
+
+
+def random_test_source(modal, block) -> tuple[str, float | None]:
+    """(the random test's file as the user gave it in its config ``block``, and as the chain read it where that
+    differs; its sampling rate in Hz or None), from the provenance modal.nc -> frf.nc keeps: for the refusal's
+    message."""
+    import os
+
+    import xarray as xr
+
+    from .io import ENGINE
+
+    given = block.get("file") if block.get("source") == "measured" else None
+    read, rate = None, None
+    frf = modal.attrs.get("input_frf")
+    if frf and os.path.exists(frf):
+        with xr.open_dataset(frf, engine=ENGINE) as ds:
+            read = ds.attrs.get("input_raw") or ds.attrs.get("input_file")
+            rate = ds.attrs.get("sampling_rate_hz")
+    name = given or read or "data/raw/random_test.nc"
+    if read and given and os.path.normpath(read) != os.path.normpath(given):
+        name += f" (read as {read})"
+    return name, float(rate) if rate is not None else None

@@ -87,6 +87,7 @@ rule stiction_stiffness:
         code=CODE_DIGEST,
         structure=config["structure"],
         stiction=config["stiction"],
+        random_test=config["random_test"],
     conda:
         "../envs/contactid.yaml"
     log:

@@ -1,32 +1,11 @@
 """Rule stiction_stiffness: k_t and k_n of Eq. 13 fitted to the natural frequencies."""
 
-import os
-
-import xarray as xr
-
-from contactid.io import ENGINE, load_dataset, provenance, write_dataset
+from contactid.io import load_dataset, provenance, write_dataset
 from contactid.linear_chain import stiction_dataset
 from contactid.logs import fmt, setup_logging
 from contactid.model_checks import stiffness_fit_check
 from contactid.parameters import structure_from_config
-from contactid.stiction import refuse_unreachable
-
-
-def random_test_source(modal) -> tuple[str, float | None]:
-    """(the random test's file as the user gave it, and as the chain read it where that differs; its sampling rate
-    in Hz or None), from the config and the provenance modal.nc -> frf.nc keeps (for the refusal's message)."""
-    block = snakemake.config.get("random_test") or {}
-    given = block.get("file") if block.get("source") == "measured" else None
-    read, rate = None, None
-    frf = modal.attrs.get("input_frf")
-    if frf and os.path.exists(frf):
-        with xr.open_dataset(frf, engine=ENGINE) as ds:
-            read = ds.attrs.get("input_raw") or ds.attrs.get("input_file")
-            rate = ds.attrs.get("sampling_rate_hz")
-    name = given or read or "data/raw/random_test.nc"
-    if read and given and os.path.normpath(read) != os.path.normpath(given):
-        name += f" (read as {read})"
-    return name, float(rate) if rate is not None else None
+from contactid.stiction import random_test_source, refuse_unreachable
 
 
 log = setup_logging(snakemake.log[0])
@@ -40,7 +19,7 @@ refuse_unreachable(
     structure_from_config(p.structure, 1e7, 1e8),
     ds,
     p.stiction,
-    *random_test_source(modal),
+    *random_test_source(modal, p.random_test),
     residue_abs=modal["residue_abs"].values if "residue_abs" in modal else None,
 )
 ds.attrs.update(
