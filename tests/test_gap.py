@@ -274,7 +274,7 @@ def test_a_candidate_removing_less_than_min_reduction_is_not_named(hc_data):
     # the right effect removes ~94 % of this gap; asking for more than it removes leaves the verdict open
     d = _diagnose(hc_data, ["normal_contact_damping"], min_reduction=0.99)
     assert d.ranking[0]["effect"] == "normal_contact_damping" and 0.5 < d.ranking[0]["reduction"] < 0.99
-    assert d.verdict == "none" and "no candidate shrinks the held-out gap by 99%" in d.reason
+    assert d.verdict == "none" and "less than gap.min_reduction 99% of it" in d.reason
 
 
 @pytest.mark.slow
@@ -282,7 +282,9 @@ def test_effect_missing_from_library_gives_none_and_points_at_the_normal_directi
     d = _diagnose(hc_data, ["viscous_friction"])
     assert d.verdict == "none", d.reason
     assert d.where["direction"] == "normal" and d.where["place"] == "normal_contact"
-    assert d.ranking[0]["effect"] == "viscous_friction" and d.ranking[0]["reduction"] > 0.3  # helps, acts elsewhere
+    # the form candidate (the beam modes' damping) is tried beside the library; viscous friction helps, acts elsewhere
+    assert {r["effect"] for r in d.ranking} == {"viscous_friction", "structural_damping"}
+    assert next(r for r in d.ranking if r["effect"] == "viscous_friction")["reduction"] > 0.3
     assert d.where["heldout_gap_before"] > 0.01  # a real gap, left unexplained
 
 

@@ -1,12 +1,12 @@
-"""The gap diagnosis's decisions without the rig: every branch of the verdict and every threshold of the
-place, on hand-made numbers (milliseconds). tests/test_gap.py and tests/test_workflow.py check the same
-decisions on rig data."""
+"""The gap diagnosis's decisions without the rig: every threshold of the place and the explanation's step rules, on
+hand-made numbers (milliseconds; the verdict's: tests/test_story.py). tests/test_gap.py and tests/test_workflow.py
+check the same decisions on rig data."""
 
 import numpy as np
 import pytest
 
 from contactid.gap import verdict as V
-from contactid.gap.verdict import place, verdict
+from contactid.gap.verdict import place
 
 SETTINGS = {"min_gap": 0.006, "noise_factor": 3.0, "min_reduction": 0.5, "separation": 1.5}  # the config's defaults
 PLACE = "tangential_contact"
@@ -23,116 +23,6 @@ def row(effect, after, before=0.02, consistent=True, acts_on=PLACE, low=None):
         "reduction": red,
         "reduction_interval": [red - 0.05 if low is None else low, red + 0.05],
     }
-
-
-# ----------------------------------------------------------------------------------------------
-# verdict
-# ----------------------------------------------------------------------------------------------
-
-
-def test_no_candidates_give_none_without_reason():
-    assert verdict([], 0.05, 1e-4, PLACE, SETTINGS) == ("none", "")
-
-
-def test_clean_winner_is_named_with_its_bootstrap_p_better():
-    rows = [row("viscous_friction", 0.002), row("structural_damping", 0.012)]
-    boots = {"viscous_friction": np.array([1.0, 2.0, 3.0, 4.0]), "structural_damping": np.array([2.0, 3.0, 4.0, 1.0])}
-    name, reason = verdict(rows, 0.02, 1e-4, PLACE, SETTINGS, boots)
-    assert name == "viscous_friction"
-    assert reason == (
-        "viscous_friction shrinks the held-out gap from 2 % to 0.2 % (90.0%); runner-up "
-        "structural_damping 1.2 %; bootstrap P(better) 0.75"
-    )
-
-
-def test_a_sole_candidate_wins_without_runner_up():
-    name, reason = verdict([row("viscous_friction", 0.002)], 0.02, 1e-4, PLACE, SETTINGS)
-    assert name == "viscous_friction"
-    assert "runner-up -;" in reason and "P(better) 1.00" in reason
-
-
-def test_gap_below_min_gap_gives_none():
-    rows = [row("viscous_friction", 0.0005, before=0.0059)]
-    name, reason = verdict(rows, 0.0059, 1e-5, PLACE, SETTINGS)
-    assert name == "none"
-    # gaps in per cent, as the report prints them beside this reason; the setting as the config writes it
-    assert reason.startswith("the held-out gap 0.59 % is below gap.min_gap = 0.006 (0.6 %)")
-    # at the threshold itself the gap counts (strict inequality): the clean winner is named
-    assert (
-        verdict([row("viscous_friction", 0.0005, before=0.006)], 0.006, 1e-5, PLACE, SETTINGS)[0] == "viscous_friction"
-    )
-
-
-def test_gap_within_the_records_scatter_gives_none():
-    rows = [row("viscous_friction", 0.002)]
-    name, reason = verdict(rows, 0.02, 0.007, PLACE, SETTINGS)  # 0.02 < 3 x 0.007
-    assert name == "none" and reason == "the held-out gap 2 % is within 3.0 x the records' scatter 0.7 %"
-    assert verdict(rows, 0.02, 0.0066, PLACE, SETTINGS)[0] == "viscous_friction"  # 0.02 > 3 x 0.0066
-
-
-def test_reduction_below_min_reduction_gives_none():
-    rows = [row("viscous_friction", 0.0102), row("structural_damping", 0.019)]  # 49 % removed
-    name, reason = verdict(rows, 0.02, 1e-4, PLACE, SETTINGS)
-    assert name == "none" and reason == "no candidate shrinks the held-out gap by 50% (best: viscous_friction, 49.0%)"
-    rows = [row("viscous_friction", 0.010), row("structural_damping", 0.019)]  # exactly 50 %: enough
-    assert verdict(rows, 0.02, 1e-4, PLACE, SETTINGS)[0] == "viscous_friction"
-    assert verdict(rows, 0.02, 1e-4, PLACE, {**SETTINGS, "min_reduction": 0.6})[0] == "none"
-
-
-def test_bootstrap_lower_bound_at_or_below_zero_gives_none():
-    for low in (0.0, -0.2):
-        rows = [row("viscous_friction", 0.002, low=low), row("structural_damping", 0.019)]
-        name, reason = verdict(rows, 0.02, 1e-4, PLACE, SETTINGS)
-        assert name == "none" and reason.startswith("no candidate shrinks the held-out gap by 50%"), low
-    rows = [row("viscous_friction", 0.002, low=1e-3), row("structural_damping", 0.019)]
-    assert verdict(rows, 0.02, 1e-4, PLACE, SETTINGS)[0] == "viscous_friction"
-
-
-def test_runner_up_too_close_gives_none():
-    rows = [row("viscous_friction", 0.004), row("normal_contact_damping", 0.0059)]  # 0.0059 < 1.5 x 0.004
-    name, reason = verdict(rows, 0.02, 1e-4, PLACE, SETTINGS)
-    assert name == "none"
-    assert reason == (
-        "viscous_friction and normal_contact_damping explain the gap about equally (held-out gaps "
-        "0.4 %, 0.59 %; separation 1.5)"
-    )
-    rows = [row("viscous_friction", 0.004), row("normal_contact_damping", 0.006)]  # exactly 1.5 x: separated
-    assert verdict(rows, 0.02, 1e-4, PLACE, SETTINGS)[0] == "viscous_friction"
-
-
-def test_no_candidate_acting_where_the_gap_lies_gives_none():
-    rows = [
-        row("normal_contact_damping", 0.001, consistent=False, acts_on="normal_contact"),
-        row("contact_separation", 0.003, consistent=False, acts_on="normal_contact"),
-    ]
-    name, reason = verdict(rows, 0.02, 1e-4, PLACE, SETTINGS)
-    assert name == "none"
-    assert reason == (
-        "the gap lies in tangential_contact and no candidate of the library acts there and explains it "
-        "(best by score: normal_contact_damping, acting on normal_contact, 95.0%)"
-    )
-    # this reason comes first, whatever the size of the gap
-    assert verdict(rows, 0.001, 1e-4, PLACE, SETTINGS)[1].startswith("the gap lies in tangential_contact")
-
-
-def test_the_winner_is_the_best_consistent_candidate_and_the_runner_up_any_other():
-    inconsistent = row("normal_contact_damping", 0.001, consistent=False, acts_on="normal_contact")
-    # the best-scored candidate acts elsewhere: the best consistent one is judged, against the best other one
-    rows = [inconsistent, row("viscous_friction", 0.002)]
-    name, reason = verdict(rows, 0.02, 1e-4, PLACE, SETTINGS)
-    assert name == "none" and reason.startswith(
-        "viscous_friction and normal_contact_damping explain the gap about equally"
-    )
-    rows = [row("viscous_friction", 0.002), {**inconsistent, "heldout_gap_after": 0.004}]
-    assert verdict(rows, 0.02, 1e-4, PLACE, SETTINGS)[0] == "viscous_friction"
-
-
-def test_verdict_reads_gap_settings_like_a_mapping():
-    from contactid.gap.diagnosis import GapSettings
-
-    rows = [row("viscous_friction", 0.004), row("normal_contact_damping", 0.0059)]
-    assert verdict(rows, 0.02, 1e-4, PLACE, GapSettings()) == verdict(rows, 0.02, 1e-4, PLACE, SETTINGS)
-    assert verdict(rows, 0.02, 1e-4, PLACE, GapSettings(separation=1.2))[0] == "viscous_friction"
 
 
 # ----------------------------------------------------------------------------------------------

@@ -9,6 +9,7 @@ from contactid.gap.diagnosis import GapSettings, diagnose, linear_stage, prepare
 from contactid.gap.floor import read_floor, resolved_gap_config
 from contactid.gap.pipeline import workflow_models
 from contactid.gap.record_checks import diagnosis_outcome
+from contactid.gap.story import records_agree
 from contactid.gap.output import diagnosis_json, gap_dataset
 from contactid.io import load_dataset, provenance, write_dataset, write_text
 from contactid.logs import setup_logging
@@ -46,7 +47,13 @@ diag = diagnose(
 with open(inp.record_checks) as fh:
     record_check = json.load(fh)
 verdict, reason, explanation = diagnosis_outcome(diag.verdict, diag.reason, diag.explanation, record_check)
-diag = dataclasses.replace(diag, verdict=verdict, reason=reason, explanation=explanation)
+diag = dataclasses.replace(
+    diag,
+    verdict=verdict,
+    reason=reason,
+    explanation=explanation,
+    trace=[*diag.trace, records_agree(record_check).as_dict()],
+)
 seconds = time.perf_counter() - t0
 prov = provenance(
     "gap_diagnosis",

@@ -21,6 +21,7 @@ import numpy as np
 from ..config import schema_defaults
 from ..random_streams import generator
 from ..rig.effects import EFFECTS
+from .story import one_story_holds
 
 log = logging.getLogger(__name__)
 
@@ -276,7 +277,7 @@ def compound_row(spec: Mapping, cfg: Mapping, effects: Mapping, item: ItemDiagno
 
     diag, model, updating = item.diag, item.model, item.updating
     cal = cfg["nonlinear"]["calibration_case"]
-    named = [s["effect"] for s in diag.explanation if s["effect"] != "model_updating"]
+    named = named_effects(diag.explanation)
     preload = float(cfg["structure"]["preload_n"])
     t_unc = time.perf_counter()
     unc = friction_uncertainty(
@@ -294,6 +295,7 @@ def compound_row(spec: Mapping, cfg: Mapping, effects: Mapping, item: ItemDiagno
         **dict(spec),
         "verdict": diag.verdict,
         "reason": diag.reason,
+        "one_story": one_story_holds(diag.summary()),
         "explanation": diag.explanation,
         "remaining_gap": diag.remaining_gap,
         "named": named,
@@ -326,6 +328,8 @@ def blind_row(spec: Mapping, item: ItemDiagnosis, converged, t_rig: float) -> di
         **dict(spec),
         "verdict": diag.verdict,
         "reason": diag.reason,
+        "one_story": one_story_holds(diag.summary()),
+        "explanation": [{k: s.get(k) for k in ("effect", "kind", "names", "share")} for s in diag.explanation],
         "correct": (diag.verdict == (true or "none")) if spec["kind"] != "leave_out" else diag.verdict == "none",
         "heldout_gap_before": diag.where["heldout_gap_before"],
         "heldout_gap_identified": diag.where.get("heldout_gap_identified", diag.where["heldout_gap_before"]),
@@ -510,6 +514,11 @@ def score(rows: list) -> dict:
         },
         **({"compound": compound_score(comp)} if comp else {}),
         "failed": [{k: r.get(k) for k in ("kind", "effect", "effects", "seed", "failed")} for r in failed],
+        "two_stories": [
+            {k: r.get(k) for k in ("kind", "effect", "effects", "seed", "verdict")}
+            for r in [*rows, *comp]
+            if not r.get("one_story", True)
+        ],
     }
 
 
@@ -721,11 +730,23 @@ def bound_errors(model, truth_friction: Mapping, preload: float, true_lever_arm:
     return {"mu_a": float((1 + err["mu"]) * r - 1), "e0_a2": float((1 + err["e0"]) * r**2 - 1)}
 
 
+def named_effects(explanation) -> list:
+    """The effects an explanation names: its steps of kind "effect" (an update that amounts to one effect by that
+    effect's name; model form and an update that names none are not effects)."""
+    out = []
+    for s in explanation:
+        if s.get("kind", "effect") != "effect":
+            continue
+        if s["effect"] != "model_updating" or s.get("names"):
+            out.append(s.get("names", s["effect"]))
+    return out
+
+
 def compound_score(rows: list) -> dict:
     """Scores of the compound items (see config/README.md, gap_benchmark.compound)."""
 
     def named(r):
-        return {s["effect"] for s in r["explanation"] if s["effect"] != "model_updating"}
+        return set(named_effects(r["explanation"]))
 
     by_n = {n: [r for r in rows if len(r["effects"]) == n] for n in (0, 1, 2)}
     share = lambda xs: float(np.mean(xs)) if xs else None  # noqa: E731

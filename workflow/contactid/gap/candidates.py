@@ -71,7 +71,9 @@ class Candidate:
     """A candidate effect: name, what it models, its parameters and theta -> Augmentation.
     ``per_channel``: the one parameter is repeated for every accelerometer channel. ``acts_on``: the
     place of the gap it can explain (one of PLACES, or "any"): a winner must act where the
-    localisation puts the gap."""
+    localisation puts the gap. ``form``: the candidate changes the base model's form (its damping) rather than adding
+    an effect at the contact or in the measurement: what it explains is the reference of what model-form differences
+    leave on the records (``story.beyond_model_form``), and it is tried even where the library in use leaves it out."""
 
     name: str
     meaning: str
@@ -79,6 +81,7 @@ class Candidate:
     augmentation: Callable[[np.ndarray], Augmentation]
     per_channel: bool = False
     acts_on: str = "any"
+    form: bool = False
 
     def n_parameters(self, n_channels: int) -> int:
         return n_channels if self.per_channel else len(self.parameters)
@@ -113,6 +116,7 @@ register(
         (Parameter("extra_damping_ratio", "1", 0.0, 0.05, domain=(0.0, 0.2)),),
         lambda th: Augmentation(extra_damping=float(th[0])),
         acts_on="structure_or_measurement",
+        form=True,
     )
 )
 register(
@@ -246,7 +250,9 @@ def joint_candidate(new: Candidate, earlier, n_channels: int) -> tuple[Candidate
     def augmentation(theta):
         return merged_augmentation(zip(cands, split(theta)))
 
-    joint = Candidate(new.name, new.meaning, tuple(p for x in parts for p in x), augmentation, False, new.acts_on)
+    joint = Candidate(
+        new.name, new.meaning, tuple(p for x in parts for p in x), augmentation, False, new.acts_on, new.form
+    )
     return joint, split
 
 

@@ -56,7 +56,8 @@ from .verdict import (
     retried,
     updating_effect,
 )
-from .verdict import verdict as _verdict
+from .isolability import isolability, signature
+from .story import resolution, tell
 
 log = logging.getLogger(__name__)
 
@@ -505,11 +506,15 @@ class Diagnosis:
     shrink: dict = field(default_factory=dict)
     explanation: list = field(default_factory=list)
     remaining_gap: dict = field(default_factory=dict)
+    trace: list = field(default_factory=list)
+    resolution: dict = field(default_factory=dict)
 
     def summary(self) -> dict:
         return {
             "verdict": self.verdict,
             "reason": self.reason,
+            "resolution": self.resolution,
+            "trace": self.trace,
             "ranking": self.ranking,
             "where": self.where,
             "explanation": self.explanation,
@@ -861,7 +866,7 @@ def explain(
                 second_step[2],
             )
             chosen = [first_step, second_step]
-        for name, (cal, sims, _), after, alternatives in chosen:
+        for k, (name, (cal, sims, _), after, alternatives) in enumerate(chosen):
             steps.append(
                 {
                     "effect": name,
@@ -874,11 +879,14 @@ def explain(
             )
             if name == held_step:  # not refitted on the records: held where the random test measured it
                 steps[-1]["held"] = True
+            if k == 0 and len(chosen) > 1:  # a pair's first half: judged with its second (story.tell)
+                steps[-1]["pair_first"] = True
             if periodicity is not None:
                 steps[-1].update(periodicity(cal, sims))
             if len(cal.steps) > 1:  # the earlier steps' parameters as refitted with this one (gap.joint_refit)
                 steps[-1]["earlier_refitted"] = {n: _parameter_values(n, theta=th) for n, th in cal.steps[:-1]}
             log.info("explanation step %d: %s leaves a held-out gap of %.4g (from %.4g)", len(steps), name, after, gap)
+            steps[-1]["_fit"] = (cal, sims)  # for the place of what is left (diagnose), not written
             gap, last = after, (cal, sims)
             remaining.remove(name)
         remaining = [n for n in remaining if later is None or n in later]
@@ -1403,7 +1411,11 @@ def diagnose(
     )
     # candidates: calibrate, predict the held-out cases (forked before the localisation runs numba's
     # parallel friction kernel in this process)
-    names = list(settings.candidates or tuple(LIBRARY))
+    library = list(settings.candidates or tuple(LIBRARY))
+    # the form candidates (the base model's damping) are the reference of what model-form differences leave, tried
+    # whether or not the library in use lists them; named as an effect only where it does (story.tell)
+    form = [n for n, c in LIBRARY.items() if c.form]
+    names = library + [n for n in form if n not in library]
     candidate_results = run.candidates(names, model, base_sims)
     structures = tuple(updating.posterior_structures()) if updating is not None else ()
     where, arrays = localise(
@@ -1433,7 +1445,6 @@ def diagnose(
         settings.place.aperiodic_limit,
     )
     scatter = float(np.std(before_b))
-    verdict, reason = _verdict(rows, before, scatter, where["place"], settings, boots)
     shrink = {
         label: {
             "effect": r["effect"],
@@ -1486,29 +1497,67 @@ def diagnose(
         where["heldout_gap_identified"] = first_before
         steps.insert(0, _updating_step(updating, first_before, before))
         log.info("explanation step 0: model updating takes the held-out gap from %.4g to %.4g", first_before, before)
-    shares, left_share = gap_shares(first_before, [s["heldout_gap_after"] for s in steps])
+    shares, _ = gap_shares(first_before, [s["heldout_gap_after"] for s in steps])
     for s, share in zip(steps, shares):
         s["share"] = share
-    if verdict == "none" and steps and steps[0]["effect"] == "model_updating":
-        by_update = _updating_verdict(updating, names, first_before, before, shares, scatter, settings)
-        verdict, reason = by_update or (verdict, reason)
-    if not held:  # every gap is the calibration case's own, which each refit lowers: no effect is tested
-        verdict, reason = NO_HELDOUT_VERDICT
+    update_effect = None
+    if steps and steps[0]["effect"] == "model_updating":
+        update_effect = _updating_verdict(updating, library, first_before, before, shares, scatter, settings)
+    story = tell(
+        steps,
+        rows,
+        before=before,
+        scatter=scatter,
+        place=where["place"],
+        settings=settings,
+        form=form,
+        model_form=[n for n in form if n not in library],
+        n_held=len(held),
+        update_effect=update_effect,
+    )
+    verdict, reason, steps = story.verdict, story.reason, story.explanation
+    where["resolution"] = resolution(
+        before,
+        {r["effect"]: r["heldout_gap_after"] for r in rows if r["effect"] in form},
+        scatter,
+        settings,
+        held=bool(held),
+    )
+    base_res = {c: gap_residual(base_sims[c], records[c], H) for c in run.score_cases}
+    where["resolution"]["isolability"] = isolability(
+        {
+            n: signature(base_res, r[2], run.score_cases)
+            for n, r in results.items()
+            if all(c in r[2] for c in run.score_cases)
+        },
+        form,
+    )
+    if not held:
         log.warning("gap diagnosis: %s", reason)
+    fits = [s.pop("_fit") for s in steps if "_fit" in s]
+    last = fits[-1] if fits else None
+    left = steps[-1]["heldout_gap_after"] if steps else before
+    left_share = (left / steps[0]["heldout_gap_before"]) ** 2 if steps else 1.0
     remaining = _remaining_gap(left, left_share, where, last, run, linear, structures)
     sims = {"base": base_sims, **{n: r[1] for n, r in results.items()}}
-    return Diagnosis(verdict, reason, rows, where, calibration_case, held, arrays, sims, shrink, steps, remaining)
+    return Diagnosis(
+        verdict,
+        reason,
+        rows,
+        where,
+        calibration_case,
+        held,
+        arrays,
+        sims,
+        shrink,
+        steps,
+        remaining,
+        trace=story.trace,
+        resolution=where.pop("resolution"),
+    )
 
 
 # s: the random test's channel delays seed a pair (``diagnose``'s delay_seeds) only where one is at least this large;
 # they come out within about 0.9 us of the truth on a structure like the model's (0.91 us on the default data, which
 # has no skew), and a seed at that level is the random test's own scatter
 DELAY_SEED_MIN = 2.0e-6
-
-# one load case configured: the candidates are scored on the case they were refitted on (their "held-out" gaps are
-# calibration gaps), which a refit lowers whatever the effect; the ranking and the explanation stay as an audit
-NO_HELDOUT_VERDICT = (
-    "none",
-    "no load case is held out (one is configured): every gap here is the calibration case's own, which refitting any "
-    "candidate lowers, so no effect can be tested; add a second load case (config load_cases) to predict",
-)

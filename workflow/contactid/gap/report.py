@@ -107,10 +107,29 @@ def _alternatives_note(step: dict) -> str:
     return r" (or, as well within gap.separation on these records, " + " or ".join(_t(a) for a in alt) + ")"
 
 
+def _kind_note(step: dict) -> str:
+    """A step that is not an effect, said: model form (a form candidate the library leaves out, a separation law that
+    never opened) or an update that names no effect (story.tell's kinds)."""
+    return {"model_form": r" (model form, not an effect)", "update": ""}.get(step.get("kind", "effect"), "")
+
+
 def explanation_text(diag: dict) -> str:
     """The additive explanation in words (Fig. gap_explanation)."""
     steps, left = diag.get("explanation") or [], diag.get("remaining_gap") or {}
-    if not steps:
+    ended = next(
+        (t for t in diag.get("trace") or [] if not t["passed"] and t["test"] not in ("records_agree", "held_out")), None
+    )
+    if not steps and ended is not None and ended["test"] != "explains_materially":
+        text = (
+            r"The explanation's first step, "
+            + _t(ended["step"])
+            + r", is not kept ("
+            + _t(ended["test"])
+            + r": "
+            + _t(ended["says"])
+            + r"), so nothing is added to the identified model. "
+        )
+    elif not steps:
         text = (
             r"No candidate shrinks the held-out gap materially (by gap.min\_reduction $="
             + _fmt(left.get("min_reduction", float("nan")), 2)
@@ -123,6 +142,7 @@ def explanation_text(diag: dict) -> str:
         periodicity = (diag.get("where") or {}).get("periodicity") or {}
         parts = [
             _t(s["effect"])
+            + _kind_note(s)
             + _alternatives_note(s)
             + _updating_note(s, diag)
             + _law_note(s)
@@ -541,10 +561,59 @@ def diagnosis_paragraphs(diag: dict) -> str:
         *([base, ""] if base else []),
         r"\paragraph{Which effect.} Verdict: \textbf{" + _t(diag["verdict"]) + r"} --- " + _t(diag["reason"]) + ".",
         "",
+        *([resolution_text(diag), ""] if diag.get("resolution") else []),
+        *([trace_text(diag), ""] if diag.get("trace") else []),
         r"\paragraph{Step by step.} " + explanation_text(diag),
         "",
     ]
     return "\n".join(lines) + "\n"
+
+
+def resolution_text(diag: dict) -> str:
+    """What these records can attribute to an effect (diagnosis.json's resolution), in words."""
+    r = diag["resolution"]
+    iso = r.get("isolability") or {}
+    pairs = iso.get("pairs") or []
+    text = r"\paragraph{Resolution.} " + _t(r["how"]) + ". "
+    if pairs:
+        text += (
+            r"These records cannot tell apart (their signatures on the held-out records, with what "
+            + (" and ".join(_t(f) for f in iso.get("form_removed") or []) or "the base model's form")
+            + r" absorbs removed, point the same way, cosine above $"
+            + _fmt(iso.get("limit", float("nan")), 2)
+            + r"$): "
+            + "; ".join(
+                " and ".join(_t(c) for c in p["candidates"]) + r" ($" + _fmt(p["cosine"], 3) + r"$)" for p in pairs
+            )
+            + "."
+        )
+    elif iso:
+        text += r"Every pair of candidates changes the held-out records in its own way (isolability table empty)."
+    return text
+
+
+def _trace_value(v) -> str:
+    if isinstance(v, bool) or v is None:
+        return _t(str(v))
+    if isinstance(v, (int, float)):
+        return "$" + _fmt(v, 3) + "$"
+    return _t(str(v))
+
+
+def trace_text(diag: dict) -> str:
+    """The decisions the verdict was told by, in order (diagnosis.json's trace): test, the step it judged, value
+    against threshold, passed or not."""
+    items = [
+        _t(t["test"])
+        + (r" (" + _t(t["step"]) + ")" if t.get("step") else "")
+        + ": "
+        + _trace_value(t["value"])
+        + r" against "
+        + _trace_value(t["threshold"])
+        + (r", passed" if t["passed"] else r", \textbf{not passed}")
+        for t in diag["trace"]
+    ]
+    return r"\paragraph{Decisions, in order.} " + "; ".join(items) + "."
 
 
 def candidates_table(diag: dict) -> str:

@@ -1,5 +1,6 @@
 """The decisions of the gap diagnosis as pure functions of plain numbers, testable without the rig:
-where the gap lies (``place``) and which candidate, if any, explains it (``verdict``).
+where the gap lies (``place``) and whether a step explains the held-out gap (``explains_materially``,
+``indistinguishable``, ...); the verdict itself is told from the explanation (``story``).
 
 ``diagnosis.localise`` and ``diagnosis.diagnose`` compute the numbers (stage gaps, drift, sensor
 misfits, ranked candidates with their held-out gaps and bootstrap intervals) and call these.
@@ -114,74 +115,6 @@ def place(
 
 def _setting(settings, name: str) -> float:
     return float(settings[name] if isinstance(settings, Mapping) else getattr(settings, name))
-
-
-def verdict(
-    rows: Sequence[Mapping],
-    before: float,
-    scatter: float,
-    place: str,
-    settings,
-    boots: Mapping[str, np.ndarray] | None = None,
-) -> tuple[str, str]:
-    """The verdict of the diagnosis and its reason: (effect name or "none", reason).
-
-    rows: the candidates, best score first, each with "effect", "acts_on", "consistent" (acts where
-    the gap lies), "reduction" (1 - held-out gap after / before), "reduction_interval" (bootstrap 95 %)
-    and "heldout_gap_after"; before: the held-out gap before; scatter: the bootstrap standard deviation
-    of the gap before (the records' scatter); place: the localisation's place; settings: a GapSettings
-    or a mapping with min_gap, noise_factor, min_reduction and separation; boots: the bootstrap
-    held-out gaps after, per effect (for the winner's P(better) than the runner-up; nan without).
-
-    The best consistent candidate is named only when the gap before is at least min_gap and
-    noise_factor x scatter, it shrinks the gap by min_reduction with the bootstrap's lower bound
-    above zero, and the runner-up's held-out gap is at least separation x the winner's."""
-    min_gap, noise_factor = _setting(settings, "min_gap"), _setting(settings, "noise_factor")
-    min_reduction, separation = _setting(settings, "min_reduction"), _setting(settings, "separation")
-    verdict, reason = "none", ""
-    eligible = [r for r in rows if r["consistent"]]
-    if rows and not eligible:
-        reason = (
-            f"the gap lies in {place} and no candidate of the library acts there and explains it "
-            f"(best by score: {rows[0]['effect']}, acting on {rows[0]['acts_on']}, {rows[0]['reduction']:.1%})"
-        )
-    elif rows:
-        best = eligible[0]
-        second = next((r for r in rows if r is not best), None)
-        if before < min_gap:
-            reason = (
-                f"the held-out gap {_pct(before)} is below gap.min_gap = {min_gap:g} ({_pct(min_gap)}): the identified "
-                f"model reproduces the records as well as the chain's own identification allows (best candidate "
-                f"{best['effect']}: {best['reduction']:.1%})"
-            )
-        elif before < noise_factor * scatter:
-            reason = (
-                f"the held-out gap {_pct(before)} is within {noise_factor} x the records' scatter {_pct(scatter, 2)}"
-            )
-        elif best["reduction"] < min_reduction or best["reduction_interval"][0] <= 0:
-            reason = (
-                f"no candidate shrinks the held-out gap by {min_reduction:.0%} (best: {best['effect']}, "
-                f"{best['reduction']:.1%})"
-            )
-        elif second is not None and second["heldout_gap_after"] < separation * best["heldout_gap_after"]:
-            reason = (
-                f"{best['effect']} and {second['effect']} explain the gap about equally (held-out gaps "
-                f"{_pct(best['heldout_gap_after'])}, {_pct(second['heldout_gap_after'])}; separation {separation})"
-            )
-        else:
-            verdict = best["effect"]
-            if second is None:
-                p_better = 1.0
-            elif boots is None:
-                p_better = float("nan")
-            else:
-                p_better = float(np.mean(np.asarray(boots[best["effect"]]) < np.asarray(boots[second["effect"]])))
-            runner_up = f"{second['effect']} {_pct(second['heldout_gap_after'])}" if second else "-"
-            reason = (
-                f"{best['effect']} shrinks the held-out gap from {_pct(before)} to {_pct(best['heldout_gap_after'])} "
-                f"({best['reduction']:.1%}); runner-up {runner_up}; bootstrap P(better) {p_better:.2f}"
-            )
-    return verdict, reason
 
 
 def _pct(gap: float, digits: int = 3) -> str:

@@ -1,0 +1,400 @@
+"""One story: the verdict derived from the explanation, every decision a small pure function with its trace.
+
+The explanation (``diagnosis.explain``) adds effects while each shrinks what is left of the held-out gap materially;
+the decisions here then say which of its steps the records attribute to an effect, in a fixed order:
+
+1. ``held_out``: a load case is held out (otherwise every gap is the calibration case's own, which any refit lowers);
+2. ``update_counts``: an accepted model update is a step only where it shrinks the held-out gap beyond the records'
+   scatter (an update the random test accepts that changes the records' gap by nothing explains none of it);
+3. for the first effect step, the tests a single effect's verdict has always had: it acts where the localisation
+   puts the gap (``acts_where_gap_lies``), the gap is above the identification's floor (``above_floor``) and beyond
+   the records' scatter (``beyond_scatter``), the step (with the second half of a pair) shrinks the whole gap by
+   gap.min_reduction with its bootstrap interval above zero (``shrinks_gap``);
+4. for every effect step, ``beyond_model_form``: the candidates that change the base model's form rather than add an
+   effect (``Candidate.form``: the beam modes' damping) are the reference of what model-form differences leave on
+   these records; a step whose alternatives (the candidates within gap.separation of it, ``verdict.indistinguishable``)
+   include such a candidate is not told apart from model-form error, and the explanation ends before it;
+5. a contact-separation step whose law never opened stands for a stiffer or harder normal law (model form): kept, as
+   ``kind`` "model_form", never the verdict.
+
+The verdict is the effect of the explanation's effect step with the largest share, or "none" exactly when no step is
+an effect (an update is not one, unless it amounts to one effect of the library, ``diagnosis._updating_verdict``). The
+reason sentence comes from the trace: the step's numbers, or the test that ended the explanation. ``resolution`` says
+what these records can attribute: the smallest change of the held-out gap a first effect must make.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Mapping, Sequence
+
+import numpy as np
+
+from .verdict import _pct, _setting, acts_where, gap_shares, never_opens
+
+
+@dataclass(frozen=True)
+class Test:
+    """One decision: which ``test``, its ``value``, its ``threshold``, whether it ``passed``, the ``step`` (effect) it
+    was applied to ("" for the whole diagnosis) and what it ``says`` in words (the reason sentence where it decides)."""
+
+    test: str
+    value: float | str | bool | None
+    threshold: float | str | None
+    passed: bool
+    says: str
+    step: str = ""
+
+    def as_dict(self) -> dict:
+        return {
+            "test": self.test,
+            "step": self.step,
+            "value": self.value,
+            "threshold": self.threshold,
+            "passed": bool(self.passed),
+            "says": self.says,
+        }
+
+
+def held_out(n_held: int) -> Test:
+    ok = n_held >= 1
+    return Test(
+        "held_out",
+        n_held,
+        1,
+        ok,
+        f"{n_held} load case(s) held out"
+        if ok
+        else "no load case is held out (one is configured): every gap here is the calibration case's own, which "
+        "refitting any candidate lowers, so no effect can be tested; add a second load case (config load_cases) to "
+        "predict",
+    )
+
+
+def update_counts(gap_before: float, gap_after: float, scatter: float, noise_factor: float) -> Test:
+    """Whether an accepted model update is a step of the explanation: it shrinks the held-out gap by more than
+    noise_factor x the records' scatter."""
+    drop = gap_before - gap_after
+    ok = bool(np.isfinite(drop) and drop > noise_factor * scatter)
+    return Test(
+        "update_counts",
+        float(drop),
+        float(noise_factor * scatter),
+        ok,
+        f"model updating takes the held-out gap from {_pct(gap_before)} to {_pct(gap_after)}"
+        + (
+            ""
+            if ok
+            else ": no more than the records' scatter, so it explains none of the gap (the diagnosis starts "
+            "from the updated model, where.model_updating)"
+        ),
+        "model_updating",
+    )
+
+
+def records_agree(check: Mapping) -> Test:
+    """The records' check (rule record_checks): no record fails with a signature (units, sign, channel order); where one
+    does, the verdict is records_disagree and nothing is explained (``record_checks.diagnosis_outcome``)."""
+    hard = [f for f in check.get("findings", []) if f.get("signature")]
+    return Test(
+        "records_agree",
+        len(hard),
+        0,
+        not hard,
+        "the records' check finds no record wrong by a units factor, a sign or a channel order"
+        if not hard
+        else "; ".join(f["message"] for f in hard),
+    )
+
+
+def acts_where_gap_lies(effect: str, acts_on: str, place: str) -> Test:
+    ok = acts_where(acts_on, place)
+    return Test(
+        "acts_where_gap_lies",
+        acts_on,
+        place,
+        ok,
+        f"{effect} acts on {acts_on}"
+        + ("" if ok else f", and the gap lies in {place}: no candidate of the library that acts there explains it"),
+        effect,
+    )
+
+
+def above_floor(gap: float, min_gap: float, effect: str = "") -> Test:
+    ok = bool(gap >= min_gap)
+    return Test(
+        "above_floor",
+        float(gap),
+        float(min_gap),
+        ok,
+        f"the held-out gap {_pct(gap)} is "
+        + ("above" if ok else "below")
+        + f" gap.min_gap {_pct(min_gap)}"
+        + (
+            ""
+            if ok
+            else ": the identified model reproduces the records as well as the chain's own identification allows"
+        ),
+        effect,
+    )
+
+
+def beyond_scatter(gap: float, scatter: float, noise_factor: float, effect: str = "") -> Test:
+    ok = bool(gap >= noise_factor * scatter)
+    return Test(
+        "beyond_scatter",
+        float(gap),
+        float(noise_factor * scatter),
+        ok,
+        f"the held-out gap {_pct(gap)} is "
+        + ("beyond" if ok else "within")
+        + f" {noise_factor:g} x the records' scatter {_pct(scatter, 2)}",
+        effect,
+    )
+
+
+def shrinks_gap(effect: str, before: float, after: float, lower: float, min_reduction: float) -> Test:
+    """The first effect shrinks the whole held-out gap by min_reduction, its bootstrap interval's lower end
+    (``lower``, of the reduction) above zero."""
+    red = 1.0 - after / before if before > 0 and np.isfinite(after) else -np.inf
+    ok = bool(red >= min_reduction and lower > 0)
+    return Test(
+        "shrinks_gap",
+        float(red),
+        float(min_reduction),
+        ok,
+        f"{effect} shrinks the held-out gap from {_pct(before)} to {_pct(after)} ({red:.1%})"
+        + (
+            ""
+            if ok
+            else f": less than gap.min_reduction {min_reduction:.0%} of it"
+            + ("" if red < min_reduction else " with its bootstrap interval reaching zero")
+        ),
+        effect,
+    )
+
+
+def beyond_model_form(effect: str, after: float, alternatives: Sequence[str], form: Sequence[str]) -> Test:
+    """A step is told apart from model-form error where no form candidate (``form``) is among its alternatives, and,
+    if its own effect is one, it has no alternatives."""
+    rivals = [a for a in alternatives if a in form]
+    if effect in form and alternatives:
+        rivals = list(alternatives)
+    ok = not rivals
+    return Test(
+        "beyond_model_form",
+        ", ".join(rivals) or "-",
+        "-",
+        ok,
+        f"{effect} leaves {_pct(after)}"
+        + (
+            ""
+            if ok
+            else f", and {' and '.join(rivals)} explain{'s' if len(rivals) == 1 else ''} the gap about as well: on "
+            "these records it is not told apart from the base model's form (gap.separation)"
+        ),
+        effect,
+    )
+
+
+def resolution(before: float, form_after: Mapping[str, float], scatter: float, settings, held: bool = True) -> dict:
+    """{heldout_gap, form_heldout_gap, how}: the smallest change of the held-out gap these records attribute to a first
+    effect. It must shrink the gap by min_reduction of it, beyond noise_factor x the scatter, and leave less than the
+    best form candidate's gap (``form_after``: {candidate: held-out gap after it}) over gap.separation; at or below the
+    floor (min_gap) no change is attributed (the whole gap)."""
+    sep, min_red = _setting(settings, "separation"), _setting(settings, "min_reduction")
+    min_gap, noise = _setting(settings, "min_gap"), _setting(settings, "noise_factor")
+    finite = {k: float(v) for k, v in form_after.items() if np.isfinite(v)}
+    best = min(finite, key=finite.get) if finite else None
+    form_gap = min(before, finite[best]) if best else before
+    if not held or before < min_gap:
+        x = before
+        how = (
+            f"the held-out gap {_pct(before)} is below the identification's floor gap.min_gap "
+            f"{_pct(min_gap)}: no change of it is attributed to an effect"
+            if held
+            else "no load case is held out: no change of the gap is attributed to an effect"
+        )
+    else:
+        parts = {
+            f"gap.min_reduction ({min_red:.0%}) of the held-out gap": min_red * before,
+            f"{noise:g} x the records' scatter": noise * scatter,
+            (
+                f"what leaves less than {best} (the base model's form: {_pct(form_gap)}) over gap.separation {sep:g}"
+                if best
+                else f"a gap over gap.separation {sep:g}"
+            ): before - form_gap / sep,
+        }
+        key = max(parts, key=parts.get)
+        x = float(parts[key])
+        how = (
+            f"An effect that changes the held-out gap ({_pct(before)}) by less than {_pct(x)} is not distinguishable "
+            f"from model-form error on these records (binding: {key})"
+        )
+    return {"heldout_gap": float(x), "form_heldout_gap": float(form_gap), "form_candidate": best, "how": how}
+
+
+def first_pass_best(rows: Sequence[Mapping], before: float) -> Test | None:
+    """Where the explanation added no effect: the first pass's best candidate, which did not shrink the held-out gap
+    materially (``verdict.explains_materially``, applied by ``diagnosis.explain``); None without candidates."""
+    finite = [r for r in rows if np.isfinite(r["heldout_gap_after"])]
+    if not finite:
+        return None
+    best = min(finite, key=lambda r: r["heldout_gap_after"])
+    return Test(
+        "explains_materially",
+        float(best["heldout_gap_after"]),
+        float(before),
+        False,
+        f"no candidate shrinks the held-out gap materially (best: {best['effect']}, {_pct(before)} -> "
+        f"{_pct(best['heldout_gap_after'])})",
+        best["effect"],
+    )
+
+
+@dataclass
+class Story:
+    verdict: str
+    reason: str
+    explanation: list
+    trace: list = field(default_factory=list)
+
+
+def _step_kind(step: Mapping, update_effect: str | None, model_form: Sequence[str] = ()) -> str:
+    """ "update" (model updating that names no effect), "model_form" (a form candidate the library in use leaves out,
+    a separation law that never opened) or "effect"."""
+    if step.get("effect") == "model_updating":
+        return "effect" if update_effect else "update"
+    return "model_form" if never_opens(step) or step.get("effect") in model_form else "effect"
+
+
+def tell(
+    steps: Sequence[Mapping],
+    rows: Sequence[Mapping],
+    *,
+    before: float,
+    scatter: float,
+    place: str,
+    settings,
+    form: Sequence[str],
+    n_held: int,
+    model_form: Sequence[str] = (),
+    update_effect: tuple[str, str] | None = None,
+) -> Story:
+    """The verdict, its reason and the explanation the records support, from the explanation's ``steps`` (model
+    updating's step first where accepted) and the first pass's ranking ``rows`` (each with effect, acts_on,
+    reduction_interval); ``before``: the held-out gap the candidates started from (the updated model's), ``scatter``
+    the records' bootstrap scatter of it, ``place`` the localisation's, ``form`` the form candidates' names
+    (``model_form``: those the library in use leaves out, never an effect),
+    ``n_held`` the held-out cases, ``update_effect``: (effect, why) where the accepted update amounts to one effect of
+    the library and explains most of the gap. Decisions in the module's order; shares recomputed on what is kept."""
+    trace: list[Test] = []
+    kept: list[dict] = []
+    t = held_out(n_held)
+    trace.append(t)
+    if not t.passed:
+        return Story("none", t.says, [], [x.as_dict() for x in trace])
+    by_row = {r["effect"]: r for r in rows}
+    ended: Test | None = None
+    first_effect = True
+    for s in steps:
+        step = dict(s)
+        name = step["effect"]
+        if name == "model_updating":
+            t = update_counts(
+                step["heldout_gap_before"], step["heldout_gap_after"], scatter, _setting(settings, "noise_factor")
+            )
+            trace.append(t)
+            if t.passed:
+                kind = _step_kind(step, update_effect[0] if update_effect else None)
+                step["kind"] = kind
+                if kind == "effect":
+                    step["names"] = update_effect[0]
+                    first_effect = False
+                kept.append(step)
+            continue
+        kind = _step_kind(step, None, model_form)
+        tests: list[Test] = []
+        if kind == "effect" and first_effect:
+            row = by_row.get(name, {})
+            g0 = float(step["heldout_gap_before"])
+            after = float(step["heldout_gap_after"])
+            if step.get("pair_first"):  # judged with its pair's second half: together they shrink the gap
+                nxt = steps[list(steps).index(s) + 1]
+                after = float(nxt["heldout_gap_after"])
+            lower = float((row.get("reduction_interval") or [1.0])[0]) if not step.get("pair_first") else 1.0
+            tests += [
+                acts_where_gap_lies(name, row.get("acts_on", "any"), place),
+                above_floor(g0, _setting(settings, "min_gap"), name),
+                beyond_scatter(g0, scatter, _setting(settings, "noise_factor"), name),
+                shrinks_gap(name, g0, after, lower, _setting(settings, "min_reduction")),
+            ]
+        if kind == "effect":
+            tests.append(beyond_model_form(name, step["heldout_gap_after"], step.get("alternatives") or [], form))
+        trace.extend(tests)
+        failed = next((x for x in tests if not x.passed), None)
+        if failed is not None:
+            ended = failed
+            break
+        step["kind"] = kind
+        if kind == "effect":
+            first_effect = False
+        kept.append(step)
+    # the shares start from the first kept step's gap (the chain's model where the update is a step)
+    start = float(kept[0]["heldout_gap_before"]) if kept else before
+    for s_, share in zip(kept, gap_shares(start, [float(x["heldout_gap_after"]) for x in kept])[0]):
+        s_["share"] = share
+    effects = [s for s in kept if s["kind"] == "effect"]
+    if not effects and ended is None:  # the explanation added no effect: its first pass's best, for the reason
+        t = first_pass_best(rows, before)
+        if t is not None:
+            trace.append(t)
+            ended = t
+    if not effects:
+        reason = (ended.says if ended else "the explanation names no effect") + _left(kept, start)
+        return Story("none", reason, kept, [x.as_dict() for x in trace])
+    top = max(effects, key=lambda s: s["share"])
+    verdict = top.get("names", top["effect"])
+    if top["effect"] == "model_updating":
+        reason = update_effect[1]
+    else:
+        alts = top.get("alternatives") or []
+        reason = (
+            f"{top['effect']} shrinks the held-out gap from {_pct(top['heldout_gap_before'])} to "
+            f"{_pct(top['heldout_gap_after'])} ({top['share']:.0%} of its power)"
+            + (f"; or, as well, {' or '.join(alts)}" if alts else "")
+        )
+    others = [s.get("names", s["effect"]) for s in effects if s is not top]
+    if others:
+        reason += f"; with {', '.join(others)}"
+    if ended is not None:
+        reason += f"; then {ended.says}"
+    return Story(verdict, reason, kept, [x.as_dict() for x in trace])
+
+
+def _left(kept: Sequence[Mapping], start: float) -> str:
+    return (
+        ""
+        if not kept
+        else f" (the explanation's steps take the held-out gap from {_pct(start)} to "
+        f"{_pct(kept[-1]['heldout_gap_after'])})"
+    )
+
+
+def one_story_holds(diagnosis: Mapping) -> bool:
+    """Whether a diagnosis.json tells one story: its verdict is the effect of the explanation's effect step with the
+    largest share (an update that names an effect by that name), "none" exactly when no step is an effect; records
+    that disagree (verdict records_disagree) have no explanation."""
+    steps = diagnosis.get("explanation") or []
+    verdict = diagnosis.get("verdict")
+    if verdict == "records_disagree":
+        return not steps
+    effects = [
+        s
+        for s in steps
+        if s.get("kind", "effect") == "effect" and (s.get("effect") != "model_updating" or s.get("names"))
+    ]
+    if not effects:
+        return verdict == "none"
+    top = max(effects, key=lambda s: s.get("share", 0.0))
+    return verdict == top.get("names", top["effect"])
