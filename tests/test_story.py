@@ -52,11 +52,11 @@ def test_a_clean_step_is_the_verdict_and_the_trace_holds_every_test():
     assert s.explanation[0]["share"] == pytest.approx(1 - 0.01)
     assert trace_of(s) == [
         ("held_out", "", True),
-        ("acts_where_gap_lies", "viscous_friction", True),
         ("above_floor", "viscous_friction", True),
         ("beyond_scatter", "viscous_friction", True),
         ("shrinks_gap", "viscous_friction", True),
         ("beyond_model_form", "viscous_friction", True),
+        ("acts_where_gap_lies", "viscous_friction", True),
     ]
     shrink = next(t for t in s.trace if t["test"] == "shrinks_gap")
     assert shrink["value"] == pytest.approx(0.9) and shrink["threshold"] == 0.5
@@ -97,6 +97,20 @@ def test_the_first_effect_shrinks_the_whole_gap_by_min_reduction_with_its_interv
     assert (s.verdict == "viscous_friction") is named
     if not named:
         assert s.explanation == [] and "shrinks the held-out gap from 2 %" in s.reason
+
+
+def test_two_effects_count_where_one_of_them_acts_where_the_gap_lies():
+    # a structural damping first and a preload drift (the records drift: place non_stationary)
+    steps = [step("structural_damping", 0.05, 0.01), step("preload_drift", 0.01, 0.003)]
+    rows = [row("structural_damping", 0.01, 0.05, acts_on="structure_or_measurement")]
+    rows.append(row("preload_drift", 0.04, 0.05, acts_on="non_stationary"))
+    s = story(steps, rows, before=0.05, place="non_stationary")
+    assert s.verdict == "structural_damping" and [x["effect"] for x in s.explanation] == [
+        "structural_damping",
+        "preload_drift",
+    ]
+    alone = story(steps[:1], rows, before=0.05, place="non_stationary")
+    assert alone.verdict == "none" and "the gap lies in non_stationary" in alone.reason
 
 
 def test_a_first_effect_acting_elsewhere_than_the_gap_ends_the_explanation():
@@ -168,10 +182,20 @@ def test_an_update_that_changes_nothing_is_no_step_and_one_that_names_an_effect_
     assert plain.verdict == "none" and [x["kind"] for x in plain.explanation] == ["update"]
 
 
-def test_a_separation_law_that_never_opens_is_model_form_not_the_verdict():
-    steps = [step("contact_separation", 0.02, 0.002, contact_opens=False)]
-    s = story(steps, [row("contact_separation", 0.002, acts_on="normal_contact")], place="normal_contact")
-    assert s.verdict == "none" and [x["kind"] for x in s.explanation] == ["model_form"]
+def test_a_separation_law_that_never_opens_is_model_form_after_other_steps_and_an_effect_first():
+    rows = [row("contact_separation", 0.002, acts_on="normal_contact")]
+    # after an update (the compound benchmark's hardening rigs): a harder normal law, model form
+    steps = [step("model_updating", 0.05, 0.02), step("contact_separation", 0.02, 0.008, contact_opens=False)]
+    s = story(steps, rows, place="normal_contact")
+    assert s.verdict == "none" and [x["kind"] for x in s.explanation] == ["update", "model_form"]
+    assert s.reason == (
+        "the explanation names no effect: its steps are model_updating (an update that names no effect), "
+        "contact_separation (model form) (the explanation's steps take the held-out gap from 5 % to 0.8 %)"
+    )
+    # first (the blind benchmark's separating contacts): judged by the first effect's tests
+    first = story([step("contact_separation", 0.02, 0.002, contact_opens=False)], rows, place="normal_contact")
+    assert first.verdict == "contact_separation"
+    assert one_story_holds({"verdict": first.verdict, "explanation": first.explanation})
 
 
 def test_no_held_out_case_tells_nothing():
