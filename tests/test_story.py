@@ -177,6 +177,21 @@ def test_an_update_that_changes_nothing_is_no_step_and_one_that_names_an_effect_
     )
     assert named.verdict == "transducer_mass_error" and named.reason.startswith("model updating (...)")
     assert named.explanation[0]["names"] == "transducer_mass_error"
+    # the update's effect counts for the place: a normal dashpot after it where the gap lies in the structure
+    with_dashpot = story(
+        [step("model_updating", 0.05, 0.01), step("normal_contact_damping", 0.01, 0.003)],
+        [
+            row("transducer_mass_error", 0.04, 0.05, acts_on="structure_or_measurement"),
+            row("normal_contact_damping", 0.004, 0.01, acts_on="normal_contact"),
+        ],
+        before=0.01,
+        place="structure_or_measurement",
+        update_effect=("transducer_mass_error", "model updating (...) takes the gap ..."),
+    )
+    assert [x.get("names", x["effect"]) for x in with_dashpot.explanation] == [
+        "transducer_mass_error",
+        "normal_contact_damping",
+    ]
     assert one_story_holds({"verdict": named.verdict, "explanation": named.explanation})
     plain = story([step("model_updating", 0.05, 0.003)], [row("viscous_friction", 0.0029, 0.003)], before=0.003)
     assert plain.verdict == "none" and [x["kind"] for x in plain.explanation] == ["update"]

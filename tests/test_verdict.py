@@ -360,6 +360,16 @@ def test_compound_score_counts_named_effects_against_the_truth():
     assert s["two_effects_both_named"] == 0.0 and s["two_effects_one_named"] == 1.0
     assert s["per_effect"]["viscous_friction"] == {"recall": 2 / 3, "precision": 2 / 3, "true": 3, "named": 3}
     assert s["perturbation_only_median_abs_error"]["mu"] == pytest.approx(0.01)
+    # a step of kind model_form or an update that names no effect is not named; an update naming one is
+    from contactid.gap.benchmark import named_effects
+
+    steps = [
+        {"effect": "model_updating", "kind": "effect", "names": "transducer_mass_error"},
+        {"effect": "contact_separation", "kind": "model_form"},
+        {"effect": "viscous_friction", "kind": "effect"},
+    ]
+    assert named_effects(steps) == ["transducer_mass_error", "viscous_friction"]
+    assert named_effects([{"effect": "model_updating", "kind": "update"}]) == []
 
 
 def test_bound_errors_take_the_lever_arm_out_of_mu_and_e0():
@@ -643,6 +653,8 @@ def test_ladder_scores_only_where_the_gap_exceeds_twice_the_floor():
     assert s["named_where_detectable"] == 0.75
     assert s["magnitude_within_where_detectable"] == pytest.approx(2 / 3)
     assert not s["all_named_and_within"] and s["false_names_below_detectable"] == 0
+    assert s["two_stories"] == 0
+    assert ladder_score([{**rows[0], "one_story": False}], 0.006)["two_stories"] == 1
 
 
 def test_a_pair_that_together_shrinks_the_gap_materially_is_added():

@@ -549,6 +549,7 @@ def ladder_score(rows: list, floor: float, tolerance: float = 0.25) -> dict:
                 "detectable": detectable,
                 "verdict": r["verdict"],
                 "named": r["verdict"] == r["effect"],
+                "one_story": r.get("one_story", True),
                 "refitted_magnitude": m,
                 "magnitude_error": err,
                 "magnitude_within": None if err is None else bool(abs(err) <= tolerance),
@@ -569,6 +570,7 @@ def ladder_score(rows: list, floor: float, tolerance: float = 0.25) -> dict:
         "false_names_below_detectable": sum(
             i["verdict"] not in ("none", i["effect"]) for i in items if "failed" not in i and not i["detectable"]
         ),
+        "two_stories": sum(not i.get("one_story", True) for i in items),
         "items": items,
     }
 

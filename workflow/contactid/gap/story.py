@@ -352,13 +352,14 @@ def tell(
         kept.append(step)
     # the localisation names one place: an explanation's effects are kept where one of them acts there (the first
     # effect alone judged so, two-effect records whose place followed the second lost both)
-    named = [x for x in kept if x["kind"] == "effect" and x["effect"] != "model_updating"]
+    named = [x for x in kept if x["kind"] == "effect"]
     if named:
+        effects_named = [x.get("names", x["effect"]) for x in named]  # an update by the effect it names
         t = acts_where_gap_lies(
-            " or ".join(x["effect"] for x in named),
-            " | ".join(by_row.get(x["effect"], {}).get("acts_on", "any") for x in named),
+            " or ".join(effects_named),
+            " | ".join(by_row.get(e, {}).get("acts_on", "any") for e in effects_named),
             place,
-            any(acts_where(by_row.get(x["effect"], {}).get("acts_on", "any"), place) for x in named),
+            any(acts_where(by_row.get(e, {}).get("acts_on", "any"), place) for e in effects_named),
         )
         trace.append(t)
         if not t.passed:
