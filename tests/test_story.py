@@ -222,6 +222,10 @@ def test_an_empty_explanation_names_the_first_pass_best_in_its_reason():
     s = story([], [row("viscous_friction", 0.015), row("structural_damping", 0.018)])
     assert s.verdict == "none"
     assert s.reason == "no candidate shrinks the held-out gap materially (best: viscous_friction, 2 % -> 1.5 %)"
+    # below the floor, the floor says it
+    low = story([], [row("viscous_friction", 0.0025, 0.003)], before=0.003)
+    assert low.reason.startswith("the held-out gap 0.3 % is below gap.min_gap 0.6 %")
+    assert low.trace[-1]["test"] == "above_floor" and not low.trace[-1]["passed"]
 
 
 def test_resolution():

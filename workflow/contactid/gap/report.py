@@ -119,7 +119,9 @@ def explanation_text(diag: dict) -> str:
     ended = next(
         (t for t in diag.get("trace") or [] if not t["passed"] and t["test"] not in ("records_agree", "held_out")), None
     )
-    if not steps and ended is not None and ended["test"] != "explains_materially":
+    if not steps and ended is not None and not ended.get("step"):
+        text = r"Nothing is added to the identified model: " + _t(ended["says"]) + ". "
+    elif not steps and ended is not None and ended["test"] != "explains_materially":
         text = (
             r"The explanation's first step, "
             + _t(ended["step"])

@@ -381,8 +381,9 @@ def tell(
             kept,
             [x.as_dict() for x in trace],
         )
-    if not effects and ended is None:  # the explanation added no step: its first pass's best, for the reason
-        t = first_pass_best(rows, before)
+    if not effects and ended is None:  # the explanation added no step: the floor, or its first pass's best
+        t = above_floor(before, _setting(settings, "min_gap"))
+        t = t if not t.passed else first_pass_best(rows, before)
         if t is not None:
             trace.append(t)
             ended = t
