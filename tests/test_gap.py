@@ -270,6 +270,22 @@ def test_diagnosis_names_the_hidden_effect_and_the_gap_shrinks(hc_diagnosis):
 
 
 @pytest.mark.slow
+def test_the_updated_model_holds_the_explained_effect_and_the_law_refitted_with_it(hc_diagnosis, hc_data):
+    from contactid.gap.report import explained_law_note
+
+    d, model = hc_diagnosis, hc_data[1]
+    u = d.updated_model
+    assert list(u["effects"]) == [d.verdict] == ["normal_contact_damping"]
+    assert u["effects"]["normal_contact_damping"]["alpha"] == pytest.approx(400.0, rel=0.1)
+    assert u["heldout_gap"] == pytest.approx(d.explanation[-1]["heldout_gap_after"])
+    assert u["friction_chain"]["mu"] == pytest.approx(model.friction[4])
+    assert u["friction"]["mu"] != u["friction_chain"]["mu"]  # refitted with the dashpot in the model
+    note = explained_law_note(u)
+    assert "normal\\_contact\\_damping" in note and "\\mu = " in note
+    assert explained_law_note({**u, "effects": {}}) == ""
+
+
+@pytest.mark.slow
 def test_a_candidate_removing_less_than_min_reduction_is_not_named(hc_data):
     # the right effect removes ~94 % of this gap; asking for more than it removes leaves the verdict open
     d = _diagnose(hc_data, ["normal_contact_damping"], min_reduction=0.99)

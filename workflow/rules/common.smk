@@ -242,9 +242,12 @@ GAP_VIEWS = ("stages", "harmonics", "cycle", "force_state", "ranking", "shrink",
 
 
 def gap_outputs():
-    return ["results/gap/diagnosis.json", "results/gap/gap.nc", "results/gap/friction_intervals.json"] + [
-        f"results/gap/gap_{v}.png" for v in GAP_VIEWS
-    ]
+    return [
+        "results/gap/diagnosis.json",
+        "results/gap/gap.nc",
+        "results/gap/updated_model.json",
+        "results/gap/friction_intervals.json",
+    ] + [f"results/gap/gap_{v}.png" for v in GAP_VIEWS]
 
 
 def measured_floor():

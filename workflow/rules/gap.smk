@@ -108,6 +108,7 @@ rule gap_diagnosis:
     output:
         diagnosis="results/gap/diagnosis.json",
         dataset="results/gap/gap.nc",
+        updated_model="results/gap/updated_model.json",
     params:
         code=CODE_DIGEST,
         records=records_digest([raw_record(c) for c in load_cases()]),

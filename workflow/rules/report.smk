@@ -10,6 +10,7 @@ rule report_fragments:
         table4="results/tables/table4.csv",
         consistency="results/tables/paper_consistency.csv",
         intervals="results/gap/friction_intervals.json",
+        updated_model="results/gap/updated_model.json",
     output:
         numbers="results/report/numbers.tex",
         setup="results/report/setup.tex",

@@ -5,7 +5,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from contactid.gap.report import updated_law_note
+from contactid.gap.report import explained_law_note, updated_law_note
 from contactid.latex import (
     contact_fragment,
     data_checks_text,
@@ -76,7 +76,8 @@ Path(out.table4).write_text(
             "truth": "rig truth",
         },
         "Friction-law parameters (paper, Table 4): working method with profile-likelihood intervals."
-        + updated_law_note(json.loads(Path(inp.intervals).read_text())),
+        + updated_law_note(json.loads(Path(inp.intervals).read_text()))
+        + explained_law_note(json.loads(Path(inp.updated_model).read_text())),
         "tab:t4",
         intervals={"identified": ("interval_low", "interval_high")},
     )

@@ -508,6 +508,7 @@ class Diagnosis:
     remaining_gap: dict = field(default_factory=dict)
     trace: list = field(default_factory=list)
     resolution: dict = field(default_factory=dict)
+    updated_model: dict = field(default_factory=dict)
 
     def summary(self) -> dict:
         return {
@@ -1554,7 +1555,58 @@ def diagnose(
         remaining,
         trace=story.trace,
         resolution=where.pop("resolution"),
+        updated_model=updated_model_summary(identified or model, model, last, steps, left),
     )
+
+
+def _friction_dict(friction, preload: float) -> dict:
+    e_f, k_c, e_t, kappa, mu = (float(x) for x in friction)
+    return {
+        "e_f": e_f,
+        "k_c": k_c,
+        "e_t": e_t,
+        "kappa": kappa,
+        "mu": mu,
+        "e0_at_preload": float(stiction_shear_stiffness(preload, e_f, k_c)),
+    }
+
+
+def updated_model_summary(chain: IdentifiedModel, base: IdentifiedModel, last, steps: list, left: float) -> dict:
+    """results/gap/updated_model.json: the model the explanation arrives at, the structure and the friction law
+    refitted with the explained effects (``last``: the last effect step's calibration and simulations; None: the model
+    diagnosed, updated or the chain's), beside the chain's own law. ``steps``: the explanation kept; ``left``: the
+    held-out gap it leaves."""
+    cal = last[0] if last is not None else None
+    model = cal.model if cal is not None else base
+    friction = cal.friction if cal is not None else model.friction
+    aug = cal.augmentation if cal is not None else NONE
+    structure = model.structure_with(aug)
+    effects = {n: _parameter_values(n, theta=th) for n, th in cal.steps} if cal is not None else {}
+    update = next((s for s in steps if s["effect"] == "model_updating"), None)
+    return {
+        "what": (
+            "the identified model with the explanation's effects, the friction law refitted with them on the "
+            "calibration case"
+            if effects
+            else "the identified model" + (" as model updating left it" if update else "") + " (no effect explained)"
+        ),
+        "effects": effects,
+        "model_updating": update["parameters"] if update else None,
+        "friction": _friction_dict(friction, model.preload),
+        "friction_chain": _friction_dict(chain.friction, chain.preload),
+        "structure": {
+            "k_t_n_per_m": float(structure.k_t),
+            "k_n_n_per_m": float(structure.k_n),
+            "youngs_modulus_pa": float(structure.youngs_modulus),
+            "tangential_lever_arm_m": float(structure.tangential_lever_arm),
+            "sensor_masses_kg": [float(m) for m in structure.sensor_masses],
+            "force_transducer_mass_kg": float(structure.force_transducer_mass),
+            "clamp_rotational_stiffness_nm_per_rad": float(structure.clamp_rotational_stiffness),
+            "extra_damping_ratio": float(aug.extra_damping),
+        },
+        "calibration_gap": float(cal.gap) if cal is not None else None,
+        "heldout_gap": float(left),
+    }
 
 
 # s: the random test's channel delays seed a pair (``diagnose``'s delay_seeds) only where one is at least this large;

@@ -226,6 +226,26 @@ def updated_law_note(intervals: dict | None) -> str:
     )
 
 
+def explained_law_note(updated: dict | None) -> str:
+    """A sentence for Table 4's caption where the gap diagnosis explained effects (results/gap/updated_model.json): the
+    friction law refitted with them beside the chain's, which the effects bias; "" where none was explained."""
+    if not updated or not updated.get("effects"):
+        return ""
+    fr = updated["friction"]
+    names = ", ".join(_t(n) for n in updated["effects"])
+    return (
+        " Refitted with the effects the gap diagnosis explains ("
+        + names
+        + r"; results/gap/updated\_model.json), the law is $\mu = "
+        + _fmt(fr["mu"], 3)
+        + r"$, $\kappa = "
+        + _fmt(fr["kappa"], 3)
+        + r"$, $e_0(N_0) = "
+        + _fmt(fr["e0_at_preload"], 3)
+        + r"$~N/m: the chain's law above carries what those effects do to the identified S."
+    )
+
+
 def intervals_text(intervals: dict | None) -> str:
     """The friction law's intervals with the model-form term (friction_intervals.json) as a paragraph and table."""
     if not intervals:
