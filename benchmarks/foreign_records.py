@@ -8,7 +8,9 @@ natural frequencies; ``truth/lc*.nc``: S, N, xi, eta on the records' time grid).
 a copy of the project (``snakemake gap summary``, about 40 s), and every stage is scored against the truth: natural
 frequencies, k_n, the contact forces and motions (NRMSE, mean removed, as summary.json's), the friction law's
 parameters with their intervals, the records' check, the held-out gap, the verdict and the explanation against what
-was done. Printed, and written to benchmarks/cache/foreign_records.json.
+was done, whether they tell one story, the resolution, the pairs the records cannot isolate, and the law refitted with
+the explained effects (results/gap/updated_model.json) against the truth. Printed, and written to
+benchmarks/cache/foreign_records.json.
 
 Usage: .venv/bin/python benchmarks/foreign_records.py [SET ...]   (default: every set under ../shared/foreign)
 """
@@ -23,6 +25,9 @@ import yaml
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import measured_project, run_gap_summary
 from independent_rig import contact_scores
+
+from contactid.gap.benchmark import named_effects
+from contactid.gap.story import one_story_holds
 
 ROOT = Path(__file__).resolve().parents[1]
 CACHE = ROOT / "benchmarks" / "cache"
@@ -80,11 +85,29 @@ def score(name: str, proj: Path, folder: Path) -> dict:
             "findings": [f["check"] for f in records.get("findings", [])],
         },
         "verdict": diagnosis["verdict"],
-        "explanation": [(e["effect"], e["parameters"], e["heldout_gap_after"]) for e in diagnosis["explanation"]],
+        "reason": diagnosis["reason"],
+        "one_story": one_story_holds(diagnosis),
+        "named": named_effects(diagnosis["explanation"]),
+        "resolution": diagnosis["resolution"]["heldout_gap"],
+        "not_isolable": [p["candidates"] for p in (diagnosis["resolution"].get("isolability") or {}).get("pairs", [])],
+        "explained_law_errors": explained_law_errors(proj, law),
+        "explanation": [
+            (e["effect"], e.get("kind"), e["parameters"], e["heldout_gap_after"]) for e in diagnosis["explanation"]
+        ],
         "heldout_gap_before": diagnosis["where"]["heldout_gap_before"],
         "remaining_gap": diagnosis["remaining_gap"]["heldout_gap"],
         "floor": (diagnosis.get("measured_floor") or {}).get("min_gap"),
     }
+
+
+def explained_law_errors(proj: Path, law: dict) -> dict:
+    """The law the explanation arrives at (results/gap/updated_model.json) against the truth, where it explains an
+    effect ({} otherwise)."""
+    path = proj / "results" / "gap" / "updated_model.json"
+    updated = json.loads(path.read_text()) if path.exists() else {}
+    if not updated.get("effects"):
+        return {}
+    return {k: updated["friction"][k] / law[tk] - 1 for k, tk in FRICTION.items()}
 
 
 def report(r: dict) -> None:
@@ -107,8 +130,15 @@ def report(r: dict) -> None:
         + f"; records check {'passed' if r['records_check']['passed'] else 'FAILED'} {r['records_check']['findings']}"
         + f"\n  diagnosis: verdict {r['verdict']}; held-out gap {r['heldout_gap_before']:.4f} (floor "
         + (f"{r['floor']:.4f}" if r["floor"] is not None else "not measured")
-        + f") -> remaining {r['remaining_gap']:.4f}; explanation "
-        + (", ".join(f"{e} {p} -> {g:.4f}" for e, p, g in r["explanation"]) or "none"),
+        + f") -> remaining {r['remaining_gap']:.4f}; resolution {r['resolution']:.4f}; explanation "
+        + (", ".join(f"{e} ({k}) {p} -> {g:.4f}" for e, k, p, g in r["explanation"]) or "none")
+        + f"; one story: {r['one_story']}; not isolable: {r['not_isolable'] or 'none'}"
+        + (
+            "\n  the law refitted with the explained effects: "
+            + ", ".join(f"{k} {v:+.1%}" for k, v in r["explained_law_errors"].items())
+            if r["explained_law_errors"]
+            else ""
+        ),
         flush=True,
     )
 

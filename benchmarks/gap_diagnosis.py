@@ -282,7 +282,7 @@ def compare(label, ds, raw, cfg, with_reference=False, scatter=False, tight=None
 
 
 def main():
-    from contactid.gap.diagnosis import _pool
+    from contactid.gap.workers import _pool
 
     _pool(2)  # forked now, before numba's parallel threads start in this process (the runs with two workers)
     cfg = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())

@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from contactid.gap.candidates import LIBRARY, Candidate, Parameter, register
-from contactid.gap.diagnosis import GapSettings, diagnose, linear_stage
+from contactid.gap.diagnosis import GapSettings, diagnose
+from contactid.gap.localise import linear_stage
 from contactid.gap.model import Augmentation
 from contactid.harmonics import harmonic_amplitudes, periodic_grid, periodic_harmonics
 from contactid.gap.pipeline import identify, rig_records
@@ -69,7 +70,7 @@ def _dual_sine_record(extra=None, noise=0.005, seed=0, detune_cycles=0.0):
 def test_aperiodic_share_is_the_noise_of_a_periodic_record_and_grows_with_motion_that_does_not_repeat():
     """harmonics.aperiodic_share: a periodic response with noise leaves the noise fraction; a tone at 0.37 f0 (not a
     harmonic) of a known rms share is found within 1 %; the record's field and the localisation's summary carry it."""
-    from contactid.gap.diagnosis import record_periodicity
+    from contactid.gap.localise import record_periodicity
     from contactid.harmonics import aperiodic_share
 
     settled = record_harmonics(_dual_sine_record(noise=0.01), "lc1", 25)
@@ -219,7 +220,7 @@ def hc_diagnosis(hc_data):
 
 def _diagnose_in_two_processes(data):
     """In a fresh process (numba's parallel threads not started: forking is safe), with two workers."""
-    from contactid.gap.diagnosis import fork_safe
+    from contactid.gap.workers import fork_safe
 
     assert fork_safe()
     return _diagnose(data, TWO, workers=2)
@@ -230,7 +231,7 @@ def test_candidates_in_two_processes_equal_the_serial_ones(hc_data, hc_diagnosis
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 
-    from contactid.gap.diagnosis import fork_safe
+    from contactid.gap.workers import fork_safe
 
     assert not fork_safe()  # this process ran the friction fit's parallel kernel: a fork here could hang
     with ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("spawn")) as ex:  # its workers may fork
@@ -702,7 +703,8 @@ def test_polish_searches_setting_polishes_every_searched_state(hc_data, monkeypa
     """gap.polish_searches reaches the candidate's search (as an argument of the task, so that a worker process sees
     it too): every state compared is polished (the default); set false, only the optimum is."""
     from contactid.gap import refit
-    from contactid.gap.diagnosis import GapSettings, _candidate_task
+    from contactid.gap.diagnosis import GapSettings
+    from contactid.gap.workers import _candidate_task
     from contactid.gap.refit import POLISH_SEARCH, baseline
 
     cfg, model, records, _ = hc_data
@@ -827,7 +829,7 @@ def test_a_step_whose_model_settles_unlike_the_records_is_flagged_and_said():
     out; the report's explanation says it beside the step."""
     from types import SimpleNamespace as NS
 
-    from contactid.gap.diagnosis import model_periodicity
+    from contactid.gap.explain import model_periodicity
     from contactid.gap.report import explanation_text
 
     records = {c: NS(aperiodic=np.array(a)) for c, a in (("lc1", [0.005, 0.006]), ("lc2", [0.3, 0.1]), ("lc3", [0.4]))}

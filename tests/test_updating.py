@@ -4,7 +4,8 @@ a known structure."""
 import numpy as np
 import pytest
 
-from contactid.gap.diagnosis import GapSettings, _updating_step
+from contactid.gap.diagnosis import GapSettings
+from contactid.gap.explain import _updating_step
 from contactid.parameters import structure_from_config
 from contactid.updating import FACTORS, UpdatingResult, apply_factors, modal_predictions, update_structure
 
@@ -286,7 +287,7 @@ def test_records_that_drift_judge_an_update_on_what_the_drift_leaves(small_confi
     import copy
 
     from contactid.friction_fit import settings_from_config
-    from contactid.gap.diagnosis import records_drift, records_test_of_update
+    from contactid.gap.evidence import records_drift, records_test_of_update
     from contactid.gap.pipeline import _refitted, identify, rig_records, structure_update
     from contactid.gap.records import record_harmonics
 

@@ -143,7 +143,7 @@ def _explain(first, passes, before=0.04, scatter=1e-4, settings=None, later=None
     pass on top of it)} offered as further first halves of a pair (``explain``'s ``seeded``)."""
     from types import SimpleNamespace
 
-    from contactid.gap.diagnosis import explain
+    from contactid.gap.explain import explain
 
     s = SimpleNamespace(**{"pair_lookahead": 0.0, **(settings or SETTINGS)})  # the lookahead where a test asks
     wrap = lambda res: {n: (_Cal(n, 0.1), {"gap": g}, None) for n, g in res.items()}  # noqa: E731
@@ -542,7 +542,7 @@ def test_an_update_that_moves_only_the_transducer_masses_is_the_transducer_mass_
 def test_a_joint_refit_step_reports_the_earlier_steps_refitted_parameters():
     from types import SimpleNamespace
 
-    from contactid.gap.diagnosis import explain
+    from contactid.gap.explain import explain
 
     first = {
         "viscous_friction": (_Cal("viscous_friction", 1222.0), {"gap": 0.02}, None),
@@ -725,7 +725,7 @@ def test_a_skew_held_at_the_random_tests_delays_seeds_the_pair_that_explains_wha
 def test_contact_opens_tells_a_separating_law_from_a_stiffer_closed_one():
     from types import SimpleNamespace
 
-    from contactid.gap.diagnosis import contact_opens
+    from contactid.gap.explain import contact_opens
     from contactid.gap.report import explanation_text
 
     def sim(n_min):
@@ -912,7 +912,7 @@ def test_the_records_call_for_the_channels_gains_only_where_they_shrink_the_gap_
 def test_the_records_choose_between_the_update_with_the_gains_and_the_structure_alone(monkeypatch):
     from dataclasses import dataclass
 
-    import contactid.gap.diagnosis as diagnosis
+    import contactid.gap.evidence as evidence
     import contactid.gap.pipeline as pipeline
 
     settled = []
@@ -939,7 +939,7 @@ def test_the_records_choose_between_the_update_with_the_gains_and_the_structure_
         test = {"heldout_gap_gains": 0.02, "heldout_gap_structure": 0.02, "heldout_gap_chain": 0.02}
         test["record_scatter"] = 1e-5
         monkeypatch.setattr(
-            diagnosis,
+            evidence,
             "records_test_of_gains",
             lambda *a, p=preferred, t=test, **kw: {**t, "gains_preferred": p, "chain": kw.get("chain")},
         )

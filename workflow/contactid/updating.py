@@ -174,7 +174,7 @@ class UpdatingResult:
     # call for the gains beyond what the structure's factors give); None where the gains took no part
     structure_alone: dict | None = None
     # where the random test could not tell the gains from the structure: the dual-sine records' test that chose
-    # (``gap.diagnosis.records_test_of_gains``: both held-out gaps, the records' scatter, ``gains_preferred``)
+    # (``gap.evidence.records_test_of_gains``: both held-out gaps, the records' scatter, ``gains_preferred``)
     gains_versus_structure: dict | None = None
 
     @classmethod

@@ -5,19 +5,15 @@ import json
 import time
 
 from contactid.gap.candidates import load_plugins
-from contactid.gap.diagnosis import (
-    GapSettings,
-    diagnose,
-    linear_stage,
-    prepare_workers,
-    random_test_delays,
-    updated_model_summary,
-)
+from contactid.gap.diagnosis import GapSettings, diagnose
+from contactid.gap.explain import updated_model_summary
+from contactid.gap.localise import linear_stage, random_test_delays
+from contactid.gap.workers import prepare_workers
 from contactid.gap.floor import read_floor, resolved_gap_config
 from contactid.gap.pipeline import workflow_models
 from contactid.gap.record_checks import diagnosis_outcome
 from contactid.gap.story import records_agree
-from contactid.gap.output import _clean, diagnosis_json, gap_dataset
+from contactid.gap.output import diagnosis_json, gap_dataset, updated_model_json
 from contactid.io import load_dataset, provenance, write_dataset, write_text
 from contactid.logs import setup_logging
 
@@ -84,5 +80,5 @@ extra = {"seconds": seconds, "provenance": prov, "records_check": record_check}
 if floor is not None:
     extra["measured_floor"] = floor
 write_text(snakemake.output.diagnosis, diagnosis_json(diag, extra))
-write_text(snakemake.output.updated_model, json.dumps(_clean({**diag.updated_model, "provenance": prov}), indent=2))
+write_text(snakemake.output.updated_model, updated_model_json(diag.updated_model, {"provenance": prov}))
 log.info("verdict %s: %s (%.1f s)", diag.verdict, diag.reason, seconds)

@@ -1,9 +1,20 @@
-"""Sim-to-real gap diagnosis (issue 7): the identified model (the "sim") against the records
-(the "real"): where they disagree, which unmodelled effect explains it, how far the gap shrinks.
+"""Sim-to-real gap diagnosis: the identified model (the "sim") against the records (the "real"): where they
+disagree, which unmodelled effect explains it, how far the gap shrinks, and what the records cannot tell.
 
-Modules: ``records`` (harmonics of the measured records, block-wise for the uncertainty),
-``model`` (the identified model and its forward simulation under the measured force),
-``candidates`` (the library of effects that can be added to the model), ``refit`` (the
-calibration refit of a candidate), ``diagnosis`` (gap, localisation, ranking, verdict),
-``benchmark`` (the blind check on rig data with a hidden effect).
+Modules, by role:
+- settings and the run: ``diagnosis`` (GapSettings, the Diagnosis and ``diagnose``, which calls the rest in order);
+- records and evidence: ``records`` (the records' harmonics, block-wise for the uncertainty), ``record_checks`` (units,
+  signs, channel order), ``localise`` (where the gap lies: stages, sensors, harmonics, cycle parts), ``evidence``
+  (held-out gaps, bootstrap, the records' tests of an update), ``isolability`` (which candidates the records cannot
+  tell apart), ``uncertainty`` (the friction law's intervals with a model-form term);
+- model, candidates and searches: ``model`` (the identified model and its forward simulation under the measured
+  force), ``candidates`` (the library of effects), ``refit`` and ``search`` (a candidate's calibration refit),
+  ``workers`` (the candidates' refits in worker processes), ``ranking`` (the first pass's rows), ``pipeline`` (the
+  models a diagnosis of the workflow's files works with);
+- decisions: ``verdict`` (where the gap lies, whether a step explains materially), ``explain`` (the additive
+  explanation and the model it arrives at), ``story`` (the verdict told from the explanation, with its trace and the
+  resolution);
+- outputs: ``output`` (diagnosis.json, gap.nc), ``figures``, ``report``;
+- evaluation, the only part that builds records with the rig: ``benchmark`` (blind, compound, ladder), ``floor``
+  (the identification's own floor).
 """

@@ -230,7 +230,8 @@ def diagnose_item(spec: Mapping, cfg: Mapping, recs: Mapping, cases: list, t0: f
     """Identify the model from an item's rig records ``recs`` (the chain, then model updating) and diagnose it with
     the item's library; ``t0`` the item's start (``time.perf_counter``, s), ``t_rig`` the rig's time (s)."""
     from ..friction_fit import settings_from_config
-    from .diagnosis import GapSettings, diagnose, linear_stage, random_test_delays
+    from .diagnosis import GapSettings, diagnose
+    from .localise import linear_stage, random_test_delays
     from .pipeline import identify, updated_model
     from .records import record_harmonics
 

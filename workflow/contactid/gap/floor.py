@@ -82,7 +82,7 @@ def identification_floor(
 ) -> dict:
     """The held-out gap the chain's own identification leaves at this drive (see the module's docstring):
     {"floor", "min_gap", "by_case", "drive_hz", "sampling_rate_hz", "record_samples", "calibration_case", "seconds"}."""
-    from .diagnosis import heldout_gap_of
+    from .evidence import heldout_gap_of
     from .pipeline import identify, rig_records
     from .records import record_harmonics
     from .refit import baseline

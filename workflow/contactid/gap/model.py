@@ -541,7 +541,7 @@ def _marched_result(
 ) -> SimResult:
     """The integrator's record of the state it reached (``settled`` or not). ``aperiodic``: where it did not settle,
     measure the share of the response that is not periodic (``extra["aperiodic"]``; read only for a candidate's
-    polished optimum, ``diagnosis.model_periodicity``: 15 ms a simulation, skipped in the searches)."""
+    polished optimum, ``explain.model_periodicity``: 15 ms a simulation, skipped in the searches)."""
     first = last = None
     if not settled and not aug.preload_drift:
         # the motion does not settle (impacts): average over as many periods as the record holds, as the

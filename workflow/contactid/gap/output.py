@@ -42,6 +42,12 @@ def diagnosis_json(diag: Diagnosis, extra: dict | None = None) -> str:
     return json.dumps(_clean({**diag.summary(), **(extra or {})}), indent=2)
 
 
+def updated_model_json(updated: dict, extra: dict | None = None) -> str:
+    """results/gap/updated_model.json: the model the explanation arrives at (``explain.updated_model_summary``),
+    non-finite numbers (a rigid clamp's stiffness) as null."""
+    return json.dumps(_clean({**updated, **(extra or {})}), indent=2)
+
+
 def localisation_variables(a: dict) -> dict:
     """The localisation arrays as dataset variables {name: (dims, values, attrs)}: the gap by sensor, harmonic and
     part of the cycle (relative, 1), the energy dissipated per cycle (J) and the force-state maps (SI)."""

@@ -180,7 +180,7 @@ def updated_model(model, modal: xr.Dataset, calibration, fit_settings, settings,
     already computed), settled by ``settled_update``. Where the accelerometer channels' gains took part in the update
     but the random test cannot tell them from the structure's factors (``UpdatingResult.structure_alone``'s
     ``gains_needed`` false), both updates are settled and the ``held_out`` records choose
-    (``diagnosis.records_test_of_gains``): the one without the gains unless the records call for them; the test is kept
+    (``evidence.records_test_of_gains``): the one without the gains unless the records call for them; the test is kept
     in ``gains_versus_structure``. Returns (model to diagnose, UpdatingResult or None when updating is off)."""
     import logging
 
@@ -191,7 +191,7 @@ def updated_model(model, modal: xr.Dataset, calibration, fit_settings, settings,
     alone = upd.structure_alone
     if not alone or alone.get("gains_needed") or not held_out or calibration is None:
         return settled_update(model, calibration, fit_settings, settings, seed, upd, held_out)
-    from .diagnosis import records_test_of_gains
+    from .evidence import records_test_of_gains
 
     m_gains, u_gains = settled_update(model, calibration, fit_settings, settings, seed, upd, held_out)
     m_alone, u_alone = settled_update(model, calibration, fit_settings, settings, seed, upd.without_gains(), held_out)
@@ -222,7 +222,7 @@ def settled_update(model, calibration, fit_settings, settings, seed: int, upd, h
     Returns (model to diagnose, UpdatingResult); the model is the chain's own when the update is not accepted. An
     update the random test's chi^2 test did not accept (its ``proposal``) is accepted when the ``held_out`` records
     ({case: RecordHarmonics}, the load cases other than the calibration case) show a held-out gap above the floor
-    that the update explains materially (``settings.updating_records_test``; ``diagnosis.records_test_of_update``);
+    that the update explains materially (``settings.updating_records_test``; ``evidence.records_test_of_update``);
     the result then says ``accepted_by`` "records" and keeps the test in ``records_test``."""
     import logging
 
@@ -238,7 +238,7 @@ def settled_update(model, calibration, fit_settings, settings, seed: int, upd, h
                 upd.effective_factors,
             )
             return model, upd
-        from .diagnosis import records_attribution, records_test_of_update
+        from .evidence import records_attribution, records_test_of_update
 
         p = upd.proposal
         m2 = _refitted(model, upd.proposed_structure(), calibration, fit_settings, seed)

@@ -81,7 +81,7 @@ def _periodicity_note(step: dict, periodicity: dict) -> str:
 
 def _updating_note(step: dict, diag: dict) -> str:
     """Why a model update was accepted, when the dual-sine records accepted it (the random test alone did not; records
-    that drift are compared with the drift refitted, ``diagnosis.records_test_of_update``)."""
+    that drift are compared with the drift refitted, ``evidence.records_test_of_update``)."""
     upd = (diag.get("where") or {}).get("model_updating") or {}
     if step.get("effect") != "model_updating" or upd.get("accepted_by") != "records":
         return ""
@@ -487,7 +487,7 @@ def _channel_gains_text(upd: dict) -> str:
 
 def _gains_versus_structure_text(test: dict | None) -> str:
     """Where the random test could not tell the channels' gains from the structure's factors: what the dual-sine
-    records chose (``diagnosis.records_test_of_gains``)."""
+    records chose (``evidence.records_test_of_gains``)."""
     if not test:
         return ""
     return (

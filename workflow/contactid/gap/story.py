@@ -1,6 +1,6 @@
 """One story: the verdict derived from the explanation, every decision a small pure function with its trace.
 
-The explanation (``diagnosis.explain``) adds effects while each shrinks what is left of the held-out gap materially;
+The explanation (``explain.explain``) adds effects while each shrinks what is left of the held-out gap materially;
 the decisions here then say which of its steps the records attribute to an effect, in a fixed order:
 
 1. ``held_out``: a load case is held out (otherwise every gap is the calibration case's own, which any refit lowers);
@@ -24,7 +24,7 @@ the decisions here then say which of its steps the records attribute to an effec
    update or another effect).
 
 The verdict is the effect of the explanation's effect step with the largest share, or "none" exactly when no step is
-an effect (an update is not one, unless it amounts to one effect of the library, ``diagnosis._updating_verdict``). The
+an effect (an update is not one, unless it amounts to one effect of the library, ``explain._updating_verdict``). The
 reason sentence comes from the trace: the step's numbers, or the test that ended the explanation. ``resolution`` says
 what these records can attribute: the smallest change of the held-out gap a first effect must make.
 """
@@ -244,7 +244,7 @@ def resolution(before: float, form_after: Mapping[str, float], scatter: float, s
 
 def first_pass_best(rows: Sequence[Mapping], before: float) -> Test | None:
     """Where the explanation added no effect: the first pass's best candidate, which did not shrink the held-out gap
-    materially (``verdict.explains_materially``, applied by ``diagnosis.explain``); None without candidates."""
+    materially (``verdict.explains_materially``, applied by ``explain.explain``); None without candidates."""
     finite = [r for r in rows if np.isfinite(r["heldout_gap_after"])]
     if not finite:
         return None

@@ -2,7 +2,7 @@
 where the gap lies (``place``) and whether a step explains the held-out gap (``explains_materially``,
 ``indistinguishable``, ...); the verdict itself is told from the explanation (``story``).
 
-``diagnosis.localise`` and ``diagnosis.diagnose`` compute the numbers (stage gaps, drift, sensor
+``localise.localise`` and ``diagnosis.diagnose`` compute the numbers (stage gaps, drift, sensor
 misfits, ranked candidates with their held-out gaps and bootstrap intervals) and call these.
 """
 
@@ -197,7 +197,7 @@ def records_prefer_gains(
     gap_structure: float, gap_gains: float, scatter: float, settings, gap_chain: float | None = None
 ) -> bool:
     """Whether the dual-sine records call for the accelerometer channels' gains where the random test cannot tell
-    them from the structure's factors (``diagnosis.records_test_of_gains``): the model updated with the gains and read
+    them from the structure's factors (``evidence.records_test_of_gains``): the model updated with the gains and read
     through them leaves a held-out gap (``gap_gains``) below the structure-alone update's (``gap_structure``) by a
     factor of ``separation`` and by more than noise_factor x the records' ``scatter``. Otherwise the structure is kept:
     a rig's structure is off a few per cent everywhere, and the candidate ``channel_gain_error`` still applies the
@@ -219,7 +219,7 @@ def records_carry_factor(gap_chain: float, alone: float, without: float, scatter
     """Whether the dual-sine records put an accepted update on one factor: that factor's effect alone (held-out gap
     ``alone``) explains the chain's gap materially (``records_accept_update``) and the update without the factor
     (``without``) leaves ``settings.separation`` times as much, as a verdict's runner-up must
-    (``diagnosis.records_attribution``)."""
+    (``evidence.records_attribution``)."""
     return (
         records_accept_update(gap_chain, alone, scatter, settings)
         and without >= _setting(settings, "separation") * alone
@@ -311,7 +311,7 @@ def updating_effect(
     profile is at least UPDATING_Z^2 times every other factor's (1.24 against 0.03 there). The same rule serves an
     update the chi^2 test accepted with no factor moved on its own (a drop just above its bar). Where the profiles
     do not tell (the ladder's transducer masses +3 %: 0.081 against the mass scale's 0.045), the records' own
-    ``attribution`` (``diagnosis.records_attribution``: the factor whose effect alone explains the gap and without
+    ``attribution`` (``evidence.records_attribution``: the factor whose effect alone explains the gap and without
     which the update does not) names it."""
     if by_records and attribution and attribution.get("effect"):
         return str(attribution["effect"])

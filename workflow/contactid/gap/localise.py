@@ -1,0 +1,337 @@
+"""Where the gap lies: the gap by stage of the chain (accelerations, generalized coordinates, the contact forces
+identified from the records against the laws, the energy per cycle, the random test's FRF), by sensor, harmonic,
+part of the cycle and load case, and the stage evidence the place is told from (the records' drift and settling,
+the inverse identification's noise, how far the structures the random test allows move eta)."""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+import xarray as xr
+
+from ..beam_model import all_modes, structural_modes
+from ..harmonics import periodic_grid
+from ..identification import modal_damping_vector
+from .model import NONE, Augmentation, IdentifiedModel, fe_model
+from .records import RecordHarmonics
+from .refit import contact_grids, identified_forces, law_friction_force
+from .verdict import DEFAULT_PLACE, PlaceThresholds, open_fraction
+from .verdict import place as _place_of
+
+log = logging.getLogger(__name__)
+
+
+def _rel(a, b) -> float:
+    return float(np.linalg.norm(np.asarray(a) - np.asarray(b)) / max(np.linalg.norm(b), 1e-300))
+
+
+def cycle_parts(g: dict, k_t: float) -> dict:
+    """Masks of one period (identified motion and forces): velocity reversal (within 4 % of the
+    period of a sign change of dxi/dt), peak compression (N in the top 10 % of its range), slip
+    (tangent stiffness dS/dxi below half of k_t) and stick (the rest)."""
+    m = g["xi"].size
+    xd = g["xi_dot"]
+    rev_idx = np.flatnonzero(np.sign(xd) != np.sign(np.roll(xd, 1)))
+    reversal = np.zeros(m, bool)
+    width = max(1, int(0.04 * m))
+    for i in rev_idx:
+        reversal[(np.arange(-width, width + 1) + i) % m] = True
+    N = g["N"]
+    peak = N >= N.max() - 0.1 * (N.max() - N.min())
+    dS = np.gradient(g["S"]) / np.where(np.abs(np.gradient(g["xi"])) > 0, np.gradient(g["xi"]), np.nan)
+    slip = (np.abs(dS) < 0.5 * k_t) & ~reversal
+    stick = ~(reversal | slip)
+    return {"stick": stick, "slip": slip, "velocity_reversal": reversal, "peak_compression": peak}
+
+
+def _response_gaps(fe, records: dict, sims: dict, H: int) -> dict:
+    """The gap of the accelerations and of the generalized coordinates (the sensors projected on the first
+    structural modes) per load case, and by sensor and by harmonic (rows: load cases)."""
+    cases = list(records)
+    phi_s = fe.sensor_vectors @ structural_modes(fe, min(3, len(records[cases[0]].sensors))).shapes
+    pinv = np.linalg.pinv(phi_s)
+    out = {"accelerations": [], "generalized_coordinates": [], "by_sensor": [], "by_harmonic": []}
+    for c in cases:
+        A, As = records[c].acceleration[:, :H], sims[c].acceleration[:, :H]
+        out["accelerations"].append(_rel(As, A))
+        out["generalized_coordinates"].append(_rel(pinv @ As, pinv @ A))
+        out["by_sensor"].append(np.linalg.norm(As - A, axis=1) / np.linalg.norm(A, axis=1))
+        out["by_harmonic"].append(np.linalg.norm(As - A, axis=0) / np.linalg.norm(A))
+    return {k: np.array(v) for k, v in out.items()}
+
+
+CYCLE_PARTS = ("stick", "slip", "velocity_reversal", "peak_compression")
+
+
+def _contact_gaps(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, sim, H: int, open_limit: float):
+    """One load case's contact-force stage: the contact forces identified from the record (inverse) against the
+    laws at the identified motion, the inverse identification's residual and noise, the contact's open fraction,
+    the energy per cycle (J; identified, simulated), the driving-point residual by part of the cycle and the
+    force-state map of what the laws leave."""
+    forces = identified_forces(model, aug, rec)
+    g = contact_grids(forces, rec.f0, model.preload, 256)
+    S_law = law_friction_force(g["xi"], g["xi_dot"], g["N"], np.asarray(model.friction), aug, model.regularization)[0]
+    S_law -= S_law.mean()
+    N_id = g["N"] - model.preload
+    # the best elastic normal law at the identified motion (stiffness + hardening): what it leaves
+    # is dissipation or opening in the normal direction
+    A_el = np.column_stack([-g["eta"], g["eta"] ** 2 - np.mean(g["eta"] ** 2)])
+    N_law = A_el @ np.linalg.lstsq(A_el, N_id, rcond=None)[0]
+    T = 1.0 / rec.f0
+    # part of the cycle: driving-point acceleration residual over one period
+    r_t = periodic_grid(sim.acceleration[0, :H] - rec.acceleration[0, :H], rec.f0, 256)[0]
+    a_rms = np.sqrt(np.mean(periodic_grid(rec.acceleration[0, :H], rec.f0, 256)[0] ** 2))
+    parts = cycle_parts(g, model.structure.k_t)
+    return {
+        # the sensors' misfit of the inverse identification at the driven harmonics (1 and 3): the
+        # structure and sensor model's consistency with the records, whatever the contact does
+        "identification_residual": float(np.sqrt(np.mean(forces.residual[[0, 2]] ** 2))),
+        "identification_noise": identification_noise(model, rec),
+        "S": _rel(S_law, g["S"]),
+        "N": _rel(N_law, N_id),
+        "open_fraction": open_fraction(g["N"], model.preload, open_limit),
+        "energy_tangential": (float(np.mean(g["S"] * g["xi_dot"]) * T), sim.energy["tangential_j"]),
+        "energy_normal": (float(-np.mean(N_id * g["eta_dot"]) * T), sim.energy["normal_j"]),
+        "cycle_parts": [
+            float(np.sqrt(np.mean(r_t[parts[p]] ** 2)) / a_rms) if parts[p].any() else 0.0 for p in CYCLE_PARTS
+        ],
+        "map": np.array([g["xi"], g["xi_dot"], g["S"] - S_law, g["eta"], g["eta_dot"], N_id - N_law]),
+    }
+
+
+def _rms(x) -> float:
+    return float(np.sqrt(np.mean(np.square(x))))
+
+
+def localise(
+    model: IdentifiedModel,
+    records: dict,
+    sims: dict,
+    n_harmonics: int,
+    linear: dict | None = None,
+    aug: Augmentation = NONE,
+    eta_limit: float = 0.1,
+    structures=(),
+    thresholds: PlaceThresholds = DEFAULT_PLACE,
+) -> tuple[dict, dict]:
+    """The gap by stage, sensor, harmonic, part of the cycle and load level (the identified model
+    as the chain left it, or with the effects ``aug`` added), the records' drift and whether each settled
+    (``record_periodicity``). Returns (summary for diagnosis.json, arrays for gap.nc)."""
+    H = n_harmonics
+    cases = list(records)
+    resp = _response_gaps(fe_model(model, aug), records, sims, H)
+    contact = [_contact_gaps(model, aug, records[c], sims[c], H, thresholds.open_limit) for c in cases]
+    per_case = {k: [row[k] for row in contact] for k in contact[0]}
+    e_t, e_n = np.array(per_case["energy_tangential"]), np.array(per_case["energy_normal"])
+    scale_e = np.abs(e_t[:, 0])
+    stage = {
+        "accelerations": _rms(resp["accelerations"]),
+        "generalized_coordinates": _rms(resp["generalized_coordinates"]),
+        "identification_residual": _rms(per_case["identification_residual"]),
+        "open_fraction": float(np.max(per_case["open_fraction"])),
+        "contact_force_S": _rms(per_case["S"]),
+        "contact_force_N": _rms(per_case["N"]),
+        "energy_tangential": _rms((e_t[:, 1] - e_t[:, 0]) / scale_e),
+        "energy_normal": _rms((e_n[:, 1] - e_n[:, 0]) / scale_e),
+    }
+    if linear is not None:
+        stage.update(linear)
+    arrays = {
+        "gap_by_sensor": resp["by_sensor"],
+        "gap_by_harmonic": resp["by_harmonic"],
+        "energy_tangential": e_t,
+        "energy_normal": e_n,
+        "gap_by_cycle_part": np.array(per_case["cycle_parts"]),
+        "force_state_map": np.array(per_case["map"]),
+    }
+    summary = {"stage": stage, **_gap_patterns(stage, arrays, records, resp["accelerations"], thresholds)}
+    summary["drift"] = {c: dict(zip(("change", "z"), record_drift(records[c], H))) for c in cases}
+    summary["periodicity"] = record_periodicity(records, thresholds.aperiodic_limit)
+    summary["identification_residual"] = dict(zip(cases, per_case["identification_residual"]))
+    summary["identification_noise"] = dict(zip(cases, per_case["identification_noise"]))
+    spread = {c: eta_model_spread(model, aug, records[c], structures) for c in cases}
+    finite = [v for v in spread.values() if np.isfinite(v)]
+    worst = max(finite) if finite else float("nan")
+    summary["eta_observability"] = {
+        "model_spread": spread,
+        "limit": eta_limit,
+        "observable": bool(not finite or worst <= eta_limit),
+    }
+    summary["place"], summary["place_reason"] = _place_of(
+        summary["drift"],
+        stage,
+        np.array(per_case["identification_residual"]),
+        np.array(per_case["identification_noise"]),
+        summary["eta_observability"]["observable"],
+        worst,
+        thresholds,
+    )
+    if not summary["eta_observability"]["observable"]:
+        summary["direction"] = "unresolved"  # the normal direction's numbers rest on an unobservable eta
+    return summary, arrays
+
+
+def _gap_patterns(stage: dict, arrays: dict, records: dict, acc_gap, thresholds: PlaceThresholds) -> dict:
+    """Where the gap lies: the largest stage, the direction (normal when the normal contact force's gap exceeds
+    ``thresholds.normal_limit`` or the contact opens), by sensor, harmonic (odd or even), part of the cycle and
+    load case, and the gap's growth with the load (the exponent of gap ~ A1^n over the load cases)."""
+    cases = list(records)
+    ph = np.mean(arrays["gap_by_harmonic"] ** 2, axis=0)
+    odd, even = float(np.sum(ph[0::2])), float(np.sum(ph[1::2]))
+    part_mean = np.mean(arrays["gap_by_cycle_part"], axis=0)
+    sensors = records[cases[0]].sensors
+    by_sensor = np.mean(arrays["gap_by_sensor"] ** 2, axis=0)
+    amps = [float(np.abs(records[c].acceleration[0, 0])) for c in cases]
+    slope = (
+        float(np.polyfit(np.log(amps), np.log(np.maximum(acc_gap, 1e-12)), 1)[0]) if len(cases) > 1 else float("nan")
+    )
+    largest = ("accelerations", "generalized_coordinates", "contact_force_S", "contact_force_N")
+    largest += ("energy_tangential", "energy_normal")
+    normal = stage["contact_force_N"] > thresholds.normal_limit or stage["open_fraction"] > 0
+    return {
+        "largest_stage": max(largest, key=lambda k: stage[k]),
+        "direction": "normal" if normal else "tangential",
+        "by_sensor": {s: float(v) for s, v in zip(sensors, np.sqrt(by_sensor))},
+        "worst_sensor": sensors[int(np.argmax(by_sensor))],
+        "by_harmonic": {int(h): float(np.sqrt(v)) for h, v in enumerate(ph, start=1)},
+        "worst_harmonic": int(np.argmax(ph)) + 1,
+        "even_share": even / max(odd + even, 1e-300),
+        "harmonic_class": "even" if even > odd else "odd",
+        "by_cycle_part": {p: float(v) for p, v in zip(CYCLE_PARTS, part_mean)},
+        "worst_cycle_part": CYCLE_PARTS[int(np.argmax(part_mean))],
+        "by_load_case": {c: float(g) for c, g in zip(cases, acc_gap)},
+        "load_exponent": slope,
+    }
+
+
+def record_drift(rec: RecordHarmonics, H: int) -> tuple[float, float]:
+    """Linear trend of the block harmonics over the record: (relative change over the record, its size in
+    units of its own standard error from the scatter about the trend; about 1 for a stationary record)."""
+    A = rec.block_acceleration[:, :, :H].reshape(rec.block_acceleration.shape[0], -1)
+    b = np.arange(A.shape[0]) - 0.5 * (A.shape[0] - 1)
+    slope = (b @ A) / (b @ b)
+    resid = A - A.mean(axis=0) - np.outer(b, slope)
+    sigma = np.sqrt(np.mean(np.sum(np.abs(resid) ** 2, axis=1)) * A.shape[0] / max(A.shape[0] - 2, 1))
+    change = float(np.linalg.norm(slope) * (A.shape[0] - 1) / np.linalg.norm(rec.acceleration[:, :H]))
+    return change, float(np.linalg.norm(slope) * np.sqrt(b @ b) / max(sigma, 1e-300))
+
+
+def record_periodicity(records: dict, limit: float) -> dict:
+    """Per load case: the share of the response that is not periodic at the drive (``RecordHarmonics.aperiodic``,
+    the worst accelerometer and each one) and whether the record settled (that share at most ``limit``). A record
+    that does not settle (impacts, chaos) has harmonics that are averages of a motion that never repeats: the gap
+    compares those averages, and a candidate, compared on harmonics, cannot be expected to explain it."""
+    out = {}
+    for c, rec in records.items():
+        a = getattr(rec, "aperiodic", None)
+        if a is None or not np.size(a):
+            continue
+        sensors = list(getattr(rec, "sensors", range(np.size(a))))
+        worst = float(np.max(a))
+        out[c] = {
+            "aperiodic_share": worst,
+            "by_sensor": {str(s): float(v) for s, v in zip(sensors, np.atleast_1d(a))},
+            "settled": bool(worst <= limit),
+        }
+    return out
+
+
+def identification_noise(model: IdentifiedModel, rec: RecordHarmonics) -> float:
+    """Standard error of the inverse identification's sensor misfit (w and 3w) from the record's blocks."""
+    import dataclasses
+
+    r = []
+    for k in range(rec.block_acceleration.shape[0]):
+        blk = dataclasses.replace(rec, acceleration=rec.block_acceleration[k], force=rec.block_force[k])
+        r.append(float(np.sqrt(np.mean(identified_forces(model, NONE, blk).residual[[0, 2]] ** 2))))
+    return float(np.std(r) / np.sqrt(len(r)))
+
+
+def eta_model_spread(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, structures) -> float:
+    """How far the identified normal motion eta moves over the structures the data allow: the largest relative
+    change (norm over the harmonics) of eta identified with each of ``structures`` (the model's structure moved
+    by one posterior standard deviation of each updated parameter, ``updating.posterior_structures``) against
+    eta with the model's own. The k_t, k_n intervals alone (the chain's test) miss the structure's own
+    uncertainty. NaN without structures."""
+    import dataclasses
+
+    if not structures:
+        return float("nan")
+    full = identified_forces(model, aug, rec).eta
+    out = 0.0
+    for p in structures:
+        other = identified_forces(dataclasses.replace(model, structure=p), aug, rec).eta
+        out = max(out, float(np.linalg.norm(other - full) / max(np.linalg.norm(full), 1e-300)))
+    return out
+
+
+# the place's thresholds (PlaceThresholds, config gap.place) and its logic live in verdict.py (pure functions,
+# unit-tested in tests/test_verdict.py)
+
+
+def random_test_delays(frf: xr.Dataset, modal: xr.Dataset) -> np.ndarray | None:
+    """Each accelerometer channel's delay on the force (s) from the random test's residue phases at its highest
+    identified mode (``modal_fit.residue_phase_delays``), None where the FRF or the modes do not allow it (logged)."""
+    from ..linear_chain import complex_frf
+    from ..modal_fit import residue_phase_delays
+
+    try:
+        H = complex_frf(frf)
+        band = (float(modal.attrs["band_low_hz"]), float(modal.attrs["band_high_hz"]))
+        tau = residue_phase_delays(
+            frf["frequency"].values, H, modal["natural_frequency"].values, modal["damping_ratio"].values, band
+        )
+    except (KeyError, ValueError, np.linalg.LinAlgError) as exc:
+        log.info("random test: no channel delays from the residue phases (%s)", exc)
+        return None
+    if not np.all(np.isfinite(tau)):
+        return None
+    log.info("random test: channel delays from the residue phases %s us", ", ".join(f"{1e6 * t:.2f}" for t in tau))
+    return tau
+
+
+def linear_stage(model: IdentifiedModel, frf: xr.Dataset, modal: xr.Dataset) -> dict:
+    """The random test's FRF against the identified model: natural frequencies (relative error) and
+    the driving-point |H1| at the identified peaks (relative error of the model's accelerance)."""
+    fe = fe_model(model)
+    modes = all_modes(fe)
+    zeta = modal_damping_vector(fe, np.asarray(model.damping))
+    wn = 2 * np.pi * modes.frequencies_hz
+    b = modes.shapes.T @ fe.force_vector
+    d = fe.sensor_vectors[0] @ modes.shapes
+    f_id = modal["natural_frequency"].values
+    freq = frf["frequency"].values
+    H1 = frf["h1_real"].values[0] + 1j * frf["h1_imag"].values[0]
+    f_model = structural_modes(fe, len(f_id)).frequencies_hz
+    peak_err = []
+    for f in f_id:
+        i = int(np.argmin(np.abs(freq - f)))
+        W = 2 * np.pi * freq[i]
+        Hm = -(W**2) * np.sum(d * b / (wn**2 - W**2 + 2j * zeta * wn * W))
+        peak_err.append(abs(Hm) / abs(H1[i]) - 1)
+    return {
+        "frf_frequency": float(np.sqrt(np.mean((f_model / f_id - 1) ** 2))),
+        "frf_peak_amplitude": float(np.sqrt(np.mean(np.square(peak_err)))),
+    }
+
+
+def _place_left(last, records, calibration_case, H, linear, structures, settings) -> dict | None:
+    """The localisation of what the explanation leaves, with its effects in the model (``last``: the last step's
+    calibration and held-out simulations); None where a simulation is missing."""
+    cal, sims = last
+    all_sims = {c: (cal.simulation if c == calibration_case else sims[c]) for c in records}
+    if any(s is None for s in all_sims.values()):
+        return None
+    where_left, _ = localise(
+        cal.model,
+        dict(records),
+        all_sims,
+        H,
+        linear,
+        aug=cal.augmentation,
+        eta_limit=settings.eta_observability_limit,
+        structures=structures,
+        thresholds=settings.place,
+    )
+    return where_left

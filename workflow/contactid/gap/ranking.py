@@ -1,0 +1,86 @@
+"""The candidates' ranking: each candidate's row (its held-out gap and bootstrap interval against the model's,
+the score, its refitted parameters and friction law, whether it acts where the localisation puts the gap and
+settles where the records do), sorted by score."""
+
+from __future__ import annotations
+
+from typing import Mapping
+
+import numpy as np
+
+from .candidates import LIBRARY
+from .explain import _parameter_values, model_periodicity
+from .records import RecordHarmonics
+from .refit import gap_value, identified_forces
+from .verdict import acts_where
+
+
+def _ranking_row(
+    name: str,
+    cal,
+    res: Mapping,
+    after: float,
+    after_b,
+    before: float,
+    before_b,
+    n_data: int,
+    records: Mapping[str, RecordHarmonics],
+    calibration_case: str,
+    where: Mapping,
+) -> dict:
+    """A candidate's row of the ranking: its held-out gap (``after``, its bootstrap ``after_b``) against the
+    model's (``before``, ``before_b``), the score (n ln(gap^2 ratio) + 2 k over ``n_data`` residual entries), its
+    refitted parameters and friction law, the structure/sensor misfit it leaves on the calibration record, and
+    whether it acts where the localisation puts the gap."""
+    k = LIBRARY[name].n_parameters(len(records[calibration_case].sensors))
+    # does the candidate make the structure and sensor model consistent with the calibration record?
+    res_after = float(
+        np.sqrt(
+            np.mean(identified_forces(cal.model, cal.augmentation, records[calibration_case]).residual[[0, 2]] ** 2)
+        )
+    )
+    acts_on = LIBRARY[name].acts_on
+    score = n_data * np.log(after**2 / before**2) + 2 * k if np.isfinite(after) else np.inf
+    red_b = 1 - after_b / before_b
+    return {
+        "effect": name,
+        "heldout_gap_before": before,
+        "heldout_gap_after": after,
+        "score": float(score),
+        "reduction": 1 - after / before if np.isfinite(after) else -np.inf,
+        "reduction_interval": [float(np.percentile(red_b, 2.5)), float(np.percentile(red_b, 97.5))],
+        "heldout_gap_after_interval": [float(np.percentile(after_b, 2.5)), float(np.percentile(after_b, 97.5))],
+        "n_parameters": k,
+        "parameters": _parameter_values(name, cal),
+        "calibration_gap": cal.gap,
+        "friction": [float(x) for x in cal.friction],
+        "heldout_gap_after_by_case": {c: gap_value(r) for c, r in res.items()},
+        "identification_residual_after": res_after,
+        "identification_noise": where["identification_noise"][calibration_case],
+        "acts_on": acts_on,
+        # a winner must act where the localisation puts the gap; the structure/sensor misfit left by the candidate
+        # (identification_residual_after, against the noise level) is reported beside it
+        "consistent": bool(acts_where(acts_on, where["place"])),
+        "evaluations": cal.evaluations,
+    }
+
+
+def _ranking(
+    results, heldout_gap, n_bootstrap, before, before_b, n_data, records, calibration_case, where, aperiodic_limit=0.1
+):
+    """The candidates' ranking rows, sorted by score (scores equal to 3 decimals are a tie, the same model solved
+    from other starts: library order), and each candidate's bootstrap held-out gaps. Each row also says where the
+    candidate's model settles unlike the records (``model_periodicity`` with ``aperiodic_limit``)."""
+    rows, boots = [], {}
+    for name, (cal, sims, res) in results.items():
+        after = heldout_gap(sims)
+        after_b = np.array([heldout_gap(sims, b) for b in range(n_bootstrap)])
+        if not np.isfinite(after):  # a held-out prediction diverged: the candidate explains nothing
+            after, after_b = np.inf, np.full(n_bootstrap, np.inf)
+        boots[name] = after_b
+        rows.append(
+            _ranking_row(name, cal, res, after, after_b, before, before_b, n_data, records, calibration_case, where)
+        )
+        rows[-1].update(model_periodicity(cal, sims, records, calibration_case, aperiodic_limit))
+    rows.sort(key=lambda r: round(r["score"], 3) if np.isfinite(r["score"]) else np.inf)
+    return rows, boots
