@@ -315,6 +315,31 @@ def test_half_the_compound_rigs_have_a_clamp_that_gives_and_the_rest_of_each_ite
     )
 
 
+def test_compound_rigs_carry_other_friction_laws_and_the_slip_limit_while_the_identification_keeps_its_own(
+    default_config,
+):
+    from contactid.gap.benchmark import FRICTION_LAW_RANGES, RANGES, compound_config, compound_items
+
+    items = compound_items(20, [1, 2], default_config["seed"], RANGES)
+    laws = [s["friction_law"] for s in items.values() if s["friction_law"]]
+    assert 12 <= len(laws) <= 28
+    for law in laws:
+        for k, (lo, hi) in FRICTION_LAW_RANGES.items():
+            assert lo <= law[k] <= hi
+    slip = [s for s in items.values() if s["friction_regularization"] == "slip_limit"]
+    assert 6 <= len(slip) <= 22
+    # drawn after the clamp: the earlier draws as they were (the clamp test above)
+    assert items["compound-14-s2"]["effects"]["normal_contact_damping"] == pytest.approx(593.0430028244796)
+    name = next(n for n, s in items.items() if s["friction_law"] and s["friction_regularization"] == "slip_limit")
+    cfg = compound_config(default_config, items[name])
+    truth, table4 = cfg["rig"]["truth"]["friction"], default_config["rig"]["truth"]["friction"]
+    law = items[name]["friction_law"]
+    assert truth["mu"] == law["mu"] and truth["kappa"] == law["kappa"]
+    assert truth["e_f_n_per_m"] == pytest.approx(table4["e_f_n_per_m"] * law["e_f_factor"])
+    assert truth["regularization"] == "slip_limit"
+    assert cfg["friction"] == default_config["friction"]  # the identified law's reading and ranges unchanged
+
+
 def test_long_benchmark_items_are_scheduled_first():
     """The scheduler's order (gap_benchmark_item's priority): compound items with a drifting preload, then items whose
     contact opens, then the other compound items, the leave-outs, and the single effects last."""

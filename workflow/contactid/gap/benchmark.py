@@ -628,12 +628,16 @@ HARDENING_CUBIC = (2.0e19, 6.0e19)  # N/m^3 of the polynomial hardening N0 - k_n
 # at the sensors changed much as relative channel gains change them (docs/gap.md, "Model updating")
 CLAMP_STIFFNESS = (1.0e5, 1.0e6)
 DAMPING_FORMS = ("modal", "stiffness_proportional", "mass_proportional")
+# a compound rig's friction law away from Table 4's (log-uniform): mu and kappa themselves, e_f and k_c as factors on
+# the configured truth's (the other simulator's other law: mu 0.33, kappa 0.25, e_f x 1.17, k_c x 0.82)
+FRICTION_LAW_RANGES = {"mu": (0.28, 0.48), "kappa": (0.15, 0.42), "e_f_factor": (0.6, 1.7), "k_c_factor": (0.7, 1.4)}
 
 
 def compound_items(n_per_seed: int, seeds, seed: int, ranges: Mapping) -> dict:
     """{name: spec} of the compound items: item k of each seed perturbs the rig's structure at random (E
     +-3 %, transducer masses +-40 %, lever arm +-8 %; polynomial hardening on or off; a damping form; on half of them a
-    clamp that gives, CLAMP_STIFFNESS) and adds
+    clamp that gives, CLAMP_STIFFNESS; on half a friction law away from Table 4's, FRICTION_LAW_RANGES; on a third
+    Eq. 21 read with the slip limit) and adds
     k mod 3 effects (two in different places), each at a random magnitude in its benchmark range."""
     items = {}
     places = list(COMPOUND_EFFECTS)
@@ -654,6 +658,14 @@ def compound_items(n_per_seed: int, seeds, seed: int, ranges: Mapping) -> dict:
                 effects[e] = float(rng.uniform(lo, hi))
             # drawn last, so that the draws above (and the items before the clamp was added) stay as they were
             clamp = float(np.exp(rng.uniform(*np.log(CLAMP_STIFFNESS)))) if rng.random() < 0.5 else None
+            # drawn after the clamp, for the same reason: on half the rigs a friction law away from Table 4's (the
+            # identified law's form holds, its values do not), on a third Eq. 21 read with the slip limit
+            law = (
+                {k: float(np.exp(rng.uniform(*np.log(r)))) for k, r in FRICTION_LAW_RANGES.items()}
+                if rng.random() < 0.5
+                else None
+            )
+            regularization = "slip_limit" if rng.random() < 1.0 / 3.0 else "none"
             items[f"compound-{k}-s{s}"] = {
                 "kind": "compound",
                 "seed": int(s),
@@ -665,13 +677,16 @@ def compound_items(n_per_seed: int, seeds, seed: int, ranges: Mapping) -> dict:
                 "normal_cubic_n_per_m3": cubic,
                 "damping_form": form,
                 "clamp_rotational_stiffness_nm_per_rad": clamp,
+                "friction_law": law,
+                "friction_regularization": regularization,
             }
     return items
 
 
 def compound_config(cfg: Mapping, spec: Mapping) -> dict:
-    """The config of a compound item's rig: rig.true_structure (with its clamp), the normal law and the damping form
-    perturbed as ``spec`` says (the identification keeps ``structure``)."""
+    """The config of a compound item's rig: rig.true_structure (with its clamp), the normal law, the damping form, the
+    friction law's values and its reading of Eq. 21 perturbed as ``spec`` says (the identification keeps
+    ``structure`` and ``friction``)."""
     import copy
 
     out = copy.deepcopy(dict(cfg))
@@ -696,6 +711,17 @@ def compound_config(cfg: Mapping, spec: Mapping) -> dict:
             "cubic_n_per_m3": float(spec["normal_cubic_n_per_m3"]),
         }
     rig["true_damping"] = {"form": spec["damping_form"], "reference_frequency_hz": 54.4}
+    law, fr = spec.get("friction_law"), dict(rig["truth"]["friction"])
+    if law:
+        fr.update(
+            mu=law["mu"],
+            kappa=law["kappa"],
+            e_f_n_per_m=fr["e_f_n_per_m"] * law["e_f_factor"],
+            k_c_per_m=fr["k_c_per_m"] * law["k_c_factor"],
+        )
+    if spec.get("friction_regularization"):
+        fr["regularization"] = spec["friction_regularization"]
+    rig["truth"]["friction"] = fr
     return out
 
 
