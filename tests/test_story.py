@@ -176,6 +176,15 @@ def test_an_update_that_changes_nothing_is_no_step_and_one_that_names_an_effect_
         update_effect=("transducer_mass_error", "model updating (...) takes the gap ..."),
     )
     assert named.verdict == "transducer_mass_error" and named.reason.startswith("model updating (...)")
+    # the place is the updated model's: an update's effect alone is not tested against it
+    elsewhere = story(
+        [step("model_updating", 0.05, 0.003)],
+        [row("transducer_mass_error", 0.04, 0.003, acts_on="structure_or_measurement")],
+        before=0.003,
+        place="contact",
+        update_effect=("transducer_mass_error", "model updating (...) takes the gap ..."),
+    )
+    assert elsewhere.verdict == "transducer_mass_error"
     assert named.explanation[0]["names"] == "transducer_mass_error"
     # the update's effect counts for the place: a normal dashpot after it where the gap lies in the structure
     with_dashpot = story(

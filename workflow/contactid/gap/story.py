@@ -352,9 +352,11 @@ def tell(
         kept.append(step)
     # the localisation names one place: an explanation's effects are kept where one of them acts there (the first
     # effect alone judged so, two-effect records whose place followed the second lost both)
-    named = [x for x in kept if x["kind"] == "effect"]
+    # the place is localised on the model the candidates start from (the updated one): an update's effect is not
+    # tested against it, but counts for the effects after it
+    named = [x for x in kept if x["kind"] == "effect" and x["effect"] != "model_updating"]
     if named:
-        effects_named = [x.get("names", x["effect"]) for x in named]  # an update by the effect it names
+        effects_named = [x.get("names", x["effect"]) for x in kept if x["kind"] == "effect"]
         t = acts_where_gap_lies(
             " or ".join(effects_named),
             " | ".join(by_row.get(e, {}).get("acts_on", "any") for e in effects_named),
