@@ -218,10 +218,10 @@ def resolution(before: float, form_after: Mapping[str, float], scatter: float, s
     if not held or before < min_gap:
         x = before
         how = (
-            f"the held-out gap {_pct(before)} is below the identification's floor gap.min_gap "
+            f"The held-out gap {_pct(before)} is below the identification's floor gap.min_gap "
             f"{_pct(min_gap)}: no change of it is attributed to an effect"
             if held
-            else "no load case is held out: no change of the gap is attributed to an effect"
+            else "No load case is held out: no change of the gap is attributed to an effect"
         )
     else:
         parts = {
