@@ -24,7 +24,7 @@ import yaml
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import measured_project, run_gap_summary
-from independent_rig import contact_scores
+from independent_rig import contact_scores, contact_text
 
 from contactid.gap.benchmark import named_effects
 from contactid.gap.story import one_story_holds
@@ -120,11 +120,7 @@ def report(r: dict) -> None:
             for k, v in f.items()
         )
         + "\n  contact: "
-        + "; ".join(
-            f"{c} S {v['S_nrmse']:.2%} (S_1 x{v['S1_ratio']:.3f}, {v['S1_phase_deg']:+.1f} deg), "
-            f"xi {v['xi_nrmse']:.2%}, N {v['N_dyn_nrmse']:.1%}"
-            for c, v in r["contact"].items()
-        )
+        + contact_text(r["contact"])
         + "\n  validation "
         + ", ".join(f"{c} {x:.2%}" for c, x in r["validation_nrmse"].items())
         + f"; records check {'passed' if r['records_check']['passed'] else 'FAILED'} {r['records_check']['findings']}"

@@ -63,6 +63,15 @@ def _harmonics(x: np.ndarray, t: np.ndarray, f0: float, n: int = 5) -> np.ndarra
     return np.array([2 * np.mean(x * np.exp(-2j * np.pi * h * f0 * t)) for h in range(1, n + 1)])
 
 
+def contact_text(contact: dict) -> str:
+    """``contact_scores``' numbers in one line: each case's S (its first harmonic's ratio and phase), xi and N."""
+    return "; ".join(
+        f"{c} S {v['S_nrmse']:.2%} (S_1 x{v['S1_ratio']:.4f}, {v['S1_phase_deg']:+.2f} deg), "
+        f"xi {v['xi_nrmse']:.2%}, N {v['N_dyn_nrmse']:.2%}"
+        for c, v in contact.items()
+    )
+
+
 def contact_scores(proj: Path, folder: Path, preload: float) -> dict:
     """Per case: NRMSE (mean removed) of the identified S, xi, N against the simulator's truth, and S's first
     harmonic's amplitude ratio and phase (degrees)."""
@@ -138,11 +147,7 @@ def report(r: dict) -> None:
             for k, v in f.items()
         )
         + "\n  contact forces: "
-        + "; ".join(
-            f"{c} S {v['S_nrmse']:.2%} (S_1 x{v['S1_ratio']:.4f}, {v['S1_phase_deg']:+.2f} deg), "
-            f"xi {v['xi_nrmse']:.2%}, N {v['N_dyn_nrmse']:.2%}"
-            for c, v in r["contact"].items()
-        )
+        + contact_text(r["contact"])
         + "\n  validation "
         + ", ".join(f"{c} {x:.2%}" for c, x in r["validation_nrmse"].items())
         + f"\n  diagnosis: verdict {r['verdict']}; held-out gap {r['heldout_gap_before']:.4f} -> remaining "

@@ -21,7 +21,7 @@ import numpy as np
 from ..config import schema_defaults
 from ..random_streams import generator
 from ..rig.effects import EFFECTS
-from .story import one_story_holds
+from .story import effect_steps, one_story_holds
 
 log = logging.getLogger(__name__)
 
@@ -760,15 +760,8 @@ def bound_errors(model, truth_friction: Mapping, preload: float, true_lever_arm:
 
 
 def named_effects(explanation) -> list:
-    """The effects an explanation names: its steps of kind "effect" (an update that amounts to one effect by that
-    effect's name; model form and an update that names none are not effects)."""
-    out = []
-    for s in explanation:
-        if s.get("kind", "effect") != "effect":
-            continue
-        if s["effect"] != "model_updating" or s.get("names"):
-            out.append(s.get("names", s["effect"]))
-    return out
+    """The effects an explanation names (``story.effect_steps``), an update by the effect it names."""
+    return [s.get("names", s["effect"]) for s in effect_steps(explanation)]
 
 
 def compound_score(rows: list) -> dict:

@@ -452,7 +452,7 @@ def diagnose(
         update_effect=update_effect,
     )
     verdict, reason, steps = story.verdict, story.reason, story.explanation
-    where["resolution"] = resolution(
+    attributable = resolution(
         before,
         {r["effect"]: r["heldout_gap_after"] for r in rows if r["effect"] in form},
         scatter,
@@ -460,7 +460,7 @@ def diagnose(
         held=bool(held),
     )
     base_res = {c: gap_residual(base_sims[c], records[c], H) for c in run.score_cases}
-    where["resolution"]["isolability"] = isolability(
+    attributable["isolability"] = isolability(
         {
             n: signature(base_res, r[2], run.score_cases)
             for n, r in results.items()
@@ -489,7 +489,7 @@ def diagnose(
         steps,
         remaining,
         trace=story.trace,
-        resolution=where.pop("resolution"),
+        resolution=attributable,
         updated_model=updated_model_summary(identified or model, model, last, steps, left),
     )
 

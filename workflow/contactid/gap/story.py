@@ -420,6 +420,16 @@ def _left(kept: Sequence[Mapping], start: float) -> str:
     )
 
 
+def effect_steps(explanation: Sequence[Mapping]) -> list:
+    """The explanation's steps that name an effect: kind "effect" (an update only where it names one, ``names``);
+    model form and an update that names none are not effects."""
+    return [
+        s
+        for s in explanation
+        if s.get("kind", "effect") == "effect" and (s.get("effect") != "model_updating" or s.get("names"))
+    ]
+
+
 def one_story_holds(diagnosis: Mapping) -> bool:
     """Whether a diagnosis.json tells one story: its verdict is the effect of the explanation's effect step with the
     largest share (an update that names an effect by that name), "none" exactly when no step is an effect; records
@@ -428,11 +438,7 @@ def one_story_holds(diagnosis: Mapping) -> bool:
     verdict = diagnosis.get("verdict")
     if verdict == "records_disagree":
         return not steps
-    effects = [
-        s
-        for s in steps
-        if s.get("kind", "effect") == "effect" and (s.get("effect") != "model_updating" or s.get("names"))
-    ]
+    effects = effect_steps(steps)
     if not effects:
         return verdict == "none"
     top = max(effects, key=lambda s: s.get("share", 0.0))
