@@ -340,6 +340,19 @@ def test_compound_rigs_carry_other_friction_laws_and_the_slip_limit_while_the_id
     assert cfg["friction"] == default_config["friction"]  # the identified law's reading and ranges unchanged
 
 
+def test_a_third_of_the_compound_rigs_damp_their_dual_sine_tests_otherwise_than_their_random_test(default_config):
+    from contactid.gap.benchmark import DUAL_SINE_DAMPING, RANGES, compound_config, compound_items
+
+    items = compound_items(20, [1, 2], default_config["seed"], RANGES)
+    off = [s["dual_sine_damping_factor"] for s in items.values() if s["dual_sine_damping_factor"] != 1.0]
+    assert 6 <= len(off) <= 22 and all(DUAL_SINE_DAMPING[0] <= f <= DUAL_SINE_DAMPING[1] for f in off)
+    # drawn last: the earlier draws as they were
+    assert items["compound-14-s2"]["effects"]["normal_contact_damping"] == pytest.approx(593.0430028244796)
+    name = next(n for n, s in items.items() if s["dual_sine_damping_factor"] != 1.0)
+    cfg = compound_config(default_config, items[name])
+    assert cfg["rig"]["true_damping"]["dual_sine_factor"] == items[name]["dual_sine_damping_factor"]
+
+
 def test_long_benchmark_items_are_scheduled_first():
     """The scheduler's order (gap_benchmark_item's priority): compound items with a drifting preload, then items whose
     contact opens, then the other compound items, the leave-outs, and the single effects last."""

@@ -631,13 +631,17 @@ DAMPING_FORMS = ("modal", "stiffness_proportional", "mass_proportional")
 # a compound rig's friction law away from Table 4's (log-uniform): mu and kappa themselves, e_f and k_c as factors on
 # the configured truth's (the other simulator's other law: mu 0.33, kappa 0.25, e_f x 1.17, k_c x 0.82)
 FRICTION_LAW_RANGES = {"mu": (0.28, 0.48), "kappa": (0.15, 0.42), "e_f_factor": (0.6, 1.7), "k_c_factor": (0.7, 1.4)}
+# on a third of the compound rigs every damping ratio differs in the dual-sine tests from the random test's by this
+# factor (uniform; rig.true_damping.dual_sine_factor): a damping that changes with level
+DUAL_SINE_DAMPING = (0.85, 1.15)
 
 
 def compound_items(n_per_seed: int, seeds, seed: int, ranges: Mapping) -> dict:
     """{name: spec} of the compound items: item k of each seed perturbs the rig's structure at random (E
     +-3 %, transducer masses +-40 %, lever arm +-8 %; polynomial hardening on or off; a damping form; on half of them a
     clamp that gives, CLAMP_STIFFNESS; on half a friction law away from Table 4's, FRICTION_LAW_RANGES; on a third
-    Eq. 21 read with the slip limit) and adds
+    Eq. 21 read with the slip limit; on a third the damping in the dual-sine tests other than in the random test,
+    DUAL_SINE_DAMPING) and adds
     k mod 3 effects (two in different places), each at a random magnitude in its benchmark range."""
     items = {}
     places = list(COMPOUND_EFFECTS)
@@ -666,6 +670,8 @@ def compound_items(n_per_seed: int, seeds, seed: int, ranges: Mapping) -> dict:
                 else None
             )
             regularization = "slip_limit" if rng.random() < 1.0 / 3.0 else "none"
+            # drawn last, for the same reason
+            dual_sine = float(rng.uniform(*DUAL_SINE_DAMPING)) if rng.random() < 1.0 / 3.0 else 1.0
             items[f"compound-{k}-s{s}"] = {
                 "kind": "compound",
                 "seed": int(s),
@@ -679,6 +685,7 @@ def compound_items(n_per_seed: int, seeds, seed: int, ranges: Mapping) -> dict:
                 "clamp_rotational_stiffness_nm_per_rad": clamp,
                 "friction_law": law,
                 "friction_regularization": regularization,
+                "dual_sine_damping_factor": dual_sine,
             }
     return items
 
@@ -710,7 +717,11 @@ def compound_config(cfg: Mapping, spec: Mapping) -> dict:
             "exponent": 1.0,
             "cubic_n_per_m3": float(spec["normal_cubic_n_per_m3"]),
         }
-    rig["true_damping"] = {"form": spec["damping_form"], "reference_frequency_hz": 54.4}
+    rig["true_damping"] = {
+        "form": spec["damping_form"],
+        "reference_frequency_hz": 54.4,
+        "dual_sine_factor": float(spec.get("dual_sine_damping_factor", 1.0)),
+    }
     law, fr = spec.get("friction_law"), dict(rig["truth"]["friction"])
     if law:
         fr.update(

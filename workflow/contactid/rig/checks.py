@@ -11,7 +11,7 @@ import pandas as pd
 
 from ..beam_model import assemble, all_modes
 from ..harmonics import harmonic_amplitudes
-from .damping import rig_damping_ratios
+from .damping import dual_sine_damping_ratios
 from .dual_sine import build_simulator, dual_sine_settings, dual_sine_test
 from .effects import EFFECTS
 from .nonlinear import control_response
@@ -61,7 +61,7 @@ def low_level_frf_check(
     ctl = control_response(sim, case["A1_m_per_s2"], case["A2_m_per_s2"], w)
     model = assemble(rig_structure(structure_cfg, rig_cfg))
     modes = all_modes(model)
-    zeta = rig_damping_ratios(rig_cfg, modes.frequencies_hz)
+    zeta = dual_sine_damping_ratios(rig_cfg, modes.frequencies_hz)
     wn = 2 * np.pi * modes.frequencies_hz
     b = modes.shapes.T @ model.force_vector
     rows = []

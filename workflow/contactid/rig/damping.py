@@ -11,6 +11,10 @@
   (as FE simulators often damp: least at f_ref, growing as f above it).
 
 Ratios are kept within [MIN_FRACTION zeta_ref, MAX_RATIO].
+
+``rig.true_damping.dual_sine_factor`` scales every ratio in the dual-sine tests against the random test's: a
+structure whose damping changes with the level and with the contact slipping (1: the same in both tests, the
+identified model's assumption).
 """
 
 from __future__ import annotations
@@ -52,3 +56,12 @@ def rig_damping_ratios(rig_cfg: Mapping, frequencies_hz) -> np.ndarray:
     td = {**defaults["true_damping"], **(rig_cfg.get("true_damping") or {})}
     ratio = rig_cfg.get("modal_damping_ratio", defaults["modal_damping_ratio"])
     return damping_ratios(frequencies_hz, float(ratio), td["form"], float(td["reference_frequency_hz"]))
+
+
+def dual_sine_damping_ratios(rig_cfg: Mapping, frequencies_hz) -> np.ndarray:
+    """The rig's damping ratio of each mode in the dual-sine tests: ``rig_damping_ratios`` times
+    rig.true_damping.dual_sine_factor."""
+    from ..config import schema_defaults
+
+    td = {**schema_defaults("rig")["true_damping"], **(rig_cfg.get("true_damping") or {})}
+    return rig_damping_ratios(rig_cfg, frequencies_hz) * float(td["dual_sine_factor"])

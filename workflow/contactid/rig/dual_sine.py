@@ -17,7 +17,7 @@ from ..beam_model import assemble
 from ..contact_laws import NormalLaw, ValanisParameters
 from ..io import raw_dataset
 from ..random_streams import generator
-from .damping import rig_damping_ratios
+from .damping import dual_sine_damping_ratios
 from .effects import effect_magnitudes
 from .frontend import add_noise, anti_alias_decimate, delay_channels
 from ..harmonics import harmonic_amplitudes
@@ -121,7 +121,7 @@ def build_simulator(
     model = assemble(params)
     red = reduced_model(model, int(n_modes or settings["n_modes"]))
     eff = effect_magnitudes(rig_cfg.get("effects"))
-    zeta = rig_damping_ratios(rig_cfg, red.omega / (2 * np.pi))
+    zeta = dual_sine_damping_ratios(rig_cfg, red.omega / (2 * np.pi))
     zeta[red.beam_mode] += eff["structural_damping"]
     q = int(oversampling or settings["oversampling"])
     contact = contact_parameters(structure_cfg, rig_cfg)
