@@ -341,6 +341,25 @@ def test_every_units_attribute_parses_and_every_variable_has_one_unit(default_ru
     assert list(fit["estimate"].values) == ["value", "interval_low", "interval_high"]
 
 
+def test_the_damping_at_test_level_is_the_random_tests_on_a_rig_damped_as_the_model(default_run):
+    import xarray as xr
+
+    # the default rig's damping has the identified model's form: the law's misfit is least at the random test's ratios
+    ds = xr.load_dataset(default_run / "results/friction/test_damping.nc", engine="netcdf4")
+    assert float(ds["damping_scale"]) == pytest.approx(1.0, abs=0.03)
+    assert float(ds["damping_scale_applied"]) == pytest.approx(1.0, abs=0.03)
+    lo, hi = ds["damping_scale_interval"].values
+    assert lo <= 1.0 <= hi and hi - lo < 0.15
+    assert ds.attrs["driven_mode"] == 1  # 54.4 Hz drives the first mode
+    modal = xr.load_dataset(default_run / "results/linear/modal.nc", engine="netcdf4")
+    np.testing.assert_allclose(ds["damping_ratio_test"].values, modal["damping_ratio"].values, rtol=0.03)
+    # the diagnosed model keeps the random test's ratios unless the held-out records confirmed a factor
+    updated = json.loads((default_run / "results/gap/updated_model.json").read_text())
+    assert updated["damping_at_test_level"]["applied"] == bool(ds.attrs["accepted"]) and not ds.attrs["accepted"]
+    summary = json.loads((default_run / "results" / "summary.json").read_text())
+    assert summary["friction"]["test_damping"]["applied_scale"] == float(ds["damping_scale_applied"])
+
+
 def test_default_records_meet_table2(default_run):
     s = json.loads((default_run / "results" / "summary.json").read_text())
     for case, (a1, a2) in {"lc1": (14, 34), "lc2": (17.5, 42.5), "lc3": (20, 50)}.items():

@@ -153,6 +153,7 @@ def report_values(
         v["fitcorr"] = fr["correlation_e_f_k_c"]
         for case, x in summary.get("validation_nrmse", {}).items():
             v[f"{case}validation"] = 100 * x
+        v["testdampingtext"] = test_damping_text(fr.get("test_damping"))
     cases = sorted(summary.get("contact_forces", {}), key=_case_order)
     if cases:
         cal = calibration_case if calibration_case in cases else cases[0]
@@ -162,6 +163,33 @@ def report_values(
         v["figcaserecon"], v["figcasephase"] = v[f"{fig}recon"], v[f"{fig}phase"]
         v["validationtext"] = validation_text(summary.get("validation_nrmse", {}), cal)
     return v
+
+
+def test_damping_text(td: Mapping | None) -> str:
+    """The report's sentence on the structure's damping in the dual-sine tests (summary.json's
+    ``friction.test_damping``, rule test_damping): the factor the calibration record binds, and whether the held-out
+    load cases confirmed it."""
+    if not td:
+        return "The dual-sine tests were identified with the random test's damping ratios."
+    which = f"mode {td['driven_mode']}'s damping ratio" if td["form"] == "driven" else "every mode's damping ratio"
+    lo, hi = td["interval"]
+    bound = (
+        rf"The law's misfit on the calibration record is least with {which} ${_fmt(td['scale'], 3)}$ times the "
+        rf"random test's (${_fmt(lo, 3)}$--${_fmt(hi, 3)}$ within its profile threshold)"
+    )
+    if abs(td["scale"] - 1.0) < 1e-9:
+        return "The law's misfit on the calibration record is least with the random test's damping ratios; they stand."
+    gaps = ""
+    if "heldout_gap_test_damping" in td:
+        gaps = (
+            rf" (held-out gap ${_fmt(100 * td['heldout_gap_random_test_damping'], 3)}\,\%$ with the random test's "
+            rf"ratios, ${_fmt(100 * td['heldout_gap_test_damping'], 3)}\,\%$ with the factor)"
+        )
+    if td["accepted"]:
+        return (
+            f"{bound}; the other load cases confirm it{gaps}, so the contact forces and the law are identified with it."
+        )
+    return f"{bound}; the other load cases do not confirm it{gaps}, so the random test's ratios stand."
 
 
 _LATEX_SPECIAL = {

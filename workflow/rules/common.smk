@@ -170,6 +170,7 @@ def summary_inputs(wildcards):
         inputs[f"validation_{c}"] = f"results/{c}/validation.nc"
     if load_cases():
         inputs["fit"] = "results/friction/friction_fit.nc"
+        inputs["test_damping"] = "results/friction/test_damping.nc"
         inputs["friction_intervals"] = "results/gap/friction_intervals.json"
         inputs["record_checks"] = "results/gap/record_checks.json"
     for c, path in truth_records().items():
@@ -258,6 +259,23 @@ def measured_floor():
 def gap_floor_input(wildcards=None):
     """The measured floor of the held-out gap where gap.measure_floor (results/gap/floor.json), else nothing."""
     return {"floor": "results/gap/floor.json"} if measured_floor() else {}
+
+
+# the gap settings the held-out records' test of a base-model change reads (contactid.gap.evidence.records_test_of_update)
+RECORDS_TEST_GAP_KEYS = (
+    "n_harmonics",
+    "candidates",
+    "min_reduction",
+    "noise_factor",
+    "n_bootstrap",
+    "max_evaluations",
+    "place",
+)
+
+
+def records_test_gap_config():
+    """The gap block's keys the held-out records' test reads (``RECORDS_TEST_GAP_KEYS``), as configured."""
+    return {k: config["gap"][k] for k in RECORDS_TEST_GAP_KEYS if k in config["gap"]}
 
 
 def benchmark_floor_input(wildcards=None):

@@ -105,6 +105,7 @@ rule gap_diagnosis:
     input:
         unpack(gap_inputs),
         record_checks="results/gap/record_checks.json",
+        test_damping="results/friction/test_damping.nc",
     output:
         diagnosis="results/gap/diagnosis.json",
         dataset="results/gap/gap.nc",

@@ -6,7 +6,7 @@ import time
 
 from contactid.gap.candidates import load_plugins
 from contactid.gap.diagnosis import GapSettings, diagnose
-from contactid.gap.explain import updated_model_summary
+from contactid.gap.explain import updated_model_summary, with_damping_at_test_level
 from contactid.gap.localise import linear_stage, random_test_delays
 from contactid.gap.workers import prepare_workers
 from contactid.gap.floor import read_floor, resolved_gap_config
@@ -16,6 +16,7 @@ from contactid.gap.story import records_agree
 from contactid.gap.output import diagnosis_json, gap_dataset, updated_model_json
 from contactid.io import load_dataset, provenance, write_dataset, write_text
 from contactid.logs import setup_logging
+from contactid.test_damping import damping_summary
 
 log = setup_logging(snakemake.log[0])
 p = snakemake.params
@@ -61,6 +62,11 @@ diag = dataclasses.replace(
     explanation=explanation,
     trace=[*diag.trace, records_agree(record_check).as_dict()],
 )
+# the damping at test level (rule test_damping) where the held-out records confirm it and no effect explains the gap
+updated = with_damping_at_test_level(
+    diag.updated_model, damping_summary(load_dataset(inp.test_damping)), diag.explanation, model.preload
+)
+diag = dataclasses.replace(diag, updated_model=updated)
 seconds = time.perf_counter() - t0
 prov = provenance(
     "gap_diagnosis",
@@ -70,13 +76,19 @@ prov = provenance(
         "modal": inp.modal,
         "frf": inp.frf,
         "fit": inp.fit,
+        "test_damping": inp.test_damping,
         **{f"raw_{c}": path for c, path in zip(p.cases, inp.raw)},
     },
 )
 ds = gap_dataset(diag, records, settings.n_harmonics)
 ds.attrs.update(prov)
 write_dataset(ds, snakemake.output.dataset)
-extra = {"seconds": seconds, "provenance": prov, "records_check": record_check}
+extra = {
+    "seconds": seconds,
+    "provenance": prov,
+    "records_check": record_check,
+    "damping_at_test_level": updated.get("damping_at_test_level"),
+}
 if floor is not None:
     extra["measured_floor"] = floor
 write_text(snakemake.output.diagnosis, diagnosis_json(diag, extra))

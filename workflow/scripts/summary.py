@@ -5,6 +5,7 @@ import json
 from contactid.io import load_dataset
 from contactid.logs import setup_logging
 from contactid.model_checks import model_checks
+from contactid.test_damping import damping_summary
 from contactid.reporting import (
     contact_force_summary,
     friction_summary,
@@ -32,6 +33,8 @@ if fit is not None:
     summary.update(friction_summary(fit, validations))
 # each fit against the accuracy it assumes (contactid.model_checks); the report's "Model checks" paragraph
 summary["model_checks"] = model_checks(stiction.attrs, stiction.sizes["mode"], None if fit is None else fit.attrs)
+if "test_damping" in inp.keys():  # the damping at test level (rule test_damping)
+    summary["friction"]["test_damping"] = damping_summary(load_dataset(inp.test_damping))
 if "friction_intervals" in inp.keys():
     with open(inp.friction_intervals) as fh:
         summary["friction"]["model_form_intervals"] = model_form_summary(json.load(fh))

@@ -6,7 +6,7 @@ and the model the explanation arrives at (results/gap/updated_model.json)."""
 from __future__ import annotations
 
 import logging
-from typing import TYPE_CHECKING, Mapping
+from typing import TYPE_CHECKING, Mapping, Sequence
 
 import numpy as np
 
@@ -311,4 +311,39 @@ def updated_model_summary(chain: IdentifiedModel, base: IdentifiedModel, last, s
         },
         "calibration_gap": float(cal.gap) if cal is not None else None,
         "heldout_gap": float(left),
+    }
+
+
+def with_damping_at_test_level(
+    updated: dict, test_damping: Mapping | None, explanation: Sequence, preload: float
+) -> dict:
+    """results/gap/updated_model.json with the damping at test level (summary.json's ``friction.test_damping``, rule
+    test_damping) where the records call for it and nothing else explains their gap: the held-out load cases confirmed
+    the factor (``accepted``), the explanation names no effect (``story.effect_steps``; an effect's refit is the
+    model then) and the diagnosed model is the chain's (the factor was weighed on the chain's structure, not an update
+    of it). The model then carries the factor, the friction law fitted with it and the held-out gap it leaves; otherwise
+    ``damping_at_test_level`` says why it is not applied."""
+    from .story import effect_steps
+
+    if not test_damping:
+        return updated
+    td = dict(test_damping)
+    if not td.get("accepted") or "law" not in td:
+        why = td.get("reason", "not profiled")
+    elif effect_steps(explanation):
+        why = "the diagnosis explains the gap by an effect, refitted with the random test's damping"
+    elif updated.get("model_updating"):
+        why = "the structure was updated; the factor was weighed on the chain's structure"
+    else:
+        why = ""
+    if why:
+        return {**updated, "damping_at_test_level": {**td, "applied": False, "why": why}}
+    law = np.array([td["law"][n] for n in ("e_f", "k_c", "e_t", "kappa", "mu")])
+    return {
+        **updated,
+        "what": "the identified model with the damping at test level the records confirm (no effect explained), the "
+        "friction law fitted with it on the calibration case",
+        "damping_at_test_level": {**td, "applied": True, "why": td.get("reason", "")},
+        "friction": _friction_dict(law, preload),
+        "heldout_gap": float(td["heldout_gap_test_damping"]),
     }

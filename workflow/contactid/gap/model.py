@@ -102,6 +102,14 @@ class IdentifiedModel:
     stiffness_scale_sd: float = 0.0
     config_modulus: float = 0.0
     k_n_bounded: bool = True
+    test_damping_ratios: tuple = ()
+
+    @property
+    def test_damping(self) -> tuple:
+        """The identified modes' damping ratios in the dual-sine tests: ``test_damping_ratios`` where given (the model
+        at a factor of ``contactid.test_damping``, weighed by ``gap.pipeline.confirmed_test_damping``), else the random
+        test's (``damping``), as the chain identifies them."""
+        return tuple(self.test_damping_ratios) or tuple(self.damping)
 
     def structure_with(self, aug: Augmentation) -> StructureParameters:
         """The structure with the augmentation's changes; changed masses re-fit k_t and k_n to the identified
@@ -279,7 +287,7 @@ def simulator(model: IdentifiedModel, aug: Augmentation, fs: float, f0: float | 
     """The reduced identified model with the augmentation, ready to integrate (step as the rig's,
     shortened to a whole number of steps per period of ``f0`` when given)."""
     red = _reduced(model.structure_with(aug), model.n_modes)[1]
-    zeta = damping_by_mode(red.beam_mode, model.damping, red.omega / (2 * np.pi))
+    zeta = damping_by_mode(red.beam_mode, model.test_damping, red.omega / (2 * np.pi))
     zeta[red.beam_mode] += aug.extra_damping
     k_n = red.k_n * aug.normal_stiffness_factor
     p = aug.unilateral_exponent if aug.unilateral_exponent >= 1.0 else 1.0

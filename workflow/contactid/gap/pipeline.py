@@ -56,6 +56,91 @@ def identify(cfg: Mapping, raw_random: xr.Dataset, raw_calibration: xr.Dataset, 
     return model.with_friction(fit.params), modes, modal, frf
 
 
+def test_level_damping(model, calibration, held_out: Mapping, fit_settings, settings, seed: int, scales):
+    """The damping at test level (``contactid.test_damping``): the friction law's misfit on the ``calibration`` record
+    (RecordHarmonics) profiled over ``scales`` with ``model``'s structure and random-test ratios, in each form of
+    ``test_damping.FORMS`` (the driven mode's ratio alone; every mode's), each confirmed or not by the ``held_out``
+    records (``confirmed_test_damping``), one of them chosen (``chosen_test_damping``). Returns the DampingProfile
+    (``test_damping.unprofiled`` where ``scales`` hold one factor)."""
+    from ..test_damping import FORMS, damping_profile, unprofiled, with_intervals
+    from .model import NONE, fe_model
+
+    if len(set(scales)) < 2:
+        return unprofiled()
+    fe = fe_model(model, NONE)
+    profiles = [
+        damping_profile(
+            fe,
+            model.damping,
+            model.frequencies,
+            calibration.force,
+            calibration.acceleration,
+            calibration.f0,
+            model.preload,
+            fit_settings,
+            seed,
+            scales,
+            form,
+        )
+        for form in FORMS
+    ]
+    tested = [confirmed_test_damping(model, p, calibration, held_out, fit_settings, settings) for p in profiles]
+    chosen = chosen_test_damping(tested)
+    if not chosen.accepted:
+        return chosen
+    return with_intervals(
+        chosen,
+        fe,
+        model.damping,
+        calibration.force,
+        calibration.acceleration,
+        calibration.f0,
+        model.preload,
+        fit_settings,
+        seed,
+    )
+
+
+def chosen_test_damping(tested):
+    """Of the profiles of each form, each with the held-out records' test (``confirmed_test_damping``): the confirmed
+    one whose held-out gap is least, else (none confirmed) the one whose misfit is least, which then is not applied.
+    The held-out records choose among the forms, not the calibration record's misfit: a form can fit the calibration
+    record better and widen the held-out gap where the other form narrows it (the other simulator's records,
+    docs/measurements.md)."""
+    confirmed = [p for p in tested if p.accepted]
+    if confirmed:
+        return min(confirmed, key=lambda p: float(p.check["heldout_gap_updated"]))
+    return min(tested, key=lambda p: float(np.min(p.misfits)))
+
+
+def confirmed_test_damping(model, profile, calibration, held_out: Mapping, fit_settings, settings):
+    """``profile`` with the held-out records' test of its factor (``profile.check``): the model with the random test's
+    ratios and the model with the driven mode's ratio times ``profile.scale``, each with the law fitted at its factor,
+    weighed on the ``held_out`` records ({case: RecordHarmonics}) as an update of the structure is
+    (``evidence.records_test_of_update``: the gap shrinks by min_reduction of it and beyond noise_factor x the records'
+    scatter), with no floor below which the gap is left alone: the floor is measured with the chain's law (rule
+    gap_floor), downstream of this choice, and a factor that halves the held-out gap is confirmed at any level. No test
+    where the factor is 1 or nothing is held out (the factor then is not applied)."""
+    import logging
+
+    from ..test_damping import check_reason
+    from .evidence import records_test_of_update
+
+    if abs(profile.scale - 1.0) < 1e-9 or not held_out:
+        logging.getLogger(__name__).info("damping at test level: %s", check_reason(profile))
+        return profile
+    base = dataclasses.replace(model, test_damping_ratios=()).with_friction(profile.law_at(1.0))
+    scaled = dataclasses.replace(model, test_damping_ratios=tuple(profile.scaled_ratios(model.damping))).with_friction(
+        profile.law_at_scale()
+    )
+    test = records_test_of_update(
+        base, scaled, held_out, dataclasses.replace(settings, min_gap=0.0), calibration, fit_settings
+    )
+    out = dataclasses.replace(profile, check=test)
+    logging.getLogger(__name__).info("damping at test level, x%.3g: %s", profile.scale, check_reason(out))
+    return out
+
+
 def rig_records(cfg: Mapping, effects: Mapping, seed: int, cases, random_test: bool = True) -> tuple[dict, dict]:
     """Raw records of the virtual rig with ``effects`` on, {'random_test': ds, case: ds, ...}, and apart
     from them (truth, never in a raw record) whether each case's response control converged."""

@@ -119,11 +119,18 @@ def memoised(enabled: bool = True):
 def identified_forces(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics) -> InverseHarmonics:
     """Contact forces of a record by inverse identification with the augmented model (memoised: the
     candidates that leave the structure, its damping and the channels as they are reuse it)."""
-    key = (model.structure_with(aug), model.damping, aug.extra_damping, tuple(aug.delays), tuple(aug.gains), id(rec))
+    key = (
+        model.structure_with(aug),
+        model.test_damping,
+        aug.extra_damping,
+        tuple(aug.delays),
+        tuple(aug.gains),
+        id(rec),
+    )
 
     def compute():
         fe = fe_model(model, aug)
-        zeta = augmented_zeta(fe, model.damping, aug.extra_damping)
+        zeta = augmented_zeta(fe, model.test_damping, aug.extra_damping)
         return inverse_harmonics(fe, zeta, rec.force, deskewed(rec, aug.delays, aug.gains), rec.f0), rec
 
     return _FORCES.get(key, compute)

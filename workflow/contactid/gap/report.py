@@ -227,22 +227,34 @@ def updated_law_note(intervals: dict | None) -> str:
 
 
 def explained_law_note(updated: dict | None) -> str:
-    """A sentence for Table 4's caption where the gap diagnosis explained effects (results/gap/updated_model.json): the
-    friction law refitted with them beside the chain's, which the effects bias; "" where none was explained."""
-    if not updated or not updated.get("effects"):
+    """A sentence for Table 4's caption where the gap diagnosis explained effects, or applied the damping at test level
+    the records confirm (results/gap/updated_model.json): the friction law refitted with them beside the chain's,
+    which they bias; "" where the model is the chain's."""
+    if not updated:
+        return ""
+    td = updated.get("damping_at_test_level") or {}
+    if updated.get("effects"):
+        what = "Refitted with the effects the gap diagnosis explains (" + ", ".join(_t(n) for n in updated["effects"])
+        tail = "the chain's law above carries what those effects do to the identified S."
+    elif td.get("applied"):
+        which = f"mode {td['driven_mode']}'s damping ratio" if td["form"] == "driven" else "every mode's damping ratio"
+        scale = _fmt(td["scale"], 3)
+        what = f"With {which} at test level, ${scale}$ times the random test's, as the other load cases confirm"
+        tail = "the chain's law above carries the damping the random test misstates."
+    else:
         return ""
     fr = updated["friction"]
-    names = ", ".join(_t(n) for n in updated["effects"])
     return (
-        " Refitted with the effects the gap diagnosis explains ("
-        + names
+        " "
+        + what
         + r"; results/gap/updated\_model.json), the law is $\mu = "
         + _fmt(fr["mu"], 3)
         + r"$, $\kappa = "
         + _fmt(fr["kappa"], 3)
         + r"$, $e_0(N_0) = "
         + _fmt(fr["e0_at_preload"], 3)
-        + r"$~N/m: the chain's law above carries what those effects do to the identified S."
+        + "$~N/m: "
+        + tail
     )
 
 
@@ -571,6 +583,31 @@ def updating_paragraph(diag: dict) -> str:
     )
 
 
+def damping_at_test_level_text(diag: dict) -> str:
+    """What became of the damping at test level (diagnosis.json's ``damping_at_test_level``, rule test_damping): the
+    factor the calibration record binds, the other load cases' test and whether the diagnosed model carries it; ""
+    where the law misfits least at the random test's ratios."""
+    td = diag.get("damping_at_test_level") or {}
+    if not td or abs(float(td.get("scale", 1.0)) - 1.0) < 1e-9:
+        return ""
+    which = f"mode {td['driven_mode']}'s damping ratio" if td["form"] == "driven" else "every mode's damping ratio"
+    text = (
+        r"\paragraph{Damping at test level.} The friction law misfits the calibration record least with "
+        + f"{which} ${_fmt(td['scale'], 3)}$ times the random test's"
+    )
+    if "heldout_gap_test_damping" in td:
+        text += (
+            f"; on the other load cases the held-out gap is {_pct(td['heldout_gap_random_test_damping'])} with the "
+            f"random test's ratios and {_pct(td['heldout_gap_test_damping'])} with the factor"
+        )
+    if td.get("applied"):
+        return text + (
+            r". Confirmed, and with no effect explained, the model the diagnosis arrives at carries it with the law "
+            r"fitted with it (results/gap/updated\_model.json, Table 4's caption)."
+        )
+    return text + ". Not applied: " + _t(td.get("why", "")) + "."
+
+
 def diagnosis_paragraphs(diag: dict) -> str:
     """The diagnosis in words (newline-terminated lines): the comparison, where the gap lies, the base model's update
     from the random test, which effect, and the additive explanation step by step."""
@@ -584,6 +621,7 @@ def diagnosis_paragraphs(diag: dict) -> str:
         r"\paragraph{Which effect.} Verdict: \textbf{" + _t(diag["verdict"]) + r"} --- " + _t(diag["reason"]) + ".",
         "",
         *([resolution_text(diag), ""] if diag.get("resolution") else []),
+        *([damping_at_test_level_text(diag), ""] if damping_at_test_level_text(diag) else []),
         *([trace_text(diag), ""] if diag.get("trace") else []),
         r"\paragraph{Step by step.} " + explanation_text(diag),
         "",
