@@ -91,6 +91,7 @@ def score(name: str, proj: Path, folder: Path) -> dict:
         "resolution": diagnosis["resolution"]["heldout_gap"],
         "not_isolable": [p["candidates"] for p in (diagnosis["resolution"].get("isolability") or {}).get("pairs", [])],
         "explained_law_errors": explained_law_errors(proj, law),
+        "explained_law_intervals": explained_law_intervals(proj, law),
         "explanation": [
             (e["effect"], e.get("kind"), e["parameters"], e["heldout_gap_after"]) for e in diagnosis["explanation"]
         ],
@@ -101,13 +102,39 @@ def score(name: str, proj: Path, folder: Path) -> dict:
 
 
 def explained_law_errors(proj: Path, law: dict) -> dict:
-    """The law the explanation arrives at (results/gap/updated_model.json) against the truth, where it explains an
-    effect ({} otherwise)."""
+    """The law of the model the diagnosis arrives at (results/gap/updated_model.json) against the truth, where it
+    differs from the chain's (an effect explained, or the damping at test level applied; {} otherwise), with e_0 at the
+    preload."""
+    from contactid.contact_laws import stiction_shear_stiffness
+
     path = proj / "results" / "gap" / "updated_model.json"
     updated = json.loads(path.read_text()) if path.exists() else {}
-    if not updated.get("effects"):
+    if not updated.get("effects") and not (updated.get("damping_at_test_level") or {}).get("applied"):
         return {}
-    return {k: updated["friction"][k] / law[tk] - 1 for k, tk in FRICTION.items()}
+    out = {k: updated["friction"][k] / law[tk] - 1 for k, tk in FRICTION.items()}
+    preload = float(yaml.safe_load((proj / "config" / "config.yaml").read_text())["structure"]["preload_n"])
+    e0 = stiction_shear_stiffness(preload, law["e_f_n_per_m"], law["k_c_per_m"])
+    return {**out, "e0": updated["friction"]["e0_at_preload"] / e0 - 1}
+
+
+def explained_law_intervals(proj: Path, law: dict) -> dict:
+    """Where the diagnosed model carries the damping at test level: the intervals of its law (rule test_damping's fit
+    at the factor), {name: {interval, covered, relative half-width}} for mu and kappa, and e0 at the preload."""
+    from contactid.contact_laws import stiction_shear_stiffness
+
+    path = proj / "results" / "gap" / "updated_model.json"
+    td = (json.loads(path.read_text()) if path.exists() else {}).get("damping_at_test_level") or {}
+    if not td.get("applied") or "law_intervals" not in td:
+        return {}
+    preload = float(yaml.safe_load((proj / "config" / "config.yaml").read_text())["structure"]["preload_n"])
+    truth = {k: law[FRICTION[k]] for k in ("mu", "kappa")}
+    truth["e0"] = stiction_shear_stiffness(preload, law["e_f_n_per_m"], law["k_c_per_m"])
+    out = {}
+    for k, t in truth.items():
+        lo, hi = td["e0_interval"] if k == "e0" else td["law_intervals"][k]
+        mid = td["law"][k] if k != "e0" else stiction_shear_stiffness(preload, td["law"]["e_f"], td["law"]["k_c"])
+        out[k] = {"interval": [lo, hi], "covered": bool(lo <= t <= hi), "halfwidth": (hi - lo) / 2 / abs(mid)}
+    return out
 
 
 def report(r: dict) -> None:
@@ -130,9 +157,19 @@ def report(r: dict) -> None:
         + (", ".join(f"{e} ({k}) {p} -> {g:.4f}" for e, k, p, g in r["explanation"]) or "none")
         + f"; one story: {r['one_story']}; not isolable: {r['not_isolable'] or 'none'}"
         + (
-            "\n  the law refitted with the explained effects: "
+            "\n  the law of the model the diagnosis arrives at (updated_model.json): "
             + ", ".join(f"{k} {v:+.1%}" for k, v in r["explained_law_errors"].items())
             if r["explained_law_errors"]
+            else ""
+        )
+        + (
+            "; intervals "
+            + ", ".join(
+                f"{k} [{v['interval'][0]:.4g}, {v['interval'][1]:.4g}] ({'in' if v['covered'] else 'OUTSIDE'}, "
+                f"half-width {v['halfwidth']:.1%})"
+                for k, v in r["explained_law_intervals"].items()
+            )
+            if r.get("explained_law_intervals")
             else ""
         ),
         flush=True,
