@@ -26,7 +26,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import measured_project, run_gap_summary
 from independent_rig import contact_scores, contact_text
 
-from contactid.gap.benchmark import named_effects
+from contactid.gap.bench_scores import named_effects
 from contactid.gap.story import one_story_holds
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -118,7 +118,7 @@ def test_the_level_test_names_the_case_off_by_a_units_factor():
 
 
 def test_the_benchmark_counts_the_checks_false_alarms():
-    from contactid.gap.benchmark import records_check_score
+    from contactid.gap.bench_scores import records_check_score
 
     rows = [
         {"records_check": {"passed": True, "findings": []}},

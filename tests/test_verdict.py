@@ -266,12 +266,12 @@ def test_material_and_floor_rules():
 
 
 # ----------------------------------------------------------------------------------------------
-# the compound benchmark's items and scores (gap.benchmark), on hand-made rows
+# the compound benchmark's items and scores (gap.bench_items, gap.bench_scores), on hand-made rows
 # ----------------------------------------------------------------------------------------------
 
 
 def test_compound_items_are_seeded_and_balanced():
-    from contactid.gap.benchmark import COMPOUND_EFFECTS, RANGES, compound_items
+    from contactid.gap.bench_items import COMPOUND_EFFECTS, RANGES, compound_items
 
     items = compound_items(6, [1, 2], 7, RANGES)
     assert len(items) == 12 and items == compound_items(6, [1, 2], 7, RANGES)
@@ -288,7 +288,7 @@ def test_compound_items_are_seeded_and_balanced():
 
 
 def test_half_the_compound_rigs_have_a_clamp_that_gives_and_the_rest_of_each_item_is_unchanged(default_config):
-    from contactid.gap.benchmark import CLAMP_STIFFNESS, RANGES, compound_config, compound_items
+    from contactid.gap.bench_items import CLAMP_STIFFNESS, RANGES, compound_config, compound_items
 
     items = compound_items(20, [1, 2], default_config["seed"], RANGES)
     clamps = [s["clamp_rotational_stiffness_nm_per_rad"] for s in items.values()]
@@ -318,7 +318,7 @@ def test_half_the_compound_rigs_have_a_clamp_that_gives_and_the_rest_of_each_ite
 def test_compound_rigs_carry_other_friction_laws_and_the_slip_limit_while_the_identification_keeps_its_own(
     default_config,
 ):
-    from contactid.gap.benchmark import FRICTION_LAW_RANGES, RANGES, compound_config, compound_items
+    from contactid.gap.bench_items import FRICTION_LAW_RANGES, RANGES, compound_config, compound_items
 
     items = compound_items(20, [1, 2], default_config["seed"], RANGES)
     laws = [s["friction_law"] for s in items.values() if s["friction_law"]]
@@ -341,7 +341,7 @@ def test_compound_rigs_carry_other_friction_laws_and_the_slip_limit_while_the_id
 
 
 def test_a_third_of_the_compound_rigs_damp_their_dual_sine_tests_otherwise_than_their_random_test(default_config):
-    from contactid.gap.benchmark import DUAL_SINE_DAMPING, RANGES, compound_config, compound_items
+    from contactid.gap.bench_items import DUAL_SINE_DAMPING, RANGES, compound_config, compound_items
 
     items = compound_items(20, [1, 2], default_config["seed"], RANGES)
     off = [s["dual_sine_damping_factor"] for s in items.values() if s["dual_sine_damping_factor"] != 1.0]
@@ -356,7 +356,7 @@ def test_a_third_of_the_compound_rigs_damp_their_dual_sine_tests_otherwise_than_
 def test_long_benchmark_items_are_scheduled_first():
     """The scheduler's order (gap_benchmark_item's priority): compound items with a drifting preload, then items whose
     contact opens, then the other compound items, the leave-outs, and the single effects last."""
-    from contactid.gap.benchmark import benchmark_items, expected_seconds, ladder_items
+    from contactid.gap.bench_items import benchmark_items, expected_seconds, ladder_items
 
     items = {**benchmark_items({}, 20260101), **ladder_items({}, 20260101)}
     cost = {name: expected_seconds(spec) for name, spec in items.items()}
@@ -373,7 +373,7 @@ def test_long_benchmark_items_are_scheduled_first():
 
 
 def test_compound_score_counts_named_effects_against_the_truth():
-    from contactid.gap.benchmark import compound_score
+    from contactid.gap.bench_scores import compound_score
 
     def row(effects, named, mu=0.01):
         return {
@@ -399,7 +399,7 @@ def test_compound_score_counts_named_effects_against_the_truth():
     assert s["per_effect"]["viscous_friction"] == {"recall": 2 / 3, "precision": 2 / 3, "true": 3, "named": 3}
     assert s["perturbation_only_median_abs_error"]["mu"] == pytest.approx(0.01)
     # a step of kind model_form or an update that names no effect is not named; an update naming one is
-    from contactid.gap.benchmark import named_effects
+    from contactid.gap.bench_scores import named_effects
 
     steps = [
         {"effect": "model_updating", "kind": "effect", "names": "transducer_mass_error"},
@@ -414,7 +414,7 @@ def test_bound_errors_take_the_lever_arm_out_of_mu_and_e0():
     from types import SimpleNamespace
 
     from contactid.contact_laws import stiction_shear_stiffness
-    from contactid.gap.benchmark import bound_errors
+    from contactid.gap.bench_scores import bound_errors
 
     truth = {"e_f_n_per_m": 3.857e7, "k_c_per_m": 2.547e5, "e_t_n_per_m": 0.0, "kappa": 0.284, "mu": 0.397}
     # the model's lever arm is 8 % short of the rig's: S, hence mu, comes out 8 % high, e_0 (1.08)^2 high
@@ -447,7 +447,7 @@ def test_the_records_accept_an_update_that_explains_a_gap_above_the_floor_materi
 
 def test_benchmark_scores_the_intervals_of_what_the_data_bind_against_the_rigs_lever_arm():
     from contactid.contact_laws import stiction_shear_stiffness
-    from contactid.gap.benchmark import compound_score, friction_truth
+    from contactid.gap.bench_scores import compound_score, friction_truth
 
     truth = {"e_f_n_per_m": 3.857e7, "k_c_per_m": 2.547e5, "e_t_n_per_m": 0.0, "kappa": 0.284, "mu": 0.397}
     t = friction_truth(truth, 70.0, 0.005)
@@ -632,12 +632,12 @@ def test_joint_candidate_starts_at_the_earlier_steps_values_and_splits_its_theta
 
 
 # ----------------------------------------------------------------------------------------------
-# the detection ladder (gap.benchmark), on hand-made rows
+# the detection ladder (gap.bench_items, gap.benchmark, gap.bench_scores), on hand-made rows
 # ----------------------------------------------------------------------------------------------
 
 
 def test_ladder_items_put_every_effect_at_fractions_of_its_typical_magnitude():
-    from contactid.gap.benchmark import ladder_items
+    from contactid.gap.bench_items import ladder_items
     from contactid.rig.effects import EFFECTS
 
     items = ladder_items({"seeds": [1, 2]}, 7)
@@ -665,7 +665,7 @@ def test_refitted_magnitude_maps_candidate_parameters_to_the_rigs_units():
 
 
 def test_ladder_scores_only_where_the_gap_exceeds_twice_the_floor():
-    from contactid.gap.benchmark import ladder_score
+    from contactid.gap.bench_scores import ladder_score
 
     def row(effect, m, gap, verdict, refit):
         return {

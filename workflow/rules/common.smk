@@ -290,22 +290,22 @@ def benchmark_base_config():
 
 def benchmark_items():
     """{item name: spec} of the blind gap benchmark (see config/README.md, gap_benchmark)."""
-    from contactid.gap.benchmark import benchmark_items as items
+    from contactid.gap.bench_items import benchmark_items as items
 
     return items(config["gap_benchmark"], int(config["seed"]))
 
 
 def ladder_items():
     """{item name: spec} of the detection ladder (gap_benchmark.ladder; `snakemake gap_ladder`)."""
-    from contactid.gap.benchmark import ladder_items as items
+    from contactid.gap.bench_items import ladder_items as items
 
     return items(config["gap_benchmark"], int(config["seed"]))
 
 
 def benchmark_item_priority(item):
     """A benchmark or ladder item's scheduling priority: its expected run time in seconds
-    (contactid.gap.benchmark.expected_seconds), so that the long items start first."""
-    from contactid.gap.benchmark import expected_seconds
+    (contactid.gap.bench_items.expected_seconds), so that the long items start first."""
+    from contactid.gap.bench_items import expected_seconds
 
     return expected_seconds({**benchmark_items(), **ladder_items()}[item])
 

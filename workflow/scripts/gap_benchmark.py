@@ -2,7 +2,7 @@
 
 import json
 
-from contactid.gap.benchmark import confusion_figure, records_check_score, score
+from contactid.gap.bench_scores import confusion_figure, records_check_score, score
 from contactid.gap.output import _clean
 from contactid.io import write_text
 from contactid.logs import setup_logging

@@ -2,7 +2,7 @@
 
 import json
 
-from contactid.gap.benchmark import ladder_score
+from contactid.gap.bench_scores import ladder_score
 from contactid.gap.floor import read_floor, resolved_gap_config
 from contactid.gap.output import _clean
 from contactid.io import write_text
