@@ -15,6 +15,7 @@ Modules, by role:
   explanation and the model it arrives at), ``story`` (the verdict told from the explanation, with its trace and the
   resolution);
 - outputs: ``output`` (diagnosis.json, gap.nc), ``figures``, ``report``;
-- evaluation, the only part that builds records with the rig: ``benchmark`` (blind, compound, ladder), ``floor``
-  (the identification's own floor).
+- evaluation, the only part that builds records with the rig: ``bench_items`` (what the blind, compound and ladder
+  items are), ``benchmark`` (running an item: its rig records, diagnosis and result row), ``bench_scores`` (the
+  items' scores), ``floor`` (the identification's own floor).
 """
