@@ -65,7 +65,7 @@ def test_the_floor_follows_the_drive():
 
 
 def test_the_report_says_the_floor_was_measured_and_what_it_is():
-    from contactid.gap.report import explanation_text, measured_floor_text
+    from contactid.gap.report_diagnosis import explanation_text, measured_floor_text
 
     left = {"heldout_gap": 0.0005, "share": 1.0, "floor": 0.001, "at_floor": True, "place": "contact"}
     diag = {"explanation": [], "remaining_gap": {**left, "min_reduction": 0.5}}
@@ -98,7 +98,7 @@ def test_a_measured_cases_response_levels_are_read_from_its_record():
 
 
 def test_the_report_says_why_a_floor_was_not_measured():
-    from contactid.gap.report import measured_floor_text
+    from contactid.gap.report_diagnosis import measured_floor_text
 
     diag = {
         "remaining_gap": {"floor": 0.006},

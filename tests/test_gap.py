@@ -97,7 +97,7 @@ def test_aperiodic_share_is_the_noise_of_a_periodic_record_and_grows_with_motion
 
 
 def test_the_report_says_which_records_did_not_settle():
-    from contactid.gap.report import periodicity_text
+    from contactid.gap.report_diagnosis import periodicity_text
 
     settled = {"aperiodic_share": 0.005, "by_sensor": {"a1": 0.005}, "settled": True}
     moving = {"aperiodic_share": 0.41, "by_sensor": {"a1": 0.41, "a3": 0.2}, "settled": False}
@@ -309,7 +309,7 @@ def test_effect_missing_from_library_gives_none_and_points_at_the_normal_directi
 def test_one_load_case_names_no_effect_and_says_that_nothing_is_held_out(hc_data):
     """With the calibration case alone, every gap is the case's own and any refit lowers it: the dashpot the three
     cases name (test above) is ranked first and shrinks that gap, but no effect is named, and the text says why."""
-    from contactid.gap.report import comparison_lines
+    from contactid.gap.report_diagnosis import comparison_lines
 
     cfg, model, records, linear = hc_data
     d = _diagnose((cfg, model, {"lc1": records["lc1"]}, linear), ["normal_contact_damping"])
@@ -585,7 +585,7 @@ def test_a_held_step_that_widens_the_gap_is_drawn_and_said_as_held():
     """A channel skew held at the random test's delays widens the gap (it exposes the dashpot it masked); the waterfall
     draws its bar upward in orange, both bars joined, and the report says it was held, not refitted."""
     from contactid.gap.figures import waterfall_bars
-    from contactid.gap.report import explanation_text
+    from contactid.gap.report_diagnosis import explanation_text
 
     steps = [
         {
@@ -830,7 +830,7 @@ def test_a_step_whose_model_settles_unlike_the_records_is_flagged_and_said():
     from types import SimpleNamespace as NS
 
     from contactid.gap.explain import model_periodicity
-    from contactid.gap.report import explanation_text
+    from contactid.gap.report_diagnosis import explanation_text
 
     records = {c: NS(aperiodic=np.array(a)) for c, a in (("lc1", [0.005, 0.006]), ("lc2", [0.3, 0.1]), ("lc3", [0.4]))}
     cal = NS(simulation=NS(first=None, extra={"aperiodic": np.array([0.36, 0.58])}))  # lc1: impacts, the record not

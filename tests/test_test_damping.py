@@ -205,7 +205,7 @@ def test_the_diagnosed_model_carries_the_damping_only_where_no_effect_explains_t
 
 
 def test_the_reports_paragraph_says_what_became_of_the_factor():
-    from contactid.gap.report import damping_at_test_level_text
+    from contactid.gap.report_diagnosis import damping_at_test_level_text
 
     td = {
         "form": "driven",

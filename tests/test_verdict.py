@@ -764,7 +764,7 @@ def test_contact_opens_tells_a_separating_law_from_a_stiffer_closed_one():
     from types import SimpleNamespace
 
     from contactid.gap.explain import contact_opens
-    from contactid.gap.report import explanation_text
+    from contactid.gap.report_diagnosis import explanation_text
 
     def sim(n_min):
         return SimpleNamespace(grid={"N": 70.0 + (70.0 - n_min) * np.cos(np.linspace(0, 2 * np.pi, 64))})
@@ -789,7 +789,7 @@ def test_contact_opens_tells_a_separating_law_from_a_stiffer_closed_one():
 
 
 def test_the_report_says_when_the_records_accepted_the_update():
-    from contactid.gap.report import explanation_text
+    from contactid.gap.report_diagnosis import explanation_text
 
     step = {
         "effect": "model_updating",
@@ -812,7 +812,7 @@ def test_the_report_says_when_the_records_accepted_the_update():
 
 
 def test_the_report_describes_the_base_models_update_and_the_channels_gains():
-    from contactid.gap.report import updating_paragraph
+    from contactid.gap.report_base_model import updating_paragraph
 
     ident = {
         "k_t": {"posterior_over_prior": 0.08, "bound_by_data": True, "posterior_sd": 0.24},
@@ -864,7 +864,7 @@ def test_the_report_describes_the_base_models_update_and_the_channels_gains():
 
 
 def test_a_step_names_the_candidates_the_records_cannot_tell_from_it():
-    from contactid.gap.report import explanation_text
+    from contactid.gap.report_diagnosis import explanation_text
 
     # a compliant clamp's gap (1.13 %): a channel skew and a normal dashpot leave 0.553 % and 0.554 %
     gaps = {

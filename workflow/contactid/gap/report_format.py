@@ -1,0 +1,15 @@
+"""The numbers' formatting the gap section's modules share (``report``, ``report_diagnosis``, ``report_base_model``,
+``report_benchmark``)."""
+
+from __future__ import annotations
+
+from ..latex import _fmt
+
+
+def num(x) -> float:
+    """A diagnosis.json number (null where it was not finite) as a float."""
+    return float("nan") if x is None else float(x)
+
+
+def pct(x) -> str:
+    return "--" if x is None else f"${_fmt(100 * float(x), 3)}$\\,\\%"
