@@ -14,7 +14,10 @@ Modules, by role:
 - decisions: ``verdict`` (where the gap lies, whether a step explains materially), ``explain`` (the additive
   explanation and the model it arrives at), ``story`` (the verdict told from the explanation, with its trace and the
   resolution);
-- outputs: ``output`` (diagnosis.json, gap.nc), ``figures``, ``report``;
+- outputs: ``output`` (diagnosis.json, gap.nc), ``figures``, ``report`` (the report's section: its assembly, the
+  candidates' table, the friction law's notes), ``report_diagnosis`` (the diagnosis in words), ``report_base_model``
+  (the base model's update in words), ``report_benchmark`` (the benchmarks' paragraphs), ``report_format`` (their
+  shared number formatting);
 - evaluation, the only part that builds records with the rig: ``bench_items`` (what the blind, compound and ladder
   items are), ``benchmark`` (running an item: its rig records, diagnosis and result row), ``bench_scores`` (the
   items' scores), ``floor`` (the identification's own floor).
