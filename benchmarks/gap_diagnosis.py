@@ -8,12 +8,12 @@ memos, the calibration searches on the gap alone (Brent, Nelder-Mead) -- the dia
 found it, on today's models and candidate library. Printed beside it:
 - the same time-marching run with today's residual-vector searches: what the solver (harmonic balance
   and the memos) changes; verdict and ranking must be the same, held-out gaps within 0.1 %;
-- the diagnosis with the other setting of ``gap.polish_searches`` (``refit.POLISH_SEARCH``; the config's, true, polishes
-  every searched state by the integrator, so that the searches stop where the time-marching ones stop; false
+- the diagnosis with the other setting of ``gap.polish_searches`` (``Numerics.polish_searches``; the config's, true,
+  polishes every searched state by the integrator, so that the searches stop where the time-marching ones stop; false
   compares the harmonic-balance states alone, faster, and stops elsewhere where the calibration gap is flat);
 - the diagnosis with its candidates in two worker processes (as the gap_diagnosis rule runs them);
 - with ``--reference-scatter``, the time-marching diagnosis itself at half and at double its settling tolerance
-  (``gap.model.SETTLING_TOL``, 2e-5): how far the reference's own held-out gaps move within its tolerance, the
+  (``Numerics.settling_tol``, 2e-5): how far the reference's own held-out gaps move within its tolerance, the
   scale the 0.1 % above is to be read against;
 - with ``--tight-tolerance TOL``, the time-marching diagnosis and the one with every searched state polished, both
   at the settling tolerance TOL (5e-7, say): as the reference converges, the fast diagnosis's held-out gaps converge
@@ -31,6 +31,7 @@ Usage: .venv/bin/python benchmarks/gap_diagnosis.py [--only default|EFFECT] [--w
        [--tight-tolerance TOL]
 """
 
+import dataclasses
 import importlib
 import io
 import json
@@ -51,8 +52,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "workflow"))
 
 from contactid.friction_parameters import parameter_dataset  # noqa: E402
-from contactid.gap.model import SETTLING_TOL, STEADY_STATE  # noqa: E402
-from contactid.gap.refit import POLISH_SEARCH, SEARCH, memoised  # noqa: E402
+from contactid.gap.numerics import DEFAULT, Numerics  # noqa: E402
 from contactid.io import load_dataset, read_raw  # noqa: E402
 
 CACHE = ROOT / "benchmarks" / "cache"
@@ -124,8 +124,9 @@ def run(
     """One diagnosis with package ``pkg`` (contactid or contactid_ref) on the datasets and raw records: steady states
     by ``method``, memos on or off, the calibration searches on the residual vector or the gap alone (``search``),
     every searched state polished by the integrator or not (``polish_search``; None: as the config's
-    gap.polish_searches), the integrator's settling tolerance (``settle_tol``; None: ``SETTLING_TOL``'s default; in
-    this process only, so with ``workers`` 1)."""
+    gap.polish_searches), the integrator's settling tolerance (``settle_tol``; None: ``Numerics``' default), all of
+    them the diagnosis's ``GapSettings.numerics`` (``contactid.gap.numerics.Numerics``; contactid_ref has its own
+    defaults)."""
     if polish_search is None:  # time marching's states are the integrator's: nothing to polish
         polish_search = method != "time_marching" and bool(cfg["gap"].get("polish_searches", False))
     gm = importlib.import_module(f"{pkg}.gap.model")
@@ -134,7 +135,9 @@ def run(
     model = gm.identified_model(cfg["structure"], ds["linear_modes"], ds["modal"], fit)
     K = cfg["nonlinear"]["n_harmonics"]
     records = {c: importlib.import_module(f"{pkg}.gap.records").record_harmonics(r, c, K) for c, r in raw.items()}
-    lin = gd.linear_stage(model, ds["frf"], ds["modal"])
+    # linear_stage and random_test_delays live in gap.localise now (in gap.diagnosis at REFERENCE)
+    gl = gd if hasattr(gd, "linear_stage") else importlib.import_module(f"{pkg}.gap.localise")
+    lin = gl.linear_stage(model, ds["frf"], ds["modal"])
     gap = (
         {**cfg["gap"], "candidates": ["multi_asperity_friction", "preload_drift"], "max_evaluations": 3}
         if warm_up
@@ -142,28 +145,23 @@ def run(
     )
     gap = {**gap, "polish_searches": bool(polish_search)}
     settings = gd.GapSettings.from_config(gap, cfg["seed"], K)
+    if pkg == "contactid":
+        numerics = Numerics(
+            steady_state=method,
+            closed_contact_hb=DEFAULT.closed_contact_hb,
+            settling_tol=DEFAULT.settling_tol if settle_tol is None else settle_tol,
+            polish_searches=bool(polish_search),
+            search=search,
+            memo=memo,
+        )
+        settings = dataclasses.replace(settings, numerics=numerics)
     fit_settings = importlib.import_module(f"{pkg}.friction_fit").settings_from_config(cfg["friction"])
-    tokens = (
-        [
-            (STEADY_STATE, STEADY_STATE.set(method)),
-            (SEARCH, SEARCH.set(search)),
-            (POLISH_SEARCH, POLISH_SEARCH.set(polish_search)),
-            (SETTLING_TOL, SETTLING_TOL.set(SETTLING_TOL.get() if settle_tol is None else settle_tol)),
-        ]
-        if pkg == "contactid"
-        else []
-    )
-    try:
-        with memoised(memo if pkg == "contactid" else True):
-            t0 = time.perf_counter()
-            kw = {"workers": workers} if workers > 1 else {}
-            if pkg == "contactid":
-                kw["channel_delays"] = gd.random_test_delays(ds["frf"], ds["modal"])
-            d = gd.diagnose(model, records, cfg["nonlinear"]["calibration_case"], settings, fit_settings, lin, **kw)
-            return d, time.perf_counter() - t0
-    finally:
-        for var, token in tokens:
-            var.reset(token)
+    t0 = time.perf_counter()
+    kw = {"workers": workers} if workers > 1 else {}
+    if pkg == "contactid":
+        kw["channel_delays"] = gl.random_test_delays(ds["frf"], ds["modal"])
+    d = gd.diagnose(model, records, cfg["nonlinear"]["calibration_case"], settings, fit_settings, lin, **kw)
+    return d, time.perf_counter() - t0
 
 
 def _gaps(d) -> dict:
@@ -218,7 +216,7 @@ def compare(label, ds, raw, cfg, with_reference=False, scatter=False, tight=None
         "two_workers": _agreement(new, two),
     }
     if scatter:
-        tol = SETTLING_TOL.get()
+        tol = DEFAULT.settling_tol
         half, _ = run("contactid", "time_marching", False, ds, raw, cfg, settle_tol=0.5 * tol)
         double, _ = run("contactid", "time_marching", False, ds, raw, cfg, settle_tol=2.0 * tol)
         row["reference_scatter"] = {

@@ -185,6 +185,25 @@ def test_settings_refuse_unknown_candidates_and_bad_thresholds():
         GapSettings.from_config({"n_harmonics": 40}, 1, 25)
 
 
+def test_the_numerical_settings_are_explicit_and_the_config_sets_the_polished_searches():
+    """The diagnosis's numerical switches are one frozen settings object (``Numerics``), carried by ``GapSettings``
+    and handed down the calls: gap.polish_searches sets its polish_searches, the other fields keep their defaults;
+    a method or a search it does not know is refused."""
+    import dataclasses
+
+    from contactid.gap.numerics import DEFAULT, Numerics
+
+    assert DEFAULT == Numerics("harmonic_balance", True, 2e-5, True, "residual", True)
+    assert GapSettings().numerics == DEFAULT and GapSettings.from_config({}, 1, 25).numerics == DEFAULT
+    assert GapSettings.from_config({"polish_searches": False}, 1, 25).numerics == Numerics(polish_searches=False)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        DEFAULT.memo = False
+    with pytest.raises(ValueError, match="steady_state"):
+        Numerics(steady_state="shooting")
+    with pytest.raises(ValueError, match="search"):
+        Numerics(search="grid")
+
+
 # ----------------------------------------------------------------------------------------------
 # the diagnosis on rig data with a hidden effect
 # ----------------------------------------------------------------------------------------------
@@ -700,20 +719,19 @@ def test_a_benchmark_item_not_diagnosed_still_gets_its_files_and_figures(tmp_pat
 
 @pytest.mark.slow
 def test_polish_searches_setting_polishes_every_searched_state(hc_data, monkeypatch):
-    """gap.polish_searches reaches the candidate's search (as an argument of the task, so that a worker process sees
-    it too): every state compared is polished (the default); set false, only the optimum is."""
+    """gap.polish_searches reaches the candidate's search (``GapSettings.numerics``, an argument of the task, so that a
+    worker process sees it too): every state compared is polished (the default); set false, only the optimum is."""
     from contactid.gap import refit
     from contactid.gap.diagnosis import GapSettings
+    from contactid.gap.numerics import Numerics
     from contactid.gap.workers import _candidate_task
-    from contactid.gap.refit import POLISH_SEARCH, baseline
+    from contactid.gap.refit import baseline
 
     cfg, model, records, _ = hc_data
     fit = settings_from_config(cfg["friction"])
     settings = GapSettings.from_config(cfg["gap"], 0, 25)
-    assert (
-        settings.polish_searches
-        and not GapSettings.from_config({**cfg["gap"], "polish_searches": False}, 0, 25).polish_searches
-    )
+    unpolished = GapSettings.from_config({**cfg["gap"], "polish_searches": False}, 0, 25)
+    assert settings.numerics == Numerics() and unpolished.numerics == Numerics(polish_searches=False)
     base = {c: baseline(model, records[c], 9)[1] for c in records}
     seen = []
     evaluate = refit.evaluate
@@ -733,10 +751,10 @@ def test_polish_searches_setting_polishes_every_searched_state(hc_data, monkeypa
         H=9,
         max_evaluations=4,
     )
-    _candidate_task(("viscous_friction", {**common, "polish_searches": True}))
-    assert len(seen) > 3 and all(seen) and not POLISH_SEARCH.get()
+    _candidate_task(("viscous_friction", {**common, "numerics": settings.numerics}))
+    assert len(seen) > 3 and all(seen)
     seen.clear()
-    _candidate_task(("viscous_friction", {**common, "polish_searches": False}))
+    _candidate_task(("viscous_friction", {**common, "numerics": unpolished.numerics}))
     assert len(seen) > 3 and seen.count(True) == 1  # the optimum alone
 
 
@@ -797,24 +815,19 @@ def test_records_whose_kinematics_lack_the_beams_shortening_name_it(small_config
 def test_search_finds_the_time_marching_searchs_optimum(hc_data):
     """The calibration search on harmonic-balance states (within 5e-4 of the integrator's orbit) finds the optimum of
     a search on time-marched states within 1 % and reports the integrator's gap there; with every state polished by
-    the integrator (``POLISH_SEARCH``) it stops where the time-marching search stops, alpha and gap within 0.1 %."""
-    from contactid.gap.model import STEADY_STATE
-    from contactid.gap.refit import POLISH_SEARCH, calibrate, evaluate
+    the integrator (``Numerics.polish_searches``, the diagnosis's default) it stops where the time-marching search
+    stops, alpha and gap within 0.1 %."""
+    from contactid.gap.numerics import Numerics
+    from contactid.gap.refit import calibrate, evaluate
 
     cfg, model, records, _ = hc_data
     fit = settings_from_config(cfg["friction"])
     cand, rec = LIBRARY["normal_contact_damping"], records["lc1"]
-    fast = calibrate(model, cand, rec, fit, 9)
-    token = STEADY_STATE.set("time_marching")
-    try:
-        marched = calibrate(model, cand, rec, fit, 9)
-    finally:
-        STEADY_STATE.reset(token)
-    token = POLISH_SEARCH.set(True)
-    try:
-        polished = calibrate(model, cand, rec, fit, 9)
-    finally:
-        POLISH_SEARCH.reset(token)
+    fast = calibrate(model, cand, rec, fit, 9, numerics=Numerics(polish_searches=False))
+    marched = calibrate(
+        model, cand, rec, fit, 9, numerics=Numerics(steady_state="time_marching", polish_searches=False)
+    )
+    polished = calibrate(model, cand, rec, fit, 9, numerics=Numerics(polish_searches=True))
     assert fast.theta[0] == pytest.approx(marched.theta[0], rel=0.01) and fast.theta[0] == pytest.approx(400, rel=0.1)
     assert fast.gap == pytest.approx(marched.gap, rel=0.01)  # 0.3 % of a 0.22 % gap (measured)
     assert polished.theta[0] == pytest.approx(marched.theta[0], rel=1e-3)

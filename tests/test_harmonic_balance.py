@@ -177,21 +177,18 @@ def test_with_every_mode_in_the_balance_the_orbit_is_the_integrators(model):
     assert np.max(np.abs(A - A_ref) / amplitude) < 1e-5
 
 
-def test_the_settling_tolerance_is_a_setting_of_the_context(model):
-    """``SETTLING_TOL`` sets the integrator's settling test where ``simulate`` is given none
+def test_the_settling_tolerance_is_a_numerical_setting(model):
+    """``Numerics.settling_tol`` sets the integrator's settling test where ``simulate`` is given no ``tol``
     (benchmarks/gap_diagnosis.py --reference-scatter runs the reference at half and double it); an explicit ``tol``
     wins. A looser test stops earlier: other harmonics, close to the default's."""
-    from contactid.gap.model import SETTLING_TOL
+    from contactid.gap.numerics import DEFAULT, Numerics
 
     rec, aug = record("lc1"), EFFECTS["none"]
+    assert DEFAULT.settling_tol == 2e-5
     default = simulate(model, aug, rec, method="time_marching").acceleration
-    token = SETTLING_TOL.set(1e-2)
-    try:
-        loose = simulate(model, aug, rec, method="time_marching").acceleration
-        explicit = simulate(model, aug, rec, method="time_marching", tol=2e-5).acceleration
-    finally:
-        SETTLING_TOL.reset(token)
-    assert SETTLING_TOL.get() == 2e-5
+    loose_numerics = Numerics(settling_tol=1e-2)
+    loose = simulate(model, aug, rec, method="time_marching", numerics=loose_numerics).acceleration
+    explicit = simulate(model, aug, rec, method="time_marching", tol=2e-5, numerics=loose_numerics).acceleration
     assert np.array_equal(explicit, default)
     rel = np.abs(loose - default).max() / np.abs(default).max()
     assert 0.0 < rel < 0.05

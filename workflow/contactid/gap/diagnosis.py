@@ -26,6 +26,7 @@ from .explain import updated_model_summary
 from .isolability import isolability, signature
 from .localise import _place_left, localise
 from .model import IdentifiedModel
+from .numerics import DEFAULT, Numerics
 from .ranking import _ranking
 from .records import RecordHarmonics
 from .refit import baseline, gap_residual
@@ -52,7 +53,9 @@ class GapSettings:
     standard error, frequency_floor the relative model-form uncertainty added to each frequency,
     updating_confidence the significance an update needs to be accepted, updating_records_test: an update the
     chi^2 test did not accept is accepted when the dual-sine records' held-out gap shrinks with it,
-    ``verdict.records_accept_update``)."""
+    ``verdict.records_accept_update``); numerics: how the steady states are found and the candidates' searches run
+    (``numerics.Numerics``; the config sets its polish_searches, gap.polish_searches, and leaves the rest at their
+    defaults)."""
 
     n_harmonics: int = 9
     identification_harmonics: int = 25
@@ -81,7 +84,8 @@ class GapSettings:
     updating_records_test: bool = True  # the records may accept an update the random test's chi^2 did not
     updating_gain_sd: float = 0.03  # prior sd of ln of each channel's sensitivity on the residues (0: calibrated)
     joint_refit: bool = True  # the explanation's later steps refit the earlier steps' parameters with theirs
-    polish_searches: bool = True  # every searched state polished by the integrator (refit.POLISH_SEARCH)
+    # how the steady states are found and the searches run (numerics.Numerics; polish_searches from gap.polish_searches)
+    numerics: Numerics = DEFAULT
     pair_lookahead: float = 3.0  # where no candidate shrinks a gap above this many min_gap materially, try a pair
     retry_unmoved: bool = False  # later passes also try the candidates whose refit alone left them off
     place: PlaceThresholds = DEFAULT_PLACE  # the localisation's thresholds (gap.place)
@@ -110,7 +114,7 @@ class GapSettings:
             max_evaluations=int(g["max_evaluations"]),
             eta_observability_limit=float(g["eta_observability_limit"]),
             joint_refit=bool(g["joint_refit"]),
-            polish_searches=bool(g["polish_searches"]),
+            numerics=Numerics(polish_searches=bool(g["polish_searches"])),
             pair_lookahead=float(g["pair_lookahead"]),
             retry_unmoved=bool(g["retry_unmoved"]),
             place=PlaceThresholds.from_config(g.get("place")),
@@ -237,7 +241,7 @@ class _DiagnosisRun:
             max_evaluations=self.settings.max_evaluations,
             channel_delays=self.channel_delays,
             channel_gains=self.channel_gains,
-            polish_searches=self.settings.polish_searches,
+            numerics=self.settings.numerics,
             **extra,
         )
 
@@ -333,7 +337,7 @@ def diagnose(
     # viscous data)
     HarmonicBalance.forget()
     held = [c for c in records if c != calibration_case]
-    base_sims = {c: baseline(model, records[c], H)[1] for c in records}
+    base_sims = {c: baseline(model, records[c], H, settings.numerics)[1] for c in records}
     run = _DiagnosisRun(
         records,
         calibration_case,
@@ -363,6 +367,7 @@ def diagnose(
         eta_limit=settings.eta_observability_limit,
         structures=structures,
         thresholds=settings.place,
+        memo=settings.numerics.memo,
     )
     results = candidate_results()
     run.draw_bootstrap()
@@ -379,6 +384,7 @@ def diagnose(
         calibration_case,
         where,
         settings.place.aperiodic_limit,
+        memo=settings.numerics.memo,
     )
     scatter = float(np.std(before_b))
     shrink = {
@@ -429,7 +435,9 @@ def diagnose(
     if updating is not None:
         where["model_updating"] = _updating_summary(updating, model)
     if identified is not None and updating is not None and updating.accepted:
-        first_before = run.heldout_gap({c: baseline(identified, records[c], H)[1] for c in run.score_cases})
+        first_before = run.heldout_gap(
+            {c: baseline(identified, records[c], H, settings.numerics)[1] for c in run.score_cases}
+        )
         where["heldout_gap_identified"] = first_before
         steps.insert(0, _updating_step(updating, first_before, before))
         log.info("explanation step 0: model updating takes the held-out gap from %.4g to %.4g", first_before, before)

@@ -132,10 +132,11 @@ def records_test_of_update(
     from .verdict import records_accept_update
 
     H = settings.n_harmonics
+    num = settings.numerics
     cases = list(held_out)
     HarmonicBalance.forget()  # no Newton history from an earlier diagnosis in this process
     models = {"chain": chain, "updated": updated}
-    sims = {label: {c: baseline(m, held_out[c], H)[1] for c in cases} for label, m in models.items()}
+    sims = {label: {c: baseline(m, held_out[c], H, num)[1] for c in cases} for label, m in models.items()}
     out = _gaps_and_scatter(held_out, settings, sims, "chain")
     library = settings.candidates if settings.candidates is not None else tuple(LIBRARY)
     if calibration is not None and fit_settings is not None and "preload_drift" in library:
@@ -152,10 +153,21 @@ def records_test_of_update(
                     fit_settings,
                     H,
                     settings.max_evaluations,
-                    start=baseline(m, calibration, H)[1],
+                    start=baseline(m, calibration, H, num)[1],
+                    # the drift's search compares the periodic states; only its optimum is polished
+                    numerics=dataclasses.replace(num, polish_searches=False),
                 )
                 drifted = {
-                    c: evaluate(cal.model, cal.augmentation, held_out[c], None, H, refit=False, start=sims[label][c])[2]
+                    c: evaluate(
+                        cal.model,
+                        cal.augmentation,
+                        held_out[c],
+                        None,
+                        H,
+                        refit=False,
+                        start=sims[label][c],
+                        numerics=num,
+                    )[2]
                     for c in cases
                 }
                 out[f"heldout_gap_{label}"] = heldout_gap_of(held_out, cases, H, drifted)
@@ -195,16 +207,17 @@ def records_test_of_gains(
     from .verdict import records_prefer_gains
 
     H = settings.n_harmonics
+    num = settings.numerics
     cases = list(held_out)
     HarmonicBalance.forget()
     aug = Augmentation(gains=tuple(float(g) for g in gains))
-    _, read, _, _ = evaluate(with_gains, aug, calibration, fit_settings.bounds, H)
-    sims_gains = {c: evaluate(read, aug, held_out[c], None, H, refit=False)[2] for c in cases}
+    _, read, _, _ = evaluate(with_gains, aug, calibration, fit_settings.bounds, H, numerics=num)
+    sims_gains = {c: evaluate(read, aug, held_out[c], None, H, refit=False, numerics=num)[2] for c in cases}
     HarmonicBalance.forget()
-    sims_alone = {c: baseline(structure_alone, held_out[c], H)[1] for c in cases}
+    sims_alone = {c: baseline(structure_alone, held_out[c], H, num)[1] for c in cases}
     sims = {"gains": sims_gains, "structure": sims_alone}
     if chain is not None:
-        sims["chain"] = {c: baseline(chain, held_out[c], H)[1] for c in cases}
+        sims["chain"] = {c: baseline(chain, held_out[c], H, num)[1] for c in cases}
     out = _gaps_and_scatter(held_out, settings, sims, "structure")
     out["gains_preferred"] = records_prefer_gains(
         out["heldout_gap_structure"],
@@ -249,12 +262,13 @@ def records_attribution(
     them 0.0074, its k_t and k_n refitted taking up part of it). Returns {"factors": {factor: {"alone": gap,
     "without": gap}}, "effect": name or None}."""
     H = settings.n_harmonics
+    num = settings.numerics
     cases = list(held_out)
 
     def heldout(model, aug):
         try:
-            model = evaluate(model, aug, calibration, bounds, H)[1]
-            sims = {c: evaluate(model, aug, held_out[c], None, H, refit=False)[2] for c in cases}
+            model = evaluate(model, aug, calibration, bounds, H, numerics=num)[1]
+            sims = {c: evaluate(model, aug, held_out[c], None, H, refit=False, numerics=num)[2] for c in cases}
             return heldout_gap_of(held_out, cases, H, sims)
         except (ValueError, FloatingPointError) as exc:  # the law or the simulation fails there: it explains nothing
             log.info("model updating, by the records: %s", exc)

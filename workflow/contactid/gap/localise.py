@@ -64,12 +64,14 @@ def _response_gaps(fe, records: dict, sims: dict, H: int) -> dict:
 CYCLE_PARTS = ("stick", "slip", "velocity_reversal", "peak_compression")
 
 
-def _contact_gaps(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, sim, H: int, open_limit: float):
+def _contact_gaps(
+    model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, sim, H: int, open_limit: float, memo: bool = True
+):
     """One load case's contact-force stage: the contact forces identified from the record (inverse) against the
     laws at the identified motion, the inverse identification's residual and noise, the contact's open fraction,
     the energy per cycle (J; identified, simulated), the driving-point residual by part of the cycle and the
-    force-state map of what the laws leave."""
-    forces = identified_forces(model, aug, rec)
+    force-state map of what the laws leave (``memo``: ``Numerics.memo``)."""
+    forces = identified_forces(model, aug, rec, memo=memo)
     g = contact_grids(forces, rec.f0, model.preload, 256)
     S_law = law_friction_force(g["xi"], g["xi_dot"], g["N"], np.asarray(model.friction), aug, model.regularization)[0]
     S_law -= S_law.mean()
@@ -87,7 +89,7 @@ def _contact_gaps(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonic
         # the sensors' misfit of the inverse identification at the driven harmonics (1 and 3): the
         # structure and sensor model's consistency with the records, whatever the contact does
         "identification_residual": float(np.sqrt(np.mean(forces.residual[[0, 2]] ** 2))),
-        "identification_noise": identification_noise(model, rec),
+        "identification_noise": identification_noise(model, rec, memo),
         "S": _rel(S_law, g["S"]),
         "N": _rel(N_law, N_id),
         "open_fraction": open_fraction(g["N"], model.preload, open_limit),
@@ -114,14 +116,16 @@ def localise(
     eta_limit: float = 0.1,
     structures=(),
     thresholds: PlaceThresholds = DEFAULT_PLACE,
+    memo: bool = True,
 ) -> tuple[dict, dict]:
     """The gap by stage, sensor, harmonic, part of the cycle and load level (the identified model
     as the chain left it, or with the effects ``aug`` added), the records' drift and whether each settled
-    (``record_periodicity``). Returns (summary for diagnosis.json, arrays for gap.nc)."""
+    (``record_periodicity``); ``memo``: the inverse identifications memoised (``Numerics.memo``). Returns (summary for
+    diagnosis.json, arrays for gap.nc)."""
     H = n_harmonics
     cases = list(records)
     resp = _response_gaps(fe_model(model, aug), records, sims, H)
-    contact = [_contact_gaps(model, aug, records[c], sims[c], H, thresholds.open_limit) for c in cases]
+    contact = [_contact_gaps(model, aug, records[c], sims[c], H, thresholds.open_limit, memo) for c in cases]
     per_case = {k: [row[k] for row in contact] for k in contact[0]}
     e_t, e_n = np.array(per_case["energy_tangential"]), np.array(per_case["energy_normal"])
     scale_e = np.abs(e_t[:, 0])
@@ -150,7 +154,7 @@ def localise(
     summary["periodicity"] = record_periodicity(records, thresholds.aperiodic_limit)
     summary["identification_residual"] = dict(zip(cases, per_case["identification_residual"]))
     summary["identification_noise"] = dict(zip(cases, per_case["identification_noise"]))
-    spread = {c: eta_model_spread(model, aug, records[c], structures) for c in cases}
+    spread = {c: eta_model_spread(model, aug, records[c], structures, memo) for c in cases}
     finite = [v for v in spread.values() if np.isfinite(v)]
     worst = max(finite) if finite else float("nan")
     summary["eta_observability"] = {
@@ -237,18 +241,20 @@ def record_periodicity(records: dict, limit: float) -> dict:
     return out
 
 
-def identification_noise(model: IdentifiedModel, rec: RecordHarmonics) -> float:
+def identification_noise(model: IdentifiedModel, rec: RecordHarmonics, memo: bool = True) -> float:
     """Standard error of the inverse identification's sensor misfit (w and 3w) from the record's blocks."""
     import dataclasses
 
     r = []
     for k in range(rec.block_acceleration.shape[0]):
         blk = dataclasses.replace(rec, acceleration=rec.block_acceleration[k], force=rec.block_force[k])
-        r.append(float(np.sqrt(np.mean(identified_forces(model, NONE, blk).residual[[0, 2]] ** 2))))
+        r.append(float(np.sqrt(np.mean(identified_forces(model, NONE, blk, memo=memo).residual[[0, 2]] ** 2))))
     return float(np.std(r) / np.sqrt(len(r)))
 
 
-def eta_model_spread(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, structures) -> float:
+def eta_model_spread(
+    model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, structures, memo: bool = True
+) -> float:
     """How far the identified normal motion eta moves over the structures the data allow: the largest relative
     change (norm over the harmonics) of eta identified with each of ``structures`` (the model's structure moved
     by one posterior standard deviation of each updated parameter, ``updating.posterior_structures``) against
@@ -258,10 +264,10 @@ def eta_model_spread(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmo
 
     if not structures:
         return float("nan")
-    full = identified_forces(model, aug, rec).eta
+    full = identified_forces(model, aug, rec, memo=memo).eta
     out = 0.0
     for p in structures:
-        other = identified_forces(dataclasses.replace(model, structure=p), aug, rec).eta
+        other = identified_forces(dataclasses.replace(model, structure=p), aug, rec, memo=memo).eta
         out = max(out, float(np.linalg.norm(other - full) / max(np.linalg.norm(full), 1e-300)))
     return out
 
@@ -333,5 +339,6 @@ def _place_left(last, records, calibration_case, H, linear, structures, settings
         eta_limit=settings.eta_observability_limit,
         structures=structures,
         thresholds=settings.place,
+        memo=settings.numerics.memo,
     )
     return where_left

@@ -12,7 +12,6 @@ library (``candidates``) maps an effect's few parameters onto these fields.
 
 from __future__ import annotations
 
-import contextvars
 import dataclasses
 from dataclasses import dataclass, field
 from functools import lru_cache
@@ -36,6 +35,7 @@ from ..rig.nonlinear import (
     reduced_model,
     stable_oversampling,
 )
+from .numerics import DEFAULT, Numerics
 from .records import RecordHarmonics
 
 
@@ -346,14 +346,6 @@ def _channels(coef: np.ndarray, aug: "Augmentation", w: float) -> np.ndarray:
     return coef
 
 
-STEADY_STATE = contextvars.ContextVar("steady_state", default="harmonic_balance")
-# a contact that may open, unpolished (a calibration search): its periodic state where it stays closed
-CLOSED_CONTACT_HB = contextvars.ContextVar("closed_contact_hb", default=True)
-# the integrator's settling test (relative change of the harmonics between 8-period chunks) where ``simulate`` is not
-# given one; benchmarks/gap_diagnosis.py --reference-scatter halves and doubles it to show the reference's own scatter
-SETTLING_TOL = contextvars.ContextVar("settling_tol", default=2e-5)
-
-
 def simulate(
     model: IdentifiedModel,
     aug: Augmentation,
@@ -366,29 +358,30 @@ def simulate(
     method: str | None = None,
     hb_harmonics: int | None = None,
     polish: bool = True,
+    numerics: Numerics = DEFAULT,
 ) -> SimResult:
     """Steady-state response of the (augmented) identified model to the record's measured force
     (its first ``force_harmonics`` harmonics), in the record's harmonics.
 
-    ``method`` "harmonic_balance" (the default, or what ``STEADY_STATE`` holds) solves the periodic
-    steady state directly (``rig.harmonic_balance`` on the integrator's own discrete equations with
+    ``method`` "harmonic_balance" (where not given: ``numerics.steady_state``, ``numerics.Numerics``) solves the
+    periodic steady state directly (``rig.harmonic_balance`` on the integrator's own discrete equations with
     ``hb_harmonics`` harmonics (all the record's by default, at most a quarter of the steps per period);
     warm-started from ``start``, a
     neighbouring simulation of the same record). That state is within about 1e-3 of the integrator's
     own periodic orbit (the harmonics it leaves out); with ``polish`` (the default; in the calibration searches
-    with ``refit.POLISH_SEARCH``) the integrator runs from
+    where ``numerics.polish_searches``) the integrator runs from
     that state until its harmonics settle by the reference's own test (8-period chunks changing by less than
-    ``tol``, by default ``SETTLING_TOL``'s 2e-5, two chunks at least) and records the last settled chunk
+    ``tol``, by default ``numerics.settling_tol``, 2e-5, two chunks at least) and records the last settled chunk
     (``record_periods`` periods, or the record's length, where it does not settle), so the result is the
     reference's to its tolerance at a fraction of its cost. Where Newton does not converge (a response
     that does not settle), and for a contact that may open, the integrator starts from the linear state
     instead; unpolished, a contact that may open is given its periodic state where that
-    stays closed, N above a tenth of the preload all period long (``CLOSED_CONTACT_HB``). "time_marching" (the
+    stays closed, N above a tenth of the preload all period long (``numerics.closed_contact_hb``). "time_marching" (the
     reference) integrates from the stuck linear system's state until the harmonics settle. With a
     preload drift the whole record's length is integrated, as measured, from the settled state at the
     record's start (in a search, unpolished: from the periodic state itself, 0.17 -> 0.13 s a simulation)."""
-    method = method or STEADY_STATE.get()
-    tol = SETTLING_TOL.get() if tol is None else float(tol)
+    method = method or numerics.steady_state
+    tol = numerics.settling_tol if tol is None else float(tol)
     if method not in ("harmonic_balance", "time_marching"):
         raise ValueError(f"simulate: method {method!r}; give 'harmonic_balance' or 'time_marching'")
     sim = simulator(model, aug, rec.fs, rec.f0)
@@ -407,7 +400,7 @@ def simulate(
         periodic = _periodic_state(sim, coef, w, n_hb, n_per, start)
         if periodic is not None and not polish and not aug.preload_drift:
             return _periodic_result(periodic, sim, model, aug, rec, grid)
-    elif method == "harmonic_balance" and not polish and not aug.preload_drift and CLOSED_CONTACT_HB.get():
+    elif method == "harmonic_balance" and not polish and not aug.preload_drift and numerics.closed_contact_hb:
         # a contact that may open but stays closed all period long is as smooth as the others: its periodic state
         # is used where it never comes near opening (N above a tenth of the preload); otherwise the integrator
         # marches from the linear state below. Polished, it marches from the linear state as the reference does:

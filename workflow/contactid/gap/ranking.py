@@ -27,16 +27,21 @@ def _ranking_row(
     records: Mapping[str, RecordHarmonics],
     calibration_case: str,
     where: Mapping,
+    memo: bool = True,
 ) -> dict:
     """A candidate's row of the ranking: its held-out gap (``after``, its bootstrap ``after_b``) against the
     model's (``before``, ``before_b``), the score (n ln(gap^2 ratio) + 2 k over ``n_data`` residual entries), its
     refitted parameters and friction law, the structure/sensor misfit it leaves on the calibration record, and
-    whether it acts where the localisation puts the gap."""
+    whether it acts where the localisation puts the gap (``memo``: the inverse identification memoised,
+    ``Numerics.memo``)."""
     k = LIBRARY[name].n_parameters(len(records[calibration_case].sensors))
     # does the candidate make the structure and sensor model consistent with the calibration record?
     res_after = float(
         np.sqrt(
-            np.mean(identified_forces(cal.model, cal.augmentation, records[calibration_case]).residual[[0, 2]] ** 2)
+            np.mean(
+                identified_forces(cal.model, cal.augmentation, records[calibration_case], memo=memo).residual[[0, 2]]
+                ** 2
+            )
         )
     )
     acts_on = LIBRARY[name].acts_on
@@ -66,7 +71,17 @@ def _ranking_row(
 
 
 def _ranking(
-    results, heldout_gap, n_bootstrap, before, before_b, n_data, records, calibration_case, where, aperiodic_limit=0.1
+    results,
+    heldout_gap,
+    n_bootstrap,
+    before,
+    before_b,
+    n_data,
+    records,
+    calibration_case,
+    where,
+    aperiodic_limit=0.1,
+    memo: bool = True,
 ):
     """The candidates' ranking rows, sorted by score (scores equal to 3 decimals are a tie, the same model solved
     from other starts: library order), and each candidate's bootstrap held-out gaps. Each row also says where the
@@ -79,7 +94,9 @@ def _ranking(
             after, after_b = np.inf, np.full(n_bootstrap, np.inf)
         boots[name] = after_b
         rows.append(
-            _ranking_row(name, cal, res, after, after_b, before, before_b, n_data, records, calibration_case, where)
+            _ranking_row(
+                name, cal, res, after, after_b, before, before_b, n_data, records, calibration_case, where, memo
+            )
         )
         rows[-1].update(model_periodicity(cal, sims, records, calibration_case, aperiodic_limit))
     rows.sort(key=lambda r: round(r["score"], 3) if np.isfinite(r["score"]) else np.inf)

@@ -10,8 +10,6 @@ cases are then predicted with theta and the refitted friction law, never fitted.
 
 from __future__ import annotations
 
-import contextlib
-import contextvars
 import logging
 from dataclasses import dataclass, replace
 
@@ -27,6 +25,7 @@ from ..identification import InverseHarmonics, inverse_harmonics, modal_damping_
 from ..rig.nonlinear import iwan_slip_weights
 from .candidates import Candidate
 from .model import NONE, Augmentation, IdentifiedModel, SimResult, fe_model, simulate
+from .numerics import DEFAULT, Numerics
 from .records import RecordHarmonics
 from .search import residual_line_search, stacked
 
@@ -88,10 +87,10 @@ class _Memo:
     def __init__(self, size: int = 64):
         self.size, self.store = size, {}
 
-    enabled = contextvars.ContextVar("memo", default=True)
-
-    def get(self, key, compute):
-        if not self.enabled.get():
+    def get(self, key, compute, enabled: bool = True):
+        """The result of ``compute`` (which returns (result, objects the key names)), from the memo where ``enabled``
+        (``Numerics.memo``); otherwise computed anew and not stored."""
+        if not enabled:
             return compute()[0]
         hit = self.store.get(key)
         if hit is None:
@@ -105,20 +104,11 @@ _FORCES = _Memo()
 _FRICTION = _Memo()
 
 
-@contextlib.contextmanager
-def memoised(enabled: bool = True):
-    """Within the block, the inverse identification and the friction refit are memoised (the default)
-    or computed anew at every call (the plain baseline the benchmark measures against)."""
-    token = _Memo.enabled.set(bool(enabled))
-    try:
-        yield
-    finally:
-        _Memo.enabled.reset(token)
-
-
-def identified_forces(model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics) -> InverseHarmonics:
-    """Contact forces of a record by inverse identification with the augmented model (memoised: the
-    candidates that leave the structure, its damping and the channels as they are reuse it)."""
+def identified_forces(
+    model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, memo: bool = True
+) -> InverseHarmonics:
+    """Contact forces of a record by inverse identification with the augmented model (memoised where ``memo``,
+    ``Numerics.memo``: the candidates that leave the structure, its damping and the channels as they are reuse it)."""
     key = (
         model.structure_with(aug),
         model.test_damping,
@@ -133,7 +123,7 @@ def identified_forces(model: IdentifiedModel, aug: Augmentation, rec: RecordHarm
         zeta = augmented_zeta(fe, model.test_damping, aug.extra_damping)
         return inverse_harmonics(fe, zeta, rec.force, deskewed(rec, aug.delays, aug.gains), rec.f0), rec
 
-    return _FORCES.get(key, compute)
+    return _FORCES.get(key, compute, memo)
 
 
 @njit(cache=True)
@@ -192,11 +182,17 @@ def contact_grids(forces: InverseHarmonics, f0: float, preload: float, m: int) -
 
 
 def refit_friction(
-    model: IdentifiedModel, aug: Augmentation, forces: InverseHarmonics, f0: float, bounds, grid: int = 512
+    model: IdentifiedModel,
+    aug: Augmentation,
+    forces: InverseHarmonics,
+    f0: float,
+    bounds,
+    grid: int = 512,
+    memo: bool = True,
 ) -> tuple[np.ndarray, float]:
     """The friction law (with the augmentation's terms) polished from the chain's fit to the
-    identified forces; returns (e_f, k_c, e_t, kappa, mu) and the NRMSE of S (memoised: a candidate
-    that changes neither the forces nor the law gets the same polish)."""
+    identified forces; returns (e_f, k_c, e_t, kappa, mu) and the NRMSE of S (memoised where ``memo``,
+    ``Numerics.memo``: a candidate that changes neither the forces nor the law gets the same polish)."""
     law = (aug.iwan_share, aug.viscous, aug.preload_drift)
     key = (
         model.friction,
@@ -219,7 +215,7 @@ def refit_friction(
         u, ssr, _ = _polish(prob, u0, xtol=1e-8, ftol=1e-10)
         return (prob.physical(u)[0], float(np.sqrt(ssr / grid))), forces
 
-    return _FRICTION.get(key, compute)
+    return _FRICTION.get(key, compute, memo)
 
 
 # ------------------------------------------------------------------------------------------
@@ -253,62 +249,55 @@ def evaluate(
     refit: bool = True,
     start: SimResult | None = None,
     polish: bool = True,
+    numerics: Numerics = DEFAULT,
 ):
     """Redo the chain with ``aug`` on one record: (gap, model with refitted friction, simulation, misfit).
     ``start``: a neighbouring simulation of the record to warm-start the steady state from; ``polish``: see
-    ``simulate`` (False: the harmonic-balance state itself, where it converges)."""
+    ``simulate`` (False: the harmonic-balance state itself, where it converges); ``numerics``: the steady state's
+    method and settling tolerance and the memos (``numerics.Numerics``)."""
     misfit = float("nan")
     if refit:
-        forces = identified_forces(model, aug, rec)
-        fr, misfit = refit_friction(model, aug, forces, rec.f0, bounds)
+        forces = identified_forces(model, aug, rec, memo=numerics.memo)
+        fr, misfit = refit_friction(model, aug, forces, rec.f0, bounds, memo=numerics.memo)
         model = model.with_friction(fr)
-    sim = simulate(model, aug, rec, start=start, hb_harmonics=2 * n_harmonics, polish=polish)
+    sim = simulate(model, aug, rec, start=start, hb_harmonics=2 * n_harmonics, polish=polish, numerics=numerics)
     return gap_value(gap_residual(sim, rec, n_harmonics)), model, sim, misfit
-
-
-# True: every state of a calibration search polished by the integrator, so that the search sees the reference's gaps
-# (to its settling tolerance): held-out gaps within 0.01-0.08 % of the time-marching diagnosis's on
-# benchmarks/gap_diagnosis.py's four data sets, against 2.4-8.6 % with the periodic states alone (False here: same
-# verdicts and, but for near ties, rankings; the searches stop elsewhere in flat calibration gaps), for 25-90 % more
-# diagnosis time (a contact that may open marches from the linear state then, as the reference does). The gap
-# setting polish_searches (true by default) sets it for a diagnosis.
-POLISH_SEARCH = contextvars.ContextVar("polish_search", default=False)
-
-
-@contextlib.contextmanager
-def polished_searches(enabled: bool = True):
-    """Within the block, every state a calibration search compares is polished by the integrator (``POLISH_SEARCH``)
-    where ``enabled``; otherwise the search compares what the caller's context says."""
-    token = POLISH_SEARCH.set(True) if enabled else None
-    try:
-        yield
-    finally:
-        if token is not None:
-            POLISH_SEARCH.reset(token)
 
 
 class _CandidateRuns:
     """The chain redone (``evaluate``) at the thetas a calibration tries, each once: called with theta, it returns
     (gap, model with refitted friction, simulation, friction misfit, augmentation), every simulation starting from
     the previous one's steady state; a theta the law or the simulation fails at gets an infinite gap (and is logged).
+    Every theta is run polished by the integrator where ``numerics.polish_searches`` (True: every state of the search,
+    so that it sees the reference's gaps to its settling tolerance: held-out gaps within 0.01-0.08 % of the
+    time-marching diagnosis's on benchmarks/gap_diagnosis.py's four data sets, against 2.4-8.6 % with the periodic
+    states alone, same verdicts and, but for near ties, rankings; for 25-90 % more diagnosis time, a contact that may
+    open marching from the linear state then, as the reference does), otherwise only where called with ``polish``.
     ``evaluations`` counts the distinct runs."""
 
-    def __init__(self, model, cand, rec, bounds, n_harmonics: int, start, base):
+    def __init__(self, model, cand, rec, bounds, n_harmonics: int, start, base, numerics: Numerics = DEFAULT):
         self.model, self.cand, self.rec, self.base = model, cand, rec, base
-        self.bounds, self.n_harmonics = bounds, n_harmonics
+        self.bounds, self.n_harmonics, self.numerics = bounds, n_harmonics, numerics
         self.last_sim = start
         self.evaluations = 0
         self.cache = {}
 
     def __call__(self, theta, polish=False):
-        polish = polish or POLISH_SEARCH.get()  # the key holds what is run: a polished search's optimum is not rerun
+        polish = polish or self.numerics.polish_searches  # the key holds what is run: a polished optimum is not rerun
         key = (*np.round(np.atleast_1d(theta), 12), polish)
         if key not in self.cache:
             self.evaluations += 1
             aug = self.base.merge(self.cand.augmentation(np.atleast_1d(theta)))
             try:
                 out = evaluate(
-                    self.model, aug, self.rec, self.bounds, self.n_harmonics, start=self.last_sim, polish=polish
+                    self.model,
+                    aug,
+                    self.rec,
+                    self.bounds,
+                    self.n_harmonics,
+                    start=self.last_sim,
+                    polish=polish,
+                    numerics=self.numerics,
                 )
                 self.last_sim = out[2]  # the next theta is a neighbour: start from here
                 if not np.isfinite(out[0]):
@@ -323,12 +312,6 @@ class _CandidateRuns:
         """The calibration gap's residual vector at ``theta`` (``gap_residual``), None where it cannot be simulated."""
         g, _, sim, _, _ = self(np.atleast_1d(theta))
         return gap_residual(sim, self.rec, self.n_harmonics) if sim is not None and np.isfinite(g) else None
-
-
-# "residual": a one-parameter candidate's search models the gap's residual vector by quadratics
-# (``search.residual_line_search``) and a joint refit takes least-squares steps on it, the default; "gap": the searches
-# see the gap alone (Brent's bounded search, Nelder-Mead; the plain reference of the benchmarks)
-SEARCH = contextvars.ContextVar("search", default="residual")
 
 
 def _per_channel_theta(
@@ -437,9 +420,11 @@ def _unresolved_from_off(value: float, p, xatol: float) -> bool:
     return not p.is_off(value) and abs(float(value) - p.off) <= xatol
 
 
-def _scalar_theta(run: _CandidateRuns, cand: Candidate, max_evaluations: int) -> np.ndarray:
+def _scalar_theta(
+    run: _CandidateRuns, cand: Candidate, max_evaluations: int, numerics: Numerics = DEFAULT
+) -> np.ndarray:
     """theta (1,) of a one-parameter candidate: a scan of the range, the search between the best point's neighbours
-    (``SEARCH``), and "off" where that is better."""
+    (``numerics.search``: on the residual vector, or on the gap alone), and "off" where that is better."""
     # a scan of the range (1/32, 1/8, 1/4, 1/2, 3/4), then the bounded search between the best point's neighbours:
     # a search over the whole range from its middle can settle in a side basin (the blind benchmark's
     # transducer-mass items: theta 0.35 instead of 0.22, a held-out gap four times larger)
@@ -453,7 +438,7 @@ def _scalar_theta(run: _CandidateRuns, cand: Candidate, max_evaluations: int) ->
     best = min(range(1, 6), key=lambda i: run(np.array([grid[i]]))[0])
     xatol = 1e-3 * (p.high - p.low)
     trio = {float(grid[i]): run.residual(grid[i]) for i in (best - 1, best, best + 1)}
-    if SEARCH.get() == "residual" and all(r is not None for r in trio.values()):
+    if numerics.search == "residual" and all(r is not None for r in trio.values()):
         x = residual_line_search(run.residual, trio, grid[best - 1], grid[best + 1], xatol, max_evaluations)
     else:
         x = minimize_scalar(
@@ -480,14 +465,16 @@ def _scalar_theta(run: _CandidateRuns, cand: Candidate, max_evaluations: int) ->
             wider.low,
             wider.high,
         )
-        return _scalar_theta(run, replace(cand, parameters=(wider,)), max_evaluations)
+        return _scalar_theta(run, replace(cand, parameters=(wider,)), max_evaluations, numerics)
     return theta
 
 
-def _simplex_theta(run: _CandidateRuns, cand: Candidate, max_evaluations: int, starts) -> np.ndarray:
+def _simplex_theta(
+    run: _CandidateRuns, cand: Candidate, max_evaluations: int, starts, numerics: Numerics = DEFAULT
+) -> np.ndarray:
     """theta of a candidate with several parameters, from the best of a scan of the first parameter (and of the earlier
-    optimum and ``starts``): a joint refit by least squares on the residual vector (``SEARCH`` "residual"; smooth
-    near the earlier optimum), otherwise Nelder-Mead on the gap in the unit cube of their ranges (a contact that
+    optimum and ``starts``): a joint refit by least squares on the residual vector (``numerics.search`` "residual";
+    smooth near the earlier optimum), otherwise Nelder-Mead on the gap in the unit cube of their ranges (a contact that
     opens makes the gap kinked)."""
     from scipy.optimize import minimize
 
@@ -503,7 +490,7 @@ def _simplex_theta(run: _CandidateRuns, cand: Candidate, max_evaluations: int, s
         scan.append(x0)
     scan += [np.clip((np.asarray(t, float) - lo) / (hi - lo), 0.0, 1.0) for t in starts]
     x0 = min(scan, key=lambda x: run(lo + x * (hi - lo))[0])
-    if joint and SEARCH.get() == "residual" and run.residual(lo + x0 * (hi - lo)) is not None:
+    if joint and numerics.search == "residual" and run.residual(lo + x0 * (hi - lo)) is not None:
         # a joint refit (smooth near the earlier optimum): least squares on the residual vector from the scan's best
         return lo + _least_squares_unit(run, lo, hi, x0, max_evaluations) * (hi - lo)
     size = 0.1 if joint else 0.25
@@ -530,6 +517,7 @@ def calibrate(
     starts=(),
     channel_delays=None,
     channel_gains=None,
+    numerics: Numerics = DEFAULT,
 ) -> Calibration:
     """theta of ``cand`` minimising the calibration case's gap (friction law refitted at each theta);
     each simulation starts from the previous one's steady state (``start``: the model's own). ``base``:
@@ -539,12 +527,13 @@ def calibrate(
     delays holds their common part (``_per_channel_theta``).
     ``channel_gains``: the channels' gains relative to one another as the random test's residues show them
     (``UpdatingResult.channel_gains``); the channel-gain candidate applies them as they are (``_held_gains``).
-    The search compares harmonic-balance states (within 5e-4 of the integrator's orbit; ``POLISH_SEARCH`` set to
-    True polishes each with the integrator); the optimum is evaluated again with the integrator's polish, so its gap
-    and simulation are the reference's (same optimum within 1 %, a quarter to a third less diagnosis time, measured
-    on 10 benchmark items).
+    ``numerics``: how the steady states are found and the search runs (``numerics.Numerics``). With
+    ``numerics.polish_searches`` (the default, the diagnosis's) every state the search compares is polished by the
+    integrator; False: the search compares harmonic-balance states (within 5e-4 of the integrator's orbit) and only
+    the optimum is evaluated again with the integrator's polish, so its gap and simulation are the reference's (same
+    optimum within 1 %, a quarter to a third less diagnosis time, measured on 10 benchmark items).
     """
-    run = _CandidateRuns(model, cand, rec, settings.bounds, n_harmonics, start, base)
+    run = _CandidateRuns(model, cand, rec, settings.bounds, n_harmonics, start, base, numerics)
     if cand.per_channel:
         j = rec.acceleration.shape[0]
         sets_delays = channel_delays is not None and bool(cand.augmentation(np.ones(j)).delays)
@@ -557,9 +546,9 @@ def calibrate(
         else:
             theta = _per_channel_theta(run, cand, rec, max_evaluations, channel_delays if sets_delays else None)
     elif len(cand.parameters) == 1:
-        theta = _scalar_theta(run, cand, max_evaluations)
+        theta = _scalar_theta(run, cand, max_evaluations, numerics)
     else:
-        theta = _simplex_theta(run, cand, max_evaluations, starts)
+        theta = _simplex_theta(run, cand, max_evaluations, starts, numerics)
     cal = _calibration_at(run, theta)
     if not np.isfinite(cal.gap):  # nothing in the range could be simulated: the effect off
         theta = (
@@ -586,14 +575,17 @@ def held(
     theta,
     start: SimResult | None = None,
     base: Augmentation = NONE,
+    numerics: Numerics = DEFAULT,
 ) -> Calibration:
     """``cand`` at ``theta`` measured elsewhere (channel delays: the random test's residue phases), not searched: the
     friction law refitted to the calibration case's forces with it, the simulation polished by the integrator."""
-    run = _CandidateRuns(model, cand, rec, settings.bounds, n_harmonics, start, base)
+    run = _CandidateRuns(model, cand, rec, settings.bounds, n_harmonics, start, base, numerics)
     return _calibration_at(run, np.asarray(theta, dtype=float))
 
 
-def baseline(model: IdentifiedModel, rec: RecordHarmonics, n_harmonics: int) -> tuple[float, SimResult]:
+def baseline(
+    model: IdentifiedModel, rec: RecordHarmonics, n_harmonics: int, numerics: Numerics = DEFAULT
+) -> tuple[float, SimResult]:
     """The identified model as the chain left it (no effect, no refit) on one record."""
-    g, _, sim, _ = evaluate(model, NONE, rec, None, n_harmonics, refit=False)
+    g, _, sim, _ = evaluate(model, NONE, rec, None, n_harmonics, refit=False, numerics=numerics)
     return g, sim

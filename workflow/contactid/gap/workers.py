@@ -13,8 +13,9 @@ from ..friction_fit import FitSettings
 from ..rig.harmonic_balance import HarmonicBalance
 from .candidates import LIBRARY, joint_candidate, merged_augmentation
 from .model import IdentifiedModel
+from .numerics import DEFAULT, Numerics
 from .records import RecordHarmonics
-from .refit import calibrate, evaluate, gap_residual, gap_value, held, polished_searches
+from .refit import calibrate, evaluate, gap_residual, gap_value, held
 
 log = logging.getLogger(__name__)
 
@@ -35,6 +36,7 @@ def _candidate(
     channel_delays=None,
     channel_gains=None,
     held_theta=None,
+    numerics: Numerics = DEFAULT,
 ):
     """One candidate added to the explanation's earlier steps ``base_steps`` ((name, theta), ...): calibrated on
     the calibration case (with ``joint``, together with the earlier steps' parameters, ``joint_candidate``;
@@ -43,15 +45,26 @@ def _candidate(
     earlier steps' optimum and this candidate's own (two effects that can stand in for each other, viscous friction
     and a normal dashpot, leave a ridge between the one-effect optimum and the truth). ``channel_delays``: the random
     test's per-channel delays and ``channel_gains`` its channels' relative gains (``refit.calibrate``). ``held_theta``:
-    the candidate at this theta, not searched (``refit.held``; the earlier steps held). Returns (calibration, sims,
-    residuals) by case."""
+    the candidate at this theta, not searched (``refit.held``; the earlier steps held). ``numerics``: how the steady
+    states are found and the searches run (``numerics.Numerics``, the diagnosis's ``GapSettings.numerics``; an
+    argument of the task, so that a worker process sees it too). Returns (calibration, sims, residuals) by case."""
     rec = records[calibration_case]
     # per-channel effects (channel delays) trade off with no contact effect and would add a dimension per channel:
     # they are held, and a per-channel candidate is refitted on the earlier steps held
     free = [n for n, _ in base_steps if not LIBRARY[n].per_channel]
     if held_theta is not None:
         base = merged_augmentation((LIBRARY[n], th) for n, th in base_steps)
-        cal = held(model, LIBRARY[name], rec, fit_settings, H, held_theta, start=base_sims[calibration_case], base=base)
+        cal = held(
+            model,
+            LIBRARY[name],
+            rec,
+            fit_settings,
+            H,
+            held_theta,
+            start=base_sims[calibration_case],
+            base=base,
+            numerics=numerics,
+        )
         cal = dataclasses.replace(cal, steps=tuple(base_steps) + ((name, cal.theta),))
     elif free and joint and not LIBRARY[name].per_channel:
         base = merged_augmentation((LIBRARY[n], th) for n, th in base_steps if n not in free)
@@ -76,6 +89,7 @@ def _candidate(
             start=base_sims[calibration_case],
             starts=mixes,
             base=base,
+            numerics=numerics,
         )
         own_theta, *refitted = split(cal.theta)
         refitted = dict(zip(free, refitted))
@@ -95,12 +109,15 @@ def _candidate(
             base=base,
             channel_delays=channel_delays,
             channel_gains=channel_gains,
+            numerics=numerics,
         )
         cal = dataclasses.replace(cal, steps=tuple(base_steps) + ((name, cal.theta),))
     sims = {calibration_case: None}
     res = {}
     for c in score_cases:
-        _, _, sim, _ = evaluate(cal.model, cal.augmentation, records[c], None, H, refit=False, start=base_sims[c])
+        _, _, sim, _ = evaluate(
+            cal.model, cal.augmentation, records[c], None, H, refit=False, start=base_sims[c], numerics=numerics
+        )
         sims[c] = sim
         res[c] = gap_residual(sim, records[c], H)
     log.info(
@@ -114,17 +131,14 @@ def _candidate(
 
 
 def _candidate_task(task):
-    """(name, common): ``_candidate(name, **common)``, every searched state polished by the integrator unless
-    ``common["polish_searches"]`` is False (``refit.polished_searches``: set here, in the process that runs the
-    candidate, since a worker does not inherit the caller's context). Each candidate starts without Newton history
+    """(name, common): ``_candidate(name, **common)`` (``common["numerics"]``: the diagnosis's numerical settings,
+    handed to the process that runs the candidate with the task). Each candidate starts without Newton history
     (``HarmonicBalance.forget``): which worker runs which candidate after which depends on timing, and a candidate
     that started from another's last Jacobian ended elsewhere where its calibration gap is flat (the default data's
     transducer-mass refit, mass error 0.0075 in one run and 0.0104 in the next)."""
     name, common = task
-    common = dict(common)
     HarmonicBalance.forget()
-    with polished_searches(common.pop("polish_searches", True)):
-        return _candidate(name, **common)
+    return _candidate(name, **common)
 
 
 def fork_safe() -> bool:
