@@ -193,7 +193,8 @@ def _identified(structure):
 
 
 def test_a_model_with_an_impossible_contact_stiffness_is_refused_before_any_allocation(foreign_structure):
-    from contactid.gap.model import NONE, simulator
+    from contactid.gap.model import NONE
+    from contactid.gap.simulation import simulator
 
     # the model the gap diagnosis got from the random test in g read as m/s^2 (model updating's k_t and k_n)
     params = structure_from_config(foreign_structure, 6.16e8, 2.49e19)
@@ -216,7 +217,8 @@ def test_a_model_with_an_impossible_contact_stiffness_is_refused_before_any_allo
 
 def test_legitimate_models_stay_well_within_the_step_limit(foreign_structure, default_config):
     from contactid.beam_model import assemble
-    from contactid.gap.model import NONE, simulator
+    from contactid.gap.model import NONE
+    from contactid.gap.simulation import simulator
     from contactid.rig.nonlinear import MAX_STEPS_PER_SAMPLE, reduced_model, stable_oversampling
 
     sim = simulator(_identified(structure_from_config(foreign_structure, 1.43e7, 2.53e7)), NONE, 5400.0, 54.0)
@@ -229,7 +231,8 @@ def test_legitimate_models_stay_well_within_the_step_limit(foreign_structure, de
 
 
 def test_the_harmonic_balance_grid_and_the_stored_record_are_bounded(foreign_structure):
-    from contactid.gap.model import NONE, simulator
+    from contactid.gap.model import NONE
+    from contactid.gap.simulation import simulator
     from contactid.rig.harmonic_balance import HarmonicBalance, grid_bytes
     from contactid.rig.nonlinear import WORK_LIMIT_BYTES, record_bytes
 
@@ -245,7 +248,8 @@ def test_the_harmonic_balance_grid_and_the_stored_record_are_bounded(foreign_str
 
 
 def test_a_record_with_too_many_samples_per_period_is_refused_naming_the_record(foreign_structure):
-    from contactid.gap.model import NONE, _check_work, simulator
+    from contactid.gap.model import NONE
+    from contactid.gap.simulation import _check_work, simulator
 
     sim = simulator(_identified(structure_from_config(foreign_structure, 1.43e7, 2.53e7)), NONE, 5.4e6, 54.0)
     rec = SimpleNamespace(case="lc1", fs=5.4e6, f0=54.0, periods=20)

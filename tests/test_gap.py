@@ -721,7 +721,7 @@ def test_a_benchmark_item_not_diagnosed_still_gets_its_files_and_figures(tmp_pat
 def test_polish_searches_setting_polishes_every_searched_state(hc_data, monkeypatch):
     """gap.polish_searches reaches the candidate's search (``GapSettings.numerics``, an argument of the task, so that a
     worker process sees it too): every state compared is polished (the default); set false, only the optimum is."""
-    from contactid.gap import refit
+    from contactid.gap import calibration
     from contactid.gap.diagnosis import GapSettings
     from contactid.gap.numerics import Numerics
     from contactid.gap.workers import _candidate_task
@@ -734,13 +734,13 @@ def test_polish_searches_setting_polishes_every_searched_state(hc_data, monkeypa
     assert settings.numerics == Numerics() and unpolished.numerics == Numerics(polish_searches=False)
     base = {c: baseline(model, records[c], 9)[1] for c in records}
     seen = []
-    evaluate = refit.evaluate
+    evaluate = calibration.evaluate
 
     def spy(*args, polish=True, **kw):
         seen.append(polish)
         return evaluate(*args, polish=polish, **kw)
 
-    monkeypatch.setattr(refit, "evaluate", spy)
+    monkeypatch.setattr(calibration, "evaluate", spy)
     common = dict(
         model=model,
         records=records,
@@ -818,7 +818,8 @@ def test_search_finds_the_time_marching_searchs_optimum(hc_data):
     the integrator (``Numerics.polish_searches``, the diagnosis's default) it stops where the time-marching search
     stops, alpha and gap within 0.1 %."""
     from contactid.gap.numerics import Numerics
-    from contactid.gap.refit import calibrate, evaluate
+    from contactid.gap.calibration import calibrate
+    from contactid.gap.refit import evaluate
 
     cfg, model, records, _ = hc_data
     fit = settings_from_config(cfg["friction"])

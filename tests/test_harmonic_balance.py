@@ -6,7 +6,8 @@ import dataclasses
 import numpy as np
 import pytest
 
-from contactid.gap.model import Augmentation, IdentifiedModel, simulate
+from contactid.gap.model import Augmentation, IdentifiedModel
+from contactid.gap.simulation import simulate
 from contactid.gap.records import RecordHarmonics
 from contactid.parameters import structure_from_config
 from contactid.rig.harmonic_balance import HarmonicBalance
@@ -124,7 +125,7 @@ def test_warm_start_from_a_neighbour_converges_in_fewer_steps(model):
 def test_guards_name_what_cannot_be_solved(model):
     import dataclasses
 
-    from contactid.gap.model import simulator
+    from contactid.gap.simulation import simulator
 
     sim = simulator(model, Augmentation(), FS, F0)
     n_per = int(round(1 / (F0 * sim.dt)))
@@ -143,7 +144,7 @@ def test_newton_matrix_by_woodbury_is_the_dense_jacobian(model):
     share, viscous friction)."""
     import dataclasses
 
-    from contactid.gap.model import simulator
+    from contactid.gap.simulation import simulator
 
     sim = simulator(model, Augmentation(hunt_crossley=300.0, iwan_share=0.3, viscous=100.0), FS, F0)
     n_per = int(round(1 / (F0 * sim.dt)))
@@ -163,7 +164,7 @@ def test_with_every_mode_in_the_balance_the_orbit_is_the_integrators(model):
     the balance alone is within 1e-5 of the integrator's settled orbit (18 harmonics: about 1e-3). Not yet
     the diagnosis's default: from the linear start, Newton at this many harmonics stalls with a stiff normal
     dashpot (Hunt-Crossley 300 s/m at lc3), where 72 harmonics converge."""
-    from contactid.gap.model import simulator
+    from contactid.gap.simulation import simulator
 
     aug, rec = EFFECTS["none"], record("lc3")
     sim = simulator(model, aug, FS, F0)

@@ -55,7 +55,7 @@ def test_a_channel_delay_search_holds_the_random_tests_common_delay():
     from types import SimpleNamespace
 
     from contactid.gap.candidates import LIBRARY
-    from contactid.gap.refit import _per_channel_theta
+    from contactid.gap.calibration import _per_channel_theta
 
     truth = np.array([6.7e-6, 13.3e-6, 20.0e-6])
     P = np.eye(3) - np.ones((3, 3)) / 3  # the gap sees only the differences between channels
@@ -141,7 +141,8 @@ def test_a_model_through_a_wide_bracket_does_not_confirm_its_own_minimum(shape, 
 
 
 class _QuadraticRuns:
-    """A calibration's runs (``refit._CandidateRuns``' interface) on a residual vector with its minimum at ``best``."""
+    """A calibration's runs (``calibration._CandidateRuns``' interface) on a residual vector with its minimum at
+    ``best``."""
 
     def __init__(self, best, scale):
         self.best, self.scale, self.thetas = best, scale, []
@@ -161,7 +162,7 @@ def test_a_refit_at_the_end_of_its_range_searches_on_within_the_parameters_domai
     to a transducer mass; the range is widened threefold past the end the optimum reached (alpha: 0-3000 s/m, then
     0-12000 and 0-30000, the domain) and searched again; an optimum inside the range is searched as before."""
     from contactid.gap.candidates import LIBRARY
-    from contactid.gap.refit import _scalar_theta
+    from contactid.gap.calibration import _scalar_theta
 
     run = _QuadraticRuns(best, 1000.0)
     theta = _scalar_theta(run, LIBRARY["normal_contact_damping"], 12)
@@ -191,7 +192,7 @@ def test_channel_delays_beyond_the_librarys_range_are_searched_where_the_random_
     from types import SimpleNamespace
 
     from contactid.gap.candidates import LIBRARY
-    from contactid.gap.refit import _per_channel_theta
+    from contactid.gap.calibration import _per_channel_theta
 
     truth = np.array([4.0e-4, 6.0e-4, 8.0e-4])
     P = np.eye(3) - np.ones((3, 3)) / 3
@@ -213,7 +214,7 @@ def test_an_optimum_the_search_cannot_tell_from_off_is_off(best, expected):
     1e-5, and the two held-out gaps stood 0.88 % apart. An optimum within the tolerance of "off" is "off"; one beyond
     it is kept."""
     from contactid.gap.candidates import LIBRARY
-    from contactid.gap.refit import _scalar_theta
+    from contactid.gap.calibration import _scalar_theta
 
     run = _QuadraticRuns(best, 0.01)
     theta = _scalar_theta(run, LIBRARY["transducer_mass_error"], 12)
@@ -227,7 +228,7 @@ def test_channel_delays_the_search_cannot_tell_from_zero_are_zero():
     from types import SimpleNamespace
 
     from contactid.gap.candidates import LIBRARY
-    from contactid.gap.refit import _per_channel_theta
+    from contactid.gap.calibration import _per_channel_theta
 
     rec = SimpleNamespace(acceleration=np.zeros((3, 9)))
     for truth, zero in (([1e-8, 1.1e-7, -2.6e-7], True), ([1e-8, 1.1e-7, -2.6e-6], False)):

@@ -130,16 +130,16 @@ def test_a_mass_change_refits_k_n_only_where_the_frequencies_feel_it(default_con
 
 
 def test_the_gap_models_reduced_structure_is_built_once_per_structure(default_config):
-    """Every simulation of the diagnosis asks for the reduced model of its structure (``gap.model.simulator``); an
-    unchanged structure is assembled and reduced once (``_reduced`` is memoised: a rebuild, an assembly and an
+    """Every simulation of the diagnosis asks for the reduced model of its structure (``gap.simulation.simulator``); an
+    unchanged structure is assembled and reduced once (``gap.model.reduced`` is memoised: a rebuild, an assembly and an
     eigen-solve, costs about 4 ms, and a diagnosis asks some 500 times)."""
-    from contactid.gap.model import _reduced
+    from contactid.gap.model import reduced
     from contactid.parameters import structure_from_config
 
     p = structure_from_config(default_config["structure"], 1.375e7, 2.686e7)
     q = structure_from_config(default_config["structure"], 1.375e7, 2.686e7)
-    assert _reduced(p, 8) is _reduced(q, 8)
-    assert _reduced(p.with_contact(1.4e7, p.k_n), 8) is not _reduced(p, 8)
+    assert reduced(p, 8) is reduced(q, 8)
+    assert reduced(p.with_contact(1.4e7, p.k_n), 8) is not reduced(p, 8)
 
 
 @pytest.mark.parametrize("scale", [0.97, 1.0, 1.03])

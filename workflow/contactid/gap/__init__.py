@@ -8,10 +8,11 @@ Modules, by role:
   signs, channel order), ``localise`` (where the gap lies: stages, sensors, harmonics, cycle parts), ``evidence``
   (held-out gaps, bootstrap, the records' tests of an update), ``isolability`` (which candidates the records cannot
   tell apart), ``uncertainty`` (the friction law's intervals with a model-form term);
-- model, candidates and searches: ``model`` (the identified model and its forward simulation under the measured
-  force), ``candidates`` (the library of effects), ``refit`` and ``search`` (a candidate's calibration refit),
-  ``workers`` (the candidates' refits in worker processes), ``ranking`` (the first pass's rows), ``pipeline`` (the
-  models a diagnosis of the workflow's files works with);
+- model, candidates and searches: ``model`` (the identified model and its augmentations), ``simulation`` (its
+  steady-state simulation under the measured force), ``candidates`` (the library of effects), ``refit`` (the chain
+  redone with an effect in the model, and the gap), ``calibration`` and ``search`` (a candidate's calibration
+  searches), ``workers`` (the candidates' refits in worker processes), ``ranking`` (the first pass's rows),
+  ``pipeline`` (the models a diagnosis of the workflow's files works with);
 - decisions: ``verdict`` (where the gap lies, whether a step explains materially), ``explain`` (the additive
   explanation and the model it arrives at), ``story`` (the verdict told from the explanation, with its trace and the
   resolution);

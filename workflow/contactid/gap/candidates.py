@@ -231,7 +231,7 @@ def joint_candidate(new: Candidate, earlier, n_channels: int) -> tuple[Candidate
     second effect (viscous friction taking on a normal dashpot's dissipation) can give it back. Returns (the
     candidate, split), split(theta) -> [theta of new, theta of each earlier step]. Every parameter has a start
     (new's: off, zero or its range's low end, unless it gives one), so the search also starts from the earlier
-    step's optimum itself (``refit.calibrate``)."""
+    step's optimum itself (``calibration.calibrate``)."""
 
     def expand(c: Candidate, theta=None):
         params = c.parameters * (n_channels if c.per_channel else 1)

@@ -13,11 +13,12 @@ import numpy as np
 from ..friction_fit import FitSettings
 from ..random_streams import generator
 from ..rig.harmonic_balance import HarmonicBalance
+from .calibration import calibrate
 from .candidates import LIBRARY
 from .localise import _rel, record_drift
 from .model import NONE, Augmentation, IdentifiedModel
 from .records import RecordHarmonics
-from .refit import baseline, calibrate, evaluate
+from .refit import baseline, evaluate
 from .verdict import DEFAULT_PLACE, UPDATING_EFFECTS, PlaceThresholds, records_carry_factor
 
 if TYPE_CHECKING:

@@ -1,11 +1,12 @@
 """The gap diagnosis's numerical settings: how a steady state is found and how a candidate's calibration search runs.
 
 ``Numerics`` is handed down explicitly, from the diagnosis's settings (``GapSettings.numerics``, built from the
-config's ``gap`` block) through the candidates' workers, ``refit.calibrate`` / ``evaluate`` / ``baseline`` and the
-searches, to ``model.simulate``. None of its fields changes what the diagnosis models; each trades time against how
-closely the diagnosis follows its time-marching reference. Fields (the default first):
+config's ``gap`` block) through the candidates' workers, ``calibration.calibrate``, ``refit.evaluate`` / ``baseline``
+and the searches, to ``simulation.simulate``. None of its fields changes what the diagnosis models; each trades time
+against how closely the diagnosis follows its time-marching reference. Fields (the default first):
 
-steady_state ("harmonic_balance"): how ``model.simulate`` finds a steady state where it is not given ``method``.
+steady_state ("harmonic_balance"): how ``simulation.simulate`` finds a steady state where it is not given
+    ``method``.
     "harmonic_balance" solves the periodic state directly (``rig.harmonic_balance``; within about 1e-3 of the
     integrator's orbit) and, where a simulation is polished, lets the integrator settle from it; "time_marching" (the
     reference, several times slower) integrates from the stuck linear system's state until the harmonics settle.
@@ -13,8 +14,8 @@ closed_contact_hb (True): an unpolished simulation (a calibration search's) of a
     normal law) takes its periodic state where the contact stays closed all period long (N above a tenth of the
     preload); False: such a model is always marched from the linear state, as the reference does (slower, the
     same where the contact opens).
-settling_tol (2e-5): the integrator's settling test where ``model.simulate`` is given no ``tol``: the relative change
-    of the harmonics between 8-period chunks. Smaller: the reference's own scatter shrinks, at more periods per
+settling_tol (2e-5): the integrator's settling test where ``simulation.simulate`` is given no ``tol``: the relative
+    change of the harmonics between 8-period chunks. Smaller: the reference's own scatter shrinks, at more periods per
     simulation (benchmarks/gap_diagnosis.py --reference-scatter halves and doubles it, --tight-tolerance sets it).
 polish_searches (True, config ``gap.polish_searches``): every state a candidate's calibration search compares is
     polished by the integrator, so that the search sees the reference's gaps (held-out gaps within 0.01-0.08 % of

@@ -440,8 +440,9 @@ def records_check_of(model, records: Mapping, calibration_case: str, n_harmonics
     """``record_checks.records_check`` of the records' harmonics ``records`` {case: RecordHarmonics}: their
     accelerances at the drive, and each against ``model``'s prediction at its measured force (harmonics
     1..``n_harmonics``)."""
-    from .model import NONE, simulate
+    from .model import NONE
     from .record_checks import accelerance_levels, model_evidence, records_check
+    from .simulation import simulate
 
     H = int(n_harmonics)
     evidence = {}

@@ -11,11 +11,12 @@ import numpy as np
 
 from ..friction_fit import FitSettings
 from ..rig.harmonic_balance import HarmonicBalance
+from .calibration import calibrate, held
 from .candidates import LIBRARY, joint_candidate, merged_augmentation
 from .model import IdentifiedModel
 from .numerics import DEFAULT, Numerics
 from .records import RecordHarmonics
-from .refit import calibrate, evaluate, gap_residual, gap_value, held
+from .refit import evaluate, gap_residual, gap_value
 
 log = logging.getLogger(__name__)
 
@@ -44,10 +45,11 @@ def _candidate(
     ``alone``: {name: theta} of the first pass (each candidate alone); a joint refit also starts between the
     earlier steps' optimum and this candidate's own (two effects that can stand in for each other, viscous friction
     and a normal dashpot, leave a ridge between the one-effect optimum and the truth). ``channel_delays``: the random
-    test's per-channel delays and ``channel_gains`` its channels' relative gains (``refit.calibrate``). ``held_theta``:
-    the candidate at this theta, not searched (``refit.held``; the earlier steps held). ``numerics``: how the steady
-    states are found and the searches run (``numerics.Numerics``, the diagnosis's ``GapSettings.numerics``; an
-    argument of the task, so that a worker process sees it too). Returns (calibration, sims, residuals) by case."""
+    test's per-channel delays and ``channel_gains`` its channels' relative gains (``calibration.calibrate``).
+    ``held_theta``: the candidate at this theta, not searched (``calibration.held``; the earlier steps held).
+    ``numerics``: how the steady states are found and the searches run (``numerics.Numerics``, the diagnosis's
+    ``GapSettings.numerics``; an argument of the task, so that a worker process sees it too). Returns (calibration,
+    sims, residuals) by case."""
     rec = records[calibration_case]
     # per-channel effects (channel delays) trade off with no contact effect and would add a dimension per channel:
     # they are held, and a per-channel candidate is refitted on the earlier steps held
