@@ -40,3 +40,27 @@ def test_the_history_patterns_find_what_they_should():
     assert HASH.findall("at 84a1b75 and c9b2c73") == ["84a1b75", "c9b2c73"]
     assert not HASH.findall("1234567 deadbee feedface 54.4 Hz")  # digits alone, letters alone
     assert DATE.findall("on 2026-12-04, not 12/04") == ["2026-12-04"]
+
+
+def test_docstrings_and_comments_tell_no_history():
+    """No commit hash or date in the package, the rule scripts or the rules: they state what the code does."""
+    found = []
+    for p in [*(ROOT / "workflow").rglob("*.py"), *(ROOT / "workflow").rglob("*.smk")]:
+        if "__pycache__" in p.parts:
+            continue
+        for n, line in enumerate(p.read_text().splitlines(), 1):
+            if HASH.search(line) or DATE.search(line):
+                found.append(f"{p.relative_to(ROOT)}:{n}")
+    assert not found, found
+
+
+def test_the_user_docs_tell_no_history():
+    """config/README.md and docs/ other than the measurement log: no commit hash, no date."""
+    found = []
+    for p in [ROOT / "config" / "README.md", *(ROOT / "docs").glob("*.md")]:
+        if p.name == "measurements.md":
+            continue
+        for n, line in enumerate(p.read_text().splitlines(), 1):
+            if HASH.search(line) or DATE.search(line):
+                found.append(f"{p.relative_to(ROOT)}:{n}: {line.strip()[:80]}")
+    assert not found, found

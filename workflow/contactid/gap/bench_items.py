@@ -77,8 +77,8 @@ def benchmark_items(cfg: Mapping, seed: int) -> dict:
 
 
 def expected_seconds(spec: Mapping) -> int:
-    """A benchmark item's expected run time (s, on one core of the 2-core reference machine; the blind benchmark
-    at 4e9292c), for the workflow's scheduler to start the long items first so that no core idles at the end
+    """A benchmark item's expected run time (s, on one core of the 2-core reference machine, as the blind benchmark
+    measured it), for the workflow's scheduler to start the long items first so that no core idles at the end
     waiting for one of them (``gap_benchmark_item``'s priority). The rig's truth sets it: a preload drift in a
     compound item (its later passes march whole records: 30-75 s) and a contact that opens (every simulation
     marched from the linear state: 31-38 s) are the long ones; most items take 10-20 s."""

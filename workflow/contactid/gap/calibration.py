@@ -107,8 +107,8 @@ def _per_channel_theta(
 
     Without ``common``: Nelder-Mead on the gap from zero, simplex steps of 10 % of the range. (Least squares on the
     residual vector found a skew's delays more exactly, but also a common delay on every channel, -28 us, that stood
-    in for a normal dashpot's dissipation: the blind benchmark's compound-13-s2 named the channel skew instead of the
-    dashpot; e722a0b.)"""
+    in for a normal dashpot's dissipation: a compound benchmark item named the channel skew instead of the dashpot;
+    docs/measurements.md.)"""
     from scipy.optimize import minimize
 
     j = rec.acceleration.shape[0]

@@ -186,8 +186,8 @@ def records_accept_update(gap_chain: float, gap_updated: float, scatter: float, 
     went to none). gap_chain, gap_updated: held-out gaps of the chain's model and of the
     updated one (each with its friction law refitted); scatter: the sd of the chain's gap over the records'
     bootstrap. Beyond the scatter alone is not enough: on rigs whose structure is the model's, updates fitted to the
-    random test's noise took 2-36 % of a contact effect's gap (multi-asperity friction) and hid the effect (the
-    blind benchmark at b4e8536: top-1 46/48)."""
+    random test's noise took a share of a contact effect's gap (multi-asperity friction) and hid the effect
+    (docs/measurements.md)."""
     if not (np.isfinite(gap_chain) and np.isfinite(gap_updated)) or at_floor(gap_chain, settings):
         return False
     return explains_most(gap_chain, gap_updated, scatter, settings)
