@@ -24,10 +24,9 @@ import yaml
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import measured_project, run_gap_summary
-from independent_rig import contact_scores, contact_text
-
 from contactid.gap.bench_scores import named_effects
 from contactid.gap.story import one_story_holds
+from independent_rig import contact_scores, contact_text
 
 ROOT = Path(__file__).resolve().parents[1]
 CACHE = ROOT / "benchmarks" / "cache"

@@ -110,7 +110,6 @@ def _reference_fit(fit):
     """The friction fit as REFERENCE reads it: one variable ``parameter_value`` over the parameters (today's dataset
     has a variable per parameter, ``contactid.friction_parameters``)."""
     import xarray as xr
-
     from contactid.friction_parameters import PARAMETER_NAMES, fitted_parameters
 
     return xr.Dataset(

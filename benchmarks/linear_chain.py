@@ -17,9 +17,8 @@ import scipy.linalg
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "workflow"))
 
-from contactid.beam_model import assemble  # noqa: E402
 import yaml  # noqa: E402
-
+from contactid.beam_model import assemble  # noqa: E402
 from contactid.config import with_defaults  # noqa: E402
 from contactid.parameters import structure_from_config  # noqa: E402
 

@@ -9,7 +9,6 @@ from pathlib import Path
 
 import numpy as np
 import yaml
-
 from contactid.config import with_defaults
 from contactid.parameters import StructureParameters, structure_from_config
 

@@ -2,7 +2,6 @@ import math
 
 import numpy as np
 import pytest
-
 from contactid.analytic import beam_frequencies_hz, clamped_free_eigenvalues, clamped_pinned_eigenvalues
 from contactid.beam_model import ContactFrequencyMap, assemble, natural_frequencies, shape_on_grid, structural_modes
 from structures import configured_structure, mass_candidate_structure

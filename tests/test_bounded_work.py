@@ -8,7 +8,6 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 import xarray as xr
-
 from contactid.io import RawDataError, WorkLimitError
 from contactid.parameters import structure_from_config
 

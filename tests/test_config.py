@@ -2,10 +2,9 @@ import copy
 from pathlib import Path
 
 import pytest
+from contactid.config import ConfigError, check_config
 from snakemake.exceptions import WorkflowError
 from snakemake.utils import validate
-
-from contactid.config import ConfigError, check_config
 
 SCHEMA = str(Path(__file__).resolve().parents[1] / "workflow" / "schemas" / "config.schema.yaml")
 
@@ -55,7 +54,6 @@ def test_exponent_notation_without_a_point_is_read_as_a_number(default_config):
     """YAML 1.1 (PyYAML, Snakemake) reads 4e-05 as text: where the schema wants a number it becomes one, and the
     config validates; text of that form where text is wanted (a sensor's name) stays text."""
     import yaml
-
     from contactid.config import numbers_written_as_text
 
     cfg = copy.deepcopy(default_config)

@@ -7,7 +7,6 @@ import re
 from pathlib import Path
 
 import yaml
-
 from contactid.config import _filled_empty
 
 ROOT = Path(__file__).resolve().parents[1]

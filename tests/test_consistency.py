@@ -1,5 +1,4 @@
 import pytest
-
 from contactid.consistency import paper_consistency_table
 
 

@@ -1,9 +1,8 @@
 """Finite-difference Jacobians with absolute steps (contactid.finite_differences) against analytic ones."""
 
 import numpy as np
-from scipy.optimize import least_squares
-
 from contactid.finite_differences import central_difference_jacobian, forward_difference_jacobian
+from scipy.optimize import least_squares
 
 
 def fun(x):

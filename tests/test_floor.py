@@ -2,7 +2,6 @@
 
 import pytest
 import yaml
-
 from contactid.gap.floor import FLOOR_FACTOR, floor_rig_config, identification_floor, resolved_gap_config
 from workflow_projects import DEFAULT_CONFIG
 
@@ -81,7 +80,6 @@ def test_a_measured_cases_response_levels_are_read_from_its_record():
     sensors at 0.30, 0.55 and 0.05 m in this file's order)."""
     import numpy as np
     import xarray as xr
-
     from contactid.gap.floor import response_targets
 
     fs, f0, n = 5120.0, 54.375, 8192

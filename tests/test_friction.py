@@ -1,10 +1,8 @@
 import numpy as np
 import pytest
-
 from contactid.contact_laws import NormalLaw, stiction_shear_stiffness
-from scipy.integrate import solve_ivp
-
 from contactid.friction import SINGULAR_GUARD, slip_limit_flag, valanis_friction_force, valanis_slope, valanis_step
+from scipy.integrate import solve_ivp
 
 P = (3.857e7, 2.547e5, 1.0e4, 0.284, 0.397)  # e_f, k_c, e_t, kappa, mu (Table 4, e_t small)
 

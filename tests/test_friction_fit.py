@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-
 from contactid.contact_laws import stiction_shear_stiffness
 from contactid.friction import valanis_friction_force, valanis_friction_force_reference
 from contactid.friction_fit import FitSettings, fit_friction_law

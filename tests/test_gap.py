@@ -5,16 +5,15 @@ import copy
 
 import numpy as np
 import pytest
-
+from contactid.friction_fit import settings_from_config
 from contactid.gap.candidates import LIBRARY, Candidate, Parameter, register
 from contactid.gap.diagnosis import GapSettings, diagnose
 from contactid.gap.localise import linear_stage
 from contactid.gap.model import Augmentation
-from contactid.harmonics import harmonic_amplitudes, periodic_grid, periodic_harmonics
 from contactid.gap.pipeline import identify, rig_records
 from contactid.gap.records import record_harmonics
+from contactid.harmonics import harmonic_amplitudes, periodic_grid, periodic_harmonics
 from contactid.io import raw_dataset
-from contactid.friction_fit import settings_from_config
 
 
 def _synthetic_record(coef_force, coef_acc, f0=50.0, fs=5120.0, n=8192, phase_shift=0.3):
@@ -702,7 +701,6 @@ def test_a_benchmark_item_not_diagnosed_still_gets_its_files_and_figures(tmp_pat
     from pathlib import Path
 
     import xarray as xr
-
     from contactid.gap.benchmark import write_item_diagnosis
     from contactid.gap.figures import failed_item_figures
 
@@ -724,8 +722,8 @@ def test_polish_searches_setting_polishes_every_searched_state(hc_data, monkeypa
     from contactid.gap import calibration
     from contactid.gap.diagnosis import GapSettings
     from contactid.gap.numerics import Numerics
-    from contactid.gap.workers import _candidate_task
     from contactid.gap.refit import baseline
+    from contactid.gap.workers import _candidate_task
 
     cfg, model, records, _ = hc_data
     fit = settings_from_config(cfg["friction"])
@@ -817,8 +815,8 @@ def test_search_finds_the_time_marching_searchs_optimum(hc_data):
     a search on time-marched states within 1 % and reports the integrator's gap there; with every state polished by
     the integrator (``Numerics.polish_searches``, the diagnosis's default) it stops where the time-marching search
     stops, alpha and gap within 0.1 %."""
-    from contactid.gap.numerics import Numerics
     from contactid.gap.calibration import calibrate
+    from contactid.gap.numerics import Numerics
     from contactid.gap.refit import evaluate
 
     cfg, model, records, _ = hc_data

@@ -5,10 +5,9 @@ import dataclasses
 
 import numpy as np
 import pytest
-
 from contactid.gap.model import Augmentation, IdentifiedModel
-from contactid.gap.simulation import simulate
 from contactid.gap.records import RecordHarmonics
+from contactid.gap.simulation import simulate
 from contactid.parameters import structure_from_config
 from contactid.rig.harmonic_balance import HarmonicBalance
 

@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-
 from contactid.beam_model import all_modes, assemble, shortening_matrix, structural_modes
 from contactid.contact_laws import NormalLaw
 from contactid.identification import (

@@ -10,14 +10,13 @@ import json
 import numpy as np
 import pytest
 import yaml
-from hypothesis import HealthCheck, given, settings
-from hypothesis import strategies as st
-
 from contactid.config import ConfigError, check_config
 from contactid.importers import import_record
 from contactid.importers.export import export_record
 from contactid.io import RawDataError, raw_dataset, read_raw, write_dataset
 from contactid.raw_checks import recovered_frequency, samples_at_limit, validate_dual_sine
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 FS, F0, N = 5120.0, 54.375, 16384  # 174 whole periods, as the rig's records
 

@@ -1,7 +1,6 @@
 """The report's LaTeX fragments: text cells escaped, numbers with the digits their uncertainty supports."""
 
 import pandas as pd
-
 from contactid.latex import contact_fragment, escape, macros, significant_digits, tabular
 
 
@@ -99,7 +98,6 @@ def _summary(cases, validation):
 
 def test_the_text_quotes_the_configured_calibration_and_figure_cases_for_any_set_of_load_cases():
     import pandas as pd
-
     from contactid.latex import macros, report_values
 
     cons = pd.DataFrame(columns=["scenario", "max_abs_err_pct", "k_t_n_per_m", "tangential_lever_arm_m"])

@@ -1,6 +1,5 @@
 import numpy as np
 import pytest
-
 from contactid.frf_synthesis import synthesised_accelerance
 from contactid.modal_fit import fit_modes, lsfd_residues, stability_poles
 from contactid.signals import h1_frf
@@ -119,7 +118,6 @@ def test_h1_and_coherence_equal_scipys_welch_and_csd(n, segment_length, overlap,
 @pytest.mark.parametrize("n", [7, 1024, 65536])
 def test_the_periodic_hann_window_is_scipys(n):
     import scipy.signal
-
     from contactid.signals import periodic_window
 
     np.testing.assert_allclose(periodic_window("hann", n), scipy.signal.get_window("hann", n), rtol=0, atol=1e-15)

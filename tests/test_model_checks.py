@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-
 from contactid.beam_model import natural_frequencies
 from contactid.latex import model_checks_text
 from contactid.model_checks import friction_fit_check, model_checks, stiffness_fit_check

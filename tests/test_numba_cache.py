@@ -10,9 +10,8 @@ import subprocess
 import sys
 from pathlib import Path
 
-import pytest
-
 import contactid
+import pytest
 from contactid import numba_cache_dir
 from contactid.io import package_digest
 

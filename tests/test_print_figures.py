@@ -8,12 +8,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 import xarray as xr
-
 from contactid import print_style as ps
 from contactid.friction_parameters import parameter_dataset
 from contactid.modal_figures import plot_fig03, plot_stability
-from contactid.studies import QUANTITIES, plot_noise_study, report_section
 from contactid.paper_figures import plot_fig04, plot_fig05, plot_fig06, plot_friction_figures
+from contactid.studies import QUANTITIES, plot_noise_study, report_section
 
 REPORT = Path(__file__).resolve().parents[1] / "paper" / "report.tex"
 FIGURES = [
@@ -318,9 +317,8 @@ def _where_for_text(diag: dict) -> dict:
 def test_the_ranking_clips_a_candidate_without_effect_at_before_and_draws_min_gap_and_the_scatter(caught):
     """Read back from the Axes: a candidate whose held-out gap after is at or above before ends at before,
     labelled no effect; the effective one ends at its own gap; the lines sit at the diagnosis' values (%)."""
-    from matplotlib.patches import Rectangle
-
     from contactid.gap import figures
+    from matplotlib.patches import Rectangle
 
     figures.ranking(_gap_diagnosis(), "gap_ranking.png")
     ax = caught["gap_ranking"].axes[0]

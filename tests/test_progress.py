@@ -7,7 +7,6 @@ import sys
 
 import numpy as np
 import pytest
-
 from contactid.friction import valanis_friction_force
 from contactid.friction_fit import FitSettings, fit_friction_law
 from contactid.logs import fmt, setup_logging

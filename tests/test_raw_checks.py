@@ -5,7 +5,6 @@ warning. Small synthetic records: 20 periods of 54 Hz at 5400 Hz (100 samples a 
 
 import numpy as np
 import pytest
-
 from contactid.io import RawDataError, raw_dataset, read_raw
 from contactid.raw_checks import (
     excitation_lines,
@@ -282,7 +281,6 @@ def test_a_driving_point_accelerance_of_the_wrong_sign_is_a_warning():
     the force's sign flipped makes it negative there: a warning naming the driving point and its resonances. A
     sensor off the driving point may have either sign."""
     import xarray as xr
-
     from contactid.raw_checks import driving_point_sign_warnings
 
     f = np.linspace(1.0, 500.0, 4000)
@@ -311,7 +309,6 @@ def test_a_record_far_from_the_random_tests_level_is_refused_naming_units():
     (slip moves and damps a resonance) it passes, whichever way; 1000 times off (mm/s^2 labelled m/s^2) it is refused
     before identification, whose inverse problem would overflow on it."""
     import xarray as xr
-
     from contactid.raw_checks import LEVEL_FACTOR_LIMIT, frf_level_check
 
     f = np.linspace(1.0, 500.0, 500)

@@ -3,7 +3,6 @@ synthetic harmonics, where the answer is known by construction."""
 
 import numpy as np
 import pytest
-
 from contactid.config import schema_defaults
 from contactid.gap.record_checks import (
     RECORDS_DISAGREE,

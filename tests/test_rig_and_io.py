@@ -2,7 +2,6 @@ import copy
 
 import numpy as np
 import pytest
-
 from contactid.io import RawDataError, raw_dataset, read_raw, write_dataset
 from contactid.rig.random_test import random_test_datasets
 
@@ -30,7 +29,6 @@ def test_the_modal_sum_is_lfilter_mode_by_mode_bit_for_bit(damping):
     # numbers scipy.signal.lfilter gives mode by mode, summed over the modes in order: the rig's records stay the
     # same to the last bit
     import scipy.signal
-
     from contactid.beam_model import assemble
     from contactid.rig.random_test import modal_acceleration_filters, modal_acceleration_sum
     from structures import configured_structure

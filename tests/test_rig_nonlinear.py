@@ -4,7 +4,6 @@ import copy
 
 import numpy as np
 import pytest
-
 from contactid.io import RawDataError, read_raw, write_dataset
 from contactid.rig.checks import convergence_study, effect_study, low_level_frf_check
 from contactid.rig.dual_sine import dual_sine_settings, dual_sine_test

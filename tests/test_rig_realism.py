@@ -5,7 +5,6 @@ import copy
 
 import numpy as np
 import pytest
-
 from contactid.config import ConfigError, check_config
 from contactid.parameters import structure_from_config
 from contactid.rig.damping import damping_ratios

@@ -12,7 +12,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 import xarray as xr
-
 from contactid.io import write_dataset
 from workflow_projects import copy_project
 

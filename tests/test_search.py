@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-
 from contactid.gap.search import quadratic_model_minimum, residual_line_search
 
 
@@ -54,8 +53,8 @@ def test_a_channel_delay_search_holds_the_random_tests_common_delay():
     from zero and ends wherever along the common direction."""
     from types import SimpleNamespace
 
-    from contactid.gap.candidates import LIBRARY
     from contactid.gap.calibration import _per_channel_theta
+    from contactid.gap.candidates import LIBRARY
 
     truth = np.array([6.7e-6, 13.3e-6, 20.0e-6])
     P = np.eye(3) - np.ones((3, 3)) / 3  # the gap sees only the differences between channels
@@ -161,8 +160,8 @@ def test_a_refit_at_the_end_of_its_range_searches_on_within_the_parameters_domai
     """A normal dashpot of 5000 s/m on the rig was refitted to the library range's 3000 and left a quarter of its gap
     to a transducer mass; the range is widened threefold past the end the optimum reached (alpha: 0-3000 s/m, then
     0-12000 and 0-30000, the domain) and searched again; an optimum inside the range is searched as before."""
-    from contactid.gap.candidates import LIBRARY
     from contactid.gap.calibration import _scalar_theta
+    from contactid.gap.candidates import LIBRARY
 
     run = _QuadraticRuns(best, 1000.0)
     theta = _scalar_theta(run, LIBRARY["normal_contact_damping"], 12)
@@ -191,8 +190,8 @@ def test_channel_delays_beyond_the_librarys_range_are_searched_where_the_random_
     +-0.2 ms clipped them to 0.2 ms each, a common error of 0.4 ms)."""
     from types import SimpleNamespace
 
-    from contactid.gap.candidates import LIBRARY
     from contactid.gap.calibration import _per_channel_theta
+    from contactid.gap.candidates import LIBRARY
 
     truth = np.array([4.0e-4, 6.0e-4, 8.0e-4])
     P = np.eye(3) - np.ones((3, 3)) / 3
@@ -213,8 +212,8 @@ def test_an_optimum_the_search_cannot_tell_from_off_is_off(best, expected):
     the other (its tolerance is 1e-3 of the range, 3.9e-3): any mass change refits the stiffness, which moves k_t by
     1e-5, and the two held-out gaps stood 0.88 % apart. An optimum within the tolerance of "off" is "off"; one beyond
     it is kept."""
-    from contactid.gap.candidates import LIBRARY
     from contactid.gap.calibration import _scalar_theta
+    from contactid.gap.candidates import LIBRARY
 
     run = _QuadraticRuns(best, 0.01)
     theta = _scalar_theta(run, LIBRARY["transducer_mass_error"], 12)
@@ -227,8 +226,8 @@ def test_channel_delays_the_search_cannot_tell_from_zero_are_zero():
     channel beyond it keeps every channel's value (the search starts from the random test's delays)."""
     from types import SimpleNamespace
 
-    from contactid.gap.candidates import LIBRARY
     from contactid.gap.calibration import _per_channel_theta
+    from contactid.gap.candidates import LIBRARY
 
     rec = SimpleNamespace(acceleration=np.zeros((3, 9)))
     for truth, zero in (([1e-8, 1.1e-7, -2.6e-7], True), ([1e-8, 1.1e-7, -2.6e-6], False)):

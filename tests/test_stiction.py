@@ -2,7 +2,6 @@ import math
 
 import numpy as np
 import pytest
-
 from contactid.beam_model import natural_frequencies
 from contactid.stiction import frequency_sigma, stiction_stiffness
 from structures import configured_structure

@@ -2,7 +2,6 @@
 on hand-made numbers (milliseconds). tests/test_gap.py checks the same decisions on rig data."""
 
 import pytest
-
 from contactid.gap.story import held_out, one_story_holds, resolution, tell
 
 SETTINGS = {"min_gap": 0.006, "noise_factor": 3.0, "min_reduction": 0.5, "separation": 1.5}  # the config's defaults

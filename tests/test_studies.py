@@ -6,7 +6,6 @@ import numpy as np
 import pytest
 import xarray as xr
 import yaml
-
 from contactid.studies import e0_at, noise_study_table
 from workflow_projects import make_project, snakemake
 

@@ -4,7 +4,6 @@ on rig records damped otherwise in their dual-sine tests (slow); the default run
 
 import numpy as np
 import pytest
-
 from contactid.friction_fit import FitSettings
 from contactid.test_damping import (
     DampingProfile,

@@ -5,7 +5,6 @@ import dataclasses
 
 import numpy as np
 import pytest
-
 from contactid.friction_fit import FitSettings
 from contactid.gap.uncertainty import (
     NAMES,

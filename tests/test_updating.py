@@ -3,7 +3,6 @@ a known structure."""
 
 import numpy as np
 import pytest
-
 from contactid.gap.diagnosis import GapSettings
 from contactid.gap.explain import _updating_step
 from contactid.parameters import structure_from_config
@@ -247,9 +246,8 @@ def test_the_updates_bar_is_the_null_quantile_of_its_chi2_drop_with_factors_the_
     # factor the data bind, one they leave at its prior, one half bound and one correlated with the first. Drawn
     # under the nominal structure, the drop from the contact-only fit to the full fit exceeds the bar in 5 % of draws;
     # chi^2_4's bar, every factor counted whole, would accept a nominal structure far less often than stated
-    from scipy.stats import chi2
-
     from contactid.updating import chi2_drop_threshold, null_drop_weights
+    from scipy.stats import chi2
 
     rng = np.random.default_rng(7)
     n = 12

@@ -4,7 +4,6 @@ check the same decisions on rig data."""
 
 import numpy as np
 import pytest
-
 from contactid.gap import verdict as V
 from contactid.gap.verdict import place
 

@@ -10,7 +10,6 @@ import shutil
 import numpy as np
 import pytest
 import yaml
-
 from workflow_projects import (
     NUMBERS,
     copy_project,
@@ -452,7 +451,6 @@ def test_report_pdf_and_generated_numbers(default_run):
 
 def test_audit_passes_clean_and_flags_a_hand_edit(default_run, tmp_path):
     import netCDF4
-
     from contactid.audit import audit
 
     clean = audit([default_run / "results", default_run / "data"], root=default_run)
@@ -545,7 +543,6 @@ def test_chain_on_measured_frfs_identifies_the_time_records_modes(small_run, mea
     stiffness fit identify the small run's natural frequencies and damping; the FRFs written back out
     (frf_measured.uff, frf_synthesised.uff) read back with pyuff on the same lines."""
     import xarray as xr
-
     from contactid.linear_chain import complex_frf
     from test_importers import _frf_sets
     from workflow_projects import FRF_FILE_TARGETS
@@ -575,7 +572,6 @@ def test_no_table_cell_prints_more_digits_than_its_interval_supports(default_run
     import re
 
     import pandas as pd
-
     from contactid.latex import significant_digits
 
     def digits(cell: str) -> int:

@@ -605,7 +605,7 @@ def _newton(x0, d, Q, gs, gds, G, Hv, xi_n, S_n, N_n, K, sa, sb, qA, qB, qC, h, 
 
 
 @njit(cache=True)
-def run_steps(
+def run_steps(  # noqa: C901
     nsteps,
     n0,
     h,

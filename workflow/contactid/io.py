@@ -261,7 +261,7 @@ def _uniform_time(t: np.ndarray, stored_dtype: np.dtype, fs: float, fail) -> np.
     return grid
 
 
-def read_raw(
+def read_raw(  # noqa: C901
     path: str | os.PathLike, dual_sine: bool = False, min_samples: int = 16, min_periods: int = 8, max_harmonic: int = 1
 ) -> xr.Dataset:
     """Load and check a raw record; raise :class:`RawDataError` naming the file,

@@ -7,8 +7,8 @@ import numpy as np
 import xarray as xr
 
 from . import print_style as ps
-from .linear_chain import complex_frf
 from .frf_synthesis import synthesised_accelerance
+from .linear_chain import complex_frf
 from .modal_fit import StabilityPoles, stability_poles
 
 

@@ -11,8 +11,8 @@ from typing import Mapping
 import numpy as np
 import xarray as xr
 
-from .io import RawDataError
 from .harmonics import harmonic_amplitudes, harmonic_content, synthesize
+from .io import RawDataError
 
 
 def driving_point_index(raw: xr.Dataset, excitation_position_m: float, path: str, tol_m: float = 1e-3) -> int:

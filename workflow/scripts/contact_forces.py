@@ -3,7 +3,6 @@
 import json
 
 import numpy as np
-
 from contactid.io import RawDataError, load_dataset, nonfinite_variables, provenance, read_raw, write_dataset
 from contactid.logs import fmt, setup_logging
 from contactid.nonlinear_chain import contact_forces_dataset

@@ -3,7 +3,6 @@
 import json
 
 import numba
-
 from contactid.gap.benchmark import run_item
 from contactid.gap.floor import read_floor, resolved_gap_config
 from contactid.gap.output import _clean

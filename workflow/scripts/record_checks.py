@@ -3,8 +3,8 @@ model's prediction at each record's measured force (units factor, sign, channel 
 
 import json
 
-from contactid.gap.record_checks import Thresholds
 from contactid.gap.pipeline import workflow_record_checks
+from contactid.gap.record_checks import Thresholds
 from contactid.io import provenance, write_text
 from contactid.logs import setup_logging
 

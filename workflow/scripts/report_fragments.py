@@ -4,7 +4,6 @@ import json
 from pathlib import Path
 
 import pandas as pd
-
 from contactid.gap.report import explained_law_note, updated_law_note
 from contactid.latex import (
     contact_fragment,

@@ -7,7 +7,6 @@ from contactid.model_checks import stiffness_fit_check
 from contactid.parameters import structure_from_config
 from contactid.stiction import random_test_source, refuse_unreachable
 
-
 log = setup_logging(snakemake.log[0])
 p = snakemake.params
 modal = load_dataset(snakemake.input.modal)

@@ -5,7 +5,6 @@ import json
 from contactid.io import load_dataset
 from contactid.logs import setup_logging
 from contactid.model_checks import model_checks
-from contactid.test_damping import damping_summary
 from contactid.reporting import (
     contact_force_summary,
     friction_summary,
@@ -14,6 +13,7 @@ from contactid.reporting import (
     model_form_summary,
     records_check_summary,
 )
+from contactid.test_damping import damping_summary
 
 log = setup_logging(snakemake.log[0])
 inp = snakemake.input

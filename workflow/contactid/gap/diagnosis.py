@@ -21,8 +21,14 @@ from ..friction_fit import FitSettings
 from ..rig.harmonic_balance import HarmonicBalance
 from .candidates import LIBRARY
 from .evidence import bootstrap_draws, heldout_gap_draws, heldout_gap_of, shrink_views
-from .explain import _updating_step, _updating_summary, _updating_verdict, explain, model_periodicity
-from .explain import updated_model_summary
+from .explain import (
+    _updating_step,
+    _updating_summary,
+    _updating_verdict,
+    explain,
+    model_periodicity,
+    updated_model_summary,
+)
 from .isolability import isolability, signature
 from .localise import _place_left, localise
 from .model import IdentifiedModel

@@ -78,7 +78,7 @@ def model_periodicity(cal, sims: Mapping, records: Mapping, calibration_case: st
     return {"aperiodic_by_case": runs, "settles_unlike_records": unlike}
 
 
-def explain(
+def explain(  # noqa: C901
     first: dict,
     names: list,
     before: float,

@@ -10,7 +10,6 @@ import xarray as xr
 
 from .diagnosis import Diagnosis
 
-
 # the force-state maps, one variable per field (name, units, what): the identified motion and what the laws leave
 MAP_FIELDS = (
     ("xi", "m", "identified tangential motion xi"),

@@ -23,7 +23,6 @@ from .numerics import DEFAULT, Numerics
 from .records import RecordHarmonics
 from .simulation import SimResult, simulate
 
-
 # ------------------------------------------------------------------------------------------
 # the gap
 # ------------------------------------------------------------------------------------------

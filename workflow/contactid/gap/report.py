@@ -9,7 +9,8 @@ from __future__ import annotations
 
 import pandas as pd
 
-from ..latex import _fmt, plain_text as _t, tabular
+from ..latex import _fmt, tabular
+from ..latex import plain_text as _t
 from .report_benchmark import benchmark_text
 from .report_diagnosis import diagnosis_paragraphs
 from .report_format import num

@@ -4,7 +4,8 @@ against its bar, accepted or not and by what, what the data bind, the channels' 
 
 from __future__ import annotations
 
-from ..latex import _fmt, plain_text as _t
+from ..latex import _fmt
+from ..latex import plain_text as _t
 from .report_format import num, pct
 from .verdict import at_floor
 

@@ -4,7 +4,8 @@ step with the measured floor; the base model's paragraph is ``report_base_model`
 
 from __future__ import annotations
 
-from ..latex import _fmt, plain_text as _t
+from ..latex import _fmt
+from ..latex import plain_text as _t
 from .report_base_model import updating_paragraph
 from .report_format import num, pct
 from .verdict import never_opens

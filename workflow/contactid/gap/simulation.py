@@ -27,7 +27,6 @@ from .model import Augmentation, IdentifiedModel, reduced
 from .numerics import DEFAULT, Numerics
 from .records import RecordHarmonics
 
-
 # what a model too stiff to integrate (``simulator``) says of its origin
 IMPLAUSIBLE_MODEL = (
     "No pin has such a contact stiffness: the model's stiffnesses and masses come from the random test (the stiffness "

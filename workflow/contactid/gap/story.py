@@ -279,7 +279,7 @@ def _step_kind(step: Mapping, update_effect: str | None, model_form: Sequence[st
     return "effect"
 
 
-def tell(
+def tell(  # noqa: C901
     steps: Sequence[Mapping],
     rows: Sequence[Mapping],
     *,

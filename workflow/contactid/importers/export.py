@@ -13,7 +13,7 @@ import numpy as np
 import xarray as xr
 import yaml
 
-from .channels import PHYSICAL, ELECTRICAL
+from .channels import ELECTRICAL, PHYSICAL
 
 # how each quantity is stored: (units, sensitivity, sensitivity_units); the default is SI
 SI = {"force": ("N", None, None), "acceleration": ("m/s^2", None, None)}

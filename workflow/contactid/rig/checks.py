@@ -9,7 +9,7 @@ from typing import Mapping
 import numpy as np
 import pandas as pd
 
-from ..beam_model import assemble, all_modes
+from ..beam_model import all_modes, assemble
 from ..harmonics import harmonic_amplitudes
 from .damping import dual_sine_damping_ratios
 from .dual_sine import build_simulator, dual_sine_settings, dual_sine_test

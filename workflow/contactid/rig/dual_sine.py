@@ -15,12 +15,12 @@ import xarray as xr
 
 from ..beam_model import assemble
 from ..contact_laws import NormalLaw, ValanisParameters
+from ..harmonics import harmonic_amplitudes
 from ..io import raw_dataset
 from ..random_streams import generator
 from .damping import dual_sine_damping_ratios
 from .effects import effect_magnitudes
 from .frontend import add_noise, anti_alias_decimate, delay_channels
-from ..harmonics import harmonic_amplitudes
 from .nonlinear import (
     ContactParameters,
     ControlResult,
