@@ -23,7 +23,8 @@ sys.path.insert(0, os.path.join(workflow.basedir, "workflow"))
 configfile: "config/config.yaml"
 
 
-from contactid.config import duplicate_key_errors, numbers_written_as_text
+from contactid.config import duplicate_key_errors
+from contactid.schema import numbers_written_as_text
 
 # a key given twice in a config file (a second `lc2:`) is kept last by every YAML reader, silently: refused, with
 # the file and lines (the config file and every --configfile merged over it)

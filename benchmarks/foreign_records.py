@@ -37,7 +37,7 @@ FRICTION = {"mu": "mu", "kappa": "kappa", "e_t": "e_t_n_per_m", "e_f": "e_f_n_pe
 def project(name: str, folder: Path) -> Path:
     """A copy of the project whose config is config/config.yaml with the set's overlay merged over it (paths made
     absolute), as `snakemake --configfile` would read it."""
-    from contactid.config import merged_over
+    from contactid.schema import merged_over
 
     overlay = yaml.safe_load((folder / "config.yaml").read_text())
     for block in [overlay["random_test"], *overlay["load_cases"].values()]:

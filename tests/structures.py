@@ -9,8 +9,8 @@ from pathlib import Path
 
 import numpy as np
 import yaml
-from contactid.config import with_defaults
 from contactid.parameters import StructureParameters, structure_from_config
+from contactid.schema import with_defaults
 
 ROOT = Path(__file__).resolve().parents[1]
 

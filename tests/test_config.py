@@ -2,7 +2,8 @@ import copy
 from pathlib import Path
 
 import pytest
-from contactid.config import ConfigError, check_config
+from contactid.config import check_config
+from contactid.schema import ConfigError
 from snakemake.exceptions import WorkflowError
 from snakemake.utils import validate
 
@@ -54,7 +55,7 @@ def test_exponent_notation_without_a_point_is_read_as_a_number(default_config):
     """YAML 1.1 (PyYAML, Snakemake) reads 4e-05 as text: where the schema wants a number it becomes one, and the
     config validates; text of that form where text is wanted (a sensor's name) stays text."""
     import yaml
-    from contactid.config import numbers_written_as_text
+    from contactid.schema import numbers_written_as_text
 
     cfg = copy.deepcopy(default_config)
     cfg["rig"]["effects"] = yaml.safe_load("channel_time_skew: 4e-05")
@@ -75,8 +76,8 @@ def test_a_config_without_its_optional_blocks_runs_at_the_schemas_defaults(defau
     """The schema is the one home of the defaults: a config of the required keys alone gets every optional block
     at its documented defaults, the same from the Snakefile's validation and from ``with_defaults`` (code run
     outside Snakemake), and the linear chain uses them (frf.segment_length 65536, not an older fallback)."""
-    from contactid.config import with_defaults
     from contactid.gap import pipeline
+    from contactid.schema import with_defaults
 
     minimal = {"seed": default_config["seed"], "structure": copy.deepcopy(default_config["structure"])}
     filled = with_defaults(minimal)
@@ -105,10 +106,10 @@ def test_a_config_without_its_optional_blocks_runs_at_the_schemas_defaults(defau
 def test_the_settings_records_left_empty_equal_the_schemas_defaults(default_config):
     """The settings records still fall back to their own field defaults where a key is missing: those must be the
     schema's (the gap diagnosis, the friction fit, the rig's random test)."""
-    from contactid.config import with_defaults
     from contactid.friction_fit import settings_from_config as fit_settings
-    from contactid.gap.diagnosis import GapSettings
+    from contactid.gap.settings import GapSettings
     from contactid.rig.random_test import settings_from_config as random_test_settings
+    from contactid.schema import with_defaults
 
     filled = with_defaults({"seed": default_config["seed"], "structure": default_config["structure"]})
     assert GapSettings.from_config({}, 1, 25) == GapSettings.from_config(filled["gap"], 1, 25)
@@ -201,7 +202,7 @@ def test_duplicate_keys_are_named_with_their_lines(tmp_path):
 
 
 def test_an_overlay_merges_as_snakemake_merges_it():
-    from contactid.config import merged_over
+    from contactid.schema import merged_over
 
     base = {"a": {"b": 1, "c": [1, 2]}, "d": 1}
     assert merged_over(base, {"a": {"c": [3]}, "e": {"f": 1}}) == {"a": {"b": 1, "c": [3]}, "d": 1, "e": {"f": 1}}

@@ -7,7 +7,7 @@ import re
 from pathlib import Path
 
 import yaml
-from contactid.config import _filled_empty
+from contactid.schema import filled_defaults
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -22,7 +22,7 @@ def _leaves(node, prefix=""):
 
 def _schema_defaults() -> dict:
     # load_cases is the user's data (a mapping of cases), not a setting with a default value
-    return {k: v for k, v in _leaves(_filled_empty()) if not k.startswith("load_cases")}
+    return {k: v for k, v in _leaves(filled_defaults()) if not k.startswith("load_cases")}
 
 
 def _split_top(cell: str, n: int) -> list:

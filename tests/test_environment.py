@@ -80,6 +80,18 @@ def test_the_python_code_is_formatted_and_passes_the_linter():
         assert out.returncode == 0, f"ruff {' '.join(args)}:\n{out.stdout[-3000:]}{out.stderr[-1000:]}"
 
 
+def test_the_package_keeps_its_layers_and_no_cycle():
+    """import-linter's contracts (pyproject.toml, [tool.importlinter]): the package's layers, deferred imports
+    included, and no cycle among the modules of a subpackage."""
+    import subprocess
+    import sys
+
+    out = subprocess.run(
+        [Path(sys.executable).parent / "lint-imports", "--no-cache"], cwd=ROOT, capture_output=True, text=True
+    )
+    assert out.returncode == 0, f"lint-imports:\n{out.stdout[-4000:]}{out.stderr[-1000:]}"
+
+
 @pytest.mark.slow
 def test_the_workflow_is_formatted_linted_and_documents_every_rule():
     """`snakefmt --no-sort --check` (pyproject.toml: line length 120) and `snakemake --lint` clean over the

@@ -7,11 +7,12 @@ import numpy as np
 import pytest
 from contactid.friction_fit import settings_from_config
 from contactid.gap.candidates import LIBRARY, Candidate, Parameter, register
-from contactid.gap.diagnosis import GapSettings, diagnose
+from contactid.gap.diagnosis import diagnose
 from contactid.gap.localise import linear_stage
 from contactid.gap.model import Augmentation
 from contactid.gap.pipeline import identify, rig_records
 from contactid.gap.records import record_harmonics
+from contactid.gap.settings import GapSettings
 from contactid.harmonics import harmonic_amplitudes, periodic_grid, periodic_harmonics
 from contactid.io import raw_dataset
 
@@ -720,9 +721,9 @@ def test_polish_searches_setting_polishes_every_searched_state(hc_data, monkeypa
     """gap.polish_searches reaches the candidate's search (``GapSettings.numerics``, an argument of the task, so that a
     worker process sees it too): every state compared is polished (the default); set false, only the optimum is."""
     from contactid.gap import calibration
-    from contactid.gap.diagnosis import GapSettings
     from contactid.gap.numerics import Numerics
     from contactid.gap.refit import baseline
+    from contactid.gap.settings import GapSettings
     from contactid.gap.workers import _candidate_task
 
     cfg, model, records, _ = hc_data

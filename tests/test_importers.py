@@ -10,11 +10,12 @@ import json
 import numpy as np
 import pytest
 import yaml
-from contactid.config import ConfigError, check_config
+from contactid.config import check_config
 from contactid.importers import import_record
 from contactid.importers.export import export_record
 from contactid.io import RawDataError, raw_dataset, read_raw, write_dataset
 from contactid.raw_checks import recovered_frequency, samples_at_limit, validate_dual_sine
+from contactid.schema import ConfigError
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -389,9 +390,9 @@ G = 9.80665
 @pytest.fixture(scope="module")
 def rig_frf(small_config):
     """The rig's FRF dataset (results/linear/frf.nc's form) of a 3.2 s random test on the small config."""
-    from contactid.config import with_defaults
     from contactid.linear_chain import frf_dataset
     from contactid.rig.random_test import random_test_datasets
+    from contactid.schema import with_defaults
 
     cfg = with_defaults(small_config)
     cfg["random_test"]["duration_s"] = 3.2

@@ -3,7 +3,6 @@ synthetic harmonics, where the answer is known by construction."""
 
 import numpy as np
 import pytest
-from contactid.config import schema_defaults
 from contactid.gap.record_checks import (
     RECORDS_DISAGREE,
     Thresholds,
@@ -12,6 +11,7 @@ from contactid.gap.record_checks import (
     model_evidence,
     records_check,
 )
+from contactid.schema import schema_defaults
 
 SENSORS = ("a1", "a2", "a3")
 

@@ -5,7 +5,7 @@ import copy
 
 import numpy as np
 import pytest
-from contactid.config import ConfigError, check_config
+from contactid.config import check_config
 from contactid.parameters import structure_from_config
 from contactid.rig.damping import damping_ratios
 from contactid.rig.dual_sine import contact_parameters, dual_sine_test
@@ -13,6 +13,7 @@ from contactid.rig.harmonic_balance import _normal_path
 from contactid.rig.nonlinear import _normal_force
 from contactid.rig.random_test import random_test_datasets
 from contactid.rig.structure import rig_structure
+from contactid.schema import ConfigError
 
 FS = 5120.0
 PERTURBED = {

@@ -98,9 +98,9 @@ def test_a_rig_damped_otherwise_in_its_dual_sine_tests_than_in_its_random_test_i
     import copy
 
     from contactid.friction_fit import settings_from_config
-    from contactid.gap.diagnosis import GapSettings
     from contactid.gap.pipeline import identify, rig_records, test_level_damping
     from contactid.gap.records import record_harmonics
+    from contactid.gap.settings import GapSettings
     from contactid.test_damping import SCALES
 
     cases = ["lc1", "lc2", "lc3"]

@@ -3,8 +3,8 @@ a known structure."""
 
 import numpy as np
 import pytest
-from contactid.gap.diagnosis import GapSettings
 from contactid.gap.explain import _updating_step
+from contactid.gap.settings import GapSettings
 from contactid.parameters import structure_from_config
 from contactid.updating import FACTORS, UpdatingResult, apply_factors, modal_predictions, update_structure
 

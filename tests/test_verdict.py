@@ -93,7 +93,7 @@ def test_the_checks_come_in_order_drift_structure_opening_normal():
 
 def test_the_place_thresholds_are_settings():
     """gap.place sets each threshold: the same records placed otherwise under other thresholds."""
-    from contactid.gap.diagnosis import GapSettings
+    from contactid.gap.settings import GapSettings
 
     settings = GapSettings.from_config(
         {"place": {"drift_z": 10.0, "residual_factor": 30.0, "normal_limit": 0.4, "open_limit": 0.1}}, 1, 25

@@ -20,16 +20,8 @@ def check_config_main(argv) -> int:
     import jsonschema
     import yaml
 
-    from .config import (
-        SCHEMA,
-        ConfigError,
-        _load_schema,
-        check_config,
-        duplicate_key_errors,
-        merged_over,
-        numbers_written_as_text,
-        with_defaults,
-    )
+    from .config import check_config, duplicate_key_errors
+    from .schema import SCHEMA, ConfigError, load_schema, merged_over, numbers_written_as_text, with_defaults
 
     parser = argparse.ArgumentParser(prog="contactid check-config", description=check_config_main.__doc__)
     parser.add_argument("config", nargs="?", default="config/config.yaml", help="the config file (YAML)")
@@ -59,7 +51,7 @@ def check_config_main(argv) -> int:
         print(f"{name}: {key}: read as the number {value!r} (write exponents with a decimal point: 4.0e-05)")
     filled = with_defaults(cfg)
     errors = sorted(
-        jsonschema.Draft202012Validator(_load_schema(SCHEMA)).iter_errors(filled), key=lambda e: list(e.path)
+        jsonschema.Draft202012Validator(load_schema(SCHEMA)).iter_errors(filled), key=lambda e: list(e.path)
     )
     for e in errors:
         print(f"{name}: {'.'.join(str(p) for p in e.path) or '(top level)'}: {e.message}")

@@ -6,123 +6,11 @@ Snakefile calls :func:`check_config` before any rule runs.
 
 from __future__ import annotations
 
-import copy
-import functools
 import os
-import re
-from pathlib import Path
 from typing import Mapping
 
 from .measured_files import record_blocks
-
-# the one home of every default: the schema's ``default``s (every optional block defaults to {}, so that its keys'
-# defaults fill in where the block is left out); the Snakefile's validation fills them into the workflow's config,
-# ``with_defaults`` into a config used outside Snakemake
-SCHEMA = Path(__file__).resolve().parents[1] / "schemas" / "config.schema.yaml"
-
-
-class ConfigError(ValueError):
-    """An inconsistent configuration."""
-
-
-# a number in exponent notation without a decimal point (4e-05): YAML 1.1, which PyYAML and Snakemake read, takes it
-# for text; YAML 1.2 and every other reader for a number
-_EXPONENT_NUMBER = re.compile(r"^[-+]?(\d+|\d+\.\d*|\.\d+)[eE][-+]?\d+$")
-
-
-def _load_schema(schema) -> dict:
-    if isinstance(schema, Mapping):
-        return dict(schema)
-    return copy.deepcopy(_schema_file(str(Path(schema).resolve())))
-
-
-@functools.lru_cache(maxsize=4)
-def _schema_file(path: str) -> dict:
-    import yaml
-
-    with open(path) as fh:
-        return yaml.load(fh, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
-
-
-def with_defaults(cfg: Mapping, schema=SCHEMA) -> dict:
-    """A copy of ``cfg`` with the schema's defaults filled in where keys are left out, as the Snakefile's
-    validation fills them (a block's own keys too, where the block is left out), so that code run outside
-    Snakemake (tests, benchmarks, the blind benchmark's items) uses the values the workflow would. A config that
-    is already complete comes back equal. Validation errors are not raised here (the Snakefile's check does)."""
-    import jsonschema
-
-    base = jsonschema.Draft202012Validator
-
-    def properties(validator, props, instance, sch):
-        if isinstance(instance, dict):
-            for key, sub in props.items():
-                if isinstance(sub, Mapping) and "default" in sub:
-                    instance.setdefault(key, copy.deepcopy(sub["default"]))
-        yield from base.VALIDATORS["properties"](validator, props, instance, sch)
-
-    filled = copy.deepcopy(dict(cfg))
-    for _ in jsonschema.validators.extend(base, {"properties": properties})(_load_schema(schema)).iter_errors(filled):
-        pass
-    return filled
-
-
-@functools.lru_cache(maxsize=None)
-def _filled_empty() -> dict:
-    return with_defaults({})
-
-
-def schema_defaults(*path: str) -> dict:
-    """The schema's defaults of the block at ``path`` (for example "rig", "dual_sine"), for code that merges a
-    block's keys over its defaults: a copy, read from the schema, the one home of the defaults."""
-    node = _filled_empty()
-    for key in path:
-        node = node[key]
-    return copy.deepcopy(node)
-
-
-def numbers_written_as_text(cfg: dict, schema) -> list:
-    """Make numbers, in place, of the values YAML 1.1 read as text where the schema (a path or a mapping) wants a
-    number: ``channel_time_skew: 4e-05`` is the text '4e-05' to PyYAML (it wants 4.0e-05), which the schema would
-    refuse as "not of type 'number'". Returns [(dotted key, number)] of the values changed. Only values of that
-    form where a number is wanted: a name or a path that looks like one elsewhere stays text."""
-
-    def texts(node):
-        if isinstance(node, str):
-            yield node
-        elif isinstance(node, Mapping):
-            for v in node.values():
-                yield from texts(v)
-        elif isinstance(node, list):
-            for v in node:
-                yield from texts(v)
-
-    if not any(_EXPONENT_NUMBER.match(t.strip()) for t in texts(cfg)):
-        return []  # nothing to look at (the usual case): no schema pass
-    import jsonschema
-
-    schema = _load_schema(schema)
-    changed = []
-    for err in jsonschema.Draft202012Validator(schema).iter_errors(cfg):
-        wanted = err.validator_value if isinstance(err.validator_value, list) else [err.validator_value]
-        if (
-            err.validator != "type"
-            or not isinstance(err.instance, str)
-            or not ({"number", "integer"} & set(wanted))
-            or not _EXPONENT_NUMBER.match(err.instance.strip())
-        ):
-            continue
-        value = float(err.instance)
-        if "number" not in wanted:  # an integer
-            if not value.is_integer():
-                continue
-            value = int(value)
-        *parents, last = list(err.absolute_path)
-        node = cfg
-        for key in parents:
-            node = node[key]
-        node[last] = value
-        changed.append((".".join(str(k) for k in err.absolute_path), value))
-    return changed
+from .schema import ConfigError, with_defaults
 
 
 def duplicate_key_errors(path: str | os.PathLike) -> list[str]:
@@ -159,18 +47,6 @@ def duplicate_key_errors(path: str | os.PathLike) -> list[str]:
     with open(path) as fh:
         yaml.load(fh, Loader=_Loader)
     return errors
-
-
-def merged_over(base: Mapping, overlay: Mapping) -> dict:
-    """``overlay`` merged over ``base`` as Snakemake merges a --configfile over the Snakefile's configfile: blocks
-    key by key, recursively; any other value (a list, a number) replaced whole."""
-    out = copy.deepcopy(dict(base))
-    for key, value in overlay.items():
-        if isinstance(value, Mapping) and isinstance(out.get(key), Mapping):
-            out[key] = merged_over(out[key], value)
-        else:
-            out[key] = copy.deepcopy(value)
-    return out
 
 
 def _true_structure_errors(structure: Mapping, changes: Mapping, path: str = "rig.true_structure") -> list:

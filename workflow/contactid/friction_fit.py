@@ -597,7 +597,7 @@ def validation_dataset(forces, fit, preload: float, n_harmonics: int, truth=None
 def settings_from_config(cfg) -> FitSettings:
     """FitSettings from the ``friction`` config block (keys left out: the schema's defaults; the search bounds left
     out: Table 4's neighbourhood, ``FitSettings.bounds``); bounds that are not (low < high) are refused."""
-    from .config import schema_defaults
+    from .schema import schema_defaults
 
     d = FitSettings()
     cfg = {**schema_defaults("friction"), **dict(cfg or {})}

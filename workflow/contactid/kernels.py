@@ -15,7 +15,7 @@ import numpy as np
 
 
 def _structure_and_rig(config: Mapping) -> tuple[dict, dict]:
-    from .config import with_defaults
+    from .schema import with_defaults
 
     filled = with_defaults(config)
     return filled["structure"], filled["rig"]

@@ -75,8 +75,8 @@ def setup_logging(path: str | None) -> logging.Logger:
 
     def log_then_raise(kind, value, tb):
         # the rule's log names the failure too (a data error by its message, anything else with its traceback)
-        from .config import ConfigError
         from .io import RawDataError
+        from .schema import ConfigError
 
         if issubclass(kind, (RawDataError, ConfigError)):
             log.error("%s", value)

@@ -107,7 +107,7 @@ def model_checks(stiction_attrs, n_frequencies: int, fit_attrs=None) -> list[dic
     if fit_attrs is not None:
         floor = fit_attrs.get("misfit_floor")
         if floor is None:
-            from .config import schema_defaults
+            from .schema import schema_defaults
 
             floor = schema_defaults("friction")["misfit_floor"]
         out.append(friction_fit_check(float(fit_attrs["misfit_nrmse"]), float(floor)))

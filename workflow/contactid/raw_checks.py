@@ -90,7 +90,7 @@ def dual_sine_check_dataset(raw: xr.Dataset, structure_cfg: Mapping, path: str, 
 
 def check_settings(checks: Mapping | None) -> dict:
     """raw_checks with the schema's defaults filled in (max_harmonic and min_periods, the record reader's, apart)."""
-    from .config import schema_defaults
+    from .schema import schema_defaults
 
     defaults = {k: v for k, v in schema_defaults("raw_checks").items() if k not in ("max_harmonic", "min_periods")}
     return {**defaults, **{k: v for k, v in dict(checks or {}).items() if v is not None}}

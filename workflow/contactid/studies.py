@@ -25,7 +25,7 @@ QUANTITIES = ("mu", "e0", "k_t")
 
 def noise_study_table(study_cfg: Mapping | None) -> pd.DataFrame:
     """The parameter table: one row per (noise_fraction, record_samples, seed), in that order."""
-    from .config import schema_defaults
+    from .schema import schema_defaults
 
     axes = {k: v for k, v in schema_defaults("noise_study").items() if k != "in_report"}  # the schema's defaults
     c = {**axes, **{k: v for k, v in dict(study_cfg or {}).items() if k in axes}}
@@ -52,11 +52,11 @@ def e0_at(e_f: float, k_c: float, normal_force: float) -> float:
 def run_point(cfg: Mapping, noise_fraction: float, record_samples: int, seed: int) -> dict:
     """One point: rig records at this noise and length (rig seed = config seed + ``seed``), the
     identification, and the relative errors of mu, e_0 (at the preload) and k_t against the rig's truth."""
-    from .config import with_defaults
     from .gap.pipeline import identify
     from .rig.dual_sine import dual_sine_test
     from .rig.random_test import random_test_datasets
     from .rig.structure import random_test_rig_config
+    from .schema import with_defaults
 
     t0 = time.perf_counter()
     cfg = with_defaults(cfg)  # a copy, at the schema's defaults where keys are left out

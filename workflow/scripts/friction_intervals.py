@@ -2,9 +2,9 @@
 
 import json
 
-from contactid.gap.diagnosis import GapSettings
 from contactid.gap.floor import read_floor, resolved_gap_config
 from contactid.gap.pipeline import workflow_models
+from contactid.gap.settings import GapSettings
 from contactid.gap.uncertainty import friction_uncertainty
 from contactid.io import write_text
 from contactid.logs import setup_logging

@@ -5,13 +5,14 @@ import json
 import time
 
 from contactid.gap.candidates import load_plugins
-from contactid.gap.diagnosis import GapSettings, diagnose
+from contactid.gap.diagnosis import diagnose
 from contactid.gap.explain import updated_model_summary, with_damping_at_test_level
 from contactid.gap.floor import read_floor, resolved_gap_config
 from contactid.gap.localise import linear_stage, random_test_delays
 from contactid.gap.output import diagnosis_json, gap_dataset, updated_model_json
 from contactid.gap.pipeline import workflow_models
 from contactid.gap.record_checks import diagnosis_outcome
+from contactid.gap.settings import GapSettings
 from contactid.gap.story import records_agree
 from contactid.gap.workers import prepare_workers
 from contactid.io import load_dataset, provenance, write_dataset, write_text

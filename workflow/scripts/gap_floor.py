@@ -7,12 +7,12 @@ gap_benchmark_floor: at the configured drive, with the configured rig's law (the
 import json
 import math
 
-from contactid.config import with_defaults
 from contactid.friction_parameters import fitted_parameters
 from contactid.gap.floor import identification_floor, response_targets
 from contactid.gap.records import record_harmonics
 from contactid.io import load_dataset, read_raw, write_text
 from contactid.logs import setup_logging
+from contactid.schema import with_defaults
 
 log = setup_logging(snakemake.log[0])
 cfg = with_defaults(snakemake.params.config)

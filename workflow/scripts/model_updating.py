@@ -2,12 +2,12 @@
 
 import json
 
-from contactid.config import with_defaults
-from contactid.gap.diagnosis import GapSettings
 from contactid.gap.pipeline import structure_update
+from contactid.gap.settings import GapSettings
 from contactid.io import load_dataset, write_text
 from contactid.logs import setup_logging
 from contactid.parameters import identified_structure
+from contactid.schema import with_defaults
 
 log = setup_logging(snakemake.log[0])
 p = snakemake.params

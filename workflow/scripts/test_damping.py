@@ -3,9 +3,9 @@ record and applied where the other load cases confirm it."""
 
 from contactid.friction_fit import settings_from_config
 from contactid.friction_parameters import parameter_dataset
-from contactid.gap.diagnosis import GapSettings
 from contactid.gap.model import identified_model
 from contactid.gap.pipeline import test_level_damping, workflow_records
+from contactid.gap.settings import GapSettings
 from contactid.io import load_dataset, provenance, write_dataset
 from contactid.logs import setup_logging
 from contactid.test_damping import profile_dataset

@@ -2,7 +2,8 @@
 disagree, which unmodelled effect explains it, how far the gap shrinks, and what the records cannot tell.
 
 Modules, by role:
-- settings and the run: ``diagnosis`` (GapSettings, the Diagnosis and ``diagnose``, which calls the rest in order),
+- settings and the run: ``settings`` (GapSettings, read once from the config), ``diagnosis`` (the Diagnosis and
+  ``diagnose``, which calls the rest in order),
   ``numerics`` (Numerics: how the steady states are found and the searches run, handed down the calls);
 - records and evidence: ``records`` (the records' harmonics, block-wise for the uncertainty), ``record_checks`` (units,
   signs, channel order), ``localise`` (where the gap lies: stages, sensors, harmonics, cycle parts), ``evidence``

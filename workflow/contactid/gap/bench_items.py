@@ -9,9 +9,9 @@ from typing import Mapping
 
 import numpy as np
 
-from ..config import schema_defaults
 from ..random_streams import generator
 from ..rig.effects import EFFECTS
+from ..schema import schema_defaults
 
 # magnitudes the benchmark draws from (rig units, see rig.effects): large enough to matter,
 # within the range where the rig's response stays periodic

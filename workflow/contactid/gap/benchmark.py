@@ -108,10 +108,11 @@ def diagnose_item(spec: Mapping, cfg: Mapping, recs: Mapping, cases: list, t0: f
     """Identify the model from an item's rig records ``recs`` (the chain, then model updating) and diagnose it with
     the item's library; ``t0`` the item's start (``time.perf_counter``, s), ``t_rig`` the rig's time (s)."""
     from ..friction_fit import settings_from_config
-    from .diagnosis import GapSettings, diagnose
+    from .diagnosis import diagnose
     from .localise import linear_stage, random_test_delays
     from .pipeline import identify, updated_model
     from .records import record_harmonics
+    from .settings import GapSettings
 
     cal = cfg["nonlinear"]["calibration_case"]
     model, modes, modal, frf = identify(cfg, recs["random_test"], recs[cal])
@@ -253,7 +254,7 @@ def run_item(spec: Mapping, cfg: Mapping, outputs: Mapping | None = None) -> dic
     """Generate the item's rig records, identify the model from them, diagnose; the result row. ``cfg``: the base
     config (keys left out: the schema's defaults). ``outputs`` ({"diagnosis": path, "dataset": path}, optional):
     where to write the item's diagnosis.json and gap.nc (``write_item_diagnosis``)."""
-    from ..config import with_defaults
+    from ..schema import with_defaults
     from .pipeline import rig_records
 
     t0 = time.perf_counter()

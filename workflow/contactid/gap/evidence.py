@@ -22,7 +22,7 @@ from .refit import baseline, evaluate
 from .verdict import DEFAULT_PLACE, UPDATING_EFFECTS, PlaceThresholds, records_carry_factor
 
 if TYPE_CHECKING:
-    from .diagnosis import GapSettings
+    from .settings import GapSettings
 
 log = logging.getLogger(__name__)
 

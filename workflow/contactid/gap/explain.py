@@ -27,7 +27,7 @@ from .verdict import (
 )
 
 if TYPE_CHECKING:
-    from .diagnosis import GapSettings
+    from .settings import GapSettings
 
 log = logging.getLogger(__name__)
 

@@ -44,7 +44,7 @@ def floor_rig_config(cfg: Mapping, friction, regularization: str, f0: float, fs:
     true damping and cubic normal term removed, the friction law ``friction`` (e_f, k_c, e_t, kappa, mu; N/m, 1/m, N/m,
     1, 1) with ``regularization`` as its truth, and the dual-sine drive at ``f0`` (Hz), sampled at ``fs`` (Hz) for
     ``n_samples`` samples (the calibration record's)."""
-    from ..config import with_defaults
+    from ..schema import with_defaults
 
     out = copy.deepcopy(dict(with_defaults(cfg)))
     rig = out["rig"]

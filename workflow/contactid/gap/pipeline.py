@@ -11,10 +11,10 @@ from typing import Mapping
 import numpy as np
 import xarray as xr
 
-from ..config import with_defaults
 from ..friction_fit import fit_friction_law, settings_from_config
 from ..friction_parameters import parameter_dataset
 from ..linear_chain import frf_dataset, linear_modes_dataset, modal_dataset, stiction_dataset
+from ..schema import with_defaults
 from .model import identified_model
 from .records import record_harmonics
 from .refit import identified_forces
@@ -22,7 +22,7 @@ from .refit import identified_forces
 
 def linear_chain(cfg: Mapping, raw_random: xr.Dataset, return_frf: bool = False):
     """random test -> FRF -> modal -> stiction -> linear modes; returns (linear_modes, modal[, frf]). Settings left
-    out of ``cfg`` take the schema's defaults (``config.with_defaults``), as in the workflow."""
+    out of ``cfg`` take the schema's defaults (``schema.with_defaults``), as in the workflow."""
     cfg = with_defaults(cfg)
     f, m, st, lm = (cfg[k] for k in ("frf", "modal", "stiction", "linear_modes"))
     frf = frf_dataset(

@@ -50,7 +50,7 @@ def damping_ratios(frequencies_hz, ratio: float, form: str = "modal", reference_
 
 def rig_damping_ratios(rig_cfg: Mapping, frequencies_hz) -> np.ndarray:
     """The rig's damping ratio of each mode (rig.modal_damping_ratio spread by rig.true_damping)."""
-    from ..config import schema_defaults
+    from ..schema import schema_defaults
 
     defaults = schema_defaults("rig")  # where rig_cfg leaves keys out
     td = {**defaults["true_damping"], **(rig_cfg.get("true_damping") or {})}
@@ -61,7 +61,7 @@ def rig_damping_ratios(rig_cfg: Mapping, frequencies_hz) -> np.ndarray:
 def dual_sine_damping_ratios(rig_cfg: Mapping, frequencies_hz) -> np.ndarray:
     """The rig's damping ratio of each mode in the dual-sine tests: ``rig_damping_ratios`` times
     rig.true_damping.dual_sine_factor."""
-    from ..config import schema_defaults
+    from ..schema import schema_defaults
 
     td = {**schema_defaults("rig")["true_damping"], **(rig_cfg.get("true_damping") or {})}
     return rig_damping_ratios(rig_cfg, frequencies_hz) * float(td["dual_sine_factor"])

@@ -48,7 +48,7 @@ CONTROL_FIELDS = (
 def dual_sine_settings(rig_cfg: Mapping, case_cfg: Mapping, sampling_rate_hz: float) -> dict:
     """Merged settings of one load case: rig.dual_sine (at the schema's defaults where left out), overridden per
     case."""
-    from ..config import schema_defaults
+    from ..schema import schema_defaults
 
     s = {**schema_defaults("rig", "dual_sine"), **(rig_cfg.get("dual_sine") or {})}
     if "excitation_frequency_hz" in case_cfg:
@@ -64,7 +64,7 @@ def dual_sine_settings(rig_cfg: Mapping, case_cfg: Mapping, sampling_rate_hz: fl
 def contact_parameters(structure_cfg: Mapping, rig_cfg: Mapping) -> ContactParameters:
     """The rig's true contact laws with the configured effects (keys of ``rig.truth`` left out: the schema's
     defaults, for a config not validated by the Snakefile)."""
-    from ..config import with_defaults
+    from ..schema import with_defaults
 
     truth = with_defaults({"rig": {"truth": rig_cfg["truth"]}})["rig"]["truth"]
     fr = ValanisParameters.from_config(truth["friction"])

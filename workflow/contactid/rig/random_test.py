@@ -159,7 +159,7 @@ def simulate_random_test(model: FEModel, settings: RandomTestSettings, seed: int
 
 def settings_from_config(random_test_cfg, rig_cfg, n_channels: int = 3) -> RandomTestSettings:
     """RandomTestSettings from the ``random_test`` and ``rig`` config blocks (keys left out: the schema's defaults)."""
-    from ..config import schema_defaults
+    from ..schema import schema_defaults
     from .structure import channel_delays, channel_gains
 
     rt = {**schema_defaults("random_test"), **dict(random_test_cfg or {})}

@@ -42,7 +42,7 @@ def rig_contact_stiffness(structure_cfg: Mapping, rig_cfg: Mapping) -> tuple[flo
 
 
 def _rig_default(key: str):
-    from ..config import schema_defaults
+    from ..schema import schema_defaults
 
     return schema_defaults("rig")[key]
 
