@@ -74,6 +74,7 @@ lint: env
 	$(PY) -m ruff check .
 	$(VENV)/bin/snakefmt --no-sort --check Snakefile workflow/rules
 	$(VENV)/bin/snakemake --lint
+	$(VENV)/bin/lint-imports
 
 # optional (not in CI by default): the noise-study sweep through a local single-node SLURM against -c2 here
 slurm-test: env
