@@ -48,13 +48,13 @@ def test_mode_numbers_print_whole_and_frequencies_to_the_hundredth():
 
 def test_a_plain_number_with_more_integer_digits_than_asked_is_rounded_to_them():
     # the model-form table's e_t interval bound 15875 N/m at 3 digits (it printed all five)
-    from contactid.latex import _fmt
+    from contactid.latex import latex_number
 
-    assert _fmt(15875.000000002, 3) == "15900"
-    assert _fmt(1968.9, 3) == "1970"
-    assert _fmt(338.22, 3) == "338"
-    assert _fmt(54.79, 4) == "54.79"
-    assert _fmt(2.185776e5, 3) == r"2.19\times10^{5}"
+    assert latex_number(15875.000000002, 3) == "15900"
+    assert latex_number(1968.9, 3) == "1970"
+    assert latex_number(338.22, 3) == "338"
+    assert latex_number(54.79, 4) == "54.79"
+    assert latex_number(2.185776e5, 3) == r"2.19\times10^{5}"
 
 
 def test_a_boolean_is_a_tex_switch_and_a_number_a_macro():

@@ -9,8 +9,8 @@ from contactid.config import check_config
 from contactid.parameters import structure_from_config
 from contactid.rig.damping import damping_ratios
 from contactid.rig.dual_sine import contact_parameters, dual_sine_test
-from contactid.rig.harmonic_balance import _normal_path
-from contactid.rig.nonlinear import _normal_force
+from contactid.rig.harmonic_balance import normal_path
+from contactid.rig.nonlinear import normal_force
 from contactid.rig.random_test import random_test_datasets
 from contactid.rig.structure import rig_structure
 from contactid.schema import ConfigError
@@ -61,20 +61,20 @@ def test_polynomial_hardening_normal_law_and_its_tangents():
     d0 = n0 / k_n  # exponent 1: N0 (d0 - eta) / d0 = N0 - k_n eta
     for eta in (-8e-7, -2e-7, 0.0, 3e-7, 1e-6):
         expected = max(n0 - k_n * eta - k3 * eta**3, 0.0)
-        assert _normal_force(eta, 0.0, n0, d0, 1.0, 0.0, True, k3) == pytest.approx(expected, rel=1e-12, abs=1e-12)
+        assert normal_force(eta, 0.0, n0, d0, 1.0, 0.0, True, k3) == pytest.approx(expected, rel=1e-12, abs=1e-12)
     # loss of contact: the cubic opens the contact before the linear spring would (eta < d0 = 2.95 um)
     eta_open = 1.5e-6
-    assert n0 - k_n * eta_open > 0 and _normal_force(eta_open, 0.0, n0, d0, 1.0, 0.0, True, k3) == 0.0
+    assert n0 - k_n * eta_open > 0 and normal_force(eta_open, 0.0, n0, d0, 1.0, 0.0, True, k3) == 0.0
     # the harmonic balance's tangents are the derivatives of the integrator's law
     eta = np.linspace(-9e-7, 9e-7, 7)
     deta = np.full(eta.size, 1e-4)
     N, dN, dNd = (np.empty(eta.size) for _ in range(3))
-    _normal_path(eta, deta, n0, d0, 1.0, k3, 30.0, True, N, dN, dNd)
+    normal_path(eta, deta, n0, d0, 1.0, k3, 30.0, True, N, dN, dNd)
     h = 1e-12
     fd = [
         (
-            _normal_force(e + h, 1e-4, n0, d0, 1.0, 30.0, True, k3)
-            - _normal_force(e - h, 1e-4, n0, d0, 1.0, 30.0, True, k3)
+            normal_force(e + h, 1e-4, n0, d0, 1.0, 30.0, True, k3)
+            - normal_force(e - h, 1e-4, n0, d0, 1.0, 30.0, True, k3)
         )
         / (2 * h)
         for e in eta

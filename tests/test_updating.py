@@ -3,7 +3,7 @@ a known structure."""
 
 import numpy as np
 import pytest
-from contactid.gap.explain import _updating_step
+from contactid.gap.explain import updating_step
 from contactid.gap.settings import GapSettings
 from contactid.parameters import structure_from_config
 from contactid.updating import FACTORS, UpdatingResult, apply_factors, modal_predictions, update_structure
@@ -96,14 +96,14 @@ def test_a_compliant_clamp_is_found_with_the_masses_and_a_rigid_one_is_stated_un
     assert upd.factors["transducer_mass_scale"] == pytest.approx(1.4, rel=0.02)
     assert upd.factors["stiffness_scale"] / upd.factors["mass_scale"] == pytest.approx(0.97, rel=0.005)
     assert upd.identifiability["clamp_compliance_scale"]["bound_by_data"]
-    step = _updating_step(upd, 0.02, 0.01)["parameters"]  # the explanation's step 0 says the clamp in N m/rad
+    step = updating_step(upd, 0.02, 0.01)["parameters"]  # the explanation's step 0 says the clamp in N m/rad
     assert step["clamp_rotational_stiffness_nm_per_rad"] == upd.structure.clamp_rotational_stiffness
     # a rigid clamp: the data bound the compliance from one side only, and the statement is "not bound"
     f, sd, R = data_of(truth)
     upd = update_structure(nominal, f, sd, R, residue_accuracy=0.01, factors=five)
     assert upd.structure.clamp_rotational_stiffness > 3e7  # within 1e-5 of the rigid clamp's frequencies
     assert not upd.identifiability["clamp_compliance_scale"]["bound_by_data"]
-    assert "clamp_rotational_stiffness_nm_per_rad" not in _updating_step(upd, 0.02, 0.01)["parameters"]
+    assert "clamp_rotational_stiffness_nm_per_rad" not in updating_step(upd, 0.02, 0.01)["parameters"]
     assert upd.factors["transducer_mass_scale"] == pytest.approx(1.4, rel=0.02)
 
 

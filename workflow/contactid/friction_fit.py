@@ -65,7 +65,10 @@ class FitResult:
 N_OPEN = 1.0e-3  # N: where the identified normal force is lower, the contact is taken as open (S = 0)
 
 
-class _Problem:
+class FitProblem:
+    """The friction fit's least-squares problem: the identified xi, N and S, the parameters' bounds and the
+    regularization."""
+
     def __init__(self, xi, normal_force, S, bounds, regularization="none"):
         # where the identified N falls to zero the contact opens and carries no friction: the law is
         # evaluated there with a vanishing normal force (the kernel refuses N <= 0)
@@ -98,7 +101,7 @@ class _Problem:
         return np.sqrt(np.mean(self.residuals(params) ** 2, axis=1))
 
 
-def _ga(problem: _Problem, settings: FitSettings, seed: int, label: str = "friction fit"):
+def _ga(problem: FitProblem, settings: FitSettings, seed: int, label: str = "friction fit"):
     from deap import base, creator, tools
 
     if not hasattr(creator, "ValanisFitness"):
@@ -170,7 +173,7 @@ def _ga(problem: _Problem, settings: FitSettings, seed: int, label: str = "frict
         random.setstate(state)
 
 
-def _polish(problem: _Problem, u0, fixed: dict | None = None, xtol: float = 1e-10, ftol: float = 1e-12):
+def least_squares_polish(problem: FitProblem, u0, fixed: dict | None = None, xtol: float = 1e-10, ftol: float = 1e-12):
     """Least-squares polish in the unit cube; ``fixed`` {index: unit value} holds parameters; ``xtol``, ``ftol``:
     scipy's least_squares tolerances (the chain's fit and its intervals keep the tight defaults)."""
     fixed = fixed or {}
@@ -224,13 +227,13 @@ def _refined_fit(
         xi = periodic_grid(coef_xi, f0, m)[0]
         n = preload + periodic_grid(coef_n, f0, m)[0]
         s = periodic_grid(coef_s, f0, m)[0]
-        problem = _Problem(xi, n, s, settings.bounds, settings.regularization)
+        problem = FitProblem(xi, n, s, settings.bounds, settings.regularization)
         if u_best is None and start is not None:
             u_best = np.clip(problem.unit(np.asarray(start, float))[0], 0.0, 1.0)
         elif u_best is None:
             u_ga, logbook = _ga(problem, settings, seed, label)
             u_best = u_ga
-        u_best, ssr, res = _polish(problem, u_best)
+        u_best, ssr, res = least_squares_polish(problem, u_best)
         p = problem.physical(u_best)[0]
         history.append((m, *p, float(np.sqrt(ssr / m))))
         log.info(
@@ -254,7 +257,7 @@ def _refined_fit(
 
 
 def profile_intervals(
-    problem: _Problem,
+    problem: FitProblem,
     u_best,
     ssr_min: float,
     n_data: int,
@@ -279,7 +282,7 @@ def profile_intervals(
     e0_vals = []
 
     def profile(i, value, start):
-        u, s_j, _ = _polish(problem, start, {i: value})
+        u, s_j, _ = least_squares_polish(problem, start, {i: value})
         if s_j <= thr:
             pp = problem.physical(u)[0]
             e0_vals.append(float(stiction_shear_stiffness(preload, pp[0], pp[1])))

@@ -13,7 +13,7 @@ import pandas as pd
 from .model_checks import FRICTION_CONSEQUENCE, FRICTION_FINDING, STIFFNESS_CONSEQUENCE, STIFFNESS_FINDING
 
 
-def _fmt(v, digits: int = 4) -> str:
+def latex_number(v, digits: int = 4) -> str:
     """A number in LaTeX (scientific notation as \\num-like m \\times 10^{e})."""
     if v is None or (isinstance(v, float) and not math.isfinite(v)):
         return "--"
@@ -60,7 +60,7 @@ def macros(values: Mapping[str, object]) -> str:
         if isinstance(v, (bool, np.bool_)):
             lines.append(f"\\newif\\if{name}\\{name}{'true' if v else 'false'}")
             continue
-        text = v if isinstance(v, str) else f"\\ensuremath{{{_fmt(v)}}}"
+        text = v if isinstance(v, str) else f"\\ensuremath{{{latex_number(v)}}}"
         lines.append(f"\\newcommand{{\\{name}}}{{{text}}}")
     return "\n".join(lines) + "\n"
 
@@ -80,7 +80,7 @@ def validation_text(validation: Mapping, calibration_case: str) -> str:
     others = sorted((c for c in validation if c != calibration_case), key=_case_order)
     if not others:
         return "One load case is configured, so there is no other for the law to predict"
-    parts = [rf"\ensuremath{{{_fmt(100 * validation[c])}}}\,\% ({case_words(c)})" for c in others]
+    parts = [rf"\ensuremath{{{latex_number(100 * validation[c])}}}\,\% ({case_words(c)})" for c in others]
     listed = parts[0] if len(parts) == 1 else ", ".join(parts[:-1]) + " and " + parts[-1]
     return f"The law predicts the other load case{'s' if len(others) > 1 else ''} with NRMSE {listed}"
 
@@ -100,8 +100,8 @@ def report_values(
     v["kt"] = st["k_t"]
     sd = float(st.get("stiffness_scale_sd", 0.0))
     v["stiffnessclause"] = (
-        rf", with Young's modulus free within a prior of ${_fmt(100 * sd, 2)}\,\%$ sd (fitted: "
-        rf"${_fmt(st['stiffness_scale'], 4)}$ times the model's),"
+        rf", with Young's modulus free within a prior of ${latex_number(100 * sd, 2)}\,\%$ sd (fitted: "
+        rf"${latex_number(st['stiffness_scale'], 4)}$ times the model's),"
         if sd > 0
         else ", with the model's Young's modulus,"
     )
@@ -113,14 +113,16 @@ def report_values(
         v["knlow"], v["knhigh"] = st["k_n_interval"]
         v["knstatement"] = "bounded on both sides"
         v["knclause"] = (
-            rf"$k_n = {_fmt(st['k_n'])}$\,N/m, bounded on both sides (interval ${_fmt(v['knlow'])}$--"
-            rf"${_fmt(v['knhigh'])}$)"
+            rf"$k_n = {latex_number(st['k_n'])}$\,N/m, bounded on both sides (interval ${latex_number(v['knlow'])}$--"
+            rf"${latex_number(v['knhigh'])}$)"
         )
     else:
         v["kn"] = st["k_n_lower_bound"]
         v["knlow"], v["knhigh"] = st["k_n_lower_bound"], float("inf")
         v["knstatement"] = "bounded from below only"
-        v["knclause"] = rf"$k_n \geq {_fmt(st['k_n_lower_bound'])}$\,N/m: the frequencies bound it from below only"
+        v["knclause"] = (
+            rf"$k_n \geq {latex_number(st['k_n_lower_bound'])}$\,N/m: the frequencies bound it from below only"
+        )
     tr = summary.get("truth", {})
     # rigtruth: the records come from the virtual rig and its truth is known (the report's text scores against it);
     # false for measured records, where the report says what it compares with instead
@@ -174,16 +176,16 @@ def test_damping_text(td: Mapping | None) -> str:
     which = f"mode {td['driven_mode']}'s damping ratio" if td["form"] == "driven" else "every mode's damping ratio"
     lo, hi = td["interval"]
     bound = (
-        rf"The law's misfit on the calibration record is least with {which} ${_fmt(td['scale'], 3)}$ times the "
-        rf"random test's (${_fmt(lo, 3)}$--${_fmt(hi, 3)}$ within its profile threshold)"
+        rf"The law's misfit on the calibration record is least with {which} ${latex_number(td['scale'], 3)}$ times the "
+        rf"random test's (${latex_number(lo, 3)}$--${latex_number(hi, 3)}$ within its profile threshold)"
     )
     if abs(td["scale"] - 1.0) < 1e-9:
         return "The law's misfit on the calibration record is least with the random test's damping ratios; they stand."
     gaps = ""
     if "heldout_gap_test_damping" in td:
         gaps = (
-            rf" (held-out gap ${_fmt(100 * td['heldout_gap_random_test_damping'], 3)}\,\%$ with the random test's "
-            rf"ratios, ${_fmt(100 * td['heldout_gap_test_damping'], 3)}\,\%$ with the factor)"
+            rf" (held-out gap ${latex_number(100 * td['heldout_gap_random_test_damping'], 3)}\,\%$ with the "
+            rf"random test's ratios, ${latex_number(100 * td['heldout_gap_test_damping'], 3)}\,\%$ with the factor)"
         )
     if td["accepted"]:
         return (
@@ -273,7 +275,7 @@ def tabular(
                 cells.append(f"${float(x):.{decimals[col]}f}$")
                 continue
             n = row_digits[i].get(col, digits)
-            cells.append("$0$" if n == 0 else f"${_fmt(x, n)}$")
+            cells.append("$0$" if n == 0 else f"${latex_number(x, n)}$")
         rows.append(" & ".join(cells) + r" \\")
     spec = "l" + "r" * (len(columns) - 1)
     return (
@@ -354,7 +356,7 @@ def setup_table(structure_cfg: Mapping) -> str:
                 rows.append(
                     {
                         "quantity": key,
-                        "value": ", ".join(_fmt(x) for x in v)
+                        "value": ", ".join(latex_number(x) for x in v)
                         if isinstance(v, list)
                         else ("rigid" if v is None else v),
                         "source": "paper" if given else "ours",
@@ -374,7 +376,13 @@ def setup_table(structure_cfg: Mapping) -> str:
     ]
     for r in rows:
         val = r["value"]
-        val = f"${_fmt(val)}$" if isinstance(val, (int, float)) else f"${val}$" if "times" in str(val) else str(val)
+        val = (
+            f"${latex_number(val)}$"
+            if isinstance(val, (int, float))
+            else f"${val}$"
+            if "times" in str(val)
+            else str(val)
+        )
         lines.append(f"{escape(r['quantity'])} & {val} & {escape(r['source'])} \\\\")
     lines += [r"\bottomrule", r"\end{tabular}", r"\end{table}"]
     return "\n".join(lines) + "\n"
@@ -440,25 +448,26 @@ def model_checks_text(checks: list) -> str:
         if c["check"] == "stiffness_fit":
             dof = int(c["dof"])
             head = (
-                rf"The stiffness fit leaves $\chi^2 = {_fmt(v, 3)}$ for {dof} degree{'s' if dof > 1 else ''} of "
-                rf"freedom (limit ${_fmt(lim, 3)}$"
+                rf"The stiffness fit leaves $\chi^2 = {latex_number(v, 3)}$ for {dof} "
+                rf"degree{'s' if dof > 1 else ''} of freedom (limit ${latex_number(lim, 3)}$"
             )
             if c["passed"]:
                 said.append(head + "): the structure with contact springs reproduces the identified frequencies.")
             else:
                 said.append(
                     head
-                    + rf", $p = {_fmt(c['p_value'], 2)}$): \textbf{{{STIFFNESS_FINDING}}}; "
+                    + rf", $p = {latex_number(c['p_value'], 2)}$): \textbf{{{STIFFNESS_FINDING}}}; "
                     + STIFFNESS_CONSEQUENCE.format(**TEX_SYMBOLS)
                     + "."
                 )
         elif c["check"] == "friction_fit":
-            head = rf"The friction law fits the identified $S$ to ${_fmt(100 * v, 3)}\,\%$ (NRMSE)"
+            head = rf"The friction law fits the identified $S$ to ${latex_number(100 * v, 3)}\,\%$ (NRMSE)"
             if c["passed"]:
-                said.append(head + rf", within the ${_fmt(100 * lim, 3)}\,\%$ its intervals assume.")
+                said.append(head + rf", within the ${latex_number(100 * lim, 3)}\,\%$ its intervals assume.")
             else:
                 said.append(
-                    head + rf", \textbf{{${_fmt(v / lim, 3)}$ times the ${_fmt(100 * lim, 3)}\,\%$ its intervals "
+                    head + rf", \textbf{{${latex_number(v / lim, 3)}$ times the "
+                    rf"${latex_number(100 * lim, 3)}\,\%$ its intervals "
                     r"assume} (\texttt{friction.misfit\_floor}): "
                     + FRICTION_FINDING.format(**TEX_SYMBOLS)
                     + "; "

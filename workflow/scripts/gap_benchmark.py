@@ -3,7 +3,7 @@
 import json
 
 from contactid.gap.bench_scores import confusion_figure, records_check_score, score
-from contactid.gap.output import _clean
+from contactid.gap.output import json_ready
 from contactid.io import write_text
 from contactid.logs import setup_logging
 
@@ -35,7 +35,7 @@ result["items"] = [
     }
     for r in rows
 ]
-write_text(snakemake.output.summary, json.dumps(_clean(result), indent=2))
+write_text(snakemake.output.summary, json.dumps(json_ready(result), indent=2))
 labels = list(result["confusion"])
 cols = sorted({c for row in result["confusion"].values() for c in row}, key=lambda c: (c == "none", c))
 lines = ["true," + ",".join(cols)]

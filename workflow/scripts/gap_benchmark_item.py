@@ -5,7 +5,7 @@ import json
 import numba
 from contactid.gap.benchmark import run_item
 from contactid.gap.floor import read_floor, resolved_gap_config
-from contactid.gap.output import _clean
+from contactid.gap.output import json_ready
 from contactid.io import write_text
 from contactid.logs import setup_logging
 
@@ -20,5 +20,5 @@ row = run_item(
     {"diagnosis": snakemake.output.diagnosis, "dataset": snakemake.output.dataset},
 )
 row["item"] = snakemake.wildcards.item
-write_text(snakemake.output.item, json.dumps(_clean(row), indent=2))
+write_text(snakemake.output.item, json.dumps(json_ready(row), indent=2))
 log.info("%s: effect %s (%.4g) -> verdict %s", row["item"], row["effect"], row["magnitude"], row["verdict"])

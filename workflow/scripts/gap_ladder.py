@@ -4,7 +4,7 @@ import json
 
 from contactid.gap.bench_scores import ladder_score
 from contactid.gap.floor import read_floor, resolved_gap_config
-from contactid.gap.output import _clean
+from contactid.gap.output import json_ready
 from contactid.io import write_text
 from contactid.logs import setup_logging
 
@@ -13,7 +13,7 @@ rows = [json.load(open(path)) for path in snakemake.input.rows]
 # gap.min_gap, or with gap.measure_floor the one rule gap_benchmark_floor measured
 floor = resolved_gap_config({"min_gap": snakemake.params.floor}, read_floor(snakemake.input))["min_gap"]
 result = ladder_score(rows, float(floor))
-write_text(snakemake.output[0], json.dumps(_clean(result), indent=2))
+write_text(snakemake.output[0], json.dumps(json_ready(result), indent=2))
 log.info(
     "detection ladder: %d items, %d detectable (held-out gap above twice the floor); named in %s, refitted "
     "magnitude within 25 %% in %s of them",

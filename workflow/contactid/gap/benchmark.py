@@ -239,10 +239,12 @@ def write_item_diagnosis(
     import xarray as xr
 
     from ..io import write_dataset, write_text
-    from .output import _clean, diagnosis_json, gap_dataset
+    from .output import diagnosis_json, gap_dataset, json_ready
 
     if item is None:
-        write_text(outputs["diagnosis"], json.dumps(_clean({"failed": failed, "benchmark_item": dict(spec)}), indent=2))
+        write_text(
+            outputs["diagnosis"], json.dumps(json_ready({"failed": failed, "benchmark_item": dict(spec)}), indent=2)
+        )
         write_dataset(xr.Dataset(attrs={"failed": failed}), outputs["dataset"])
         return
     extra = {"seconds": item.t_diag, "benchmark_item": dict(spec)}

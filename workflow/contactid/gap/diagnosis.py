@@ -22,23 +22,23 @@ from ..rig.harmonic_balance import HarmonicBalance
 from .candidates import LIBRARY
 from .evidence import bootstrap_draws, heldout_gap_draws, heldout_gap_of, shrink_views
 from .explain import (
-    _updating_step,
-    _updating_summary,
-    _updating_verdict,
     explain,
     model_periodicity,
     updated_model_summary,
+    updating_step,
+    updating_summary,
+    updating_verdict,
 )
 from .isolability import isolability, signature
-from .localise import _place_left, localise
+from .localise import localise, place_left
 from .model import IdentifiedModel
-from .ranking import _ranking
+from .ranking import rank_candidates
 from .records import RecordHarmonics
 from .refit import baseline, gap_residual
 from .settings import GapSettings
 from .story import resolution, tell
 from .verdict import at_floor, gap_shares, retried
-from .workers import _candidates
+from .workers import start_candidates
 
 log = logging.getLogger(__name__)
 
@@ -103,8 +103,8 @@ class _DiagnosisRun:
 
     def candidates(self, names, model: IdentifiedModel, base_sims: dict, **extra):
         """The candidates ``names`` calibrated on the calibration case and predicting the scored cases, in
-        ``workers`` processes (``_candidates``; call the result to collect them)."""
-        return _candidates(
+        ``workers`` processes (``start_candidates``; call the result to collect them)."""
+        return start_candidates(
             names,
             self.workers,
             model=model,
@@ -177,7 +177,7 @@ def _remaining_gap(left, left_share, where, last, run: _DiagnosisRun, linear, st
         "place_reason": where["place_reason"],
     }
     if last is not None and not remaining["at_floor"]:
-        where_left = _place_left(last, run.records, run.calibration_case, run.H, linear, structures, settings)
+        where_left = place_left(last, run.records, run.calibration_case, run.H, linear, structures, settings)
         if where_left is not None:
             remaining["place"] = where_left["place"]
             remaining["place_reason"] = where_left["place_reason"]
@@ -197,7 +197,7 @@ def diagnose(
     channel_delays=None,
 ) -> Diagnosis:
     """Run the whole diagnosis on the load cases' records (``calibration_case`` for the refits,
-    the others held out); the candidates in ``workers`` processes (see ``_candidates``). ``identified``: the
+    the others held out); the candidates in ``workers`` processes (see ``start_candidates``). ``identified``: the
     chain's own model when ``model`` is its update (``gap.pipeline.updated_model``; ``updating`` its
     UpdatingResult): the explanation then starts with the update's step. ``channel_delays``: each accelerometer
     channel's delay on the force (s) as the random test shows it (``random_test_delays``), held in common by the
@@ -249,7 +249,7 @@ def diagnose(
     run.draw_bootstrap()
     before, before_b = run.heldout_gaps(base_sims)
     n_data = 2 * sum(gap_residual(base_sims[c], records[c], H).size for c in run.score_cases)
-    rows, boots = _ranking(
+    rows, boots = rank_candidates(
         results,
         run.heldout_gap,
         settings.n_bootstrap,
@@ -309,20 +309,20 @@ def diagnose(
     )
     first_before = before
     if updating is not None:
-        where["model_updating"] = _updating_summary(updating, model)
+        where["model_updating"] = updating_summary(updating, model)
     if identified is not None and updating is not None and updating.accepted:
         first_before = run.heldout_gap(
             {c: baseline(identified, records[c], H, settings.numerics)[1] for c in run.score_cases}
         )
         where["heldout_gap_identified"] = first_before
-        steps.insert(0, _updating_step(updating, first_before, before))
+        steps.insert(0, updating_step(updating, first_before, before))
         log.info("explanation step 0: model updating takes the held-out gap from %.4g to %.4g", first_before, before)
     shares, _ = gap_shares(first_before, [s["heldout_gap_after"] for s in steps])
     for s, share in zip(steps, shares):
         s["share"] = share
     update_effect = None
     if steps and steps[0]["effect"] == "model_updating":
-        update_effect = _updating_verdict(updating, library, first_before, before, shares, scatter, settings)
+        update_effect = updating_verdict(updating, library, first_before, before, shares, scatter, settings)
     story = tell(
         steps,
         rows,

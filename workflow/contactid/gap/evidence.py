@@ -15,7 +15,7 @@ from ..random_streams import generator
 from ..rig.harmonic_balance import HarmonicBalance
 from .calibration import calibrate
 from .candidates import LIBRARY
-from .localise import _rel, record_drift
+from .localise import record_drift, relative_difference
 from .model import NONE, Augmentation, IdentifiedModel
 from .records import RecordHarmonics
 from .refit import baseline, evaluate
@@ -41,7 +41,7 @@ def shrink_views(records, cases, before_sims, after_sims, boot, H) -> dict:
         row = {}
         for key, sims in (("before", before_sims), ("after", after_sims)):
             As = sims[c].acceleration[:, :H]
-            row[key] = _rel(As, A)
+            row[key] = relative_difference(As, A)
             Ab = boot[c]
             vals = np.linalg.norm((As[None] - Ab).reshape(Ab.shape[0], -1), axis=1) / np.linalg.norm(A)
             row[f"{key}_interval"] = [float(np.percentile(vals, 2.5)), float(np.percentile(vals, 97.5))]

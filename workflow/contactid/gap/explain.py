@@ -32,7 +32,7 @@ if TYPE_CHECKING:
 log = logging.getLogger(__name__)
 
 
-def _parameter_values(name: str, cal=None, theta=None) -> dict:
+def parameter_values(name: str, cal=None, theta=None) -> dict:
     """{parameter name: refitted value} of a calibrated candidate, or of ``theta`` (per-channel ones numbered by
     channel)."""
     cand = LIBRARY[name]
@@ -179,7 +179,7 @@ def explain(  # noqa: C901
             steps.append(
                 {
                     "effect": name,
-                    "parameters": _parameter_values(name, cal),
+                    "parameters": parameter_values(name, cal),
                     "heldout_gap_before": gap,
                     "heldout_gap_after": after,
                     "alternatives": alternatives,
@@ -193,7 +193,7 @@ def explain(  # noqa: C901
             if periodicity is not None:
                 steps[-1].update(periodicity(cal, sims))
             if len(cal.steps) > 1:  # the earlier steps' parameters as refitted with this one (gap.joint_refit)
-                steps[-1]["earlier_refitted"] = {n: _parameter_values(n, theta=th) for n, th in cal.steps[:-1]}
+                steps[-1]["earlier_refitted"] = {n: parameter_values(n, theta=th) for n, th in cal.steps[:-1]}
             log.info("explanation step %d: %s leaves a held-out gap of %.4g (from %.4g)", len(steps), name, after, gap)
             steps[-1]["_fit"] = (cal, sims)  # for the place of what is left (diagnose), not written
             gap, last = after, (cal, sims)
@@ -207,7 +207,7 @@ def explain(  # noqa: C901
     return steps, gap, last
 
 
-def _updating_summary(updating, model: IdentifiedModel) -> dict:
+def updating_summary(updating, model: IdentifiedModel) -> dict:
     """diagnosis.json's model_updating block: the update's summary and the friction law the candidates start
     from (refitted with the updated structure when the update is accepted)."""
     e_f, k_c, e_t, kappa, mu = model.friction
@@ -224,7 +224,7 @@ def _updating_summary(updating, model: IdentifiedModel) -> dict:
     }
 
 
-def _updating_step(updating, gap_before: float, gap_after: float) -> dict:
+def updating_step(updating, gap_before: float, gap_after: float) -> dict:
     """The explanation's step 0 when the model updating was accepted: the factors (and the clamp's stiffness in N m/rad
     where the data bind its compliance, which a test engineer reads more easily than the factor) and the held-out gap
     it took away."""
@@ -239,7 +239,7 @@ def _updating_step(updating, gap_before: float, gap_after: float) -> dict:
     }
 
 
-def _updating_verdict(updating, names, gap_before, gap_after, shares, scatter, settings) -> tuple[str, str] | None:
+def updating_verdict(updating, names, gap_before, gap_after, shares, scatter, settings) -> tuple[str, str] | None:
     """(verdict, reason) when the accepted update explains most of the gap (the largest share, and min_reduction of
     the whole gap as a candidate's verdict needs: ``verdict.explains_most``) and amounts to one effect of the library
     in use; otherwise None."""
@@ -286,7 +286,7 @@ def updated_model_summary(chain: IdentifiedModel, base: IdentifiedModel, last, s
     friction = cal.friction if cal is not None else model.friction
     aug = cal.augmentation if cal is not None else NONE
     structure = model.structure_with(aug)
-    effects = {n: _parameter_values(n, theta=th) for n, th in cal.steps} if cal is not None else {}
+    effects = {n: parameter_values(n, theta=th) for n, th in cal.steps} if cal is not None else {}
     update = next((s for s in steps if s["effect"] == "model_updating"), None)
     return {
         "what": (

@@ -22,7 +22,8 @@ from .verdict import place as _place_of
 log = logging.getLogger(__name__)
 
 
-def _rel(a, b) -> float:
+def relative_difference(a, b) -> float:
+    """||a - b|| / ||b||: how far ``a`` is from ``b``, relative to ``b``."""
     return float(np.linalg.norm(np.asarray(a) - np.asarray(b)) / max(np.linalg.norm(b), 1e-300))
 
 
@@ -54,8 +55,8 @@ def _response_gaps(fe, records: dict, sims: dict, H: int) -> dict:
     out = {"accelerations": [], "generalized_coordinates": [], "by_sensor": [], "by_harmonic": []}
     for c in cases:
         A, As = records[c].acceleration[:, :H], sims[c].acceleration[:, :H]
-        out["accelerations"].append(_rel(As, A))
-        out["generalized_coordinates"].append(_rel(pinv @ As, pinv @ A))
+        out["accelerations"].append(relative_difference(As, A))
+        out["generalized_coordinates"].append(relative_difference(pinv @ As, pinv @ A))
         out["by_sensor"].append(np.linalg.norm(As - A, axis=1) / np.linalg.norm(A, axis=1))
         out["by_harmonic"].append(np.linalg.norm(As - A, axis=0) / np.linalg.norm(A))
     return {k: np.array(v) for k, v in out.items()}
@@ -90,8 +91,8 @@ def _contact_gaps(
         # structure and sensor model's consistency with the records, whatever the contact does
         "identification_residual": float(np.sqrt(np.mean(forces.residual[[0, 2]] ** 2))),
         "identification_noise": identification_noise(model, rec, memo),
-        "S": _rel(S_law, g["S"]),
-        "N": _rel(N_law, N_id),
+        "S": relative_difference(S_law, g["S"]),
+        "N": relative_difference(N_law, N_id),
         "open_fraction": open_fraction(g["N"], model.preload, open_limit),
         "energy_tangential": (float(np.mean(g["S"] * g["xi_dot"]) * T), sim.energy["tangential_j"]),
         "energy_normal": (float(-np.mean(N_id * g["eta_dot"]) * T), sim.energy["normal_j"]),
@@ -322,7 +323,7 @@ def linear_stage(model: IdentifiedModel, frf: xr.Dataset, modal: xr.Dataset) -> 
     }
 
 
-def _place_left(last, records, calibration_case, H, linear, structures, settings) -> dict | None:
+def place_left(last, records, calibration_case, H, linear, structures, settings) -> dict | None:
     """The localisation of what the explanation leaves, with its effects in the model (``last``: the last step's
     calibration and held-out simulations); None where a simulation is missing."""
     cal, sims = last

@@ -21,11 +21,13 @@ MAP_FIELDS = (
 )
 
 
-def _clean(x):
+def json_ready(x):
+    """``x`` ready for json.dumps: numpy scalars as Python ones, non-finite floats as None (null), keys as
+    strings."""
     if isinstance(x, dict):
-        return {str(k): _clean(v) for k, v in x.items()}
+        return {str(k): json_ready(v) for k, v in x.items()}
     if isinstance(x, (list, tuple)):
-        return [_clean(v) for v in x]
+        return [json_ready(v) for v in x]
     if isinstance(x, (np.floating, float)):
         return None if not math.isfinite(float(x)) else float(x)
     if isinstance(x, (np.bool_,)):
@@ -38,13 +40,13 @@ def _clean(x):
 def diagnosis_json(diag: Diagnosis, extra: dict | None = None) -> str:
     """diagnosis.json: verdict, reason, ranking [{effect, heldout_gap_before, heldout_gap_after, score, ...}],
     where (localisation summary), cases (non-finite numbers as null)."""
-    return json.dumps(_clean({**diag.summary(), **(extra or {})}), indent=2)
+    return json.dumps(json_ready({**diag.summary(), **(extra or {})}), indent=2)
 
 
 def updated_model_json(updated: dict, extra: dict | None = None) -> str:
     """results/gap/updated_model.json: the model the explanation arrives at (``explain.updated_model_summary``),
     non-finite numbers (a rigid clamp's stiffness) as null."""
-    return json.dumps(_clean({**updated, **(extra or {})}), indent=2)
+    return json.dumps(json_ready({**updated, **(extra or {})}), indent=2)
 
 
 def localisation_variables(a: dict) -> dict:

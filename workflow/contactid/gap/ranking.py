@@ -9,7 +9,7 @@ from typing import Mapping
 import numpy as np
 
 from .candidates import LIBRARY
-from .explain import _parameter_values, model_periodicity
+from .explain import model_periodicity, parameter_values
 from .records import RecordHarmonics
 from .refit import gap_value, identified_forces
 from .verdict import acts_where
@@ -56,7 +56,7 @@ def _ranking_row(
         "reduction_interval": [float(np.percentile(red_b, 2.5)), float(np.percentile(red_b, 97.5))],
         "heldout_gap_after_interval": [float(np.percentile(after_b, 2.5)), float(np.percentile(after_b, 97.5))],
         "n_parameters": k,
-        "parameters": _parameter_values(name, cal),
+        "parameters": parameter_values(name, cal),
         "calibration_gap": cal.gap,
         "friction": [float(x) for x in cal.friction],
         "heldout_gap_after_by_case": {c: gap_value(r) for c, r in res.items()},
@@ -70,7 +70,7 @@ def _ranking_row(
     }
 
 
-def _ranking(
+def rank_candidates(
     results,
     heldout_gap,
     n_bootstrap,

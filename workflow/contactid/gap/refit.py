@@ -14,7 +14,7 @@ from numba import njit
 
 from ..beam_model import all_modes
 from ..friction import initial_stiffness, iwan_force, valanis_friction_force
-from ..friction_fit import _polish, _Problem
+from ..friction_fit import FitProblem, least_squares_polish
 from ..harmonics import periodic_grid
 from ..identification import InverseHarmonics, inverse_harmonics, modal_damping_vector
 from ..rig.nonlinear import iwan_slip_weights
@@ -149,7 +149,7 @@ def law_friction_force(xi, xi_dot, N, params, aug: Augmentation, regularization:
     return S
 
 
-class _AugmentedProblem(_Problem):
+class _AugmentedProblem(FitProblem):
     def __init__(self, xi, xi_dot, N, S, bounds, aug, regularization):
         super().__init__(xi, N, S, bounds, regularization)
         self.xi_dot, self.aug = xi_dot, aug
@@ -203,7 +203,7 @@ def refit_friction(
         u0 = np.clip(prob.unit(np.asarray(model.friction))[0], 1e-6, 1 - 1e-6)
         # looser than the chain's own polish (1e-10, 1e-12): the law's parameters move by about 1e-8 of their ranges,
         # far below what the gap resolves, and a refit takes a fifth fewer evaluations of the law
-        u, ssr, _ = _polish(prob, u0, xtol=1e-8, ftol=1e-10)
+        u, ssr, _ = least_squares_polish(prob, u0, xtol=1e-8, ftol=1e-10)
         return (prob.physical(u)[0], float(np.sqrt(ssr / grid))), forces
 
     return _FRICTION.get(key, compute, memo)

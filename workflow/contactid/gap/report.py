@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import pandas as pd
 
-from ..latex import _fmt, tabular
+from ..latex import latex_number, tabular
 from ..latex import plain_text as _t
 from .report_benchmark import benchmark_text
 from .report_diagnosis import diagnosis_paragraphs
@@ -27,7 +27,8 @@ def updated_law_note(intervals: dict | None) -> str:
     par = intervals.get("parameters") or {}
     symbols = {"mu": r"\mu", "kappa": r"\kappa", "e0": r"e_0(N_0)"}
     parts = [
-        f"${sym} = {_fmt(par[n]['value'], 3)}$ (${_fmt(par[n]['interval'][0], 3)}$--${_fmt(par[n]['interval'][1], 3)}$)"
+        f"${sym} = {latex_number(par[n]['value'], 3)}$ "
+        f"(${latex_number(par[n]['interval'][0], 3)}$--${latex_number(par[n]['interval'][1], 3)}$)"
         for n, sym in symbols.items()
         if n in par
     ]
@@ -49,7 +50,7 @@ def explained_law_note(updated: dict | None) -> str:
         tail = "the chain's law above carries what those effects do to the identified S."
     elif td.get("applied"):
         which = f"mode {td['driven_mode']}'s damping ratio" if td["form"] == "driven" else "every mode's damping ratio"
-        scale = _fmt(td["scale"], 3)
+        scale = latex_number(td["scale"], 3)
         what = f"With {which} at test level, ${scale}$ times the random test's, as the other load cases confirm"
         tail = "the chain's law above carries the damping the random test misstates."
     else:
@@ -59,11 +60,11 @@ def explained_law_note(updated: dict | None) -> str:
         " "
         + what
         + r"; results/gap/updated\_model.json), the law is $\mu = "
-        + _fmt(fr["mu"], 3)
+        + latex_number(fr["mu"], 3)
         + r"$, $\kappa = "
-        + _fmt(fr["kappa"], 3)
+        + latex_number(fr["kappa"], 3)
         + r"$, $e_0(N_0) = "
-        + _fmt(fr["e0_at_preload"], 3)
+        + latex_number(fr["e0_at_preload"], 3)
         + "$~N/m: "
         + tail
     )

@@ -4,14 +4,14 @@ against its bar, accepted or not and by what, what the data bind, the channels' 
 
 from __future__ import annotations
 
-from ..latex import _fmt
+from ..latex import latex_number
 from ..latex import plain_text as _t
 from .report_format import num, pct
 from .verdict import at_floor
 
 
 def _factor_list(factors: dict) -> str:
-    return ", ".join(_t(k) + r" $\times" + _fmt(float(v), 4) + "$" for k, v in factors.items())
+    return ", ".join(_t(k) + r" $\times" + latex_number(float(v), 4) + "$" for k, v in factors.items())
 
 
 def _records_verdict(rt: dict | None) -> str:
@@ -76,7 +76,7 @@ def _channel_gains_text(upd: dict) -> str:
         r" The accelerometer channels' gains relative to one another (their logarithms sum to zero), read off the "
         r"random test's residues: "
         + ", ".join(
-            f"channel {i + 1} ${_fmt(float(g), 4)}$" + (r" ($\pm$\," + pct(s) + ")" if s is not None else "")
+            f"channel {i + 1} ${latex_number(float(g), 4)}$" + (r" ($\pm$\," + pct(s) + ")" if s is not None else "")
             for i, (g, s) in enumerate(zip(gains, list(sd) + [None] * (len(gains) - len(sd))))
         )
         + significance
@@ -93,9 +93,9 @@ def _gains_versus_structure_text(test: dict | None) -> str:
         return ""
     return (
         r"But the structure's factors alone fit the random test as well ($\chi^2$ lower by "
-        + _fmt(num(test.get("gains_drop")), 3)
+        + latex_number(num(test.get("gains_drop")), 3)
         + r" with the gains, "
-        + _fmt(num(test.get("gains_threshold")), 3)
+        + latex_number(num(test.get("gains_threshold")), 3)
         + r" needed), so the dual-sine records chose: held-out gap "
         + pct(test.get("heldout_gap_gains"))
         + r" with the update read through the gains, "
@@ -115,17 +115,17 @@ def updating_paragraph(diag: dict) -> str:
         return ""
     chi2 = (
         r"$\chi^2$ "
-        + _fmt(num(upd.get("chi2_nominal")), 3)
+        + latex_number(num(upd.get("chi2_nominal")), 3)
         + r" for the nominal structure, "
-        + _fmt(num(upd.get("chi2_updated")), 3)
+        + latex_number(num(upd.get("chi2_updated")), 3)
         + r" for the best update ("
         + str(upd.get("n_data", "--"))
         + r" data); "
         + (
             r"a drop of "
-            + _fmt(num(upd.get("chi2_threshold")), 3)
+            + latex_number(num(upd.get("chi2_threshold")), 3)
             + r" is significant for the "
-            + _fmt(num(upd.get("effective_factors")), 2)
+            + latex_number(num(upd.get("effective_factors")), 2)
             + r" factors the data bind"
             if upd.get("chi2_threshold") is not None
             else r"no drop is significant"

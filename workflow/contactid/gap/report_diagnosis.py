@@ -4,7 +4,7 @@ step with the measured floor; the base model's paragraph is ``report_base_model`
 
 from __future__ import annotations
 
-from ..latex import _fmt
+from ..latex import latex_number
 from ..latex import plain_text as _t
 from .report_base_model import updating_paragraph
 from .report_format import num, pct
@@ -49,9 +49,9 @@ def _updating_note(step: dict, diag: dict) -> str:
         return ""
     return (
         r" (not significant on the random test alone, $\chi^2$ "
-        + _fmt(upd.get("chi2_nominal", float("nan")), 3)
+        + latex_number(upd.get("chi2_nominal", float("nan")), 3)
         + r" $\to$ "
-        + _fmt(upd.get("chi2_updated", float("nan")), 3)
+        + latex_number(upd.get("chi2_updated", float("nan")), 3)
         + r"; accepted because it shrinks the held-out gap of the dual-sine records materially"
         + (
             r", compared on what their preload drift leaves, the drift refitted on each model)"
@@ -96,7 +96,7 @@ def explanation_text(diag: dict) -> str:
     elif not steps:
         text = (
             r"No candidate shrinks the held-out gap materially (by gap.min\_reduction $="
-            + _fmt(left.get("min_reduction", float("nan")), 2)
+            + latex_number(left.get("min_reduction", float("nan")), 2)
             + r"$ of what lies above the floor, gap.min\_gap "
             + pct(left.get("floor"))
             + r"; by a factor of gap.separation; beyond the records' scatter), so "
@@ -112,7 +112,7 @@ def explanation_text(diag: dict) -> str:
             + _law_note(s)
             + _periodicity_note(s, periodicity)
             + (r" (held where the random test measured it, not refitted: " if s.get("held") else r" (refitted: ")
-            + ", ".join(f"{_t(k)} $= {_fmt(v, 3)}$" for k, v in s["parameters"].items())
+            + ", ".join(f"{_t(k)} $= {latex_number(v, 3)}$" for k, v in s["parameters"].items())
             + r") takes the held-out gap from "
             + pct(s["heldout_gap_before"])
             + " to "
@@ -158,11 +158,11 @@ def measured_floor_text(diag: dict) -> str:
     return (
         r" The floor gap.min\_gap is measured for these records (gap.measure\_floor): the rig without effects, the "
         r"identified friction law as its truth, driven at $"
-        + _fmt(m["drive_hz"], 4)
+        + latex_number(m["drive_hz"], 4)
         + r"$~Hz and identified by the chain, leaves a held-out gap of "
         + pct(m["floor"])
         + r"; gap.min\_gap is $"
-        + _fmt(m["factor"], 2)
+        + latex_number(m["factor"], 2)
         + r"$ times it."
     )
 
@@ -275,7 +275,7 @@ def damping_at_test_level_text(diag: dict) -> str:
     which = f"mode {td['driven_mode']}'s damping ratio" if td["form"] == "driven" else "every mode's damping ratio"
     text = (
         r"\paragraph{Damping at test level.} The friction law misfits the calibration record least with "
-        + f"{which} ${_fmt(td['scale'], 3)}$ times the random test's"
+        + f"{which} ${latex_number(td['scale'], 3)}$ times the random test's"
     )
     if "heldout_gap_test_damping" in td:
         text += (
@@ -322,10 +322,11 @@ def resolution_text(diag: dict) -> str:
             r"These records cannot tell apart (their signatures on the held-out records, with what "
             + (" and ".join(_t(f) for f in iso.get("form_removed") or []) or "the base model's form")
             + r" absorbs removed, point the same way, cosine above $"
-            + _fmt(iso.get("limit", float("nan")), 2)
+            + latex_number(iso.get("limit", float("nan")), 2)
             + r"$): "
             + "; ".join(
-                " and ".join(_t(c) for c in p["candidates"]) + r" ($" + _fmt(p["cosine"], 3) + r"$)" for p in pairs
+                " and ".join(_t(c) for c in p["candidates"]) + r" ($" + latex_number(p["cosine"], 3) + r"$)"
+                for p in pairs
             )
             + "."
         )
@@ -338,7 +339,7 @@ def _trace_value(v) -> str:
     if isinstance(v, bool) or v is None:
         return _t(str(v))
     if isinstance(v, (int, float)):
-        return "$" + _fmt(v, 3) + "$"
+        return "$" + latex_number(v, 3) + "$"
     return _t(str(v))
 
 

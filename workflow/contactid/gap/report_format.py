@@ -3,7 +3,7 @@
 
 from __future__ import annotations
 
-from ..latex import _fmt
+from ..latex import latex_number
 
 
 def num(x) -> float:
@@ -12,4 +12,4 @@ def num(x) -> float:
 
 
 def pct(x) -> str:
-    return "--" if x is None else f"${_fmt(100 * float(x), 3)}$\\,\\%"
+    return "--" if x is None else f"${latex_number(100 * float(x), 3)}$\\,\\%"

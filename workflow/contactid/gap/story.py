@@ -24,7 +24,7 @@ the decisions here then say which of its steps the records attribute to an effec
    update or another effect).
 
 The verdict is the effect of the explanation's effect step with the largest share, or "none" exactly when no step is
-an effect (an update is not one, unless it amounts to one effect of the library, ``explain._updating_verdict``). The
+an effect (an update is not one, unless it amounts to one effect of the library, ``explain.updating_verdict``). The
 reason sentence comes from the trace: the step's numbers, or the test that ended the explanation. ``resolution`` says
 what these records can attribute: the smallest change of the held-out gap a first effect must make.
 """
@@ -36,7 +36,7 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
-from .verdict import _pct, _setting, acts_where, gap_shares, never_opens
+from .verdict import acts_where, gap_shares, never_opens, percent, setting
 
 
 @dataclass(frozen=True)
@@ -87,7 +87,7 @@ def update_counts(gap_before: float, gap_after: float, scatter: float, noise_fac
         float(drop),
         float(noise_factor * scatter),
         ok,
-        f"model updating takes the held-out gap from {_pct(gap_before)} to {_pct(gap_after)}"
+        f"model updating takes the held-out gap from {percent(gap_before)} to {percent(gap_after)}"
         + (
             ""
             if ok
@@ -135,9 +135,9 @@ def above_floor(gap: float, min_gap: float, effect: str = "") -> Test:
         float(gap),
         float(min_gap),
         ok,
-        f"the held-out gap {_pct(gap)} is "
+        f"the held-out gap {percent(gap)} is "
         + ("above" if ok else "below")
-        + f" gap.min_gap {_pct(min_gap)}"
+        + f" gap.min_gap {percent(min_gap)}"
         + (
             ""
             if ok
@@ -154,9 +154,9 @@ def beyond_scatter(gap: float, scatter: float, noise_factor: float, effect: str 
         float(gap),
         float(noise_factor * scatter),
         ok,
-        f"the held-out gap {_pct(gap)} is "
+        f"the held-out gap {percent(gap)} is "
         + ("beyond" if ok else "within")
-        + f" {noise_factor:g} x the records' scatter {_pct(scatter, 2)}",
+        + f" {noise_factor:g} x the records' scatter {percent(scatter, 2)}",
         effect,
     )
 
@@ -171,7 +171,7 @@ def shrinks_gap(effect: str, before: float, after: float, lower: float, min_redu
         float(red),
         float(min_reduction),
         ok,
-        f"{effect} shrinks the held-out gap from {_pct(before)} to {_pct(after)} ({red:.1%})"
+        f"{effect} shrinks the held-out gap from {percent(before)} to {percent(after)} ({red:.1%})"
         + (
             ""
             if ok
@@ -194,7 +194,7 @@ def beyond_model_form(effect: str, after: float, alternatives: Sequence[str], fo
         ", ".join(rivals) or "-",
         "-",
         ok,
-        f"{effect} leaves {_pct(after)}"
+        f"{effect} leaves {percent(after)}"
         + (
             ""
             if ok
@@ -210,16 +210,16 @@ def resolution(before: float, form_after: Mapping[str, float], scatter: float, s
     effect. It must shrink the gap by min_reduction of it, beyond noise_factor x the scatter, and leave less than the
     best form candidate's gap (``form_after``: {candidate: held-out gap after it}) over gap.separation; at or below the
     floor (min_gap) no change is attributed (the whole gap)."""
-    sep, min_red = _setting(settings, "separation"), _setting(settings, "min_reduction")
-    min_gap, noise = _setting(settings, "min_gap"), _setting(settings, "noise_factor")
+    sep, min_red = setting(settings, "separation"), setting(settings, "min_reduction")
+    min_gap, noise = setting(settings, "min_gap"), setting(settings, "noise_factor")
     finite = {k: float(v) for k, v in form_after.items() if np.isfinite(v)}
     best = min(finite, key=finite.get) if finite else None
     form_gap = min(before, finite[best]) if best else before
     if not held or before < min_gap:
         x = before
         how = (
-            f"The held-out gap {_pct(before)} is below the identification's floor gap.min_gap "
-            f"{_pct(min_gap)}: no change of it is attributed to an effect"
+            f"The held-out gap {percent(before)} is below the identification's floor gap.min_gap "
+            f"{percent(min_gap)}: no change of it is attributed to an effect"
             if held
             else "No load case is held out: no change of the gap is attributed to an effect"
         )
@@ -228,7 +228,7 @@ def resolution(before: float, form_after: Mapping[str, float], scatter: float, s
             f"gap.min_reduction ({min_red:.0%}) of the held-out gap": min_red * before,
             f"{noise:g} x the records' scatter": noise * scatter,
             (
-                f"what leaves less than {best} (the base model's form: {_pct(form_gap)}) over gap.separation {sep:g}"
+                f"what leaves less than {best} (the base model's form: {percent(form_gap)}) over gap.separation {sep:g}"
                 if best
                 else f"a gap over gap.separation {sep:g}"
             ): before - form_gap / sep,
@@ -236,8 +236,8 @@ def resolution(before: float, form_after: Mapping[str, float], scatter: float, s
         key = max(parts, key=parts.get)
         x = float(parts[key])
         how = (
-            f"An effect that changes the held-out gap ({_pct(before)}) by less than {_pct(x)} is not distinguishable "
-            f"from model-form error on these records (binding: {key})"
+            f"An effect that changes the held-out gap ({percent(before)}) by less than {percent(x)} is not "
+            f"distinguishable from model-form error on these records (binding: {key})"
         )
     return {"heldout_gap": float(x), "form_heldout_gap": float(form_gap), "form_candidate": best, "how": how}
 
@@ -254,8 +254,8 @@ def first_pass_best(rows: Sequence[Mapping], before: float) -> Test | None:
         float(best["heldout_gap_after"]),
         float(before),
         False,
-        f"no candidate shrinks the held-out gap materially (best: {best['effect']}, {_pct(before)} -> "
-        f"{_pct(best['heldout_gap_after'])})",
+        f"no candidate shrinks the held-out gap materially (best: {best['effect']}, {percent(before)} -> "
+        f"{percent(best['heldout_gap_after'])})",
         best["effect"],
     )
 
@@ -313,7 +313,7 @@ def tell(  # noqa: C901
         name = step["effect"]
         if name == "model_updating":
             t = update_counts(
-                step["heldout_gap_before"], step["heldout_gap_after"], scatter, _setting(settings, "noise_factor")
+                step["heldout_gap_before"], step["heldout_gap_after"], scatter, setting(settings, "noise_factor")
             )
             trace.append(t)
             if t.passed:
@@ -335,9 +335,9 @@ def tell(  # noqa: C901
                 after = float(nxt["heldout_gap_after"])
             lower = float((row.get("reduction_interval") or [1.0])[0]) if not step.get("pair_first") else 1.0
             tests += [
-                above_floor(g0, _setting(settings, "min_gap"), name),
-                beyond_scatter(g0, scatter, _setting(settings, "noise_factor"), name),
-                shrinks_gap(name, g0, after, lower, _setting(settings, "min_reduction")),
+                above_floor(g0, setting(settings, "min_gap"), name),
+                beyond_scatter(g0, scatter, setting(settings, "noise_factor"), name),
+                shrinks_gap(name, g0, after, lower, setting(settings, "min_reduction")),
             ]
         if kind == "effect":
             tests.append(beyond_model_form(name, step["heldout_gap_after"], step.get("alternatives") or [], form))
@@ -384,7 +384,7 @@ def tell(  # noqa: C901
             [x.as_dict() for x in trace],
         )
     if not effects and ended is None:  # the explanation added no step: the floor, or its first pass's best
-        t = above_floor(before, _setting(settings, "min_gap"))
+        t = above_floor(before, setting(settings, "min_gap"))
         t = t if not t.passed else first_pass_best(rows, before)
         if t is not None:
             trace.append(t)
@@ -399,8 +399,8 @@ def tell(  # noqa: C901
     else:
         alts = top.get("alternatives") or []
         reason = (
-            f"{top['effect']} shrinks the held-out gap from {_pct(top['heldout_gap_before'])} to "
-            f"{_pct(top['heldout_gap_after'])} ({top['share']:.0%} of its power)"
+            f"{top['effect']} shrinks the held-out gap from {percent(top['heldout_gap_before'])} to "
+            f"{percent(top['heldout_gap_after'])} ({top['share']:.0%} of its power)"
             + (f"; or, as well, {' or '.join(alts)}" if alts else "")
         )
     others = [s.get("names", s["effect"]) for s in effects if s is not top]
@@ -415,8 +415,8 @@ def _left(kept: Sequence[Mapping], start: float) -> str:
     return (
         ""
         if not kept
-        else f" (the explanation's steps take the held-out gap from {_pct(start)} to "
-        f"{_pct(kept[-1]['heldout_gap_after'])})"
+        else f" (the explanation's steps take the held-out gap from {percent(start)} to "
+        f"{percent(kept[-1]['heldout_gap_after'])})"
     )
 
 

@@ -83,12 +83,12 @@ def place(
     if np.median(z) > thresholds.drift_z:
         change = np.median([v["change"] for v in drift.values()])
         return "non_stationary", (
-            f"the records' harmonics drift by {_pct(change, 2)} over a record ({np.median(z):.0f} standard errors)"
+            f"the records' harmonics drift by {percent(change, 2)} over a record ({np.median(z):.0f} standard errors)"
         )
     if np.median(id_res / scatter) > thresholds.residual_factor:
         return "structure_or_measurement", (
             f"the linear structure and sensor model cannot fit the records at w "
-            f"and 3w (sensor misfit {_pct(np.median(id_res), 2)}, "
+            f"and 3w (sensor misfit {percent(np.median(id_res), 2)}, "
             f"{np.median(id_res / scatter):.0f} x the scatter)"
         )
     if stage["open_fraction"] > 0:
@@ -113,11 +113,12 @@ def place(
     )
 
 
-def _setting(settings, name: str) -> float:
+def setting(settings, name: str) -> float:
+    """The gap setting ``name`` (min_gap, min_reduction, ...) from GapSettings or a mapping of them."""
     return float(settings[name] if isinstance(settings, Mapping) else getattr(settings, name))
 
 
-def _pct(gap: float, digits: int = 3) -> str:
+def percent(gap: float, digits: int = 3) -> str:
     """A held-out gap (a fraction) for people: in per cent, as the report prints every gap ("0.298 %")."""
     return f"{100 * float(gap):.{digits}g} %"
 
@@ -130,15 +131,13 @@ def explains_most(gap: float, after: float, scatter: float, settings) -> bool:
     if not (np.isfinite(gap) and np.isfinite(after)):
         return False
     drop = gap - after
-    return bool(
-        drop >= _setting(settings, "min_reduction") * gap and drop > _setting(settings, "noise_factor") * scatter
-    )
+    return bool(drop >= setting(settings, "min_reduction") * gap and drop > setting(settings, "noise_factor") * scatter)
 
 
 def explainable(gap: float, settings) -> float:
     """The part of a held-out gap an effect can explain: what lies above the identification's own floor (min_gap),
     taken in quadrature as an rms is, sqrt(gap^2 - min_gap^2) (0 at or below the floor)."""
-    return float(np.sqrt(max(gap**2 - _setting(settings, "min_gap") ** 2, 0.0)))
+    return float(np.sqrt(max(gap**2 - setting(settings, "min_gap") ** 2, 0.0)))
 
 
 def explains_materially(gap: float, after: float, scatter: float, settings) -> bool:
@@ -159,10 +158,10 @@ def explains_materially(gap: float, after: float, scatter: float, settings) -> b
     above = explainable(gap, settings)
     shrink = above - explainable(after, settings)
     return bool(
-        shrink >= _setting(settings, "min_reduction") * above
+        shrink >= setting(settings, "min_reduction") * above
         and shrink > 0.0
-        and gap >= _setting(settings, "separation") * after
-        and gap - after > _setting(settings, "noise_factor") * scatter
+        and gap >= setting(settings, "separation") * after
+        and gap - after > setting(settings, "noise_factor") * scatter
     )
 
 
@@ -172,7 +171,7 @@ def indistinguishable(gaps: Mapping[str, float], best: str, settings) -> list:
     first. gaps: {candidate: held-out gap after it} of the pass. A step with such alternatives says which effect
     explains the gap only up to them (a compliant clamp's 1.13 % was taken to 0.553 % by a channel skew and to
     0.554 % by a normal dashpot)."""
-    limit = _setting(settings, "separation") * gaps[best]
+    limit = setting(settings, "separation") * gaps[best]
     others = [n for n, g in gaps.items() if n != best and np.isfinite(g) and g < limit]
     return sorted(others, key=lambda n: gaps[n])
 
@@ -208,11 +207,11 @@ def records_prefer_gains(
     and the explanation left 3.9 % naming neither effect; with the gains, both were named and 1.3 % left."""
     if not (np.isfinite(gap_structure) and np.isfinite(gap_gains)):
         return False
-    beyond = _setting(settings, "noise_factor") * scatter
+    beyond = setting(settings, "noise_factor") * scatter
     if gap_structure - gap_gains <= beyond:
         return False
     contradicted = gap_chain is not None and np.isfinite(gap_chain) and gap_structure - gap_chain > beyond
-    return bool(contradicted or gap_structure >= _setting(settings, "separation") * gap_gains)
+    return bool(contradicted or gap_structure >= setting(settings, "separation") * gap_gains)
 
 
 def records_carry_factor(gap_chain: float, alone: float, without: float, scatter: float, settings) -> bool:
@@ -222,7 +221,7 @@ def records_carry_factor(gap_chain: float, alone: float, without: float, scatter
     (``evidence.records_attribution``)."""
     return (
         records_accept_update(gap_chain, alone, scatter, settings)
-        and without >= _setting(settings, "separation") * alone
+        and without >= setting(settings, "separation") * alone
     )
 
 
@@ -245,7 +244,7 @@ def retried(first_thetas: Mapping[str, Sequence], library: Mapping, settings) ->
 
 def at_floor(gap: float, settings) -> bool:
     """Whether a held-out gap is at the identification's own floor (below min_gap): nothing left to explain."""
-    return bool(gap < _setting(settings, "min_gap"))
+    return bool(gap < setting(settings, "min_gap"))
 
 
 def gap_shares(before: float, steps_after: Sequence[float]) -> tuple[list, float]:

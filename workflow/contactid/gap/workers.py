@@ -176,7 +176,7 @@ def prepare_workers(workers: int) -> bool:
     return workers > 1 and _pool(workers) is not None
 
 
-def _candidates(names, workers: int, **common):
+def start_candidates(names, workers: int, **common):
     """Start the candidates (see ``_candidate``) and return a function that gives {name: (calibration, sims,
     residuals)} in library order. With ``workers`` > 1 they run at once in forked worker processes while this
     process goes on (the results equal the serial ones to the last digit: each candidate starts without Newton

@@ -87,17 +87,17 @@ def contact_parameters(structure_cfg: Mapping, rig_cfg: Mapping) -> ContactParam
 
 def normal_tangent_ratio(contact: ContactParameters, k_n: float, load: float) -> float:
     """The normal law's tangent stiffness where the compression reaches ``load`` x N0, over k_n (>= 1): the
-    integrator's law and the harmonic balance's tangent of it (``_normal_path``), at the compression found by
+    integrator's law and the harmonic balance's tangent of it (``normal_path``), at the compression found by
     ``brentq``."""
     from scipy.optimize import brentq
 
-    from .harmonic_balance import _normal_path
+    from .harmonic_balance import normal_path
 
     c = contact
 
     def normal(eta):  # N (N) and dN/deta (N/m) of the elastic law
         N, dN, dNd = np.empty(1), np.empty(1), np.empty(1)
-        _normal_path(
+        normal_path(
             np.array([eta]), np.zeros(1), c.preload, c.static_approach, c.exponent, c.cubic, 0.0, True, N, dN, dNd
         )
         return N[0], dN[0]

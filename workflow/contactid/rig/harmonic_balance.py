@@ -35,11 +35,11 @@ from .nonlinear import (
     WORK_LIMIT_BYTES,
     ContactParameters,
     ReducedModel,
-    _normal_force,
-    _work_limit_error,
     friction_record,
     gib,
+    normal_force,
     stiffest_mode,
+    work_limit_error,
 )
 
 
@@ -192,10 +192,10 @@ def _propagate(coef, dxi, dN_from, dN, out):
 
 
 @njit(cache=True)
-def _normal_path(eta, deta, n0, delta0, p, cubic, hc, unilateral, N, dN_deta, dN_ddeta):
-    """Normal force and its tangents along the path (the integrator's ``_normal_force``)."""
+def normal_path(eta, deta, n0, delta0, p, cubic, hc, unilateral, N, dN_deta, dN_ddeta):
+    """Normal force and its tangents along the path (the integrator's ``normal_force``)."""
     for i in range(eta.size):
-        N[i] = _normal_force(eta[i], deta[i], n0, delta0, p, hc, unilateral, cubic)
+        N[i] = normal_force(eta[i], deta[i], n0, delta0, p, hc, unilateral, cubic)
         if unilateral and (eta[i] >= delta0 or N[i] <= 0.0):
             dN_deta[i] = 0.0
             dN_ddeta[i] = 0.0
@@ -244,7 +244,7 @@ class HarmonicBalance:
             raise ValueError(f"harmonic balance: M = {M} points cannot resolve H = {H} harmonics (M >= 4 H)")
         need = grid_bytes(M, H, red.omega.size)
         if need > WORK_LIMIT_BYTES:
-            raise _work_limit_error(
+            raise work_limit_error(
                 f"harmonic balance: {M} points per period ({2 * np.pi / w / M:.3g} s steps) with {H} harmonics and "
                 f"{red.omega.size} coordinates need {gib(need)}, above the limit of {gib(WORK_LIMIT_BYTES)} "
                 "(contactid.rig.nonlinear.WORK_LIMIT_BYTES); the step follows the model's stiffest mode, at "
@@ -342,7 +342,7 @@ class HarmonicBalance:
     def _normal(self, eta, deta):
         c = self.contact
         N, dN, dNd = np.empty(self.M), np.empty(self.M), np.empty(self.M)
-        _normal_path(
+        normal_path(
             eta,
             deta,
             c.preload,

@@ -89,7 +89,8 @@ it integrates on the project's rig (174 periods of 754 steps) 44 MB; a record at
 steps per period) 0.2-0.3 GiB. Past it a ``WorkLimitError``."""
 
 
-def _work_limit_error(message: str):
+def work_limit_error(message: str):
+    """A WorkLimitError with ``message`` (imported when raised)."""
     from ..io import WorkLimitError  # here: this module is imported where xarray is not needed
 
     return WorkLimitError(message)
@@ -164,7 +165,7 @@ def stable_oversampling(red: ReducedModel, fs: float, q_min: int, stiffening: fl
                 f"the viscous friction's rate sigma_2 |dxi/dq|^2 = {rate:.3g} 1/s (sigma_2 = {viscous:.3g} N s/m) is "
                 f"{rate / fs:.3g} x the sampling rate {fs:g} Hz"
             )
-        raise _work_limit_error(
+        raise work_limit_error(
             f"{what}: the explicit integration would need {q} steps per sample, above the limit of "
             f"{MAX_STEPS_PER_SAMPLE} (contactid.rig.nonlinear.MAX_STEPS_PER_SAMPLE; a legitimate model needs 8 to "
             "about 170)"
@@ -273,7 +274,7 @@ def _contact_state(z, v, xi_v, eta_v, G, dxi_dq):
 
 
 @njit(cache=True)
-def _normal_force(eta, deta, n0, delta0, p, hc, unilateral, cubic):
+def normal_force(eta, deta, n0, delta0, p, hc, unilateral, cubic):
     """N = [N0 ((delta0 - eta)/delta0)^p - k_3 eta^3] (1 - hc deta/dt) (N), zero once the contact opens; a
     bilateral law (``unilateral`` False, p = 1) is the linear spring of Eq. 13 (plus the cubic) and may pull.
     With p = 1 the elastic part is the polynomial hardening N0 - k_n eta - k_3 eta^3 (cubic = k_3, N/m^3)."""
@@ -500,7 +501,7 @@ def integrate(z, v, state, x_sl, t0, n_steps, dt, model, contact, drive, store_f
     S_val = state[0]
     dxi_dq = np.empty(z.size)
     xi_lin, xi, eta, deta, dxi = _contact_state(z, v, xi_v, eta_v, G, dxi_dq)
-    N = _normal_force(eta, deta, n0, delta0, p, hc, unilateral, cubic)
+    N = normal_force(eta, deta, n0, delta0, p, hc, unilateral, cubic)
     P = n0
     a = np.empty(n)
     t = t0
@@ -521,7 +522,7 @@ def integrate(z, v, state, x_sl, t0, n_steps, dt, model, contact, drive, store_f
         xi_old = xi
         N_old = N
         xi_lin, xi, eta, deta, dxi = _contact_state(z, v, xi_v, eta_v, G, dxi_dq)
-        N = _normal_force(eta, deta, n0, delta0, p, hc, unilateral, cubic)  # explicit estimate for the friction law
+        N = normal_force(eta, deta, n0, delta0, p, hc, unilateral, cubic)  # explicit estimate for the friction law
         if N <= 1e-6 or N_old <= 1e-6:  # open, or re-contact: the contact sticks where it lands (valanis_step)
             S_val = 0.0
         else:
@@ -538,7 +539,7 @@ def integrate(z, v, state, x_sl, t0, n_steps, dt, model, contact, drive, store_f
         P = _static_preload(t, n0, drive)
         f = _excitation(f_sin, f_cos, w, t)
         # normal force: elastic part explicit, Hunt-Crossley damping implicit (it is stiff)
-        N_el = N if hc == 0.0 else _normal_force(eta, 0.0, n0, delta0, p, 0.0, unilateral, cubic)  # N w/o dashpot
+        N_el = N if hc == 0.0 else normal_force(eta, 0.0, n0, delta0, p, 0.0, unilateral, cubic)  # N w/o dashpot
         uDu, uy = _damped_velocity(z, v, a, dt, c, om2, f, S_tot, N_el, P, xi_lin, eta, dxi_dq, model)
         N = _damped_normal_force(v, N_el, uDu, uy, dt, c, eta_v, hc, unilateral)
         for i in range(n):
@@ -625,7 +626,7 @@ class DualSineSimulator:
         need = record_bytes(n_store, n_r, state)
         if need > WORK_LIMIT_BYTES:
             per_period = 2 * np.pi / (float(w) * self.dt) if w else float("nan")
-            raise _work_limit_error(
+            raise work_limit_error(
                 f"time integration: storing {n_store} steps ({n_store / per_period:.4g} periods of "
                 f"{per_period:.6g} steps, dt = {self.dt:.3g} s, {getattr(self, 'oversampling', '?')} steps per sample) "
                 f"of a {n_r}-coordinate model needs {gib(need)}, above the limit of {gib(WORK_LIMIT_BYTES)} "
