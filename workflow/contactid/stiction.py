@@ -190,8 +190,8 @@ def stiction_stiffness(
     model's) with a Gaussian prior of that sd on ln s adds ln s / sd to the residuals, and every profile refits it.
     The frequencies' errors of a structure whose stiffness is uncertain are correlated (every mode moves with
     sqrt(s)); held at s = 1, the fit gives that error to k_t and k_n: on a beam 3 % softer than the model, k_t 20 %
-    low and k_n 6.6 times too soft with an interval that excluded the truth (docs/measurements.md, twenty-third
-    session). With sd 0 the structure is the model's (s = 1), the fit as before.
+    low and k_n 6.6 times too soft with an interval that excluded the truth (docs/measurements.md, "A rig whose beam
+    is softer than the model"). With sd 0 the structure is the model's (s = 1), the fit as before.
     """
     f_id = np.asarray(f_id_hz, dtype=float)
     sigma = np.asarray(sigma_hz, dtype=float)

@@ -194,7 +194,7 @@ def _unresolved_from_off(value: float, p, xatol: float) -> bool:
     it then is. On the effect-free default data the transducer-mass search ended at -1.07e-5 (tolerance 3.9e-3) in
     one diagnosis and at "off" in the other: a mass change however small refits k_t and k_n to the frequencies
     (``model._refit_contact``), whose k_n is flat there and moved k_t by 1e-5, and the held-out gaps of the two
-    diagnoses stood 0.88 % apart (docs/measurements.md, thirty-fifth session)."""
+    diagnoses stood 0.88 % apart (docs/measurements.md, "The searches stop where time marching stops")."""
     return not p.is_off(value) and abs(float(value) - p.off) <= xatol
 
 
