@@ -10,7 +10,8 @@ whether the identified model is fit for the records. Two fits state their own ac
   springs cannot reproduce the frequencies: k_t and k_n then absorb a structural error (Young's modulus,
   masses, lever arm, clamp), and their intervals hold for the model's structure only. On a rig 3 % softer
   than the model (E), the fit put k_n at 3.6e6 N/m (truth 2.37e7) with an interval that excluded the truth,
-  at chi^2 = 13.1 for one degree of freedom (docs/measurements.md, "A rig whose beam is softer than the model, the benchmark's time by stage, and the test suite");
+  at chi^2 = 13.1 for one degree of freedom (docs/measurements.md, "A rig whose beam is softer than the model, the
+  benchmark's time by stage, and the test suite");
 - the friction fit (Table 4) profiles its intervals with the identified S assumed accurate to
   ``friction.misfit_floor`` (relative): a misfit beyond it means the law, or the S it is fitted to, does not
   describe the record to that accuracy, and its intervals are narrower than the error of its parameters.

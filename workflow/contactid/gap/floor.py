@@ -3,7 +3,8 @@
 ``gap.min_gap`` is the held-out gap below which the diagnosis explains nothing: what the chain's own identification
 leaves on records without any unmodelled effect. That floor depends on the drive: 0.30 % on the default data at
 54.4 Hz (the value 0.006 was set as about twice it), 0.05 % at 60 Hz, where a viscous friction of 300 N s/m raised
-the held-out gap to 0.46 % and stayed below the fixed floor (docs/measurements.md, "The floor measured at the records' drive").
+the held-out gap to 0.46 % and stayed below the fixed floor (docs/measurements.md, "The floor measured at the records'
+drive").
 
 ``gap.measure_floor`` (true by default) measures it: the rig, with no effect, its nominal structure and damping
 (none of ``rig.true_structure``, ``rig.true_damping``, nor a cubic normal law) and the identified friction law as

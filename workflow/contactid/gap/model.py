@@ -188,7 +188,8 @@ def _refit_contact(
     ``stiction.LN_SCALE_BOUNDS`` of the config's. Held at the chain's E, a mass candidate's refit gave the chain's
     stiffness scale (1.0043 on transducer masses 30 % heavy: the scale had taken up part of the mass error) to the
     refitted structure, and the candidate's calibration settled at +62 %; with E refitted as the chain fits it,
-    at +30.5 % (docs/measurements.md, "The mass candidate's stiffness refit, the line search's safeguard and the records' attribution").
+    at +30.5 % (docs/measurements.md, "The mass candidate's stiffness refit, the line search's safeguard and the
+    records' attribution").
 
     ``refit_k_n`` False: where the frequencies bound k_n from one side only, the chain's linear modes use the prior
     k_n, not the fit's; so does the refit (the fit is the chain's, k_n then set to the prior: at no mass change the
