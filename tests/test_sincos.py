@@ -4,7 +4,7 @@ import platform
 
 import numpy as np
 import pytest
-from contactid.rig.nonlinear import _excitation
+from contactid.rig.integrator import _excitation
 from contactid.sincos import HAS_LIBM_SINCOS, sin_cos
 
 GLIBC = platform.libc_ver()[0] == "glibc"

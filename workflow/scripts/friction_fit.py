@@ -1,6 +1,7 @@
 """Rule friction_fit: GA + polish of the modified Valanis law on the calibration case (Table 4)."""
 
-from contactid.friction_fit import friction_fit_dataset, settings_from_config
+from contactid.friction_datasets import friction_fit_dataset
+from contactid.friction_fit import settings_from_config
 from contactid.friction_parameters import fitted_parameters
 from contactid.io import load_dataset, provenance, write_dataset
 from contactid.logs import fmt, setup_logging

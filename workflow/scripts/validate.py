@@ -1,6 +1,6 @@
 """Rule validate: the fitted law predicts S(t) of a load case from its own xi(t), N(t)."""
 
-from contactid.friction_fit import validation_dataset
+from contactid.friction_datasets import validation_dataset
 from contactid.io import load_dataset, provenance, write_dataset
 from contactid.logs import fmt, setup_logging
 

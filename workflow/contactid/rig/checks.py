@@ -11,10 +11,10 @@ import pandas as pd
 
 from ..beam_model import all_modes, assemble
 from ..harmonics import harmonic_amplitudes
+from .control import control_response
 from .damping import dual_sine_damping_ratios
 from .dual_sine import build_simulator, dual_sine_settings, dual_sine_test
 from .effects import EFFECTS
-from .nonlinear import control_response
 from .structure import rig_structure
 
 

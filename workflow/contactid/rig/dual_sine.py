@@ -18,14 +18,13 @@ from ..contact_laws import NormalLaw, ValanisParameters
 from ..harmonics import harmonic_amplitudes
 from ..io import raw_dataset
 from ..random_streams import generator
+from .control import ControlResult, control_response
 from .damping import dual_sine_damping_ratios
 from .effects import effect_magnitudes
 from .frontend import add_noise, anti_alias_decimate, delay_channels
 from .nonlinear import (
     ContactParameters,
-    ControlResult,
     DualSineSimulator,
-    control_response,
     reduced_model,
     stable_oversampling,
 )

@@ -31,13 +31,13 @@ import scipy.linalg
 from numba import njit
 
 from ..friction import initial_stiffness, iwan_force, valanis_step
+from .integrator import normal_force
 from .nonlinear import (
     WORK_LIMIT_BYTES,
     ContactParameters,
     ReducedModel,
     friction_record,
     gib,
-    normal_force,
     stiffest_mode,
     work_limit_error,
 )
