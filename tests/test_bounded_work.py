@@ -160,7 +160,7 @@ def test_a_fit_pinned_at_a_bound_far_from_the_data_is_refused_even_within_the_ra
 
 def test_amplitudes_in_g_are_refused_by_the_stiffness_step_and_true_ones_pass(foreign_structure, default_config):
     from contactid.stiction import refuse_unreachable
-    from contactid.updating import modal_predictions
+    from contactid.updating_model import modal_predictions
 
     st = default_config["stiction"]
     params = structure_from_config(foreign_structure, 1e7, 1e8)

@@ -14,7 +14,8 @@ from contactid.config import check_config
 from contactid.importers import import_record
 from contactid.importers.export import export_record
 from contactid.io import RawDataError, raw_dataset, read_raw, write_dataset
-from contactid.raw_checks import recovered_frequency, samples_at_limit, validate_dual_sine
+from contactid.raw_checks import samples_at_limit
+from contactid.raw_checks_dual_sine import recovered_frequency, validate_dual_sine
 from contactid.schema import ConfigError
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -261,7 +262,7 @@ def test_a_steady_drift_is_kept_for_the_gap_diagnosis_and_a_transient_or_a_stron
     last, steadily (steps within 10 % of each other), and the raw check refused the record at its 5 % stationarity
     tolerance: the workflow could not diagnose its own typical drift. A steady drift up to raw_checks.drift_tolerance
     (0.25) is now kept with a warning; a transient (its first step the larger) or a stronger drift is refused."""
-    from contactid.raw_checks import steady_drift
+    from contactid.raw_checks_dual_sine import steady_drift
 
     raw = dual_sine()
     drift = raw.copy(deep=True)
@@ -565,7 +566,7 @@ def test_frf_channel_map_by_node_and_the_config_checks(rig_frf, tmp_path, small_
 
 
 def test_frf_resolution_check_without_a_time_record(rig_frf):
-    from contactid.raw_checks import validate_frf_resolution
+    from contactid.raw_checks_random import validate_frf_resolution
 
     frf, _ = rig_frf  # lines 1.25 Hz apart
     with pytest.raises(RawDataError, match=r"f\.uff: FRF resolution check failed: the lines are 1\.25 Hz apart"):

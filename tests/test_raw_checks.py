@@ -1,18 +1,15 @@
-"""The raw checks refuse a record with the cause its numbers show (contactid.raw_checks, contactid.io.read_raw): a dead
-channel as dead (not clipped), a clean periodic record as good (its peak sample repeating every period is no flat top),
-a wrong sampling rate as one (not as an unsettled record), a missing units attribute as missing, and an offset as a
-warning. Small synthetic records: 20 periods of 54 Hz at 5400 Hz (100 samples a period, as the shared lc1.nc)."""
+"""The raw checks refuse a record with the cause its numbers show (contactid.raw_checks, raw_checks_dual_sine and
+raw_checks_random, contactid.io.read_raw): a dead channel as dead (not clipped), a clean periodic record as good (its
+peak sample repeating every period is no flat top), a wrong sampling rate as one (not as an unsettled record), a
+missing units attribute as missing, and an offset as a warning. Small synthetic records: 20 periods of 54 Hz at
+5400 Hz (100 samples a period, as the shared lc1.nc)."""
 
 import numpy as np
 import pytest
 from contactid.io import RawDataError, raw_dataset, read_raw
-from contactid.raw_checks import (
-    excitation_lines,
-    flat_tops,
-    recovered_frequency,
-    validate_dual_sine,
-    validate_random_test,
-)
+from contactid.raw_checks import flat_tops
+from contactid.raw_checks_dual_sine import excitation_lines, recovered_frequency, validate_dual_sine
+from contactid.raw_checks_random import validate_random_test
 
 FS, F0, N = 5400.0, 54.0, 2000
 SENSORS, POSITIONS = ["a1", "a2", "a3"], [0.55, 0.3, 0.05]
@@ -281,7 +278,7 @@ def test_a_driving_point_accelerance_of_the_wrong_sign_is_a_warning():
     the force's sign flipped makes it negative there: a warning naming the driving point and its resonances. A
     sensor off the driving point may have either sign."""
     import xarray as xr
-    from contactid.raw_checks import driving_point_sign_warnings
+    from contactid.raw_checks_random import driving_point_sign_warnings
 
     f = np.linspace(1.0, 500.0, 4000)
     w = 2 * np.pi * f
@@ -309,7 +306,7 @@ def test_a_record_far_from_the_random_tests_level_is_refused_naming_units():
     (slip moves and damps a resonance) it passes, whichever way; 1000 times off (mm/s^2 labelled m/s^2) it is refused
     before identification, whose inverse problem would overflow on it."""
     import xarray as xr
-    from contactid.raw_checks import LEVEL_FACTOR_LIMIT, frf_level_check
+    from contactid.raw_checks_dual_sine import LEVEL_FACTOR_LIMIT, frf_level_check
 
     f = np.linspace(1.0, 500.0, 500)
     frf = xr.Dataset(

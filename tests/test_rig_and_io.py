@@ -161,5 +161,8 @@ def test_jobs_that_fit_nothing_do_not_import_scipy_optimize():
     """The linear chain's FRF, modal-fit and raw-check jobs, and the contact-force jobs, import the modules of the
     stiffness fit and of model updating for their models and results alone; scipy.optimize (0.3 s a job) is imported
     by the fits that use it."""
-    code = "import contactid.linear_chain, contactid.updating, contactid.raw_checks, contactid.stiction"
+    code = (
+        "import contactid.linear_chain, contactid.updating, contactid.updating_model, contactid.updating_result, "
+        "contactid.raw_checks, contactid.raw_checks_dual_sine, contactid.raw_checks_random, contactid.stiction"
+    )
     assert not _imports_in_a_fresh_process("scipy.optimize", code)

@@ -6,7 +6,9 @@ import pytest
 from contactid.gap.explain import updating_step
 from contactid.gap.settings import GapSettings
 from contactid.parameters import structure_from_config
-from contactid.updating import FACTORS, UpdatingResult, apply_factors, modal_predictions, update_structure
+from contactid.updating import update_structure
+from contactid.updating_model import FACTORS, apply_factors, modal_predictions
+from contactid.updating_result import UpdatingResult
 
 
 @pytest.fixture(scope="module")

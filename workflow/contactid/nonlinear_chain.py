@@ -22,7 +22,7 @@ from .identification import (
     nrmse,
 )
 from .parameters import identified_structure
-from .raw_checks import driving_point_index
+from .raw_checks_dual_sine import driving_point_index
 
 
 def linear_model(structure_cfg: Mapping, linear_modes: xr.Dataset) -> FEModel:

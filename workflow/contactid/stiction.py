@@ -495,9 +495,9 @@ g taken per m/s^2), makes 9.81, a kN force 1000; a factor 3 lies far from both."
 
 def amplitude_ratio(params: StructureParameters, residue_abs, k_t: float, k_n: float, stiffness_scale: float = 1.0):
     """The median over sensors and modes of the measured residues (``residue_abs`` (sensor, mode), modal.nc's) over
-    those of the described structure at the fitted k_t, k_n and stiffness scale (``updating.modal_predictions``); None
-    where the shapes do not match (another sensor layout)."""
-    from .updating import modal_predictions
+    those of the described structure at the fitted k_t, k_n and stiffness scale (``updating_model.modal_predictions``);
+    None where the shapes do not match (another sensor layout)."""
+    from .updating_model import modal_predictions
 
     measured = np.asarray(residue_abs, dtype=float)
     fitted = params.with_contact(float(k_t), float(k_n))

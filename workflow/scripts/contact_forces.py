@@ -7,7 +7,7 @@ from contactid.io import RawDataError, load_dataset, nonfinite_variables, proven
 from contactid.logs import fmt, setup_logging
 from contactid.nonlinear_chain import contact_forces_dataset
 from contactid.parameters import identified_structure
-from contactid.updating import UpdatingResult
+from contactid.updating_result import UpdatingResult
 
 log = setup_logging(snakemake.log[0])
 inp, nl = snakemake.input, snakemake.params.nonlinear

@@ -8,8 +8,8 @@ import json
 from contactid.io import provenance, read_raw, write_dataset
 from contactid.linear_chain import check_sensor_layout, frf_dataset
 from contactid.logs import fmt, setup_logging
-from contactid.raw_checks import (
-    check_settings,
+from contactid.raw_checks import check_settings
+from contactid.raw_checks_random import (
     driving_point_sign_warnings,
     validate_coherence,
     validate_random_test,

@@ -9,7 +9,8 @@ import json
 from contactid.importers.frf_uff import measured_frf_dataset
 from contactid.io import provenance, write_dataset
 from contactid.logs import fmt, setup_logging
-from contactid.raw_checks import check_settings, validate_coherence, validate_frf_resolution
+from contactid.raw_checks import check_settings
+from contactid.raw_checks_random import validate_coherence, validate_frf_resolution
 
 log = setup_logging(snakemake.log[0])
 p = snakemake.params

@@ -8,7 +8,8 @@ import json
 from contactid.io import load_dataset, provenance, read_raw, write_dataset
 from contactid.linear_chain import check_sensor_layout
 from contactid.logs import setup_logging
-from contactid.raw_checks import check_settings, dual_sine_check_dataset, frf_level_check, validate_dual_sine
+from contactid.raw_checks import check_settings
+from contactid.raw_checks_dual_sine import dual_sine_check_dataset, frf_level_check, validate_dual_sine
 
 log = setup_logging(snakemake.log[0])
 p = snakemake.params

@@ -250,7 +250,7 @@ def diagnosed_model(
     modal.nc and friction_fit.nc; the model to diagnose, the chain's updated by model_updating.json's summary
     (``updated_model``, which the ``held_out`` records may also accept) or the chain's own when updating is off;
     the UpdatingResult or None)."""
-    from ..updating import UpdatingResult
+    from ..updating_result import UpdatingResult
 
     chain = identified_model(structure_cfg, modes, modal, fit)
     if not updating_summary["enabled"]:
@@ -384,7 +384,7 @@ def _without_factor(model, upd, factor: str):
     """The structure of ``upd``'s proposal with ``factor`` at 1 (the others as proposed), its stiffness fit redone as
     a mass candidate's is (``IdentifiedModel.refit_stiffness``: k_t and k_n refitted to the chain's frequencies, k_n
     kept where the chain's modes use the prior k_n), E as the factors set it."""
-    from ..updating import apply_factors
+    from ..updating_model import apply_factors
 
     p = upd.proposal
     factors = {k: (1.0 if k == factor else float(v)) for k, v in p["factors"].items()}

@@ -105,12 +105,12 @@ def record_harmonics(raw: xr.Dataset, case: str, n_harmonics: int, n_blocks: int
 
 
 def _drive_frequency(force: np.ndarray, fs: float, declared_hz: float) -> float:
-    """The drive's frequency as the force record shows it (``raw_checks.recovered_frequency``), for the share of
-    the response that is not periodic: a declared frequency off by the raw checks' tolerance (0.02 cycles over the
-    record) would leave 4 % of the fundamental and more of each higher harmonic unfitted, a settled record read as
-    one that does not settle. The declared one where the record's strongest line is not one of its first three
+    """The drive's frequency as the force record shows it (``raw_checks_dual_sine.recovered_frequency``), for the
+    share of the response that is not periodic: a declared frequency off by the raw checks' tolerance (0.02 cycles
+    over the record) would leave 4 % of the fundamental and more of each higher harmonic unfitted, a settled record
+    read as one that does not settle. The declared one where the record's strongest line is not one of its first three
     harmonics."""
-    from ..raw_checks import recovered_frequency
+    from ..raw_checks_dual_sine import recovered_frequency
 
     f, h = recovered_frequency(np.asarray(force, dtype=float), fs, declared_hz)
     return f if h in (1, 2, 3) and abs(f / declared_hz - 1.0) < 0.01 else declared_hz

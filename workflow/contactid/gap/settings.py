@@ -55,7 +55,7 @@ class GapSettings:
     residue_accuracy: float = 0.01
     frequency_floor: float = 0.001
     updating_confidence: float = 0.95
-    updating_prior_sd: tuple = ()  # ((factor, sd of its ln), ...) replacing contactid.updating.FACTORS' priors
+    updating_prior_sd: tuple = ()  # ((factor, sd of its ln), ...) replacing contactid.updating_model.FACTORS' priors
     updating_records_test: bool = True  # the records may accept an update the random test's chi^2 did not
     updating_gain_sd: float = 0.03  # prior sd of ln of each channel's sensitivity on the residues (0: calibrated)
     joint_refit: bool = True  # the explanation's later steps refit the earlier steps' parameters with theirs
@@ -108,7 +108,7 @@ class GapSettings:
 
 def _updating_settings(b: Mapping) -> dict:
     """GapSettings fields of the config block gap.model_updating (its defaults filled in)."""
-    from ..updating import FACTORS
+    from ..updating_model import FACTORS
 
     params = tuple(b["parameters"])
     unknown = [x for x in params if x not in FACTORS]

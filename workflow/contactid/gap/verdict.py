@@ -271,7 +271,7 @@ UPDATING_Z = 2.0  # a factor moved when |ln factor| exceeds this many posterior 
 
 def _profile(ident: Mapping) -> float | None:
     """A factor's profile as the verdict reads it: its group's (held at nominal with the group's other factors,
-    ``updating.PROFILE_GROUPS``) where it has one, else its own (None in an older model_updating.json)."""
+    ``updating_model.PROFILE_GROUPS``) where it has one, else its own (None in an older model_updating.json)."""
     return ident.get("group_profile_chi2_increase", ident.get("profile_chi2_increase"))
 
 
