@@ -68,7 +68,7 @@ def _shared_run(config, name: str) -> wp.BackgroundRun:
 # when each run is ready, roughly (the later ones follow the small run and share the machine): a test that reads a run
 # waits for it, so the tests are ordered by the latest run they read, the others first; within one rank they keep
 # their order. The measured run ends last (about 40 s after the acceptance run in a fresh clone): its tests used to
-# wait for it in the middle of tests/test_workflow.py with every other test of that file still to run
+# wait for it in the middle of tests/workflow/test_workflow.py with every other test of that file still to run
 READY_RANK = {
     "small_run": 1,
     "other_seed_run": 2,

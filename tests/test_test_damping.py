@@ -1,6 +1,7 @@
 """The damping at test level (contactid/test_damping.py, gap.pipeline.test_level_damping, and what the gap diagnosis
 does with it, gap.explain.with_damping_at_test_level): small pure parts on hand-made numbers; the profile and its test
-on rig records damped otherwise in their dual-sine tests (slow); the default run's in tests/test_workflow.py."""
+on rig records damped otherwise in their dual-sine tests (slow); the default run's in
+tests/workflow/test_workflow.py."""
 
 import numpy as np
 import pytest

@@ -124,7 +124,7 @@ def make_project(tmp: Path, overrides: dict | None = None, config: Path = DEFAUL
     shutil.copytree(ROOT / "paper", tmp / "paper")
     (tmp / "config").mkdir()
     cfg = yaml.safe_load(Path(config).read_text())
-    # the blind gap benchmark (about 45 min) stays out of the tests' report; tests/test_gap.py checks the diagnosis
+    # the blind gap benchmark (about 45 min) stays out of the tests' report; tests/gap/test_gap.py checks the diagnosis
     cfg["gap_benchmark"]["in_report"] = False
     cfg["noise_study"]["in_report"] = False  # the 30-job study likewise; tests/test_studies.py runs a small one
     for dotted, value in (overrides or {}).items():

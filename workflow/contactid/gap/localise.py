@@ -274,7 +274,7 @@ def eta_model_spread(
 
 
 # the place's thresholds (PlaceThresholds, config gap.place) and its logic live in verdict.py (pure functions,
-# unit-tested in tests/test_verdict.py)
+# unit-tested in tests/gap/test_verdict.py)
 
 
 def random_test_delays(frf: xr.Dataset, modal: xr.Dataset) -> np.ndarray | None:

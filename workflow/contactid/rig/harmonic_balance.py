@@ -18,7 +18,7 @@ damping, the shortening's axial-force term); the tangent Jacobian is exact where
 sticks and close elsewhere, so Newton converges in a few steps from the linear solution or
 from a neighbouring solution (``start``).
 
-The time integrator stays the reference: ``tests/test_harmonic_balance.py`` checks that the
+The time integrator stays the reference: ``tests/rig/test_harmonic_balance.py`` checks that the
 harmonics agree within 0.1 % on every load case and model effect.
 """
 

@@ -9,7 +9,7 @@ from pathlib import Path
 import yaml
 from contactid.schema import filled_defaults
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def _leaves(node, prefix=""):

@@ -3,7 +3,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_every_requirement_is_pinned_and_mirrored_in_the_conda_env():
@@ -50,7 +50,7 @@ def test_stop_slurm_stops_only_the_daemons_start_slurm_recorded(tmp_path):
     import os
     import subprocess
 
-    script = Path(__file__).resolve().parents[1] / ".ci/slurm/stop-slurm"
+    script = Path(__file__).resolve().parents[2] / ".ci/slurm/stop-slurm"
     ours, other = (subprocess.Popen(["sleep", "60"]) for _ in range(2))
     reused = subprocess.Popen(["sleep", "60"])  # listed under another program's name: a reused pid
     try:

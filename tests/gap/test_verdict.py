@@ -1,6 +1,6 @@
 """The gap diagnosis's decisions without the rig: every threshold of the place and the explanation's step rules, on
-hand-made numbers (milliseconds; the verdict's: tests/test_story.py). tests/test_gap.py and tests/test_workflow.py
-check the same decisions on rig data."""
+hand-made numbers (milliseconds; the verdict's: tests/gap/test_story.py). tests/gap/test_gap.py and
+tests/workflow/test_workflow.py check the same decisions on rig data."""
 
 import numpy as np
 import pytest

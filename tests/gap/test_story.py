@@ -1,5 +1,5 @@
 """One story (gap/story.py): the verdict derived from the explanation, each decision a pure function with its trace,
-on hand-made numbers (milliseconds). tests/test_gap.py checks the same decisions on rig data."""
+on hand-made numbers (milliseconds). tests/gap/test_gap.py checks the same decisions on rig data."""
 
 import pytest
 from contactid.gap.story import held_out, one_story_holds, resolution, tell

@@ -4,7 +4,7 @@ other, the README's map names every document, and the README states what is true
 import re
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 PACKAGE = ROOT / "workflow" / "contactid"
 # a commit hash: 7-12 hex characters with a digit and a letter among them; a date: YYYY-MM-DD
 HASH = re.compile(r"\b(?=[0-9a-f]*[0-9])(?=[0-9a-f]*[a-f])[0-9a-f]{7,12}\b")

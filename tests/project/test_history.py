@@ -5,7 +5,7 @@ import csv
 import re
 from pathlib import Path
 
-HISTORY = Path(__file__).resolve().parents[1] / "benchmarks" / "history.csv"
+HISTORY = Path(__file__).resolve().parents[2] / "benchmarks" / "history.csv"
 COLUMNS = ["date", "commit", "target", "seconds", "scores", "machine", "source"]
 DATE = re.compile(r"^\d{4}-\d{2}-\d{2}$")
 COMMIT = re.compile(r"^[0-9a-f]{7,40}$")

@@ -5,7 +5,7 @@ commit hash. An entry's first line gives its date and commit."""
 import re
 from pathlib import Path
 
-LOG = Path(__file__).resolve().parents[1] / "docs" / "measurements.md"
+LOG = Path(__file__).resolve().parents[2] / "docs" / "measurements.md"
 # a commit hash: 7-12 hex characters with a digit and a letter among them; a date: YYYY-MM-DD
 HASH = re.compile(r"\b(?=[0-9a-f]*[0-9])(?=[0-9a-f]*[a-f])[0-9a-f]{7,12}\b", re.IGNORECASE)
 DATE = re.compile(r"\b\d{4}-\d{2}-\d{2}\b")
