@@ -1,7 +1,9 @@
 import copy
+from pathlib import Path
 
 import numpy as np
 import pytest
+import xarray as xr
 from contactid.io import RawDataError, raw_dataset, read_raw, write_dataset
 from contactid.rig.random_test import random_test_datasets
 
@@ -138,8 +140,6 @@ def test_jobs_read_datasets_without_importing_pint_and_pint_values_still_convert
     quantities convert as xarray converts them (the magnitudes)."""
     import importlib.util
 
-    import xarray as xr
-
     assert importlib.util.find_spec("pint") is not None  # installed: otherwise this test proves nothing
     path = tmp_path / "x.nc"
     coords = {"x": ("x", [0.0, 1.0, 2.0], {"units": "s", "long_name": "time"})}
@@ -166,3 +166,20 @@ def test_jobs_that_fit_nothing_do_not_import_scipy_optimize():
         "contactid.raw_checks, contactid.raw_checks_dual_sine, contactid.raw_checks_random, contactid.stiction"
     )
     assert not _imports_in_a_fresh_process("scipy.optimize", code)
+
+
+def test_a_failed_write_leaves_the_previous_file_untouched(tmp_path, monkeypatch):
+    path = tmp_path / "out.nc"
+    good = xr.Dataset({"x": ("i", np.arange(4.0), {"units": "1", "long_name": "x"})})
+    write_dataset(good, path)
+    before = path.read_bytes()
+
+    def broken(self, target, *a, **k):
+        Path(target).write_bytes(b"CDF\x01 half a file")
+        raise OSError("disk full")
+
+    monkeypatch.setattr(xr.Dataset, "to_netcdf", broken)
+    with pytest.raises(OSError, match="disk full"):
+        write_dataset(good.assign(x=good["x"] * 2), path)
+    assert path.read_bytes() == before
+    assert [p.name for p in tmp_path.iterdir()] == ["out.nc"]  # no temporary file left behind

@@ -126,7 +126,8 @@ def make_project(tmp: Path, overrides: dict | None = None, config: Path = DEFAUL
     cfg = yaml.safe_load(Path(config).read_text())
     # the blind gap benchmark (about 45 min) stays out of the tests' report; tests/gap/test_gap.py checks the diagnosis
     cfg["gap_benchmark"]["in_report"] = False
-    cfg["noise_study"]["in_report"] = False  # the 30-job study likewise; tests/test_studies.py runs a small one
+    # the 30-job study likewise; tests/workflow/test_noise_study.py runs a small one
+    cfg["noise_study"]["in_report"] = False
     for dotted, value in (overrides or {}).items():
         set_dotted(cfg, dotted, value)
     (tmp / "config" / "config.yaml").write_text(yaml.safe_dump(cfg))

@@ -1,6 +1,7 @@
 """The workflow survives interruption: a run killed in the rig or in the friction fit resumes with
 ``snakemake --rerun-incomplete`` to results bit-identical to an uninterrupted run in another directory
-(the shared run on the small config); outputs are written whole or not at all."""
+(the shared run on the small config). (That an output is written whole or not at all:
+tests/test_rig_and_io.py.)"""
 
 import os
 import signal
@@ -12,7 +13,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 import xarray as xr
-from contactid.io import write_dataset
 from workflow_projects import copy_project
 
 TARGET = "results/friction/friction_fit.nc"
@@ -137,20 +137,3 @@ def test_killed_runs_resume_to_bit_identical_results(small_run, tmp_path):
         assert x.attrs["content_sha256"] == y.attrs["content_sha256"], name
         for v in x.data_vars:
             np.testing.assert_array_equal(x[v].values, y[v].values, err_msg=f"{name}:{v}")
-
-
-def test_a_failed_write_leaves_the_previous_file_untouched(tmp_path, monkeypatch):
-    path = tmp_path / "out.nc"
-    good = xr.Dataset({"x": ("i", np.arange(4.0), {"units": "1", "long_name": "x"})})
-    write_dataset(good, path)
-    before = path.read_bytes()
-
-    def broken(self, target, *a, **k):
-        Path(target).write_bytes(b"CDF\x01 half a file")
-        raise OSError("disk full")
-
-    monkeypatch.setattr(xr.Dataset, "to_netcdf", broken)
-    with pytest.raises(OSError, match="disk full"):
-        write_dataset(good.assign(x=good["x"] * 2), path)
-    assert path.read_bytes() == before
-    assert [p.name for p in tmp_path.iterdir()] == ["out.nc"]  # no temporary file left behind

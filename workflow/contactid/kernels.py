@@ -4,8 +4,8 @@ Every kernel is ``@njit(cache=True)`` and cached per code digest (``contactid.NU
 step the workflow's first jobs compile them (about 28 s of CPU, 10-13 s of the first run's wall time on two
 cores). ``compile_kernels`` calls each kernel that Python code calls, through the functions the workflow uses, on
 a problem a few steps long, so that numba compiles (or loads) the signatures the jobs use: float64 C arrays,
-floats, ints and flags, whatever the configured values. tests/test_numba_cache.py checks that the signatures the
-acceptance run (the default target) compiles are among them.
+floats, ints and flags, whatever the configured values. tests/workflow/test_compile_kernels.py checks that the
+signatures the acceptance run (the default target) compiles are among them.
 """
 
 import dataclasses
