@@ -116,3 +116,26 @@ def test_the_drift_check_sees_a_wrong_default():
     assert _split_top("[1e5, 1e9], [1e5, 1e11]", 2) == ["[1e5, 1e9]", "[1e5, 1e11]"]
     rows = {"place": ["`{drift_z: 8.0, residual_factor: 20.0}`"]}
     assert _row_for("gap.place.drift_z", rows) == rows["place"]
+
+
+def test_the_settings_objects_defaults_are_the_schemas():
+    """The settings dataclasses keep field defaults (for calls outside the workflow); each equals what the schema's
+    defaults give through the object's own from_config, so no setting has a second default of its own."""
+    import dataclasses
+
+    from contactid.friction_fit import FitSettings, settings_from_config
+    from contactid.gap.settings import GapSettings
+    from contactid.gap.verdict import PlaceThresholds
+
+    pairs = [
+        (GapSettings(), GapSettings.from_config({}, 0, GapSettings().identification_harmonics)),
+        (FitSettings(), settings_from_config({})),
+        (PlaceThresholds(), PlaceThresholds.from_config(None)),
+    ]
+    for plain, from_schema in pairs:
+        differ = {
+            f.name: (getattr(plain, f.name), getattr(from_schema, f.name))
+            for f in dataclasses.fields(plain)
+            if str(getattr(plain, f.name)) != str(getattr(from_schema, f.name))
+        }
+        assert not differ, f"{type(plain).__name__}'s field defaults differ from the schema's: {differ}"
