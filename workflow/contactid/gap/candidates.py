@@ -84,6 +84,8 @@ class Candidate:
     form: bool = False
 
     def n_parameters(self, n_channels: int) -> int:
+        """The number of parameters the candidate fits: one per accelerometer channel where ``per_channel``, otherwise
+        its parameters' count."""
         return n_channels if self.per_channel else len(self.parameters)
 
 

@@ -50,6 +50,10 @@ log = logging.getLogger(__name__)
 
 @dataclass
 class Diagnosis:
+    """The diagnosis's outcome: the verdict and its reason sentence, the candidates' ranking, where the gap lies, the
+    calibration and held-out cases, the explanation's steps with the gap they leave, the decisions' trace, the
+    resolution, the shrinkage, the updated model, and the arrays and simulations the report plots."""
+
     verdict: str
     reason: str
     ranking: list
@@ -66,6 +70,8 @@ class Diagnosis:
     updated_model: dict = field(default_factory=dict)
 
     def summary(self) -> dict:
+        """The diagnosis as diagnosis.json holds it: every field but the arrays, the simulations and the updated
+        model."""
         return {
             "verdict": self.verdict,
             "reason": self.reason,

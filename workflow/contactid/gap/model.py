@@ -131,6 +131,7 @@ class IdentifiedModel:
         )
 
     def with_friction(self, friction) -> "IdentifiedModel":
+        """The model with its friction parameters (e_f, k_c, e_t, kappa, mu) replaced by ``friction``."""
         return dataclasses.replace(self, friction=tuple(float(x) for x in friction))
 
 
@@ -251,6 +252,8 @@ def _refit_contact(
 
 @lru_cache(maxsize=32)
 def reduced(params: StructureParameters, n_modes: int):
+    """The FE model of ``params`` and its reduced model on the lowest ``n_modes`` stuck modes
+    (``rig.nonlinear.reduced_model``), as a pair; the last 32 are cached."""
     model = assemble(params)
     return model, reduced_model(model, n_modes)
 

@@ -12,4 +12,5 @@ def num(x) -> float:
 
 
 def pct(x) -> str:
+    """A diagnosis.json fraction as a LaTeX percentage (three significant digits), "--" where it is null."""
     return "--" if x is None else f"${latex_number(100 * float(x), 3)}$\\,\\%"

@@ -67,6 +67,8 @@ class GapSettings:
 
     @classmethod
     def from_config(cls, gap_cfg: Mapping | None, seed: int, n_harmonics_id: int) -> "GapSettings":
+        """The settings from config ``gap`` (keys left out take the schema's defaults), the run's seed and the number of
+        harmonics the identification used; raises ValueError for a candidate the library does not have."""
         from ..schema import schema_defaults
 
         defaults = schema_defaults("gap")  # keys left out take the schema's defaults

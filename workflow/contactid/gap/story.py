@@ -52,6 +52,7 @@ class Test:
     step: str = ""
 
     def as_dict(self) -> dict:
+        """The decision as a trace entry of diagnosis.json: test, step, value, threshold, passed and says."""
         return {
             "test": self.test,
             "step": self.step,
@@ -63,6 +64,7 @@ class Test:
 
 
 def held_out(n_held: int) -> Test:
+    """Whether at least one load case is held out (``n_held`` of them), without which no effect can be tested."""
     ok = n_held >= 1
     return Test(
         "held_out",
@@ -129,6 +131,7 @@ def acts_where_gap_lies(effect: str, acts_on: str, place: str, ok: bool | None =
 
 
 def above_floor(gap: float, min_gap: float, effect: str = "") -> Test:
+    """Whether the held-out gap (a fraction) is at or above the identification's floor gap.min_gap."""
     ok = bool(gap >= min_gap)
     return Test(
         "above_floor",
@@ -148,6 +151,7 @@ def above_floor(gap: float, min_gap: float, effect: str = "") -> Test:
 
 
 def beyond_scatter(gap: float, scatter: float, noise_factor: float, effect: str = "") -> Test:
+    """Whether the held-out gap (a fraction) is at least noise_factor x the records' scatter."""
     ok = bool(gap >= noise_factor * scatter)
     return Test(
         "beyond_scatter",
@@ -262,6 +266,9 @@ def first_pass_best(rows: Sequence[Mapping], before: float) -> Test | None:
 
 @dataclass
 class Story:
+    """What ``tell`` derives: the verdict (an effect or "none"), its reason sentence, the explanation's steps kept and
+    the trace of the decisions (``Test.as_dict``)."""
+
     verdict: str
     reason: str
     explanation: list

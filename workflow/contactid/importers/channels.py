@@ -62,6 +62,7 @@ class ChannelSpec:
 
     @property
     def quantity(self) -> str:
+        """The quantity the channel measures: "force" for the force channel, otherwise "acceleration"."""
         return "force" if self.role == "force" else "acceleration"
 
     def factor(self) -> float:
@@ -91,10 +92,12 @@ class ImportSpec:
 
     @property
     def force(self) -> ChannelSpec:
+        """The force channel (the map's first)."""
         return self.channels[0]
 
     @property
     def sensors(self) -> tuple:
+        """The accelerometer channels (ChannelSpec), in the map's order."""
         return self.channels[1:]
 
 

@@ -71,6 +71,7 @@ class FrfSensor:
     units: str | None = None
 
     def describe(self) -> str:
+        """The FRF dataset that holds the sensor, in words for messages: its id1, or its response node and direction."""
         if self.channel is not None:
             return f"id1 {self.channel!r}"
         return f"response node {self.node}" + ("" if self.direction is None else f" direction {self.direction}")

@@ -13,6 +13,9 @@ from typing import Mapping
 
 @dataclass(frozen=True)
 class EffectSpec:
+    """One switchable effect: its name, the unit of its magnitude, what it models, a typical magnitude and the allowed
+    range [low, high]."""
+
     name: str
     unit: str
     meaning: str

@@ -322,6 +322,8 @@ class HarmonicBalance:
         return np.hstack([Z[:, :1].real, Z[:, 1:].real, Z[:, 1:].imag])
 
     def to_complex(self, U: np.ndarray) -> np.ndarray:
+        """(n, 2H + 1) real -> (n, H + 1) complex: the mean, then Z_h from its real and imaginary parts (the inverse of
+        ``to_real``)."""
         H = self.H
         return np.hstack([U[:, :1] + 0j, U[:, 1 : H + 1] + 1j * U[:, H + 1 :]])
 
@@ -412,6 +414,8 @@ class HarmonicBalance:
         }
 
     def residual(self, U: np.ndarray, Fb: np.ndarray, p: dict | None = None) -> tuple[np.ndarray, dict]:
+        """The HB residual R = L U - Fb - project(g) ((n, 2H + 1), real basis) of the harmonics U against the force Fb
+        (``force_vector``), with the contact path it used (``path``, or ``p`` where given)."""
         p = self.path(U) if p is None else p
         R = np.einsum("jab,jb->ja", self.L, U) - Fb - self.project(p["g"]).T
         return R, p

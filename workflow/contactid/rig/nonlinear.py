@@ -281,6 +281,8 @@ class DualSineSimulator:
         self.reset()
 
     def reset(self):
+        """Return to rest: zero coordinates, velocities, friction state and Iwan sliders at t = 0, no preload drift and
+        no last chunk."""
         n = self.red.omega.size
         self.z = np.zeros(n)
         self.v = np.zeros(n)
@@ -391,6 +393,7 @@ class DualSineSimulator:
         )
 
     def restore(self, snap: tuple) -> None:
+        """Return the integrator to a state ``snapshot`` took."""
         z, v, state, x_sl, t, rate, t0 = snap
         self.z[:], self.v[:], self.state[:], self.x_sl[:] = z, v, state, x_sl
         self.t, self.drift_rate, self.drift_t0 = t, rate, t0
