@@ -95,6 +95,7 @@ def compile_kernels_main(argv) -> int:
 
 
 def main(argv=None) -> int:
+    """Run the ``contactid`` command line: dispatch to audit, check-config or compile-kernels; returns the exit code."""
     argv = sys.argv[1:] if argv is None else list(argv)
     parser = argparse.ArgumentParser(
         prog="contactid",

@@ -74,6 +74,8 @@ def audit(paths, root: str | os.PathLike | None = None) -> pd.DataFrame:
 
 
 def main(argv=None) -> int:
+    """Command line of ``contactid audit``: print the audit table (and write it to ``--out``); returns 1 if any
+    dataset is flagged, else 0."""
     parser = argparse.ArgumentParser(prog="python -m contactid audit", description=__doc__.splitlines()[0])
     parser.add_argument("paths", nargs="*", default=["results", "data"], help="directories or files to audit")
     parser.add_argument("--out", help="write the audit table to this CSV file")

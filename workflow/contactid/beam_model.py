@@ -65,6 +65,7 @@ class FEModel:
 
     @property
     def n_dof(self) -> int:
+        """Number of degrees of freedom of the assembled model."""
         return self.mass.shape[0]
 
     @property

@@ -27,6 +27,9 @@ TABLE4 = {"e_f": 3.857e7, "k_c": 2.547e5, "e_t": 0.0, "kappa": 0.284, "mu": 0.39
 
 @dataclass(frozen=True)
 class Scenario:
+    """A modelling assumption to test against Table 1: its label, a description, the ``StructureParameters`` fields
+    it fixes (name -> value) and the names of those it fits."""
+
     name: str
     description: str
     fixed: dict

@@ -24,6 +24,8 @@ class ValanisParameters:
 
     @classmethod
     def from_config(cls, c) -> "ValanisParameters":
+        """Read the law from a config mapping (keys ``e_f_n_per_m``, ``k_c_per_m``, ``e_t_n_per_m``, ``kappa``,
+        ``mu``)."""
         return cls(
             float(c["e_f_n_per_m"]), float(c["k_c_per_m"]), float(c["e_t_n_per_m"]), float(c["kappa"]), float(c["mu"])
         )

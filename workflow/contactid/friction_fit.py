@@ -49,6 +49,12 @@ class FitSettings:
 
 @dataclass
 class FitResult:
+    """The friction fit: params (5,) best-fit e_f (N/m), k_c (1/m), e_t (N/m), kappa, mu; misfit, the NRMSE of S;
+    e_0 at the preload (N/m); the GA logbook (generation, min, mean misfit) and the grid refinement history;
+    intervals (5, 2) profile-likelihood confidence intervals (NaN when not profiled), bounded (5, 2) whether each
+    side closes inside the search bounds, e_0's interval (N/m); correlation (5, 5) of the parameters; the final grid
+    size; the profiles per parameter and the fit's warnings."""
+
     params: np.ndarray
     misfit: float
     e0_at_preload: float
@@ -89,10 +95,13 @@ class FitProblem:
         return out
 
     def unit(self, p):
+        """Parameters (n, 5) to unit-cube coordinates (n, 5); the inverse of :meth:`physical`."""
         v = np.where(LOG_SCALED, np.log10(np.maximum(np.atleast_2d(p), 1e-300)), np.atleast_2d(p))
         return (v - self.lo) / (self.hi - self.lo)
 
     def residuals(self, params):
+        """(n, n_samples) residuals of the mean-removed S for each of the (n, 5) parameter sets, over the rms of the
+        identified S."""
         S = valanis_friction_force(self.xi, self.N, params, regularization=self.regularization)
         S = S - S.mean(axis=1, keepdims=True)
         return (S - self.S) / self.scale

@@ -90,6 +90,7 @@ def package_digest() -> str:
 
 
 def git_revision() -> str:
+    """Commit hash of the package's git checkout, or ``unknown`` where git or the repository is unavailable."""
     try:
         out = subprocess.run(
             ["git", "rev-parse", "HEAD"], capture_output=True, text=True, timeout=5, cwd=Path(__file__).resolve().parent

@@ -130,6 +130,7 @@ def frf_result_dataset(frequency_hz, h1, coherence, block_h1, sensors, positions
 
 
 def complex_frf(ds: xr.Dataset, prefix: str = "h1") -> np.ndarray:
+    """Complex FRF from the dataset's ``{prefix}_real`` and ``{prefix}_imag`` variables, in their shape (m/s^2/N)."""
     return ds[f"{prefix}_real"].values + 1j * ds[f"{prefix}_imag"].values
 
 

@@ -105,6 +105,7 @@ class StructureParameters:
         return replace(self, k_t=float(k_t), k_n=float(k_n))
 
     def replace(self, **changes) -> "StructureParameters":
+        """The same structure with the named fields changed."""
         return replace(self, **changes)
 
 

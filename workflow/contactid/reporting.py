@@ -82,6 +82,8 @@ def stiction_summary(stiction: xr.Dataset) -> dict:
 
 
 def linear_summary(modal: xr.Dataset, stiction: xr.Dataset, truth: xr.Dataset | None) -> dict:
+    """The linear part of summary.json: natural frequencies (Hz), damping ratios, the stiction block and, where a
+    truth is given, its frequencies, k_t and k_n (N/m)."""
     out = {
         "natural_frequencies_hz": [float(f) for f in modal["natural_frequency"].values],
         "damping_ratios": [float(z) for z in modal["damping_ratio"].values],

@@ -45,6 +45,7 @@ class StiffnessFit:
 
     @property
     def k_n_lower_bound(self) -> float:
+        """Lower end of the k_n interval (N/m)."""
         return self.k_n_interval[0]
 
 
@@ -295,6 +296,7 @@ class Reachability:
 
     @property
     def reachable(self) -> bool:
+        """Whether the record is accepted (no reasons to refuse it)."""
         return not self.reasons
 
 

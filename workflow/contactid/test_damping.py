@@ -92,6 +92,7 @@ class DampingProfile:
         return self.laws[int(np.argmin(np.abs(np.log(self.scales / scale))))]
 
     def law_at_scale(self) -> np.ndarray:
+        """The friction law (e_f, k_c, e_t, kappa, mu) fitted at the least-misfit factor ``scale``."""
         return self.law_at(self.scale)
 
 

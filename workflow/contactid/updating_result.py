@@ -156,6 +156,7 @@ class UpdatingResult:
         return out
 
     def summary(self) -> dict:
+        """The update as written to model_updating.json (read back by :meth:`from_summary`)."""
         return {
             "accepted": self.accepted,
             "factors": dict(self.factors),
