@@ -102,7 +102,7 @@ def test_a_rig_damped_otherwise_in_its_dual_sine_tests_than_in_its_random_test_i
     from contactid.gap.pipeline import identify, rig_records, test_level_damping
     from contactid.gap.records import record_harmonics
     from contactid.gap.settings import GapSettings
-    from contactid.test_damping import SCALES
+    from contactid.schema import schema_defaults
 
     cases = ["lc1", "lc2", "lc3"]
     cfg = copy.deepcopy(small_config)
@@ -114,7 +114,13 @@ def test_a_rig_damped_otherwise_in_its_dual_sine_tests_than_in_its_random_test_i
     chain = identify(cfg, recs["random_test"], recs["lc1"])[0]
     held_out = {c: records[c] for c in cases[1:]}
     profile = test_level_damping(
-        chain, records["lc1"], held_out, settings_from_config(cfg["friction"]), settings, 1, SCALES
+        chain,
+        records["lc1"],
+        held_out,
+        settings_from_config(cfg["friction"]),
+        settings,
+        1,
+        schema_defaults("nonlinear")["test_damping_scales"],
     )
     assert profile.accepted and profile.form == "all"
     assert profile.applied_scale == pytest.approx(factor, rel=0.03)

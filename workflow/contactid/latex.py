@@ -173,7 +173,9 @@ def test_damping_text(td: Mapping | None) -> str:
     load cases confirmed it."""
     if not td:
         return "The dual-sine tests were identified with the random test's damping ratios."
-    which = f"mode {td['driven_mode']}'s damping ratio" if td["form"] == "driven" else "every mode's damping ratio"
+    from .test_damping import ratio_words  # the report's fragments alone need it: kept off latex's import
+
+    which = ratio_words(td["form"], td["driven_mode"])
     lo, hi = td["interval"]
     bound = (
         rf"The law's misfit on the calibration record is least with {which} ${latex_number(td['scale'], 3)}$ times the "

@@ -2,17 +2,17 @@
 record binds, the driven mode's alone or every mode's.
 
 The inverse identification subtracts the structure's damping from the measured response; what is left is the contact
-force S. The damping ratios come from the random test, at 0.02-0.5 N rms with the contact stuck, through a windowed
-FRF estimate; the dual-sine tests run at other amplitudes, with the contact slipping. Where the structure's damping at
-test level differs from the random test's, the identified S carries a viscous term c dxi/dt that the friction law
-(Eqs. 21-22) cannot represent: the law's misfit grows, and its kappa and mu move to absorb what they can. So the law's
-misfit on the calibration record, profiled over one factor, binds it: the law fitted (GA, as rule friction_fit fits
-it) at each factor of ``SCALES`` (and 1), the minimum refined by a parabola in log(factor), the interval where the
-misfit stays within the friction fit's own profile-likelihood threshold (``friction_fit.profile_intervals``'s, at
-``FitSettings.confidence``). Two forms (``FORMS``) are profiled: the factor on the ratio of the mode the test drives
-near resonance alone (where the random test's estimate of that lightly damped mode is off, the others right), and
-on every mode's ratio (a damping that changes with level everywhere; the drive's harmonics sit near the higher modes,
-the third near the second mode); the form whose profile reaches the lower misfit is kept.
+force S. The damping ratios come from the random test, at 0.02-0.5 N rms with the contact stuck, through a windowed FRF
+estimate; the dual-sine tests run at other amplitudes, with the contact slipping. Where the structure's damping at test
+level differs from the random test's, the identified S carries a viscous term c dxi/dt that the friction law (Eqs.
+21-22) cannot represent: the law's misfit grows, and its kappa and mu move to absorb what they can. So the law's misfit
+on the calibration record, profiled over one factor, binds it: the law fitted (GA, as rule friction_fit fits it) at each
+factor of ``nonlinear.test_damping_scales`` (and 1), the minimum refined by a parabola in log(factor), the interval
+where the misfit stays within the friction fit's own profile-likelihood threshold (``friction_fit.profile_intervals``'s,
+at ``FitSettings.confidence``). Two forms (``FORMS``) are profiled: the factor on the ratio of the mode the test drives
+near resonance alone (where the random test's estimate of that lightly damped mode is off, the others right), and on
+every mode's ratio (a damping that changes with level everywhere; the drive's harmonics sit near the higher modes, the
+third near the second mode); the held-out load cases choose between them (``gap.pipeline.chosen_test_damping``).
 
 A factor away from 1 is a change of the base model suggested by one record, and a stand-in for anything else the law
 cannot represent takes the same road (a viscous friction at the contact, a clamp, transducer masses: on such rigs the
@@ -40,9 +40,6 @@ from .friction_parameters import PARAMETER_NAMES, PARAMETER_UNITS
 from .identification import inverse_harmonics, modal_damping_vector
 
 log = logging.getLogger(__name__)
-
-# the factors profiled: a tenth apart below 1, an eighth above (the config's nonlinear.test_damping_scales)
-SCALES = (0.7, 0.8, 0.9, 1.0, 1.12, 1.25, 1.4)
 
 
 @dataclass(frozen=True)
@@ -127,6 +124,12 @@ def scaled(damping_ratios, scale: float, mode: int, form: str) -> np.ndarray:
     return out
 
 
+def ratio_words(form: str, driven_mode: int) -> str:
+    """The damping ratios a factor of ``form`` scales, in words: "mode 1's damping ratio" (``driven_mode``, from 1)
+    or "every mode's damping ratio"."""
+    return f"mode {driven_mode}'s damping ratio" if form == "driven" else "every mode's damping ratio"
+
+
 def driven_mode(frequencies_hz, f0: float) -> int:
     """The identified mode nearest the drive ``f0`` (Hz): the one the dual-sine test drives near resonance."""
     return int(np.argmin(np.abs(np.asarray(frequencies_hz, dtype=float) - f0)))
@@ -142,7 +145,7 @@ def damping_profile(
     preload: float,
     settings: FitSettings,
     seed: int,
-    scales=SCALES,
+    scales,
     form: str = "driven",
 ) -> DampingProfile:
     """The misfit profile over the damping factor on the calibration record's harmonics (``F_coef`` (K,),
@@ -196,11 +199,10 @@ def damping_profile(
         form,
     )
     log.info(
-        "damping at test level, profiled: the law's misfit is least (%.4g) with %s damping ratio%s x %.3g, within "
+        "damping at test level, profiled: the law's misfit is least (%.4g) with %s x %.3g, within "
         "the threshold %.4g over [%.3g, %.3g]%s",
         misfits[j],
-        f"mode {mode + 1}'s" if form == "driven" else "every mode's",
-        "" if form == "driven" else "s",
+        ratio_words(form, mode + 1),
         profile.scale,
         thr,
         *profile.interval,
@@ -220,14 +222,23 @@ def with_intervals(
     settings: FitSettings,
     seed: int,
 ) -> DampingProfile:
-    """``profile`` with the profile-likelihood intervals of the law fitted at its factor (the fit of
-    ``damping_profile``'s grid redone from the same seed, with intervals, as rule friction_fit gives them)."""
+    """``profile`` with the profile-likelihood intervals of the law fitted at its factor, as rule friction_fit gives
+    them: the fit polished from the law ``damping_profile`` found there (no second GA), then profiled."""
     import dataclasses
 
     r = profile.scaled_ratios(damping_ratios)
     h = inverse_harmonics(model, modal_damping_vector(model, r), F_coef, A_coef, f0)
     fit = fit_friction_law(
-        h.xi, h.N_dyn, h.S, f0, preload, settings, seed, A_coef.shape[1], label=f"damping x{profile.scale:.3g}"
+        h.xi,
+        h.N_dyn,
+        h.S,
+        f0,
+        preload,
+        settings,
+        seed,
+        A_coef.shape[1],
+        label=f"damping x{profile.scale:.3g}",
+        start=profile.law_at_scale(),
     )
     return dataclasses.replace(
         profile, law_intervals=np.asarray(fit.intervals, dtype=float), e0_interval=tuple(map(float, fit.e0_interval))
@@ -291,11 +302,14 @@ def profile_dataset(profile: DampingProfile, damping_ratios) -> xr.Dataset:
                 {}
                 if profile.law_intervals is None
                 else {
-                    "law_interval": (
-                        ("parameter", "end"),
-                        profile.law_intervals,
-                        {"units": "1", "long_name": "profile-likelihood interval of the law at damping_scale"},
-                    ),
+                    **{
+                        f"law_interval_{name}": (
+                            "end",
+                            profile.law_intervals[i],
+                            {"units": unit, "long_name": f"profile-likelihood interval of {name} at damping_scale"},
+                        )
+                        for i, (name, unit) in enumerate(zip(PARAMETER_NAMES, PARAMETER_UNITS))
+                    },
                     "e0_interval": (
                         "end",
                         np.array(profile.e0_interval),
@@ -312,7 +326,6 @@ def profile_dataset(profile: DampingProfile, damping_ratios) -> xr.Dataset:
         coords={
             "scale": ("scale", profile.scales, {"units": "1", "long_name": "damping factor profiled"}),
             "end": ["low", "high"],
-            "parameter": list(PARAMETER_NAMES),
         },
         attrs=attrs,
     )

@@ -11,6 +11,7 @@ import pandas as pd
 
 from ..latex import latex_number, tabular
 from ..latex import plain_text as _t
+from ..test_damping import ratio_words
 from .report_benchmark import benchmark_text
 from .report_diagnosis import diagnosis_paragraphs
 from .report_format import num
@@ -49,7 +50,7 @@ def explained_law_note(updated: dict | None) -> str:
         what = "Refitted with the effects the gap diagnosis explains (" + ", ".join(_t(n) for n in updated["effects"])
         tail = "the chain's law above carries what those effects do to the identified S."
     elif td.get("applied"):
-        which = f"mode {td['driven_mode']}'s damping ratio" if td["form"] == "driven" else "every mode's damping ratio"
+        which = ratio_words(td["form"], td["driven_mode"])
         scale = latex_number(td["scale"], 3)
         what = f"With {which} at test level, ${scale}$ times the random test's, as the other load cases confirm"
         tail = "the chain's law above carries the damping the random test misstates."

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from ..latex import latex_number
 from ..latex import plain_text as _t
+from ..test_damping import ratio_words
 from .report_base_model import updating_paragraph
 from .report_format import num, pct
 from .verdict import never_opens
@@ -272,7 +273,7 @@ def damping_at_test_level_text(diag: dict) -> str:
     td = diag.get("damping_at_test_level") or {}
     if not td or abs(float(td.get("scale", 1.0)) - 1.0) < 1e-9:
         return ""
-    which = f"mode {td['driven_mode']}'s damping ratio" if td["form"] == "driven" else "every mode's damping ratio"
+    which = ratio_words(td["form"], td["driven_mode"])
     text = (
         r"\paragraph{Damping at test level.} The friction law misfits the calibration record least with "
         + f"{which} ${latex_number(td['scale'], 3)}$ times the random test's"
