@@ -145,6 +145,14 @@ def test_summary_and_report_say_the_factor_and_whether_the_other_load_cases_conf
     assert td["law"] == {"e_f": 0.0, "k_c": 1.0, "e_t": 2.0, "kappa": 3.0, "mu": 4.0}  # fitted at 0.9
     text = test_damping_text(td)
     assert "mode 1's damping ratio $0.900$" in text and "confirm it" in text and r"$0.630\,\%$" in text
+    # the law's intervals at the factor, each parameter in its own units, back in the summary
+    import dataclasses
+
+    with_law = dataclasses.replace(p, law_intervals=np.arange(10.0).reshape(5, 2), e0_interval=(1.0e7, 1.1e7))
+    ds = profile_dataset(with_law, [0.004, 0.005])
+    assert ds["law_interval_e_f"].attrs["units"] != ds["law_interval_kappa"].attrs["units"]
+    summary = damping_summary(ds)
+    assert summary["law_intervals"]["kappa"] == [6.0, 7.0] and summary["e0_interval"] == [1.0e7, 1.1e7]
     refused = damping_summary(profile_dataset(_profile(0.9, {**p.check, "accepted": False}), [0.004, 0.005]))
     assert "do not confirm it" in test_damping_text(refused) and refused["applied_scale"] == 1.0
     assert "random test's damping ratios" in test_damping_text(None)

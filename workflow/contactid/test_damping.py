@@ -366,9 +366,7 @@ def damping_summary(ds: xr.Dataset) -> dict:
     if f"profile_{PARAMETER_NAMES[0]}" in ds:  # the law fitted at the least-misfit factor
         i = int(np.argmin(np.abs(np.log(ds["scale"].values / out["scale"]))))
         out["law"] = {n: float(ds[f"profile_{n}"].values[i]) for n in PARAMETER_NAMES}
-    if "law_interval" in ds:
-        out["law_intervals"] = {
-            n: [float(v) for v in ds["law_interval"].values[k]] for k, n in enumerate(PARAMETER_NAMES)
-        }
+    if f"law_interval_{PARAMETER_NAMES[0]}" in ds:
+        out["law_intervals"] = {n: [float(v) for v in ds[f"law_interval_{n}"].values] for n in PARAMETER_NAMES}
         out["e0_interval"] = [float(v) for v in ds["e0_interval"].values]
     return out
