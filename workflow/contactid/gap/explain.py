@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING, Mapping, Sequence
 import numpy as np
 
 from ..contact_laws import stiction_shear_stiffness
+from ..friction_parameters import PARAMETER_NAMES
 from .candidates import LIBRARY
 from .model import NONE, IdentifiedModel
 from .verdict import (
@@ -338,7 +339,7 @@ def with_damping_at_test_level(
         why = ""
     if why:
         return {**updated, "damping_at_test_level": {**td, "applied": False, "why": why}}
-    law = np.array([td["law"][n] for n in ("e_f", "k_c", "e_t", "kappa", "mu")])
+    law = np.array([td["law"][n] for n in PARAMETER_NAMES])
     return {
         **updated,
         "what": "the identified model with the damping at test level the records confirm (no effect explained), the "
