@@ -1,7 +1,8 @@
 """Rule frf: H1 and coherence of each accelerometer over the force (Welch).
 
 The random test is validated first (format, clipping, record length, FRF resolution) and the coherence
-after (share of lines in modal.band_hz reaching raw_checks.min_coherence); warnings go into the dataset."""
+after (share of lines in modal.band_hz reaching raw_checks.min_coherence); warnings go into the dataset.
+"""
 
 import json
 

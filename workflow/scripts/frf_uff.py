@@ -1,6 +1,8 @@
-"""Rules frf_measured_uff / frf_synthesised_uff: the measured H1 FRFs with their coherence, or the FRFs the
-identified modes synthesise (LSFD), of every sensor as UFF58 datasets (function types 4 and 6) for other modal
-tools; read back by pyuff and by the uff58_frf importer."""
+"""Rules frf_measured_uff / frf_synthesised_uff: every sensor's FRFs as UFF58 datasets.
+
+The measured H1 FRFs with their coherence, or the FRFs the identified modes synthesise (LSFD), as UFF58 datasets
+(function types 4 and 6) for other modal tools; read back by pyuff and by the uff58_frf importer.
+"""
 
 import json
 

@@ -1,8 +1,11 @@
-"""Rule import_uff58_frf: measured FRFs (UFF58 datasets of function type 4, accelerance, with coherence where
-given) -> results/linear/frf.nc, the dataset the frf rule writes from a time record.
+"""Rule import_uff58_frf: measured FRFs (UFF58) -> results/linear/frf.nc.
+
+The UFF58 datasets of function type 4 (accelerance, with coherence where given) become the dataset the frf rule
+writes from a time record.
 
 The frequency axis is checked (even, covering modal.band_hz), then the FRF checks that need no time record: the
-resolution (raw_checks.max_frf_resolution_hz) and the coherence in the modal band; warnings go into the dataset."""
+resolution (raw_checks.max_frf_resolution_hz) and the coherence in the modal band; warnings go into the dataset.
+"""
 
 import json
 

@@ -1,7 +1,8 @@
 """Rule raw_check: read and validate a dual-sine record (rig, measured or imported); harmonic content.
 
 A failed check (format, length, clipping, excitation frequency, stationarity) stops this load case with
-a message naming the file, the channel, the check and the measured value; warnings go into the dataset."""
+a message naming the file, the channel, the check and the measured value; warnings go into the dataset.
+"""
 
 import json
 

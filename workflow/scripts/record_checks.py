@@ -1,5 +1,8 @@
-"""Rule record_checks: the load cases' records against each other (accelerance levels) and against the identified
-model's prediction at each record's measured force (units factor, sign, channel order, gross disagreement)."""
+"""Rule record_checks: the load cases' records against each other and against the identified model.
+
+The records against each other (accelerance levels) and against the identified model's prediction at each record's
+measured force (units factor, sign, channel order, gross disagreement).
+"""
 
 import json
 

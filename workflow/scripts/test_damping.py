@@ -1,5 +1,7 @@
-"""Rule test_damping: the driven mode's damping at test level, profiled by the friction law's misfit on the calibration
-record and applied where the other load cases confirm it."""
+"""Rule test_damping: the driven mode's damping at test level.
+
+Profiled by the friction law's misfit on the calibration record and applied where the other load cases confirm it.
+"""
 
 from contactid.friction_fit import settings_from_config
 from contactid.friction_parameters import parameter_dataset
