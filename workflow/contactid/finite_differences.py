@@ -16,11 +16,33 @@ import numpy as np
 
 
 def central_difference_jacobian(
-    fun: Callable[[np.ndarray], np.ndarray], step: float, lower=-np.inf, upper=np.inf
+    fun: Callable[[np.ndarray], np.ndarray],
+    step: float,
+    lower: float | np.ndarray = -np.inf,
+    upper: float | np.ndarray = np.inf,
 ) -> Callable[[np.ndarray], np.ndarray]:
-    """jac(x) -> (m, n): central differences of ``fun`` (R^n -> R^m) with the absolute ``step`` (same units as
-    x); one-sided (second order, three points) where x +- step would leave [``lower``, ``upper``]. 2n calls of
-    ``fun`` per Jacobian."""
+    """Build a Jacobian of central differences of ``fun`` with an absolute step.
+
+    The differences are one-sided (second order, three points) where x +- step would leave [``lower``, ``upper``].
+    2n calls of ``fun`` per Jacobian.
+
+    Parameters
+    ----------
+    fun
+        Residual function R^n -> R^m: the variables x [unit of x], shape (n,), to the residuals r [unit of r],
+        shape (m,).
+    step
+        Absolute step of every variable [unit of x] (the same at every x).
+    lower
+        Lower bounds of the variables [unit of x]: a float for all, or shape (n,).
+    upper
+        Upper bounds of the variables [unit of x]: a float for all, or shape (n,).
+
+    Returns
+    -------
+    jac : Callable[[np.ndarray], np.ndarray]
+        jac(x), x [unit of x] of shape (n,), returns the Jacobian dr/dx [unit of r / unit of x], shape (m, n).
+    """
 
     def jac(x) -> np.ndarray:
         x = np.asarray(x, float)
@@ -42,11 +64,37 @@ def central_difference_jacobian(
 
 
 def forward_difference_jacobian(
-    fun: Callable[[np.ndarray], np.ndarray], step: float, lower=-np.inf, upper=np.inf
+    fun: Callable[[np.ndarray], np.ndarray],
+    step: float,
+    lower: float | np.ndarray = -np.inf,
+    upper: float | np.ndarray = np.inf,
 ) -> tuple[Callable, Callable]:
-    """(fun', jac): ``fun`` that remembers its last evaluation, and jac(x) -> (m, n) by forward differences of the
-    absolute ``step`` (backward where x + step would pass ``upper``) that reuses fun'(x) when least_squares has just
-    evaluated it. n calls of ``fun`` per Jacobian, for residuals that cost a simulation each."""
+    """Build ``fun`` that remembers its last evaluation and a Jacobian of forward differences that reuses it.
+
+    The Jacobian takes forward differences of the absolute ``step`` (backward where x + step would pass ``upper``)
+    and reuses fun'(x) when least_squares has just evaluated it: n calls of ``fun`` per Jacobian, for residuals that
+    cost a simulation each.
+
+    Parameters
+    ----------
+    fun
+        Residual function R^n -> R^m: the variables x [unit of x], shape (n,), to the residuals r [unit of r],
+        shape (m,).
+    step
+        Absolute step of every variable [unit of x] (the same at every x).
+    lower
+        Lower bounds of the variables [unit of x]: a float for all, or shape (n,).
+    upper
+        Upper bounds of the variables [unit of x]: a float for all, or shape (n,).
+
+    Returns
+    -------
+    remembered : Callable
+        fun'(x): ``fun`` that keeps its last x and residuals r [unit of r], shape (m,), and returns the residuals as
+        floats.
+    jac : Callable
+        jac(x), x [unit of x] of shape (n,), returns the Jacobian dr/dx [unit of r / unit of x], shape (m, n).
+    """
     last: dict = {}
 
     def remembered(x) -> np.ndarray:

@@ -18,7 +18,7 @@ import subprocess
 import sys
 import tempfile
 from pathlib import Path
-from typing import Mapping
+from typing import Any, Collection, Mapping, Sequence
 
 import numpy as np
 import xarray as xr
@@ -29,11 +29,14 @@ ENGINE = "netcdf4"
 
 
 def _defer_pint_until_imported() -> None:
-    """xarray asks, for every index it builds, whether the values are a pint Quantity, and imports pint to know
+    """Keep xarray from importing pint until something else has imported it.
+
+    xarray asks, for every index it builds, whether the values are a pint Quantity, and imports pint to know
     (0.3-0.4 s, in every job of the workflow, when pint is installed: the tests use it to read the units). No value
     can be a Quantity of a module nobody imported: until pint is in ``sys.modules`` the answer is "no type" without
     importing it, afterwards xarray's own answer. Where xarray's internals differ (another version), nothing is
-    changed."""
+    changed.
+    """
     try:
         from xarray.namedarray import pycompat
 
@@ -45,6 +48,7 @@ def _defer_pint_until_imported() -> None:
 
     class _PintWhenImported:
         def __getattr__(self, attr):
+            """Answer "no type" / "not available" while pint is not imported, afterwards pint's own attribute."""
             if "pint" not in sys.modules and attr in ("type", "available"):
                 return () if attr == "type" else False
             cache["pint"] = real("pint")
@@ -61,14 +65,28 @@ class RawDataError(ValueError):
 
 
 class WorkLimitError(RawDataError):
-    """A computation refused because its memory, sized by a record or by a model identified from one, would pass a
-    stated limit (``rig.nonlinear.MAX_STEPS_PER_SAMPLE``, ``rig.nonlinear.WORK_LIMIT_BYTES``): the message says what
-    is too large, the limit, which record or model quantity made it so and the likely cause (most often a record
-    read in the wrong units or at the wrong sampling rate, whose identified model is then impossible)."""
+    """A computation refused because its memory would pass a stated limit.
+
+    The memory is sized by a record or by a model identified from one; the limits are
+    ``rig.nonlinear.MAX_STEPS_PER_SAMPLE`` and ``rig.nonlinear.WORK_LIMIT_BYTES``. The message says what is too large,
+    the limit, which record or model quantity made it so and the likely cause (most often a record read in the wrong
+    units or at the wrong sampling rate, whose identified model is then impossible).
+    """
 
 
 def file_digest(path: str | os.PathLike) -> str:
-    """sha256 of a file's bytes (hex)."""
+    """Return the sha256 of a file's bytes.
+
+    Parameters
+    ----------
+    path
+        The file.
+
+    Returns
+    -------
+    digest : str
+        The digest in hex.
+    """
     h = hashlib.sha256()
     with open(path, "rb") as fh:
         for chunk in iter(lambda: fh.read(1 << 20), b""):
@@ -76,21 +94,46 @@ def file_digest(path: str | os.PathLike) -> str:
     return h.hexdigest()
 
 
-def config_digest(subset) -> str:
-    """sha256 of a config subset, serialised canonically."""
+def config_digest(subset: Any) -> str:
+    """Return the sha256 of a config subset, serialised canonically.
+
+    Parameters
+    ----------
+    subset
+        The config subset: anything JSON can serialise (keys sorted; other values by their ``str``).
+
+    Returns
+    -------
+    digest : str
+        The digest in hex.
+    """
     return hashlib.sha256(json.dumps(subset, sort_keys=True, default=str).encode()).hexdigest()
 
 
 def package_digest() -> str:
-    """sha256 over the package's Python sources (names and bytes): a rule parameter, so that
-    Snakemake reruns what a changed contactid computed (the same digest names numba's cache)."""
+    """Return the sha256 over the package's Python sources (names and bytes).
+
+    A rule parameter, so that Snakemake reruns what a changed contactid computed (the same digest names numba's
+    cache).
+
+    Returns
+    -------
+    digest : str
+        The digest in hex (``contactid.code_digest``).
+    """
     from . import code_digest
 
     return code_digest()
 
 
 def git_revision() -> str:
-    """Commit hash of the package's git checkout, or ``unknown`` where git or the repository is unavailable."""
+    """Return the commit hash of the package's git checkout.
+
+    Returns
+    -------
+    revision : str
+        The commit hash, or ``unknown`` where git or the repository is unavailable.
+    """
     try:
         out = subprocess.run(
             ["git", "rev-parse", "HEAD"], capture_output=True, text=True, timeout=5, cwd=Path(__file__).resolve().parent
@@ -100,9 +143,29 @@ def git_revision() -> str:
         return "unknown"
 
 
-def provenance(rule: str, config_subset=None, inputs: Mapping[str, str] | None = None) -> dict:
-    """Global attributes naming the producing rule, package version, git
-    revision, a digest of the config subset used and digests of the inputs."""
+def provenance(
+    rule: str, config_subset: Mapping[str, Any] | None = None, inputs: Mapping[str, str] | None = None
+) -> dict:
+    """Return the global attributes that say where a dataset comes from.
+
+    They name the producing rule, the package version, the git revision, a digest of the config subset used and the
+    inputs with their digests.
+
+    Parameters
+    ----------
+    rule
+        The producing rule.
+    config_subset
+        The config the rule read ({section or key: value}); None: nothing.
+    inputs
+        The rule's input files {name: path}; None: none.
+
+    Returns
+    -------
+    attrs : dict
+        ``producer_rule``, ``contactid_version``, ``git_revision``, ``config_digest`` and, per input,
+        ``input_{name}`` (its path) and ``input_{name}_sha256``.
+    """
     attrs = {
         "producer_rule": rule,
         "contactid_version": __version__,
@@ -116,8 +179,20 @@ def provenance(rule: str, config_subset=None, inputs: Mapping[str, str] | None =
 
 
 def content_digest(ds: xr.Dataset) -> str:
-    """sha256 over the data variables' names, dimensions and values (the audit recomputes it to
-    find datasets edited after they were written)."""
+    """Return the sha256 over a dataset's data variables' names, dimensions and values.
+
+    The audit recomputes it to find datasets edited after they were written.
+
+    Parameters
+    ----------
+    ds
+        The dataset.
+
+    Returns
+    -------
+    digest : str
+        The digest in hex.
+    """
     h = hashlib.sha256()
     for name in sorted(ds.data_vars):
         var = ds[name]
@@ -131,9 +206,21 @@ def content_digest(ds: xr.Dataset) -> str:
     return h.hexdigest()
 
 
-def nonfinite_variables(datasets: Mapping[str, xr.Dataset], skip=()) -> list[str]:
-    """``label: variable`` of every real or complex variable of ``datasets`` {label: dataset} that holds a NaN or an
-    infinite number (variables named in ``skip`` left out): where a NaN came from."""
+def nonfinite_variables(datasets: Mapping[str, xr.Dataset], skip: Collection[str] = ()) -> list[str]:
+    """Return the variables that hold a NaN or an infinite number: where a NaN came from.
+
+    Parameters
+    ----------
+    datasets
+        The datasets to look through, {label: dataset}; their real and complex data variables are read.
+    skip
+        Names of variables left out.
+
+    Returns
+    -------
+    found : list[str]
+        ``label: variable`` of every such variable.
+    """
     out = []
     for label, data in datasets.items():
         for name, var in data.data_vars.items():
@@ -144,9 +231,23 @@ def nonfinite_variables(datasets: Mapping[str, xr.Dataset], skip=()) -> list[str
 
 
 def write_dataset(ds: xr.Dataset, path: str | os.PathLike) -> None:
-    """Write ``ds`` whole or not at all: to a temporary file beside ``path``,
-    then renamed over it. Every data variable must carry ``units`` and
-    ``long_name``; the content digest is stored as the attribute ``content_sha256``."""
+    """Write ``ds`` whole or not at all: to a temporary file beside ``path``, then renamed over it.
+
+    Every data variable must carry ``units`` and ``long_name``; the content digest is stored as the attribute
+    ``content_sha256``.
+
+    Parameters
+    ----------
+    ds
+        The dataset.
+    path
+        The netCDF file to write (its directory is made where missing).
+
+    Raises
+    ------
+    ValueError
+        When a data variable lacks ``units`` or ``long_name``.
+    """
     for name, var in ds.data_vars.items():
         missing = [a for a in ("units", "long_name") if a not in var.attrs]
         if missing:
@@ -169,7 +270,15 @@ def write_dataset(ds: xr.Dataset, path: str | os.PathLike) -> None:
 
 
 def write_text(path: str | os.PathLike, text: str) -> None:
-    """Write a text file whole or not at all (temporary file, then renamed over ``path``)."""
+    """Write a text file whole or not at all (temporary file, then renamed over ``path``).
+
+    Parameters
+    ----------
+    path
+        The file to write (its directory is made where missing).
+    text
+        Its content.
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(path.name + ".tmp")
@@ -182,14 +291,55 @@ def write_text(path: str | os.PathLike, text: str) -> None:
 
 
 def load_dataset(path: str | os.PathLike) -> xr.Dataset:
-    """Eagerly load a dataset (the file is closed on return)."""
+    """Eagerly load a dataset (the file is closed on return).
+
+    Parameters
+    ----------
+    path
+        The netCDF file.
+
+    Returns
+    -------
+    ds : xr.Dataset
+        The dataset, in memory.
+    """
     return xr.load_dataset(path, engine=ENGINE)
 
 
 def raw_dataset(
-    time, force, acceleration, sensor_names, positions, sampling_rate_hz: float, attrs: Mapping | None = None
+    time: np.ndarray,
+    force: np.ndarray,
+    acceleration: np.ndarray,
+    sensor_names: Sequence[str],
+    positions: Sequence[float] | np.ndarray,
+    sampling_rate_hz: float,
+    attrs: Mapping | None = None,
 ) -> xr.Dataset:
-    """Build a raw record in the documented format."""
+    """Build a raw record in the documented format.
+
+    Parameters
+    ----------
+    time
+        Sample times [s], shape (n_t,).
+    force
+        Excitation force at d_p [N], shape (n_t,).
+    acceleration
+        Lateral accelerations [m/s^2], shape (n_sensors, n_t).
+    sensor_names
+        The sensors' names, n_sensors of them.
+    positions
+        The sensors' distances from the clamp [m], shape (n_sensors,).
+    sampling_rate_hz
+        Sampling rate [Hz] (the global attribute ``sampling_rate_hz``).
+    attrs
+        Further global attributes (e.g. ``excitation_frequency_hz``); None: none.
+
+    Returns
+    -------
+    raw : xr.Dataset
+        The raw record: ``force(time)``, ``acceleration(sensor, time)``, coordinates ``time``, ``sensor`` and
+        ``position(sensor)``.
+    """
     ds = xr.Dataset(
         {
             "force": ("time", np.asarray(force, dtype=float), {"units": "N", "long_name": "excitation force at d_p"}),
@@ -225,9 +375,12 @@ TIME_UNITS = {
 
 
 def _time_in_seconds(time: xr.DataArray, fail) -> np.ndarray:
-    """The time coordinate in seconds (float64): numbers in the unit their ``units`` attribute states (s, ms or us;
-    none: s), or dates and durations as xarray decodes CF units ("seconds since ...": seconds from the first
-    sample). ``fail(msg)`` raises the reader's error."""
+    """Return the time coordinate in seconds (float64).
+
+    Numbers are read in the unit their ``units`` attribute states (s, ms or us; none: s), dates and durations as
+    xarray decodes CF units ("seconds since ...": seconds from the first sample). ``fail(msg)`` raises the reader's
+    error.
+    """
     v = time.values
     if v.dtype.kind == "M":  # dates: the first sample is t = 0
         return (v - v[0]).astype("timedelta64[ns]").astype(np.int64) * 1e-9
@@ -242,11 +395,13 @@ def _time_in_seconds(time: xr.DataArray, fail) -> np.ndarray:
 
 
 def _uniform_time(t: np.ndarray, stored_dtype: np.dtype, fs: float, fail) -> np.ndarray:
-    """The record's time axis t0 + k / fs (float64), after checking that the file's times ``t`` (s) lie on it: within
-    a hundredth of a sample, or within twice what the file's number type resolves (float32 keeps 3.2 s to 1.2e-7 s,
-    128 s to 7.6e-6 s: 4 % of a sample at 5120 Hz). A time axis whose steps are not 1 / fs, or whose
-    sampling_rate_hz does not match it by a hundredth of a sample over the record, is refused: the harmonics are
-    read at fs."""
+    """Return the record's time axis t0 + k / fs (float64), after checking that the file's times lie on it.
+
+    The file's times ``t`` (s) must lie on it within a hundredth of a sample, or within twice what the file's number
+    type resolves (float32 keeps 3.2 s to 1.2e-7 s, 128 s to 7.6e-6 s: 4 % of a sample at 5120 Hz). A time axis whose
+    steps are not 1 / fs, or whose sampling_rate_hz does not match it by a hundredth of a sample over the record, is
+    refused: the harmonics are read at fs.
+    """
     k = np.arange(t.size)
     grid = t[0] + k / fs
     resolution = 2 * np.finfo(stored_dtype).eps * float(np.max(np.abs(t))) if stored_dtype.kind == "f" else 0.0
@@ -265,11 +420,36 @@ def _uniform_time(t: np.ndarray, stored_dtype: np.dtype, fs: float, fail) -> np.
 def read_raw(  # noqa: C901
     path: str | os.PathLike, dual_sine: bool = False, min_samples: int = 16, min_periods: int = 8, max_harmonic: int = 1
 ) -> xr.Dataset:
-    """Load and check a raw record; raise :class:`RawDataError` naming the file,
-    the field and the fix when it does not follow the documented format.
+    """Load and check a raw record.
 
-    For dual-sine records, the record must also hold ``min_periods`` periods of the
-    excitation and resolve ``max_harmonic`` harmonics below the Nyquist frequency."""
+    Raise :class:`RawDataError` naming the file, the field and the fix when it does not follow the documented format.
+    Times in ms or us, or as CF dates, are converted to seconds and the axis rebuilt as t0 + k / fs; positions in cm
+    or mm are converted to m; force and acceleration are read as float64. For dual-sine records, the record must also
+    hold ``min_periods`` periods of the excitation and resolve ``max_harmonic`` harmonics below the Nyquist frequency.
+
+    Parameters
+    ----------
+    path
+        The netCDF raw record.
+    dual_sine
+        Whether it is a dual-sine record (it then needs ``excitation_frequency_hz``).
+    min_samples
+        The fewest samples a record may hold.
+    min_periods
+        The fewest periods of the excitation a dual-sine record may hold.
+    max_harmonic
+        The highest harmonic of the excitation a dual-sine record must resolve below the Nyquist frequency.
+
+    Returns
+    -------
+    raw : xr.Dataset
+        The checked record in the documented format (time in s, positions in m, float64 signals).
+
+    Raises
+    ------
+    RawDataError
+        When the file is missing, cannot be read as netCDF, or does not follow the documented format.
+    """
     path = str(path)
     if not os.path.exists(path):
         raise RawDataError(f"{path}: file not found; set 'file:' to an existing netCDF raw record")

@@ -27,13 +27,48 @@ RATE_TOLERANCE = {"uff58": 1e-5, "tdms": 1e-9, "csv": 1e-6}
 
 
 def sidecar_path(file: str, sidecar: str | None = None) -> str:
-    """The CSV's sidecar YAML: as given, else the CSV's path with the suffix .yaml."""
+    """Return the path of a CSV's sidecar YAML: as given, else the CSV's path with the suffix .yaml.
+
+    Parameters
+    ----------
+    file
+        Path of the CSV file.
+    sidecar
+        Path of its sidecar as configured, or None.
+
+    Returns
+    -------
+    path : str
+        The sidecar's path.
+    """
     return sidecar or str(Path(file).with_suffix(".yaml"))
 
 
 def record_spec(block: Mapping, where: str) -> ImportSpec:
-    """The import of a configured record (a load case or the random test with ``format`` other
-    than netcdf): the channel map from the config block, or from the sidecar for CSV."""
+    """Return the import of a configured record (a load case or the random test with ``format`` other than netcdf).
+
+    The channel map comes from the config block, or from the sidecar for CSV (whose ``sampling_rate_hz`` and
+    ``excitation_frequency_hz`` the config block may state instead).
+
+    Parameters
+    ----------
+    block
+        The record's config block (a load case of ``load_cases`` or ``random_test``): ``format``, ``file``,
+        ``sidecar`` and ``channels``, ``sampling_rate_hz`` and ``excitation_frequency_hz`` are read.
+    where
+        The block's place in the config, for the messages (e.g. "load_cases.lc1").
+
+    Returns
+    -------
+    spec : ImportSpec
+        The parsed channel map with the file, its format and the rates.
+
+    Raises
+    ------
+    RawDataError
+        When ``file`` is not set; for CSV, when the block gives ``channels``, the sidecar is missing or not valid
+        YAML, or the sidecar and the block state different rates.
+    """
     fmt = block.get("format", "netcdf")
     file = block.get("file")
     if not file:
@@ -86,8 +121,31 @@ def _sampling_rate(spec: ImportSpec, samples: dict) -> float:
 
 
 def import_record(block: Mapping, where: str, dual_sine: bool) -> xr.Dataset:
-    """The raw dataset (format of ``contactid.io``) of a configured import: channels mapped by
-    name, converted to N and m/s^2 by the map's units and sensitivities, on one time axis."""
+    """Return the raw dataset (format of ``contactid.io``) of a configured import.
+
+    The channels are mapped by name, converted to N and m/s^2 by the map's units and sensitivities, on one time
+    axis; the attributes record the source format, file and each channel's conversion.
+
+    Parameters
+    ----------
+    block
+        The record's config block, as ``record_spec`` reads it.
+    where
+        The block's place in the config, for the messages.
+    dual_sine
+        Whether the record is a dual-sine test (it then needs ``excitation_frequency_hz``).
+
+    Returns
+    -------
+    raw : xr.Dataset
+        The raw record (force [N], acceleration [m/s^2] per sensor, time [s], sensor positions [m]).
+
+    Raises
+    ------
+    RawDataError
+        When the channels have different lengths or no samples, a dual-sine record has no excitation frequency, or a
+        converted sample is not finite.
+    """
     spec = record_spec(block, where)
     samples = read_channels(spec)
     lengths = {r: s.values.size for r, s in samples.items()}
