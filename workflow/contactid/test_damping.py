@@ -1,5 +1,7 @@
-"""The structure's damping at test level: the random test's damping ratios scaled by the factor the calibration
-record binds, the driven mode's alone or every mode's.
+"""The structure's damping at test level.
+
+The random test's damping ratios scaled by the factor the calibration record binds, the driven mode's alone or every
+mode's.
 
 The inverse identification subtracts the structure's damping from the measured response; what is left is the contact
 force S. The damping ratios come from the random test, at 0.02-0.5 N rms with the contact stuck, through a windowed FRF
@@ -31,6 +33,7 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Iterable, Sequence
 
 import numpy as np
 import xarray as xr
@@ -39,15 +42,49 @@ from .friction_fit import FitSettings, fit_friction_law
 from .friction_parameters import PARAMETER_NAMES, PARAMETER_UNITS
 from .identification import inverse_harmonics, modal_damping_vector
 
+if TYPE_CHECKING:
+    from .beam_model import FEModel
+
 log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
 class DampingProfile:
-    """The law's misfit (relative rms of S, ``FitResult.misfit``) at each factor of ``scales`` on the damping ratio of
-    identified mode ``mode`` (index); the factor where it is least (``scale``) and its ``interval`` (a side at the
-    grid's end: not bound there, ``bounded`` false), the threshold misfit, and the friction law (e_f, k_c, e_t,
-    kappa, mu) fitted at each factor."""
+    """The law's misfit profiled over the damping factor, and the friction law fitted at each factor.
+
+    The factor scales the damping ratio of identified mode ``mode`` (form "driven") or of every mode (form "all").
+
+    Attributes
+    ----------
+    scales
+        The factors profiled [-], shape (n_scales,), ascending (1, ``nonlinear.test_damping_scales`` and the
+        parabola's refined least).
+    misfits
+        The law's misfit at each factor, the relative rms of S (``FitResult.misfit``) [-], shape (n_scales,).
+    laws
+        The friction law fitted at each factor, shape (n_scales, 5), its columns e_f [N/m], k_c [1/m], e_t [N/m],
+        kappa [-] and mu [-].
+    scale
+        The factor where the misfit is least [-].
+    interval
+        (low, high): the factors whose misfit stays within the threshold around ``scale`` [-].
+    bounded
+        (low, high): whether each side of the interval is bound inside the profiled grid (a side at the grid's end:
+        not bound there, false).
+    threshold
+        The threshold misfit [-].
+    mode
+        The driven mode's index among the identified modes (from 0).
+    form
+        "driven": the driven mode's ratio scaled; "all": every identified mode's (``FORMS``).
+    check
+        The held-out records' test (``records_test_of_update``'s result), None: not taken.
+    law_intervals
+        Profile-likelihood intervals of the law at ``scale`` (``with_intervals``), shape (5, 2) (low, high) per
+        parameter, each in its unit: e_f [N/m], k_c [1/m], e_t [N/m], kappa [-], mu [-]; None: not computed.
+    e0_interval
+        (low, high) of e_0 at the preload for the law at ``scale`` [N/m]; None: not computed.
+    """
 
     scales: np.ndarray
     misfits: np.ndarray
@@ -66,44 +103,107 @@ class DampingProfile:
 
     @property
     def accepted(self) -> bool:
-        """Whether the factor is applied: the held-out records confirmed it (``check``'s ``accepted``)."""
+        """Whether the factor is applied: the held-out records confirmed it (``check``'s ``accepted``).
+
+        Returns
+        -------
+        accepted : bool
+            Whether the held-out records' test accepted the factor.
+        """
         return bool(self.check is not None and self.check.get("accepted"))
 
     @property
     def applied_scale(self) -> float:
-        """The factor applied: ``scale`` where the held-out records confirmed it, else 1 (the random test's ratio)."""
+        """The factor applied: ``scale`` where the held-out records confirmed it, else 1 (the random test's ratio).
+
+        Returns
+        -------
+        applied_scale : float
+            The factor applied [-].
+        """
         return self.scale if self.accepted else 1.0
 
-    def scaled_ratios(self, damping_ratios, scale: float | None = None) -> np.ndarray:
-        """``damping_ratios`` with the ``form``'s modes (mode ``mode``, or all) times ``scale`` (default: the
-        least-misfit factor)."""
+    def scaled_ratios(self, damping_ratios: Sequence[float] | np.ndarray, scale: float | None = None) -> np.ndarray:
+        """Return ``damping_ratios`` with the ``form``'s modes (mode ``mode``, or all) times ``scale``.
+
+        Parameters
+        ----------
+        damping_ratios
+            The identified modes' damping ratios [-], shape (n_modes,).
+        scale
+            The factor [-]; None: the least-misfit factor ``scale``.
+
+        Returns
+        -------
+        ratios : np.ndarray
+            The scaled damping ratios [-], shape (n_modes,).
+        """
         return scaled(damping_ratios, self.scale if scale is None else scale, self.mode, self.form)
 
-    def ratios(self, damping_ratios) -> np.ndarray:
-        """The identified modes' damping ratios at test level: ``damping_ratios``, mode ``mode``'s times
-        ``applied_scale``."""
+    def ratios(self, damping_ratios: Sequence[float] | np.ndarray) -> np.ndarray:
+        """Return the identified modes' damping ratios at test level.
+
+        That is ``damping_ratios`` with the ``form``'s modes (mode ``mode``, or all) times ``applied_scale``.
+
+        Parameters
+        ----------
+        damping_ratios
+            The identified modes' damping ratios from the random test [-], shape (n_modes,).
+
+        Returns
+        -------
+        ratios : np.ndarray
+            The damping ratios at test level [-], shape (n_modes,).
+        """
         return self.scaled_ratios(damping_ratios, self.applied_scale)
 
     def law_at(self, scale: float) -> np.ndarray:
-        """The friction law (e_f, k_c, e_t, kappa, mu) fitted at the profiled factor nearest ``scale``."""
+        """Return the friction law fitted at the profiled factor nearest ``scale`` (nearest in log(factor)).
+
+        Parameters
+        ----------
+        scale
+            The factor [-], positive.
+
+        Returns
+        -------
+        law : np.ndarray
+            (e_f [N/m], k_c [1/m], e_t [N/m], kappa [-], mu [-]), shape (5,).
+        """
         return self.laws[int(np.argmin(np.abs(np.log(self.scales / scale))))]
 
     def law_at_scale(self) -> np.ndarray:
-        """The friction law (e_f, k_c, e_t, kappa, mu) fitted at the least-misfit factor ``scale``."""
+        """Return the friction law fitted at the least-misfit factor ``scale``.
+
+        Returns
+        -------
+        law : np.ndarray
+            (e_f [N/m], k_c [1/m], e_t [N/m], kappa [-], mu [-]), shape (5,).
+        """
         return self.law_at(self.scale)
 
 
 def unprofiled() -> DampingProfile:
-    """The profile of a configuration that profiles nothing (``nonlinear.test_damping_scales`` [1.0]): the random
-    test's ratios."""
+    """Return the profile of a configuration that profiles nothing (``nonlinear.test_damping_scales`` [1.0]).
+
+    It keeps the random test's ratios: the factor 1, no misfit and no law.
+
+    Returns
+    -------
+    profile : DampingProfile
+        The profile at the factor 1 alone (misfit and law NaN).
+    """
     return DampingProfile(
         np.ones(1), np.full(1, np.nan), np.full((1, 5), np.nan), 1.0, (1.0, 1.0), (False, False), np.nan
     )
 
 
 def _threshold(misfit_min: float, n_data: int, settings: FitSettings) -> float:
-    """The misfit a factor may reach and stay inside the interval: the friction fit's profile threshold
-    (``profile_intervals``) in misfit terms, n_data = 2K Fourier coefficients, five law parameters and the factor."""
+    """Return the misfit a factor may reach and stay inside the interval.
+
+    The friction fit's profile threshold (``profile_intervals``) in misfit terms, n_data = 2K Fourier coefficients,
+    five law parameters and the factor.
+    """
     from scipy.stats import chi2
 
     sigma2 = max(misfit_min**2 * n_data / max(n_data - 6, 1), settings.misfit_floor**2)
@@ -113,8 +213,30 @@ def _threshold(misfit_min: float, n_data: int, settings: FitSettings) -> float:
 FORMS = ("driven", "all")
 
 
-def scaled(damping_ratios, scale: float, mode: int, form: str) -> np.ndarray:
-    """``damping_ratios`` with mode ``mode``'s times ``scale`` (``form`` "driven") or every mode's ("all")."""
+def scaled(damping_ratios: Sequence[float] | np.ndarray, scale: float, mode: int, form: str) -> np.ndarray:
+    """Return ``damping_ratios`` with mode ``mode``'s times ``scale`` (``form`` "driven") or every mode's ("all").
+
+    Parameters
+    ----------
+    damping_ratios
+        The identified modes' damping ratios [-], shape (n_modes,).
+    scale
+        The factor [-].
+    mode
+        The driven mode's index (from 0).
+    form
+        "driven" or "all" (``FORMS``).
+
+    Returns
+    -------
+    ratios : np.ndarray
+        The scaled damping ratios [-], shape (n_modes,), a new array.
+
+    Raises
+    ------
+    ValueError
+        When ``form`` is not one of ``FORMS``.
+    """
     if form not in FORMS:
         raise ValueError(f"damping at test level: form {form!r}; give one of {FORMS}")
     out = np.array(damping_ratios, dtype=float)
@@ -125,33 +247,90 @@ def scaled(damping_ratios, scale: float, mode: int, form: str) -> np.ndarray:
 
 
 def ratio_words(form: str, driven_mode: int) -> str:
-    """The damping ratios a factor of ``form`` scales, in words: "mode 1's damping ratio" (``driven_mode``, from 1)
-    or "every mode's damping ratio"."""
+    """Return the damping ratios a factor of ``form`` scales, in words.
+
+    Parameters
+    ----------
+    form
+        "driven" or "all".
+    driven_mode
+        The driven mode's number (from 1).
+
+    Returns
+    -------
+    words : str
+        "mode 1's damping ratio" (form "driven") or "every mode's damping ratio".
+    """
     return f"mode {driven_mode}'s damping ratio" if form == "driven" else "every mode's damping ratio"
 
 
-def driven_mode(frequencies_hz, f0: float) -> int:
-    """The identified mode nearest the drive ``f0`` (Hz): the one the dual-sine test drives near resonance."""
+def driven_mode(frequencies_hz: Sequence[float] | np.ndarray, f0: float) -> int:
+    """Return the identified mode nearest the drive: the one the dual-sine test drives near resonance.
+
+    Parameters
+    ----------
+    frequencies_hz
+        The identified modes' natural frequencies [Hz], shape (n_modes,).
+    f0
+        The drive's frequency [Hz].
+
+    Returns
+    -------
+    mode : int
+        The mode's index (from 0).
+    """
     return int(np.argmin(np.abs(np.asarray(frequencies_hz, dtype=float) - f0)))
 
 
 def damping_profile(
-    model,
-    damping_ratios,
-    frequencies_hz,
+    model: FEModel,
+    damping_ratios: Sequence[float] | np.ndarray,
+    frequencies_hz: Sequence[float] | np.ndarray,
     F_coef: np.ndarray,
     A_coef: np.ndarray,
     f0: float,
     preload: float,
     settings: FitSettings,
     seed: int,
-    scales,
+    scales: Iterable[float],
     form: str = "driven",
 ) -> DampingProfile:
-    """The misfit profile over the damping factor on the calibration record's harmonics (``F_coef`` (K,),
-    ``A_coef`` (sensors, K) of the drive ``f0``), with the FE ``model`` (the identified linear model) and the random
-    test's ``damping_ratios`` of the identified modes at ``frequencies_hz``; the law fitted at each factor from the same
-    ``seed``."""
+    """Profile the law's misfit over the damping factor on the calibration record's harmonics.
+
+    The law is fitted at each factor (and at 1) from the same ``seed``; the least is refined by a parabola in
+    log(factor) through it and its neighbours, and the interval is where the misfit stays within the friction fit's
+    profile threshold.
+
+    Parameters
+    ----------
+    model
+        The FE model of the identified linear model.
+    damping_ratios
+        The random test's damping ratios of the identified modes [-], shape (n_modes,).
+    frequencies_hz
+        The identified modes' natural frequencies [Hz], shape (n_modes,).
+    F_coef
+        The calibration record's force harmonics 1..K [N], complex, shape (K,).
+    A_coef
+        Its acceleration harmonics [m/s^2], complex, shape (n_sensors, K).
+    f0
+        The drive's frequency [Hz].
+    preload
+        The static normal preload [N].
+    settings
+        The friction fit's settings.
+    seed
+        The GA's random seed.
+    scales
+        The factors to profile [-] (1 is added).
+    form
+        "driven" (the driven mode's ratio) or "all" (every mode's).
+
+    Returns
+    -------
+    profile : DampingProfile
+        The profile, its least-misfit factor, interval and threshold, and the law at each factor.
+    """
     K = A_coef.shape[1]
     ratios = np.asarray(damping_ratios, dtype=float)
     mode = driven_mode(frequencies_hz, f0)
@@ -213,8 +392,8 @@ def damping_profile(
 
 def with_intervals(
     profile: DampingProfile,
-    model,
-    damping_ratios,
+    model: FEModel,
+    damping_ratios: Sequence[float] | np.ndarray,
     F_coef: np.ndarray,
     A_coef: np.ndarray,
     f0: float,
@@ -222,8 +401,37 @@ def with_intervals(
     settings: FitSettings,
     seed: int,
 ) -> DampingProfile:
-    """``profile`` with the profile-likelihood intervals of the law fitted at its factor, as rule friction_fit gives
-    them: the fit polished from the law ``damping_profile`` found there (no second GA), then profiled."""
+    """Return ``profile`` with the profile-likelihood intervals of the law fitted at its factor.
+
+    As rule friction_fit gives them: the fit polished from the law ``damping_profile`` found there (no second GA),
+    then profiled.
+
+    Parameters
+    ----------
+    profile
+        The profile (``damping_profile``).
+    model
+        The FE model of the identified linear model.
+    damping_ratios
+        The random test's damping ratios of the identified modes [-], shape (n_modes,).
+    F_coef
+        The calibration record's force harmonics 1..K [N], complex, shape (K,).
+    A_coef
+        Its acceleration harmonics [m/s^2], complex, shape (n_sensors, K).
+    f0
+        The drive's frequency [Hz].
+    preload
+        The static normal preload [N].
+    settings
+        The friction fit's settings.
+    seed
+        The random seed.
+
+    Returns
+    -------
+    profile : DampingProfile
+        ``profile`` with ``law_intervals`` and ``e0_interval``.
+    """
     import dataclasses
 
     r = profile.scaled_ratios(damping_ratios)
@@ -245,10 +453,24 @@ def with_intervals(
     )
 
 
-def profile_dataset(profile: DampingProfile, damping_ratios) -> xr.Dataset:
-    """results/friction/test_damping.nc: the least-misfit factor, its interval, the profile, the held-out records' test
-    (attributes ``heldout_gap_*``, ``record_scatter``, ``accepted``, ``reason``), the factor applied and the ratios at
-    test level."""
+def profile_dataset(profile: DampingProfile, damping_ratios: Sequence[float] | np.ndarray) -> xr.Dataset:
+    """Build the dataset of results/friction/test_damping.nc.
+
+    It holds the least-misfit factor, its interval, the profile, the held-out records' test (attributes
+    ``heldout_gap_*``, ``record_scatter``, ``accepted``, ``reason``), the factor applied and the ratios at test level.
+
+    Parameters
+    ----------
+    profile
+        The profile, with the held-out records' test where taken.
+    damping_ratios
+        The random test's damping ratios of the identified modes [-], shape (n_modes,).
+
+    Returns
+    -------
+    ds : xr.Dataset
+        The dataset (every variable with ``units`` and ``long_name``).
+    """
     check = profile.check or {}
     attrs = {
         "misfit_threshold": profile.threshold,
@@ -332,7 +554,19 @@ def profile_dataset(profile: DampingProfile, damping_ratios) -> xr.Dataset:
 
 
 def check_reason(profile: DampingProfile) -> str:
-    """One sentence on why the factor is applied or not (from the held-out records' test)."""
+    """Return one sentence on why the factor is applied or not (from the held-out records' test).
+
+    Parameters
+    ----------
+    profile
+        The profile, with the held-out records' test where taken (``heldout_gap_chain``, ``heldout_gap_updated`` and
+        ``record_scatter`` are read).
+
+    Returns
+    -------
+    reason : str
+        The sentence.
+    """
     check = profile.check
     if abs(profile.scale - 1.0) < 1e-9:
         return "the law misfits least at the random test's ratio"
@@ -349,8 +583,19 @@ def check_reason(profile: DampingProfile) -> str:
 
 
 def damping_summary(ds: xr.Dataset) -> dict:
-    """summary.json's ``friction.test_damping`` from a test_damping.nc: the form, the least-misfit factor and its
-    interval, the factor applied, the held-out records' gaps and the reason."""
+    """Return summary.json's ``friction.test_damping`` from a test_damping.nc.
+
+    Parameters
+    ----------
+    ds
+        The dataset of test_damping.nc (``profile_dataset``).
+
+    Returns
+    -------
+    summary : dict
+        The form, the driven mode, the least-misfit factor and its interval, the factor applied, whether accepted,
+        the reason, the held-out records' gaps, and where stored the law at the factor and its intervals.
+    """
     out = {
         "form": str(ds.attrs.get("form", "driven")),
         "driven_mode": int(ds.attrs["driven_mode"]),

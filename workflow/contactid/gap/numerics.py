@@ -41,7 +41,28 @@ SEARCHES = ("residual", "gap")
 
 @dataclass(frozen=True)
 class Numerics:
-    """How the gap diagnosis computes (see the module's docstring for each field and what it trades)."""
+    """How the gap diagnosis computes (see the module's docstring for each field and what it trades).
+
+    Attributes
+    ----------
+    steady_state
+        How ``simulation.simulate`` finds a steady state where it is not given ``method``: "harmonic_balance" or
+        "time_marching" (``STEADY_STATES``).
+    closed_contact_hb
+        Whether an unpolished simulation of a contact that may open takes its periodic state where the contact stays
+        closed all period long.
+    settling_tol
+        The integrator's settling test where ``simulation.simulate`` is given no ``tol``: the relative change of the
+        harmonics between 8-period chunks [-], positive.
+    polish_searches
+        Whether every state a candidate's calibration search compares is polished by the integrator (config
+        ``gap.polish_searches``).
+    search
+        How a candidate's search runs: "residual" (quadratic models of the gap's residual vector, least-squares
+        steps) or "gap" (the gap alone: Brent's bounded search, Nelder-Mead) (``SEARCHES``).
+    memo
+        Whether the inverse identification and the friction refit are memoised.
+    """
 
     steady_state: str = "harmonic_balance"
     closed_contact_hb: bool = True
@@ -51,6 +72,13 @@ class Numerics:
     memo: bool = True
 
     def __post_init__(self):
+        """Check the fields: a known steady state and search, a positive settling tolerance.
+
+        Raises
+        ------
+        ValueError
+            When ``steady_state`` or ``search`` is not one of the known names, or ``settling_tol`` is not positive.
+        """
         if self.steady_state not in STEADY_STATES:
             raise ValueError(f"Numerics.steady_state = {self.steady_state!r}; give one of {', '.join(STEADY_STATES)}")
         if self.search not in SEARCHES:

@@ -39,8 +39,33 @@ IMPLAUSIBLE_MODEL = (
 
 
 def simulator(model: IdentifiedModel, aug: Augmentation, fs: float, f0: float | None = None) -> DualSineSimulator:
-    """The reduced identified model with the augmentation, ready to integrate (step as the rig's,
-    shortened to a whole number of steps per period of ``f0`` when given)."""
+    """Build the reduced identified model with the augmentation, ready to integrate.
+
+    The step is the rig's (``rig.nonlinear.stable_oversampling`` steps per sample), shortened to a whole number of
+    steps per period of ``f0`` when given.
+
+    Parameters
+    ----------
+    model
+        The chain's identified model (structure, damping ratios, friction law, preload, modes kept, oversampling).
+    aug
+        Effects added to the identified model (extra damping, normal law, Iwan share, preload drift, ...).
+    fs
+        Sampling rate of the record the simulation stands for [Hz].
+    f0
+        Excitation frequency [Hz]; None (or 0): the step is not fitted to a period.
+
+    Returns
+    -------
+    simulator : DualSineSimulator
+        The integrator of the reduced model, its ``oversampling`` the steps per sample it takes.
+
+    Raises
+    ------
+    WorkLimitError
+        When the identified model is too stiff to integrate within ``rig.nonlinear``'s limits (the message adds
+        the likely cause, ``IMPLAUSIBLE_MODEL``, unless the viscous friction's rate made the steps).
+    """
     red = reduced(model.structure_with(aug), model.n_modes)[1]
     zeta = damping_by_mode(red.beam_mode, model.test_damping, red.omega / (2 * np.pi))
     zeta[red.beam_mode] += aug.extra_damping
@@ -73,13 +98,34 @@ def simulator(model: IdentifiedModel, aug: Augmentation, fs: float, f0: float | 
 
 @dataclass
 class SimResult:
-    """A forward simulation's harmonics (same convention and time origin as RecordHarmonics):
-    acceleration (j, H); contact signals S, N (total), xi, eta (H,) complex and their means;
-    one period of each on ``grid`` points (for force-state maps and cycle energies); the energy
-    dissipated per cycle by friction (tangential) and by the normal contact (J); whether the
-    response settled; the first- and last-third accelerations for a drifting record; ``extra``: the method, and for
-    a response that does not settle (not drifting) ``aperiodic``, each sensor's share of its response that is not
-    periodic (``harmonics.aperiodic_share``, at the record's rate)."""
+    """A forward simulation's harmonics (same convention and time origin as RecordHarmonics).
+
+    Attributes
+    ----------
+    acceleration
+        The sensors' acceleration harmonics 1..n_harmonics as the channels record them [m/s^2], complex,
+        shape (n_sensors, n_harmonics), n_harmonics the record's harmonics.
+    contact
+        The contact signals' harmonics {"S", "N" (total), "xi", "eta", "xi_dot", "eta_dot"}: each complex, shape
+        (n_harmonics,), in N, N, m, m, m/s and m/s (their means are ``extra["means"]``).
+    grid
+        One period of each contact signal (mean + harmonics) on ``grid`` points, same keys plus "t" (s), each of
+        shape (grid,): for force-state maps and cycle energies.
+    energy
+        The energy dissipated per cycle by friction (``tangential_j``) and by the normal contact (``normal_j``), in J.
+    settled
+        Whether the response settled.
+    first
+        The acceleration harmonics of the record's first third [m/s^2], complex, shape (n_sensors, n_harmonics), for a
+        drifting record (None otherwise).
+    last
+        The same of the record's last third [m/s^2], shape (n_sensors, n_harmonics), or None.
+    extra
+        The method ("harmonic_balance" or "time_marching"), the signals' ``means``, the harmonic-balance state ``Z``
+        and ``iterations`` where it was used, and for a response that does not settle (not drifting)
+        ``aperiodic``, each sensor's share of its response that is not periodic (``harmonics.aperiodic_share``, at
+        the record's rate).
+    """
 
     acceleration: np.ndarray
     contact: dict
@@ -92,7 +138,10 @@ class SimResult:
 
 
 def _channels(coef: np.ndarray, aug: "Augmentation", w: float) -> np.ndarray:
-    """The sensors' harmonics (j, H) as the channels record them: each late by its delay and read with its gain."""
+    """Return the sensors' harmonics (j, H) as the channels record them.
+
+    Each channel is late by its delay and read with its gain.
+    """
     if len(aug.delays):
         h = np.arange(1, coef.shape[-1] + 1)
         coef = coef * np.exp(-1j * np.outer(np.asarray(aug.delays, dtype=float), h * w))
@@ -115,26 +164,66 @@ def simulate(
     polish: bool = True,
     numerics: Numerics = DEFAULT,
 ) -> SimResult:
-    """Steady-state response of the (augmented) identified model to the record's measured force
-    (its first ``force_harmonics`` harmonics), in the record's harmonics.
+    """Return the steady-state response of the (augmented) identified model to the record's measured force.
+
+    The force is the record's first ``force_harmonics`` harmonics; the response is given in the record's harmonics.
 
     ``method`` "harmonic_balance" (where not given: ``numerics.steady_state``, ``numerics.Numerics``) solves the
     periodic steady state directly (``rig.harmonic_balance`` on the integrator's own discrete equations with
     ``hb_harmonics`` harmonics (all the record's by default, at most a quarter of the steps per period);
-    warm-started from ``start``, a
-    neighbouring simulation of the same record). That state is within about 1e-3 of the integrator's
-    own periodic orbit (the harmonics it leaves out); with ``polish`` (the default; in the calibration searches
-    where ``numerics.polish_searches``) the integrator runs from
-    that state until its harmonics settle by the reference's own test (8-period chunks changing by less than
-    ``tol``, by default ``numerics.settling_tol``, 2e-5, two chunks at least) and records the last settled chunk
-    (``record_periods`` periods, or the record's length, where it does not settle), so the result is the
-    reference's to its tolerance at a fraction of its cost. Where Newton does not converge (a response
-    that does not settle), and for a contact that may open, the integrator starts from the linear state
-    instead; unpolished, a contact that may open is given its periodic state where that
-    stays closed, N above a tenth of the preload all period long (``numerics.closed_contact_hb``). "time_marching" (the
-    reference) integrates from the stuck linear system's state until the harmonics settle. With a
-    preload drift the whole record's length is integrated, as measured, from the settled state at the
-    record's start (in a search, unpolished: from the periodic state itself, 0.17 -> 0.13 s a simulation)."""
+    warm-started from ``start``, a neighbouring simulation of the same record). That state is within about 1e-3 of
+    the integrator's own periodic orbit (the harmonics it leaves out); with ``polish`` (the default; in the
+    calibration searches where ``numerics.polish_searches``) the integrator runs from that state until its harmonics
+    settle by the reference's own test (8-period chunks changing by less than ``tol``, by default
+    ``numerics.settling_tol``, 2e-5, two chunks at least) and records the last settled chunk (``record_periods``
+    periods, or the record's length, where it does not settle), so the result is the reference's to its tolerance at
+    a fraction of its cost. Where Newton does not converge (a response that does not settle), and for a contact that
+    may open, the integrator starts from the linear state instead; unpolished, a contact that may open is given its
+    periodic state where that stays closed, N above a tenth of the preload all period long
+    (``numerics.closed_contact_hb``). "time_marching" (the reference) integrates from the stuck linear system's state
+    until the harmonics settle. With a preload drift the whole record's length is integrated, as measured, from the
+    settled state at the record's start (in a search, unpolished: from the periodic state itself, 0.17 -> 0.13 s a
+    simulation). A simulation whose memory would pass ``rig.nonlinear.WORK_LIMIT_BYTES`` is refused
+    (``io.WorkLimitError``, from ``_check_work`` or ``simulator``) before anything is allocated.
+
+    Parameters
+    ----------
+    model
+        The chain's identified model.
+    aug
+        Effects added to the model.
+    rec
+        The record whose measured force drives the model (its harmonics, f0, fs and periods).
+    record_periods
+        Periods recorded where the response does not settle (at least the record's own periods then).
+    force_harmonics
+        How many of the record's force harmonics drive the model.
+    tol
+        The settling test's relative change of the harmonics between 8-period chunks [-]; None:
+        ``numerics.settling_tol``.
+    grid
+        Points of the one period of the contact signals in ``SimResult.grid``.
+    start
+        A neighbouring simulation of the same record whose harmonic-balance state warm-starts this one, or None.
+    method
+        "harmonic_balance" or "time_marching"; None: ``numerics.steady_state``.
+    hb_harmonics
+        Harmonics of the harmonic balance; None: all the record's (at most a quarter of the steps per period).
+    polish
+        Whether the integrator runs from the harmonic-balance state until it settles.
+    numerics
+        The gap diagnosis's numerical settings.
+
+    Returns
+    -------
+    result : SimResult
+        The simulated harmonics, contact signals, cycle energies and how they were reached.
+
+    Raises
+    ------
+    ValueError
+        When ``method`` (or ``numerics.steady_state``) is neither "harmonic_balance" nor "time_marching".
+    """
     method = method or numerics.steady_state
     tol = numerics.settling_tol if tol is None else float(tol)
     if method not in ("harmonic_balance", "time_marching"):
@@ -181,10 +270,13 @@ def simulate(
 
 
 def _check_work(sim: DualSineSimulator, rec: RecordHarmonics, n_per: int, n_hb: int, periods: int, hb: bool) -> None:
-    """Refuse (``io.WorkLimitError``) a simulation whose harmonic-balance grid (``n_per`` points, ``n_hb``
-    harmonics) or whose stored record (``periods`` periods of ``n_per`` steps, what an unsettled response or a drifting
-    preload integrates) would pass ``rig.nonlinear.WORK_LIMIT_BYTES``, before anything is allocated; the message says
-    whether the model's step (its steps per sample) or the record (its samples per period, its periods) makes it so."""
+    """Refuse a simulation too large for ``rig.nonlinear.WORK_LIMIT_BYTES``, before anything is allocated.
+
+    Raises ``io.WorkLimitError`` where the harmonic-balance grid (``n_per`` points, ``n_hb`` harmonics) or the stored
+    record (``periods`` periods of ``n_per`` steps, what an unsettled response or a drifting preload integrates) would
+    pass the limit; the message says whether the model's step (its steps per sample) or the record (its samples per
+    period, its periods) makes it so.
+    """
     from ..rig.harmonic_balance import grid_bytes
 
     n = sim.red.omega.size
@@ -217,8 +309,10 @@ def _check_work(sim: DualSineSimulator, rec: RecordHarmonics, n_per: int, n_hb: 
 
 
 def _periodic_state(sim: DualSineSimulator, coef, w, H, n_per, start):
-    """The periodic steady state by harmonic balance (the reduced model as the integrator has it,
-    on the integrator's own points per period), or None where Newton does not converge."""
+    """Return the periodic steady state by harmonic balance, or None where Newton does not converge.
+
+    The balance solves the reduced model as the integrator has it, on the integrator's own points per period.
+    """
     from ..rig.harmonic_balance import HarmonicBalance
 
     contact = dataclasses.replace(sim.contact, preload_drift=0.0)
@@ -248,7 +342,7 @@ def _contact_harmonics(sig: dict, t_first: float, w: float, n_per: int, H: int) 
 
 
 def _period_grid(contact: dict, means: dict, f0: float, H: int, grid: int) -> dict:
-    """One period on a uniform grid (Fourier synthesis of the harmonics + mean)."""
+    """Return one period on a uniform grid (Fourier synthesis of the harmonics + mean)."""
     grids = {k: means[k] + periodic_grid(c[:H], f0, grid)[0] for k, c in contact.items()}
     grids["t"] = np.arange(grid) / (grid * f0)
     return grids
@@ -295,9 +389,12 @@ def _marched_result(
     grid,
     aperiodic: bool = True,
 ) -> SimResult:
-    """The integrator's record of the state it reached (``settled`` or not). ``aperiodic``: where it did not settle,
-    measure the share of the response that is not periodic (``extra["aperiodic"]``; read only for a candidate's
-    polished optimum, ``explain.model_periodicity``: 15 ms a simulation, skipped in the searches)."""
+    """Return the integrator's record of the state it reached (``settled`` or not).
+
+    ``aperiodic``: where it did not settle, measure the share of the response that is not periodic
+    (``extra["aperiodic"]``; read only for a candidate's polished optimum, ``explain.model_periodicity``: 15 ms a
+    simulation, skipped in the searches).
+    """
     first = last = None
     if not settled and not aug.preload_drift:
         # the motion does not settle (impacts): average over as many periods as the record holds, as the

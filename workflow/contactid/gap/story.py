@@ -32,17 +32,36 @@ what these records can attribute: the smallest change of the held-out gap a firs
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Mapping, Sequence
+from typing import TYPE_CHECKING, Mapping, Sequence
 
 import numpy as np
 
 from .verdict import acts_where, gap_shares, never_opens, percent, setting
 
+if TYPE_CHECKING:
+    from .settings import GapSettings
+
 
 @dataclass(frozen=True)
 class Test:
-    """One decision: which ``test``, its ``value``, its ``threshold``, whether it ``passed``, the ``step`` (effect) it
-    was applied to ("" for the whole diagnosis) and what it ``says`` in words (the reason sentence where it decides)."""
+    """One decision of the story, an entry of its trace.
+
+    Attributes
+    ----------
+    test
+        Which test ("held_out", "update_counts", "above_floor", ...).
+    value
+        The test's value [-]: a held-out gap or its change (fractions), a count, or words (the alternatives, a
+        place).
+    threshold
+        What the value is held against [-], in the value's terms.
+    passed
+        Whether the test passed.
+    says
+        What it says in words (the reason sentence where it decides).
+    step
+        The step (effect) it was applied to; "" for the whole diagnosis.
+    """
 
     test: str
     value: float | str | bool | None
@@ -52,7 +71,13 @@ class Test:
     step: str = ""
 
     def as_dict(self) -> dict:
-        """The decision as a trace entry of diagnosis.json: test, step, value, threshold, passed and says."""
+        """Return the decision as a trace entry of diagnosis.json.
+
+        Returns
+        -------
+        entry : dict
+            {test, step, value, threshold, passed, says}.
+        """
         return {
             "test": self.test,
             "step": self.step,
@@ -64,7 +89,18 @@ class Test:
 
 
 def held_out(n_held: int) -> Test:
-    """Whether at least one load case is held out (``n_held`` of them), without which no effect can be tested."""
+    """Test whether at least one load case is held out, without which no effect can be tested.
+
+    Parameters
+    ----------
+    n_held
+        How many load cases are held out.
+
+    Returns
+    -------
+    test : Test
+        The decision "held_out" (value ``n_held``, threshold 1).
+    """
     ok = n_held >= 1
     return Test(
         "held_out",
@@ -80,8 +116,26 @@ def held_out(n_held: int) -> Test:
 
 
 def update_counts(gap_before: float, gap_after: float, scatter: float, noise_factor: float) -> Test:
-    """Whether an accepted model update is a step of the explanation: it shrinks the held-out gap by more than
-    noise_factor x the records' scatter."""
+    """Test whether an accepted model update is a step of the explanation.
+
+    It is one where it shrinks the held-out gap by more than noise_factor x the records' scatter.
+
+    Parameters
+    ----------
+    gap_before
+        Held-out gap before the update (a fraction) [-].
+    gap_after
+        Held-out gap after the update [-].
+    scatter
+        The records' bootstrap scatter of the held-out gap [-].
+    noise_factor
+        Factor on the scatter the drop must exceed (gap.noise_factor) [-].
+
+    Returns
+    -------
+    test : Test
+        The decision "update_counts" of the step "model_updating" (value the drop, threshold noise_factor x scatter).
+    """
     drop = gap_before - gap_after
     ok = bool(np.isfinite(drop) and drop > noise_factor * scatter)
     return Test(
@@ -101,8 +155,21 @@ def update_counts(gap_before: float, gap_after: float, scatter: float, noise_fac
 
 
 def records_agree(check: Mapping) -> Test:
-    """The records' check (rule record_checks): no record fails with a signature (units, sign, channel order); where one
-    does, the verdict is records_disagree and nothing is explained (``record_checks.diagnosis_outcome``)."""
+    """Test the records' check (rule record_checks): no record fails with a signature (units, sign, channel order).
+
+    Where one does, the verdict is records_disagree and nothing is explained (``record_checks.diagnosis_outcome``).
+
+    Parameters
+    ----------
+    check
+        The records' check: its ``findings``, each a mapping with ``signature`` (set where a record is wrong by a
+        units factor, a sign or a channel order) and ``message``.
+
+    Returns
+    -------
+    test : Test
+        The decision "records_agree" (value the count of such findings, threshold 0).
+    """
     hard = [f for f in check.get("findings", []) if f.get("signature")]
     return Test(
         "records_agree",
@@ -116,8 +183,24 @@ def records_agree(check: Mapping) -> Test:
 
 
 def acts_where_gap_lies(effect: str, acts_on: str, place: str, ok: bool | None = None) -> Test:
-    """The explanation's effects (``effect``, "a or b"; ``acts_on`` theirs) act where the localisation puts the gap
-    (``ok``: whether one of them does, when several; otherwise ``verdict.acts_where``)."""
+    """Test whether the explanation's effects act where the localisation puts the gap.
+
+    Parameters
+    ----------
+    effect
+        The explanation's effects, "a or b".
+    acts_on
+        Where they act ("a | b").
+    place
+        Where the localisation puts the gap.
+    ok
+        Whether one of them acts there, when several; None: ``verdict.acts_where(acts_on, place)``.
+
+    Returns
+    -------
+    test : Test
+        The decision "acts_where_gap_lies" of the step ``effect``.
+    """
     ok = acts_where(acts_on, place) if ok is None else bool(ok)
     return Test(
         "acts_where_gap_lies",
@@ -131,7 +214,22 @@ def acts_where_gap_lies(effect: str, acts_on: str, place: str, ok: bool | None =
 
 
 def above_floor(gap: float, min_gap: float, effect: str = "") -> Test:
-    """Whether the held-out gap (a fraction) is at or above the identification's floor gap.min_gap."""
+    """Test whether the held-out gap is at or above the identification's floor gap.min_gap.
+
+    Parameters
+    ----------
+    gap
+        The held-out gap (a fraction) [-].
+    min_gap
+        The identification's floor, gap.min_gap [-].
+    effect
+        The step the test is applied to; "": the whole diagnosis.
+
+    Returns
+    -------
+    test : Test
+        The decision "above_floor".
+    """
     ok = bool(gap >= min_gap)
     return Test(
         "above_floor",
@@ -151,7 +249,24 @@ def above_floor(gap: float, min_gap: float, effect: str = "") -> Test:
 
 
 def beyond_scatter(gap: float, scatter: float, noise_factor: float, effect: str = "") -> Test:
-    """Whether the held-out gap (a fraction) is at least noise_factor x the records' scatter."""
+    """Test whether the held-out gap is at least noise_factor x the records' scatter.
+
+    Parameters
+    ----------
+    gap
+        The held-out gap (a fraction) [-].
+    scatter
+        The records' bootstrap scatter of the held-out gap [-].
+    noise_factor
+        Factor on the scatter, gap.noise_factor [-].
+    effect
+        The step the test is applied to; "": the whole diagnosis.
+
+    Returns
+    -------
+    test : Test
+        The decision "beyond_scatter".
+    """
     ok = bool(gap >= noise_factor * scatter)
     return Test(
         "beyond_scatter",
@@ -166,8 +281,28 @@ def beyond_scatter(gap: float, scatter: float, noise_factor: float, effect: str 
 
 
 def shrinks_gap(effect: str, before: float, after: float, lower: float, min_reduction: float) -> Test:
-    """The first effect shrinks the whole held-out gap by min_reduction, its bootstrap interval's lower end
-    (``lower``, of the reduction) above zero."""
+    """Test whether the first effect shrinks the whole held-out gap by min_reduction.
+
+    Its bootstrap interval's lower end (``lower``, of the reduction) must be above zero too.
+
+    Parameters
+    ----------
+    effect
+        The effect of the step.
+    before
+        The held-out gap before the step [-].
+    after
+        The held-out gap after it (after the pair's second half for a pair) [-].
+    lower
+        Lower end of the bootstrap interval of the reduction 1 - after / before [-].
+    min_reduction
+        The least reduction of the whole gap, gap.min_reduction [-].
+
+    Returns
+    -------
+    test : Test
+        The decision "shrinks_gap" (value the reduction 1 - after / before).
+    """
     red = 1.0 - after / before if before > 0 and np.isfinite(after) else -np.inf
     ok = bool(red >= min_reduction and lower > 0)
     return Test(
@@ -187,8 +322,27 @@ def shrinks_gap(effect: str, before: float, after: float, lower: float, min_redu
 
 
 def beyond_model_form(effect: str, after: float, alternatives: Sequence[str], form: Sequence[str]) -> Test:
-    """A step is told apart from model-form error where no form candidate (``form``) is among its alternatives, and,
-    if its own effect is one, it has no alternatives."""
+    """Test whether a step is told apart from model-form error.
+
+    It is where no form candidate (``form``) is among its alternatives, and, if its own effect is one, it has no
+    alternatives.
+
+    Parameters
+    ----------
+    effect
+        The step's effect.
+    after
+        The held-out gap after the step [-].
+    alternatives
+        The candidates within gap.separation of the step (``verdict.indistinguishable``).
+    form
+        The form candidates' names (``Candidate.form``).
+
+    Returns
+    -------
+    test : Test
+        The decision "beyond_model_form" (value the rivals among the alternatives, "-" for none).
+    """
     rivals = [a for a in alternatives if a in form]
     if effect in form and alternatives:
         rivals = list(alternatives)
@@ -209,11 +363,39 @@ def beyond_model_form(effect: str, after: float, alternatives: Sequence[str], fo
     )
 
 
-def resolution(before: float, form_after: Mapping[str, float], scatter: float, settings, held: bool = True) -> dict:
-    """{heldout_gap, form_heldout_gap, how}: the smallest change of the held-out gap these records attribute to a first
-    effect. It must shrink the gap by min_reduction of it, beyond noise_factor x the scatter, and leave less than the
-    best form candidate's gap (``form_after``: {candidate: held-out gap after it}) over gap.separation; at or below the
-    floor (min_gap) no change is attributed (the whole gap)."""
+def resolution(
+    before: float,
+    form_after: Mapping[str, float],
+    scatter: float,
+    settings: GapSettings | Mapping[str, float],
+    held: bool = True,
+) -> dict:
+    """Return the smallest change of the held-out gap these records attribute to a first effect.
+
+    It must shrink the gap by min_reduction of it, beyond noise_factor x the scatter, and leave less than the best
+    form candidate's gap (``form_after``) over gap.separation; below the floor (min_gap) no change is attributed
+    (the whole gap).
+
+    Parameters
+    ----------
+    before
+        The held-out gap the candidates start from [-].
+    form_after
+        {candidate: held-out gap after it} of the form candidates [-]; non-finite gaps are left out.
+    scatter
+        The records' bootstrap scatter of the held-out gap [-].
+    settings
+        The gap settings (``GapSettings`` or a mapping of them): separation, min_reduction, min_gap and noise_factor
+        are read, each [-].
+    held
+        Whether a load case is held out.
+
+    Returns
+    -------
+    resolution : dict
+        {heldout_gap (the smallest change, a fraction), form_heldout_gap, form_candidate (the best form candidate or
+        None), how (a sentence saying which bound binds)}.
+    """
     sep, min_red = setting(settings, "separation"), setting(settings, "min_reduction")
     min_gap, noise = setting(settings, "min_gap"), setting(settings, "noise_factor")
     finite = {k: float(v) for k, v in form_after.items() if np.isfinite(v)}
@@ -247,8 +429,24 @@ def resolution(before: float, form_after: Mapping[str, float], scatter: float, s
 
 
 def first_pass_best(rows: Sequence[Mapping], before: float) -> Test | None:
-    """Where the explanation added no effect: the first pass's best candidate, which did not shrink the held-out gap
-    materially (``verdict.explains_materially``, applied by ``explain.explain``); None without candidates."""
+    """Return the decision naming the first pass's best candidate, where the explanation added no effect.
+
+    That candidate did not shrink the held-out gap materially (``verdict.explains_materially``, applied by
+    ``explain.explain``).
+
+    Parameters
+    ----------
+    rows
+        The first pass's ranking, each row with ``effect`` and ``heldout_gap_after``.
+    before
+        The held-out gap the candidates started from [-].
+
+    Returns
+    -------
+    test : Test | None
+        The failed decision "explains_materially" of the best candidate (least finite held-out gap after it); None
+        without candidates.
+    """
     finite = [r for r in rows if np.isfinite(r["heldout_gap_after"])]
     if not finite:
         return None
@@ -266,8 +464,19 @@ def first_pass_best(rows: Sequence[Mapping], before: float) -> Test | None:
 
 @dataclass
 class Story:
-    """What ``tell`` derives: the verdict (an effect or "none"), its reason sentence, the explanation's steps kept and
-    the trace of the decisions (``Test.as_dict``)."""
+    """What ``tell`` derives.
+
+    Attributes
+    ----------
+    verdict
+        The verdict: an effect or "none".
+    reason
+        Its reason sentence.
+    explanation
+        The explanation's steps kept (each with its ``kind`` and ``share``).
+    trace
+        The trace of the decisions (``Test.as_dict``).
+    """
 
     verdict: str
     reason: str
@@ -276,9 +485,11 @@ class Story:
 
 
 def _step_kind(step: Mapping, update_effect: str | None, model_form: Sequence[str] = (), first: bool = False) -> str:
-    """The step's kind: "update" (model updating that names no effect), "model_form" (a form candidate the library in
-    use leaves out; a separation law that never opened, after other steps) or "effect". ``first``: the explanation's
-    first step."""
+    """Return the step's kind: "update", "model_form" or "effect".
+
+    "update" is model updating that names no effect, "model_form" a form candidate the library in use leaves out (or a
+    separation law that never opened, after other steps). ``first``: the explanation's first step.
+    """
     if step.get("effect") == "model_updating":
         return "effect" if update_effect else "update"
     if step.get("effect") in model_form or (never_opens(step) and not first):
@@ -293,19 +504,47 @@ def tell(  # noqa: C901
     before: float,
     scatter: float,
     place: str,
-    settings,
+    settings: GapSettings | Mapping[str, float],
     form: Sequence[str],
     n_held: int,
     model_form: Sequence[str] = (),
     update_effect: tuple[str, str] | None = None,
 ) -> Story:
-    """The verdict, its reason and the explanation the records support, from the explanation's ``steps`` (model
-    updating's step first where accepted) and the first pass's ranking ``rows`` (each with effect, acts_on,
-    reduction_interval); ``before``: the held-out gap the candidates started from (the updated model's), ``scatter``
-    the records' bootstrap scatter of it, ``place`` the localisation's, ``form`` the form candidates' names
-    (``model_form``: those the library in use leaves out, never an effect),
-    ``n_held`` the held-out cases, ``update_effect``: (effect, why) where the accepted update amounts to one effect of
-    the library and explains most of the gap. Decisions in the module's order; shares recomputed on what is kept."""
+    """Derive the verdict, its reason and the explanation the records support.
+
+    Decisions in the module's order; shares recomputed on what is kept.
+
+    Parameters
+    ----------
+    steps
+        The explanation's steps (model updating's step first where accepted), each with ``effect``,
+        ``heldout_gap_before``, ``heldout_gap_after`` and where they apply ``alternatives``, ``pair_first``.
+    rows
+        The first pass's ranking, each row with effect, acts_on, reduction_interval and heldout_gap_after.
+    before
+        The held-out gap the candidates started from (the updated model's) [-].
+    scatter
+        The records' bootstrap scatter of it [-].
+    place
+        Where the localisation puts the gap.
+    settings
+        The gap settings (``GapSettings`` or a mapping of them): noise_factor, min_gap and min_reduction are read,
+        each [-].
+    form
+        The form candidates' names.
+    n_held
+        How many load cases are held out.
+    model_form
+        The form candidates the library in use leaves out, never an effect.
+    update_effect
+        (effect, why) where the accepted update amounts to one effect of the library and explains most of the gap;
+        None otherwise.
+
+    Returns
+    -------
+    story : Story
+        The verdict, its reason, the steps kept and the trace.
+    """
     trace: list[Test] = []
     kept: list[dict] = []
     t = held_out(n_held)
@@ -428,8 +667,21 @@ def _left(kept: Sequence[Mapping], start: float) -> str:
 
 
 def effect_steps(explanation: Sequence[Mapping]) -> list:
-    """The explanation's steps that name an effect: kind "effect" (an update only where it names one, ``names``);
-    model form and an update that names none are not effects."""
+    """Return the explanation's steps that name an effect.
+
+    Those of kind "effect" (an update only where it names one, ``names``); model form and an update that names none
+    are not effects.
+
+    Parameters
+    ----------
+    explanation
+        The explanation's steps (diagnosis.json's ``explanation``).
+
+    Returns
+    -------
+    steps : list
+        The steps that name an effect, in order.
+    """
     return [
         s
         for s in explanation
@@ -438,9 +690,22 @@ def effect_steps(explanation: Sequence[Mapping]) -> list:
 
 
 def one_story_holds(diagnosis: Mapping) -> bool:
-    """Whether a diagnosis.json tells one story: its verdict is the effect of the explanation's effect step with the
-    largest share (an update that names an effect by that name), "none" exactly when no step is an effect; records
-    that disagree (verdict records_disagree) have no explanation."""
+    """Check whether a diagnosis.json tells one story.
+
+    Its verdict is the effect of the explanation's effect step with the largest share (an update that names an effect
+    by that name), "none" exactly when no step is an effect; records that disagree (verdict records_disagree) have no
+    explanation.
+
+    Parameters
+    ----------
+    diagnosis
+        The diagnosis (diagnosis.json's content): ``verdict`` and ``explanation`` are read.
+
+    Returns
+    -------
+    holds : bool
+        Whether it tells one story.
+    """
     steps = diagnosis.get("explanation") or []
     verdict = diagnosis.get("verdict")
     if verdict == "records_disagree":
