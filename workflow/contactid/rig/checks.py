@@ -1,5 +1,8 @@
-"""Checks on the virtual rig itself: time-step and mode-count convergence, agreement
-with the linear FRF at low level, and the change each unmodelled effect makes."""
+"""Checks on the virtual rig itself.
+
+Time-step and mode-count convergence, agreement with the linear FRF at low level, and the change each unmodelled
+effect makes.
+"""
 
 from __future__ import annotations
 
@@ -29,8 +32,29 @@ def _steady_harmonics(sim, F1, F3, w, harmonics=(1, 2, 3, 4, 5)):
 def convergence_study(
     structure_cfg: Mapping, rig_cfg: Mapping, case_cfg: Mapping, sampling_rate_hz: float
 ) -> pd.DataFrame:
-    """Driving-point harmonics 1-5 at the controlled force of ``case_cfg`` for the default
-    model, half the time step, and twice the retained modes; relative changes (%)."""
+    """Return the time-step and mode-count convergence of the driving-point harmonics.
+
+    Driving-point harmonics 1-5 at the controlled force of ``case_cfg`` for the default model, half the time step, and
+    twice the retained modes; relative changes (%).
+
+    Parameters
+    ----------
+    structure_cfg
+        The config's ``structure`` block.
+    rig_cfg
+        The config's ``rig`` block (``dual_sine``, ``truth``, ``effects``, damping, ...).
+    case_cfg
+        The load case: its target driving-point amplitudes ``A1_m_per_s2`` and ``A2_m_per_s2`` at w and 3w [m/s^2],
+        and optionally ``excitation_frequency_hz``.
+    sampling_rate_hz
+        The records' sampling rate [Hz].
+
+    Returns
+    -------
+    study : pd.DataFrame
+        One row per variant ("half time step", "double modes") and harmonic: ``amplitude_m_per_s2`` (the default
+        model's, m/s^2) and ``change_pct`` (the variant's relative change, %).
+    """
     s = dual_sine_settings(rig_cfg, case_cfg, sampling_rate_hz)
     w = 2 * np.pi * s["excitation_frequency_hz"]
     sim = build_simulator(structure_cfg, rig_cfg, s)
@@ -52,8 +76,29 @@ def convergence_study(
 def low_level_frf_check(
     structure_cfg: Mapping, rig_cfg: Mapping, sampling_rate_hz: float, frequency_hz: float = 54.4, level: float = 0.02
 ) -> pd.DataFrame:
-    """Dual-sine test at a low level (the contact sticks) against the full FE model's
-    stuck linear driving-point accelerance at f and 3f (with the rig's modal damping)."""
+    """Compare a dual-sine test at a low level (the contact sticks) with the full FE model's linear accelerance.
+
+    The FE model's is the stuck linear driving-point accelerance at f and 3f (with the rig's modal damping).
+
+    Parameters
+    ----------
+    structure_cfg
+        The config's ``structure`` block.
+    rig_cfg
+        The config's ``rig`` block.
+    sampling_rate_hz
+        The records' sampling rate [Hz].
+    frequency_hz
+        The excitation frequency f [Hz] (moved to a whole number of periods in the record).
+    level
+        The target driving-point amplitude at f [m/s^2]; at 3f it is 2.5 times as much.
+
+    Returns
+    -------
+    check : pd.DataFrame
+        One row per harmonic (1 and 3): ``frequency_hz`` (Hz), the rig's and the FE model's accelerance magnitudes
+        ``rig_accelerance`` and ``fe_accelerance`` ((m/s^2)/N) and ``difference_pct`` (%).
+    """
     case = {"A1_m_per_s2": level, "A2_m_per_s2": 2.5 * level, "excitation_frequency_hz": frequency_hz}
     s = dual_sine_settings(rig_cfg, case, sampling_rate_hz)
     w = 2 * np.pi * s["excitation_frequency_hz"]
@@ -88,9 +133,32 @@ def effect_study(
     magnitudes: Mapping | None = None,
     seed: int = 0,
 ) -> pd.DataFrame:
-    """Each effect alone at its typical magnitude (or ``magnitudes``) against the baseline,
-    noise-free: change of the force amplitudes and NRMSE (%) of the recorded
-    driving-point acceleration and force."""
+    """Return the change each unmodelled effect makes, alone, against the baseline.
+
+    Each effect runs alone at its typical magnitude (or ``magnitudes``), noise-free: change of the force amplitudes
+    and NRMSE (%) of the recorded driving-point acceleration and force.
+
+    Parameters
+    ----------
+    structure_cfg
+        The config's ``structure`` block (``sensors.names`` is read too).
+    rig_cfg
+        The config's ``rig`` block; its ``effects`` are replaced by each effect in turn.
+    case_cfg
+        The load case (``A1_m_per_s2``, ``A2_m_per_s2``, optionally ``excitation_frequency_hz``).
+    sampling_rate_hz
+        The records' sampling rate [Hz].
+    magnitudes
+        {effect: magnitude} in each effect's unit (``EFFECTS``); effects left out: their typical magnitude.
+    seed
+        The random seed of the tests.
+
+    Returns
+    -------
+    study : pd.DataFrame
+        One row per effect: ``magnitude`` and its ``unit``, ``F1_change_pct`` and ``F3_change_pct`` (%),
+        ``drive_acceleration_nrmse_pct`` and ``force_nrmse_pct`` (%) and ``min_normal_force_n`` (N).
+    """
 
     def run(effects):
         rc = copy.deepcopy(dict(rig_cfg))

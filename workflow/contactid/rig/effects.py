@@ -13,8 +13,23 @@ from typing import Mapping
 
 @dataclass(frozen=True)
 class EffectSpec:
-    """One switchable effect: its name, the unit of its magnitude, what it models, a typical magnitude and the allowed
-    range [low, high]."""
+    """One switchable effect.
+
+    Attributes
+    ----------
+    name
+        The effect's name (its key under ``rig.effects``).
+    unit
+        The unit of its magnitude ("1", "s", "s/m", "N s/m").
+    meaning
+        What it models.
+    typical
+        A typical magnitude [unit of unit].
+    low
+        The low end of the allowed range [unit of unit].
+    high
+        The high end of the allowed range [unit of unit].
+    """
 
     name: str
     unit: str
@@ -110,9 +125,24 @@ EFFECTS = {
 
 
 def effect_magnitudes(effects_cfg: Mapping | None) -> dict[str, float]:
-    """Validated {name: magnitude} with every known effect (0 = off).
+    """Return the validated {name: magnitude} with every known effect (0 = off).
 
-    Raises ValueError naming the key, the allowed range and the known names."""
+    Parameters
+    ----------
+    effects_cfg
+        The config's ``rig.effects`` {name: magnitude}, in each effect's unit; None: none.
+
+    Returns
+    -------
+    magnitudes : dict[str, float]
+        {name: magnitude} of every effect of ``EFFECTS``, each in its own unit [unit of EffectSpec.unit]; 0 where off.
+
+    Raises
+    ------
+    ValueError
+        When a name is not a known effect, a magnitude is not a number or lies outside its allowed range (the message
+        names the key, the allowed range and the known names).
+    """
     out = {name: 0.0 for name in EFFECTS}
     for name, value in (effects_cfg or {}).items():
         if name not in EFFECTS:

@@ -23,9 +23,11 @@ from ..sincos import sin_cos
 
 @njit(cache=True)
 def _contact_state(z, v, xi_v, eta_v, G, dxi_dq):
-    """xi_lin, xi (with the shortening z G z / 2), eta, their rates; dxi/dq = xi_v - G z is written into ``dxi_dq``
-    (n_r,), a buffer the caller keeps: no array is made per step (the matrix products as loops, equal to them to
-    rounding)."""
+    """Return xi_lin, xi (with the shortening z G z / 2), eta and the rates of eta and xi.
+
+    dxi/dq = xi_v - G z is written into ``dxi_dq`` (n_r,), a buffer the caller keeps: no array is made per step (the
+    matrix products as loops, equal to them to rounding).
+    """
     n = z.size
     xi_lin = 0.0
     eta = 0.0
@@ -47,10 +49,39 @@ def _contact_state(z, v, xi_v, eta_v, G, dxi_dq):
 
 
 @njit(cache=True)
-def normal_force(eta, deta, n0, delta0, p, hc, unilateral, cubic):
-    """N = [N0 ((delta0 - eta)/delta0)^p - k_3 eta^3] (1 - hc deta/dt) (N), zero once the contact opens; a
-    bilateral law (``unilateral`` False, p = 1) is the linear spring of Eq. 13 (plus the cubic) and may pull.
-    With p = 1 the elastic part is the polynomial hardening N0 - k_n eta - k_3 eta^3 (cubic = k_3, N/m^3)."""
+def normal_force(
+    eta: float, deta: float, n0: float, delta0: float, p: float, hc: float, unilateral: bool, cubic: float
+) -> float:
+    """Return the total normal force N = [N0 ((delta0 - eta)/delta0)^p - k_3 eta^3] (1 - hc deta/dt).
+
+    N is zero once the contact opens; a bilateral law (``unilateral`` False, p = 1) is the linear spring of Eq. 13
+    (plus the cubic) and may pull. With p = 1 the elastic part is the polynomial hardening N0 - k_n eta - k_3 eta^3
+    (cubic = k_3, N/m^3).
+
+    Parameters
+    ----------
+    eta
+        Normal gap change eta [m], positive when the contact opens.
+    deta
+        Its rate deta/dt [m/s].
+    n0
+        Static preload N0 [N].
+    delta0
+        Static approach delta0 [m].
+    p
+        Exponent p of the unilateral law [-] (the bilateral law is linear whatever p).
+    hc
+        Hunt-Crossley coefficient alpha [s/m].
+    unilateral
+        Whether the contact may open (N is then never negative).
+    cubic
+        Cubic hardening coefficient k_3 [N/m^3].
+
+    Returns
+    -------
+    normal_force : float
+        Total normal force N [N], compression positive.
+    """
     if not unilateral:
         return (n0 * (delta0 - eta) / delta0 - cubic * eta**3) * (1.0 - hc * deta)
     if eta >= delta0:
@@ -64,11 +95,13 @@ def normal_force(eta, deta, n0, delta0, p, hc, unilateral, cubic):
 
 @njit(cache=True)
 def _excitation(f_sin, f_cos, w, t):
-    """f(t) = sum_h f_sin[h-1] sin(h w t) + f_cos[h-1] cos(h w t) (N). A harmonic with a sine and a cosine takes both
-    from one ``sin_cos`` call (the same digits as np.sin and np.cos, an eighth less time a step with five
-    harmonics). The Chebyshev recurrence from one pair (a fifth less, results equal to rounding) flipped the outcome
-    of a benchmark item whose rig response does not settle, and of two near-tied compound items (the blind
-    benchmark's items are chosen at random, a rounding change moves some across a decision)."""
+    """Return the excitation f(t) = sum_h f_sin[h-1] sin(h w t) + f_cos[h-1] cos(h w t) (N).
+
+    A harmonic with a sine and a cosine takes both from one ``sin_cos`` call (the same digits as np.sin and np.cos, an
+    eighth less time a step with five harmonics). The Chebyshev recurrence from one pair (a fifth less, results equal
+    to rounding) flipped the outcome of a benchmark item whose rig response does not settle, and of two near-tied
+    compound items (the blind benchmark's items are chosen at random, a rounding change moves some across a decision).
+    """
     f = 0.0
     for k in range(f_sin.size):
         a = f_sin[k]
@@ -85,9 +118,29 @@ def _excitation(f_sin, f_cos, w, t):
 
 
 class KernelModel(NamedTuple):
-    """The reduced model as the time-stepping kernel reads it (arrays float64): omega (n_r,) rad/s; zeta (n_r,);
-    xi_v, eta_v (n_r,) the linear contact coordinates; G (n_r, n_r) the shortening; bF (n_r,) the generalized
-    force of a unit force at d_p; k_t, k_n (N/m) the linear springs built into omega."""
+    """The reduced model as the time-stepping kernel reads it (arrays float64).
+
+    The coordinates z are mass-normalised (``rig.nonlinear.ReducedModel``), in m kg^0.5.
+
+    Attributes
+    ----------
+    omega
+        Natural frequencies of the reduced stuck system [rad/s], shape (n_r,).
+    zeta
+        Modal damping ratios [-], shape (n_r,).
+    xi_v
+        The linear tangential contact coordinate xi_lin = xi_v . z [kg^-0.5], shape (n_r,).
+    eta_v
+        The normal contact coordinate eta = eta_v . z [kg^-0.5], shape (n_r,).
+    G
+        The shortening matrix, xi = xi_lin - z G z / 2 [1/(m kg)], shape (n_r, n_r).
+    bF
+        The generalized force of a unit force at d_p [kg^-0.5], shape (n_r,).
+    k_t
+        The linear tangential contact spring built into omega [N/m].
+    k_n
+        The linear normal contact spring built into omega [N/m].
+    """
 
     omega: np.ndarray
     zeta: np.ndarray
@@ -100,9 +153,32 @@ class KernelModel(NamedTuple):
 
 
 class KernelContact(NamedTuple):
-    """The contact laws as the kernel reads them: fr the friction record (``friction_record``); the normal law
-    n0 (N), delta0 (m), p, cubic (N/m^3), hc (s/m), unilateral; visc (N s/m) the viscous friction; iw_share and
-    iw_w the Iwan share and slider weights (``ContactParameters``)."""
+    """The contact laws as the kernel reads them (``ContactParameters``).
+
+    Attributes
+    ----------
+    fr
+        The friction record (``rig.nonlinear.friction_record``), shape (6,), one unit per entry: e_f [N/m], k_c
+        [1/m], e_t [N/m], kappa [-], mu [-] and the slip-limit flag [-] (1.0: the ``slip_limit`` reading of Eq. 21).
+    n0
+        Static preload N0 of the normal law [N].
+    delta0
+        Static approach delta0 [m].
+    p
+        Exponent p of the normal law [-].
+    cubic
+        Cubic hardening coefficient k_3 [N/m^3].
+    hc
+        Hunt-Crossley coefficient alpha [s/m].
+    unilateral
+        Whether the contact may open.
+    visc
+        Viscous friction coefficient sigma_2 [N s/m].
+    iw_share
+        Share of the tangential contact carried by the Iwan element [-].
+    iw_w
+        The Iwan sliders' weights, their slip limits as fractions of mu N [-], shape (n_sliders,), summing to 1.
+    """
 
     fr: np.ndarray
     n0: float
@@ -117,8 +193,24 @@ class KernelContact(NamedTuple):
 
 
 class KernelDrive(NamedTuple):
-    """The excitation f = sum_h f_sin[h-1] sin(h w t) + f_cos[h-1] cos(h w t) (N) at w (rad/s), and the static
-    preload's drift P(t) = n0 (1 + drift_rate (t - drift_t0)) after drift_t0 (s)."""
+    """The excitation and the static preload's drift as the kernel reads them.
+
+    The excitation is f = sum_h f_sin[h-1] sin(h w t) + f_cos[h-1] cos(h w t) (N) at w (rad/s), the static preload's
+    drift P(t) = n0 (1 + drift_rate (t - drift_t0)) after drift_t0 (s).
+
+    Attributes
+    ----------
+    f_sin
+        Sine amplitudes of harmonics 1..n_harmonics [N], shape (n_harmonics,).
+    f_cos
+        Cosine amplitudes of harmonics 1..n_harmonics [N], shape (n_harmonics,).
+    w
+        Fundamental angular frequency w [rad/s].
+    drift_rate
+        Relative change of the preload per second [1/s]; 0: no drift.
+    drift_t0
+        Time the drift starts at [s].
+    """
 
     f_sin: np.ndarray
     f_cos: np.ndarray
@@ -128,8 +220,31 @@ class KernelDrive(NamedTuple):
 
 
 class KernelRecord(NamedTuple):
-    """Where the kernel writes the stored steps (row = step - store_from): a, z, v (n_store, n_r); s, n, xi, eta,
-    f, dxi, deta (n_store,)."""
+    """Where the kernel writes the stored steps (row = step - store_from).
+
+    Attributes
+    ----------
+    a
+        Modal accelerations [m kg^0.5/s^2], shape (n_store, n_r).
+    z
+        Mass-normalised coordinates [m kg^0.5], shape (n_store, n_r), or (0, n_r) where they are not kept.
+    v
+        Their velocities [m kg^0.5/s], shape (n_store, n_r), or (0, n_r) where they are not kept.
+    s
+        Total tangential contact force S [N], shape (n_store,).
+    n
+        Total normal contact force N [N], shape (n_store,).
+    xi
+        Tangential contact motion xi [m], shape (n_store,).
+    eta
+        Normal contact motion eta [m], shape (n_store,).
+    f
+        Excitation force [N], shape (n_store,).
+    dxi
+        Rate of xi [m/s], shape (n_store,).
+    deta
+        Rate of eta [m/s], shape (n_store,).
+    """
 
     a: np.ndarray
     z: np.ndarray
@@ -145,8 +260,11 @@ class KernelRecord(NamedTuple):
 
 @njit(cache=True)
 def _initial_friction_force(S_val, xi, dxi, N, x_sl, contact, no_flags):
-    """The total tangential force at the start of a run, S = (1 - s) S_valanis + s S_iwan + sigma_2 dxi/dt (N),
-    with s the Iwan share; the Iwan and viscous parts only while the contact is closed (N > 0)."""
+    """Return the total tangential force at the start of a run.
+
+    S = (1 - s) S_valanis + s S_iwan + sigma_2 dxi/dt (N), with s the Iwan share; the Iwan and viscous parts only
+    while the contact is closed (N > 0).
+    """
     fr = contact.fr
     e0 = initial_stiffness(max(N, 1e-12), fr[0], fr[1])
     s_iw = 0.0
@@ -157,8 +275,11 @@ def _initial_friction_force(S_val, xi, dxi, N, x_sl, contact, no_flags):
 
 @njit(cache=True)
 def _friction_force(S_val, xi, dxi, N, x_sl, contact, no_flags):
-    """The total tangential force after a step, S = (1 - s) S_valanis + s S_iwan + sigma_2 dxi/dt (N), with s the
-    Iwan share; zero once the contact opens (N <= 0), and the Iwan sliders' anchors (m) then follow xi."""
+    """Return the total tangential force after a step.
+
+    S = (1 - s) S_valanis + s S_iwan + sigma_2 dxi/dt (N), with s the Iwan share; zero once the contact opens
+    (N <= 0), and the Iwan sliders' anchors (m) then follow xi.
+    """
     if N > 0.0:
         fr = contact.fr
         e0 = initial_stiffness(N, fr[0], fr[1])
@@ -171,8 +292,10 @@ def _friction_force(S_val, xi, dxi, N, x_sl, contact, no_flags):
 
 @njit(cache=True)
 def _static_preload(t, n0, drive):
-    """The static preload P(t) = N0 (1 + drift_rate (t - drift_t0)) after drift_t0 while it drifts, N0 otherwise
-    (N)."""
+    """Return the static preload P(t) (N).
+
+    P(t) = N0 (1 + drift_rate (t - drift_t0)) after drift_t0 while it drifts, N0 otherwise.
+    """
     if drive.drift_rate != 0.0 and t > drive.drift_t0:
         return n0 * (1.0 + drive.drift_rate * (t - drive.drift_t0))
     return n0
@@ -180,9 +303,11 @@ def _static_preload(t, n0, drive):
 
 @njit(cache=True)
 def _modal_load(i, f, S_tot, N, P, xi_lin, eta, dxi_dq, model):
-    """The generalized force on mode i (N kg^-1/2): F f - dxi/dq S + deta/dq (N - P) with the linear contact
-    springs built into omega (k_t xi_lin, k_n eta) removed again; the modal damping and stiffness are the
-    caller's."""
+    """Return the generalized force on mode i (N kg^-1/2).
+
+    F f - dxi/dq S + deta/dq (N - P) with the linear contact springs built into omega (k_t xi_lin, k_n eta) removed
+    again; the modal damping and stiffness are the caller's.
+    """
     return (
         model.bF[i] * f
         - dxi_dq[i] * S_tot
@@ -194,9 +319,12 @@ def _modal_load(i, f, S_tot, N, P, xi_lin, eta, dxi_dq, model):
 
 @njit(cache=True)
 def _damped_velocity(z, v, a, dt, c, om2, f, S_tot, N_el, P, xi_lin, eta, dxi_dq, model):
-    """Second half-step of the velocity (m kg^1/2/s, in place) under the elastic normal force N_el (N), with the
-    diagonal modal damping c = 2 zeta omega (1/s) taken implicitly: v = (v_half + dt/2 g) / (1 + dt/2 c). The half-step
-    velocity v_half is kept in ``a``. Returns (sum eta_v^2 / D, eta_v . v) for the normal damping's correction."""
+    """Take the second half-step of the velocity (m kg^1/2/s, in place) under the elastic normal force N_el (N).
+
+    The diagonal modal damping c = 2 zeta omega (1/s) is taken implicitly: v = (v_half + dt/2 g) / (1 + dt/2 c). The
+    half-step velocity v_half is kept in ``a``. Returns (sum eta_v^2 / D, eta_v . v) for the normal damping's
+    correction.
+    """
     eta_v = model.eta_v
     uDu = 0.0
     uy = 0.0
@@ -212,9 +340,11 @@ def _damped_velocity(z, v, a, dt, c, om2, f, S_tot, N_el, P, xi_lin, eta, dxi_dq
 
 @njit(cache=True)
 def _damped_normal_force(v, N_el, uDu, uy, dt, c, eta_v, hc, unilateral):
-    """The total normal force N = N_el (1 - hc deta/dt) (N) with the Hunt-Crossley damping taken implicitly (it is
-    stiff): the velocities (in place) are corrected along eta_v by the damping force at the end of the step. A
-    unilateral contact's damping cannot pull: N drops to zero and only N_el is taken off again."""
+    """Return the total normal force N = N_el (1 - hc deta/dt) (N), the Hunt-Crossley damping taken implicitly.
+
+    The damping is stiff: the velocities (in place) are corrected along eta_v by the damping force at the end of the
+    step. A unilateral contact's damping cannot pull: N drops to zero and only N_el is taken off again.
+    """
     c_n = hc * N_el
     if c_n > 0.0:
         beta = 0.5 * dt * c_n
@@ -237,8 +367,10 @@ def _damped_normal_force(v, N_el, uDu, uy, dt, c, eta_v, hc, unilateral):
 
 @njit(cache=True)
 def _store_step(out, r, a, z, v, S_tot, N, xi, eta, f, dxi, deta):
-    """Write one step to row r of ``out`` (KernelRecord); the coordinates and velocities only where ``out`` has rows
-    for them."""
+    """Write one step to row r of ``out`` (KernelRecord).
+
+    The coordinates and velocities are written only where ``out`` has rows for them.
+    """
     keep_state = out.z.shape[0] > 0
     for i in range(a.size):
         out.a[r, i] = a[i]
@@ -255,13 +387,57 @@ def _store_step(out, r, a, z, v, S_tot, N, xi, eta, f, dxi, deta):
 
 
 @njit(cache=True)
-def integrate(z, v, state, x_sl, t0, n_steps, dt, model, contact, drive, store_from, out):
+def integrate(
+    z: np.ndarray,
+    v: np.ndarray,
+    state: np.ndarray,
+    x_sl: np.ndarray,
+    t0: float,
+    n_steps: int,
+    dt: float,
+    model: KernelModel,
+    contact: KernelContact,
+    drive: KernelDrive,
+    store_from: int,
+    out: KernelRecord,
+) -> float:
     """Advance the reduced model ``n_steps`` steps of ``dt`` from time ``t0``.
 
-    z, v (n_r,), state = [S_valanis, xi, N] and x_sl (Iwan anchors) are updated in place; ``model``
-    (KernelModel), ``contact`` (KernelContact) and ``drive`` (KernelDrive) are read. From step ``store_from`` on,
-    the acceleration, coordinates, contact forces and motions, velocities and the force are written to ``out``
-    (KernelRecord; row = step - store_from). Returns the time reached.
+    z, v, state and x_sl are updated in place; ``model``, ``contact`` and ``drive`` are read. From step
+    ``store_from`` on, the acceleration, coordinates, contact forces and motions, velocities and the force are
+    written to ``out`` (row = step - store_from).
+
+    Parameters
+    ----------
+    z
+        Mass-normalised coordinates [m kg^0.5], shape (n_r,); updated in place.
+    v
+        Their velocities [m kg^0.5/s], shape (n_r,); updated in place.
+    state
+        The contact state (S_valanis [N], xi [m], N [N]), shape (3,); updated in place.
+    x_sl
+        The Iwan sliders' anchors [m], shape (n_sliders,); updated in place.
+    t0
+        Time at the start [s].
+    n_steps
+        How many steps to take.
+    dt
+        Time step [s].
+    model
+        The reduced model.
+    contact
+        The contact laws.
+    drive
+        The excitation and the preload's drift.
+    store_from
+        The first step stored.
+    out
+        Where the stored steps are written, n_steps - store_from rows.
+
+    Returns
+    -------
+    t : float
+        The time reached [s].
     """
     omega, zeta, xi_v, eta_v, G = model.omega, model.zeta, model.xi_v, model.eta_v, model.G
     fr, n0, delta0, p, cubic, hc = contact.fr, contact.n0, contact.delta0, contact.p, contact.cubic, contact.hc

@@ -11,6 +11,7 @@ end does, and receive independent Gaussian sensor noise.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Callable, Mapping
 
 import numpy as np
 import scipy.signal
@@ -21,19 +22,41 @@ from ..random_streams import generator
 from .damping import damping_ratios
 from .frontend import add_noise, anti_alias_decimate, delay_channels
 
+if TYPE_CHECKING:
+    import xarray as xr
+
 
 @dataclass(frozen=True)
 class RandomTestSettings:
     """Settings of the random test (SI units).
 
-    sampling_rate_hz: output sampling rate; duration_s: recorded length;
-    band_hz: (low, high) band of the random force; force_rms_n: its rms (N);
-    noise_fraction: sensor noise rms as a fraction of each channel's rms;
-    modal_damping_ratio: damping ratio (at damping_reference_hz, spread over the modes by damping_form,
-    see ``rig.damping``); oversampling: internal
-    integration rate over output rate; settle_s: discarded start-up time;
-    channel_delays_s: per-accelerometer sampling delay (effect channel_time_skew);
-    channel_gains: per-accelerometer sensitivity factor (effect channel_gain_error).
+    Attributes
+    ----------
+    sampling_rate_hz
+        Output sampling rate [Hz].
+    duration_s
+        Recorded length [s].
+    band_hz
+        (low, high) band of the random force [Hz].
+    force_rms_n
+        The random force's rms [N].
+    noise_fraction
+        Sensor noise rms as a fraction of each channel's rms [-].
+    modal_damping_ratio
+        Damping ratio [-] at damping_reference_hz, spread over the modes by damping_form (see ``rig.damping``).
+    oversampling
+        Internal integration rate over output rate.
+    settle_s
+        Discarded start-up time [s].
+    channel_delays_s
+        Per-accelerometer sampling delay [s] (effect channel_time_skew), or None.
+    channel_gains
+        Per-accelerometer sensitivity factor [-] (effect channel_gain_error), or None.
+    damping_form
+        How the damping ratio spreads over the modes ("modal", "stiffness_proportional", "mass_proportional",
+        "rayleigh"; ``rig.damping``).
+    damping_reference_hz
+        The frequency at which the form gives modal_damping_ratio [Hz].
     """
 
     sampling_rate_hz: float = 5120.0
@@ -52,22 +75,49 @@ class RandomTestSettings:
 
 @dataclass(frozen=True)
 class RandomTestRecord:
-    """Raw random-test signals: time (s), force (N), acceleration (n_sensors, n) in m/s^2."""
+    """Raw random-test signals.
+
+    Attributes
+    ----------
+    time
+        Sample times [s], shape (n_t,).
+    force
+        Force at d_p [N], shape (n_t,).
+    acceleration
+        Accelerations at the sensors [m/s^2], shape (n_sensors, n_t).
+    """
 
     time: np.ndarray
     force: np.ndarray
     acceleration: np.ndarray
 
 
-def modal_acceleration_filters(model: FEModel, damping_ratio, dt: float):
-    """Discrete (b, a) filters from the force at d_p to each modal acceleration
-    and the modal participation at each sensor, FOH-exact for every mode. damping_ratio: one value
-    for every mode, or a function of the modes' frequencies (Hz) giving each its ratio.
+def modal_acceleration_filters(
+    model: FEModel, damping_ratio: float | Callable[[np.ndarray], np.ndarray], dt: float
+) -> tuple[list, np.ndarray]:
+    """Build discrete (b, a) filters from the force at d_p to each modal acceleration, FOH-exact for every mode.
 
-    Modes above the simulation's Nyquist frequency are left out: their
-    acceleration response below the output band edge is below
-    (f_band / f_Nyquist)^2 of their (already tiny) quasi-static part.
-    Returns (filters, sensor_participation (n_sensors, n_modes)).
+    Modes above the simulation's Nyquist frequency are left out: their acceleration response below the output band
+    edge is below (f_band / f_Nyquist)^2 of their (already tiny) quasi-static part.
+
+    Parameters
+    ----------
+    model
+        The FE model (the contact stuck).
+    damping_ratio
+        One damping ratio [-] for every mode, or a function of the modes' frequencies [Hz], shape (n_modes,), giving
+        each its ratio, shape (n_modes,).
+    dt
+        The simulation's time step [s].
+
+    Returns
+    -------
+    filters : list
+        One (b, a) pair per mode kept (below the Nyquist frequency 0.5 / dt), lowest first: the discrete transfer
+        function from the force [N] to the mass-normalised modal acceleration [m kg^0.5/s^2].
+    sensor_participation : np.ndarray
+        The mass-normalised mode shapes at the sensors [kg^-0.5], shape (n_sensors, n_modes), n_modes the modes
+        kept.
     """
     modes = all_modes(model)
     keep = modes.frequencies_hz < 0.5 / dt
@@ -91,8 +141,11 @@ def modal_acceleration_filters(model: FEModel, damping_ratio, dt: float):
 
 @njit(cache=True)
 def _filtered_modal_sum(f, b, a, weights, out):
-    """out[c, i] = sum over modes m (in order) of weights[c, m] y_m[i], y_m the second-order filter (b[m], a[m],
-    normalised by a[m, 0]) of f in the direct form II transposed, as scipy.signal.lfilter computes it."""
+    """Write out[c, i] = sum over modes m (in order) of weights[c, m] y_m[i].
+
+    y_m is the second-order filter (b[m], a[m], normalised by a[m, 0]) of f in the direct form II transposed, as
+    scipy.signal.lfilter computes it.
+    """
     n_modes, n_channels = b.shape[0], weights.shape[0]
     z0 = np.zeros(n_modes)
     z1 = np.zeros(n_modes)
@@ -110,11 +163,27 @@ def _filtered_modal_sum(f, b, a, weights, out):
             out[c, i] = acc[c]
 
 
-def modal_acceleration_sum(force: np.ndarray, filters, sensor_participation: np.ndarray) -> np.ndarray:
-    """The accelerations (n_sensors, n) at the sensors (m/s^2): each mode's filter (``modal_acceleration_filters``)
-    applied to ``force`` (N) and summed with its participation, mode by mode. One pass over the record with every
-    mode's filter state at once: the same numbers as scipy.signal.lfilter per mode and a sum over the modes, bit
-    for bit (tests/test_rig_and_io.py), in about half the time (0.73 -> 0.41 s for the 130 s random test at 20 kHz)."""
+def modal_acceleration_sum(force: np.ndarray, filters: list, sensor_participation: np.ndarray) -> np.ndarray:
+    """Return the accelerations at the sensors: each mode's filter applied to the force, summed with its participation.
+
+    Mode by mode, in one pass over the record with every mode's filter state at once: the same numbers as
+    scipy.signal.lfilter per mode and a sum over the modes, bit for bit (tests/test_rig_and_io.py), in about half the
+    time (0.73 -> 0.41 s for the 130 s random test at 20 kHz).
+
+    Parameters
+    ----------
+    force
+        The force at d_p [N], shape (n_t,).
+    filters
+        Each mode's (b, a) filter (``modal_acceleration_filters``), second order at most.
+    sensor_participation
+        The mode shapes at the sensors [kg^-0.5], shape (n_sensors, n_modes).
+
+    Returns
+    -------
+    acceleration : np.ndarray
+        The accelerations at the sensors [m/s^2], shape (n_sensors, n_t).
+    """
     b = np.array([np.pad(num, (0, 3 - num.size)) / den[0] for num, den in filters]).reshape(-1, 3)
     a = np.array([np.pad(den, (0, 3 - den.size)) / den[0] for num, den in filters]).reshape(-1, 3)
     w = np.ascontiguousarray(sensor_participation, dtype=float)
@@ -124,7 +193,22 @@ def modal_acceleration_sum(force: np.ndarray, filters, sensor_participation: np.
 
 
 def simulate_random_test(model: FEModel, settings: RandomTestSettings, seed: int) -> RandomTestRecord:
-    """Simulate force and accelerations of the low-level random test."""
+    """Simulate force and accelerations of the low-level random test.
+
+    Parameters
+    ----------
+    model
+        The rig's FE model (the contact stuck).
+    settings
+        The test's settings.
+    seed
+        The random seed (the force and the noise draw from their own streams of it).
+
+    Returns
+    -------
+    record : RandomTestRecord
+        The recorded time, force and accelerations (after the anti-alias filter, the decimation and the noise).
+    """
     s = settings
     q = int(s.oversampling)
     fs_sim = s.sampling_rate_hz * q
@@ -157,8 +241,28 @@ def simulate_random_test(model: FEModel, settings: RandomTestSettings, seed: int
     return RandomTestRecord(time, force, acc)
 
 
-def settings_from_config(random_test_cfg, rig_cfg, n_channels: int = 3) -> RandomTestSettings:
-    """RandomTestSettings from the ``random_test`` and ``rig`` config blocks (keys left out: the schema's defaults)."""
+def settings_from_config(random_test_cfg: Mapping | None, rig_cfg: Mapping, n_channels: int = 3) -> RandomTestSettings:
+    """Build the RandomTestSettings from the ``random_test`` and ``rig`` config blocks.
+
+    Keys left out take the schema's defaults.
+
+    Parameters
+    ----------
+    random_test_cfg
+        The config's ``random_test`` block: ``sampling_rate_hz``, ``duration_s``, ``band_hz`` and ``force_rms_n`` are
+        read; None: the defaults.
+    rig_cfg
+        The config's ``rig`` block: ``noise_fraction``, ``modal_damping_ratio``, ``oversampling``,
+        ``true_damping`` (``form``, ``reference_frequency_hz``) and the effects channel_time_skew and
+        channel_gain_error are read.
+    n_channels
+        The number of accelerometers.
+
+    Returns
+    -------
+    settings : RandomTestSettings
+        The test's settings.
+    """
     from ..schema import schema_defaults
     from .structure import channel_delays, channel_gains
 
@@ -181,11 +285,35 @@ def settings_from_config(random_test_cfg, rig_cfg, n_channels: int = 3) -> Rando
     )
 
 
-def random_test_datasets(structure_cfg, rig_cfg, random_test_cfg, seed: int, n_truth_modes: int = 6):
-    """Raw record and truth of the rig's random test as two xarray Datasets.
+def random_test_datasets(
+    structure_cfg: Mapping, rig_cfg: Mapping, random_test_cfg: Mapping | None, seed: int, n_truth_modes: int = 6
+) -> tuple[xr.Dataset, xr.Dataset]:
+    """Return the raw record and the truth of the rig's random test as two xarray Datasets.
 
-    The raw dataset holds only what a real test records; the truth holds the
-    rig's parameters, exact natural frequencies and mode shapes at the sensors.
+    The raw dataset holds only what a real test records; the truth holds the rig's parameters, exact natural
+    frequencies and mode shapes at the sensors.
+
+    Parameters
+    ----------
+    structure_cfg
+        The config's ``structure`` block (its ``sensors``' ``names`` and ``positions_m`` name the raw record's
+        sensors).
+    rig_cfg
+        The config's ``rig`` block.
+    random_test_cfg
+        The config's ``random_test`` block; None: the defaults.
+    seed
+        The random seed.
+    n_truth_modes
+        How many modes the truth lists.
+
+    Returns
+    -------
+    raw : xr.Dataset
+        The raw record in the format of ``contactid.io``.
+    truth : xr.Dataset
+        The true natural frequencies (Hz), damping ratios and mass-normalised mode shapes at the sensors, k_t and
+        k_n (N/m), and the rig's parameters as attributes.
     """
     import dataclasses
 
