@@ -1,5 +1,6 @@
-"""Command line: `python -m contactid {audit, check-config, compile-kernels} ...` (also installed as the `contactid`
-command).
+"""The contactid command line: the audit, the config's check and the kernels' compilation.
+
+`python -m contactid {audit, check-config, compile-kernels} ...` (also installed as the `contactid` command):
 
 audit            the provenance and integrity of every dataset in results/ and data/
 check-config     a config file against the schema and the cross-field checks, before any rule runs
@@ -9,14 +10,28 @@ compile-kernels  numba's kernels compiled into the workflow's cache ahead of its
 import argparse
 import os
 import sys
+from collections.abc import Sequence
 
 
-def check_config_main(argv) -> int:
-    """Validate a config file as the Snakefile reads it: merged over the base config (config/config.yaml, as
-    `snakemake --configfile FILE` merges it; the base itself, or a file with --alone, is checked alone), duplicate
-    keys, the schema with its defaults, the cross-field checks and the measured files (relative paths from the
-    current directory, the project's); print what is wrong (key and how to fix it) or that it is valid. Returns 1
-    when it is not."""
+def check_config_main(argv: Sequence[str]) -> int:
+    """Validate a config file as the Snakefile reads it, and print what is wrong or that it is valid.
+
+    The file is merged over the base config (config/config.yaml, as `snakemake --configfile FILE` merges it; the
+    base itself, or a file with --alone, is checked alone), then checked for duplicate keys, against the schema with
+    its defaults, by the cross-field checks and for the measured files (relative paths from the current directory,
+    the project's). What is wrong is printed with its key and how to fix it.
+
+    Parameters
+    ----------
+    argv
+        The command's arguments after ``check-config``: the config file (default config/config.yaml), ``--base``
+        (the config it is merged over) and ``--alone``.
+
+    Returns
+    -------
+    status : int
+        The exit status: 0 when the config is valid, 1 when it is not (or cannot be read).
+    """
     import jsonschema
     import yaml
 
@@ -66,10 +81,24 @@ def check_config_main(argv) -> int:
     return 0
 
 
-def compile_kernels_main(argv) -> int:
-    """Compile numba's kernels into the cache the workflow's jobs read (.snakemake/numba-cache/<code digest> under
-    the project directory), so that its first run does not compile them in its jobs. Where the config cannot be
-    read, says so and leaves the compiling to the workflow (exit 0: nothing is lost)."""
+def compile_kernels_main(argv: Sequence[str]) -> int:
+    """Compile numba's kernels into the cache the workflow's jobs read.
+
+    The cache is .snakemake/numba-cache/<code digest> under the project directory, so that the workflow's first run
+    does not compile the kernels in its jobs. Where the config cannot be read, this says so and leaves the compiling
+    to the workflow (exit 0: nothing is lost).
+
+    Parameters
+    ----------
+    argv
+        The command's arguments after ``compile-kernels``: the config file (default config/config.yaml),
+        ``--group`` (only these kernels, repeatable) and ``--cache`` (the cache's base directory).
+
+    Returns
+    -------
+    status : int
+        The exit status: always 0 (a config that cannot be read leaves the compiling to the workflow).
+    """
     import yaml
 
     from . import use_numba_cache_under
@@ -94,8 +123,19 @@ def compile_kernels_main(argv) -> int:
     return 0
 
 
-def main(argv=None) -> int:
-    """Run the ``contactid`` command line: dispatch to audit, check-config or compile-kernels; returns the exit code."""
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the ``contactid`` command line: dispatch to audit, check-config or compile-kernels.
+
+    Parameters
+    ----------
+    argv
+        The command-line arguments after the program's name, the subcommand first (None: ``sys.argv[1:]``).
+
+    Returns
+    -------
+    status : int
+        The subcommand's exit status; 2 (after printing the help) when no subcommand is given.
+    """
     argv = sys.argv[1:] if argv is None else list(argv)
     parser = argparse.ArgumentParser(
         prog="contactid",

@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+from collections.abc import Iterable, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -23,8 +24,25 @@ from .io import ENGINE, content_digest, file_digest
 
 
 def audit_dataset(path: Path, root: Path | None = None) -> dict:
-    """One row of the audit: producer, inputs and the problems found (empty: clean). Relative
-    input paths are resolved against ``root`` (the project directory; default: the current one)."""
+    """Return one row of the audit: the dataset's producer, its inputs and the problems found.
+
+    The stored content digest is recomputed (a mismatch: edited after its rule wrote it), each recorded input's digest
+    is compared with the file's (a mismatch: the dataset is stale), and every variable is checked for ``units``,
+    ``long_name`` and finite values (unless its ``nonfinite_meaning`` attribute says what they mean).
+
+    Parameters
+    ----------
+    path
+        The netCDF dataset.
+    root
+        The directory relative input paths are resolved against (the project directory; None: the current one).
+
+    Returns
+    -------
+    row : dict
+        ``dataset`` (the path), ``producer`` (its ``producer_rule``), ``inputs`` (joined by "; "), ``status`` ("ok",
+        "flagged" or "unreadable") and ``problems`` (joined by "; "; empty: clean).
+    """
     problems = []
     try:
         ds = xr.load_dataset(path, engine=ENGINE)
@@ -64,8 +82,21 @@ def audit_dataset(path: Path, root: Path | None = None) -> dict:
     }
 
 
-def audit(paths, root: str | os.PathLike | None = None) -> pd.DataFrame:
-    """Audit every netCDF file under ``paths``; relative input paths resolve against ``root``."""
+def audit(paths: Iterable[str | os.PathLike], root: str | os.PathLike | None = None) -> pd.DataFrame:
+    """Audit every netCDF file under ``paths``.
+
+    Parameters
+    ----------
+    paths
+        Directories (searched recursively for ``*.nc``) or files.
+    root
+        The directory relative input paths are resolved against (the project directory; None: the current one).
+
+    Returns
+    -------
+    table : pd.DataFrame
+        One row per dataset (``audit_dataset``), sorted by path: columns dataset, producer, inputs, status, problems.
+    """
     files = sorted({p for top in paths for p in (Path(top).rglob("*.nc") if Path(top).is_dir() else [Path(top)])})
     return pd.DataFrame(
         [audit_dataset(p, None if root is None else Path(root)) for p in files],
@@ -73,9 +104,20 @@ def audit(paths, root: str | os.PathLike | None = None) -> pd.DataFrame:
     )
 
 
-def main(argv=None) -> int:
-    """Command line of ``contactid audit``: print the audit table (and write it to ``--out``); returns 1 if any
-    dataset is flagged, else 0."""
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line of ``contactid audit``: print the audit table (and write it to ``--out``).
+
+    Parameters
+    ----------
+    argv
+        The arguments after ``audit``: the paths (default results and data), ``--out`` (a CSV file) and ``--root``
+        (the project directory the recorded input paths are relative to); None: ``sys.argv[1:]``.
+
+    Returns
+    -------
+    status : int
+        The exit status: 1 if any dataset is flagged (or unreadable), else 0.
+    """
     parser = argparse.ArgumentParser(prog="python -m contactid audit", description=__doc__.splitlines()[0])
     parser.add_argument("paths", nargs="*", default=["results", "data"], help="directories or files to audit")
     parser.add_argument("--out", help="write the audit table to this CSV file")

@@ -13,25 +13,60 @@ import difflib
 import json
 import os
 from pathlib import Path
-from typing import Iterator, Mapping
+from typing import Iterable, Iterator, Mapping
 
 
 def record_blocks(cfg: Mapping) -> list[tuple[str, Mapping]]:
-    """(config key, block) of every record the config names: the random test, then each load case."""
+    """Return the (config key, block) of every record the config names: the random test, then each load case.
+
+    Parameters
+    ----------
+    cfg
+        The workflow's config: its ``random_test`` block and the ``load_cases`` mapping are read.
+
+    Returns
+    -------
+    blocks : list[tuple[str, Mapping]]
+        ("random_test", block) then ("load_cases.<case>", block) for each load case; a missing block is {}.
+    """
     blocks = [("random_test", cfg.get("random_test") or {})]
     return blocks + [(f"load_cases.{c}", lc or {}) for c, lc in (cfg.get("load_cases") or {}).items()]
 
 
 def measured_records(cfg: Mapping) -> Iterator[tuple[str, Mapping]]:
-    """(config key, block) of every record the config reads from a file (``record_blocks`` whose ``source`` is
-    measured, with a ``file``)."""
+    """Yield the (config key, block) of every record the config reads from a file.
+
+    Those of ``record_blocks`` whose ``source`` is measured, with a ``file``.
+
+    Parameters
+    ----------
+    cfg
+        The workflow's config: its ``random_test`` block and the ``load_cases`` mapping are read (each block's
+        ``source`` and ``file``).
+
+    Yields
+    ------
+    record : tuple[str, Mapping]
+        The record's config key ("random_test" or "load_cases.<case>") and its block.
+    """
     for where, block in record_blocks(cfg):
         if block.get("source", "rig") == "measured" and block.get("file"):
             yield where, block
 
 
 def record_files(block: Mapping) -> list[tuple[str, str]]:
-    """(key, path) of the files a measured record's block reads: its ``file``, and for CSV its sidecar YAML."""
+    """Return the (key, path) of the files a measured record's block reads: its ``file``, and for CSV its sidecar YAML.
+
+    Parameters
+    ----------
+    block
+        A measured record's config block: ``file``, ``format`` and (for CSV) ``sidecar`` are read.
+
+    Returns
+    -------
+    files : list[tuple[str, str]]
+        ("file", path) and, for CSV, ("sidecar", the sidecar YAML's path).
+    """
     files = [("file", str(block["file"]))]
     if block.get("format") == "csv":
         from .importers import sidecar_path
@@ -41,7 +76,7 @@ def record_files(block: Mapping) -> list[tuple[str, str]]:
 
 
 def _near_names(path: Path) -> str:
-    """' (did you mean ...?)' for the closest names in the file's folder, or what the folder holds, or ''."""
+    """Return ' (did you mean ...?)' for the closest names in the file's folder, or what the folder holds, or ''."""
     folder = path.parent
     if not folder.is_dir():
         return f" (the folder {str(folder)!r} does not exist either)"
@@ -53,9 +88,23 @@ def _near_names(path: Path) -> str:
 
 
 def missing_file_errors(cfg: Mapping, root: str | os.PathLike = ".") -> list[str]:
-    """A message for every measured file (and CSV sidecar) the config names that does not exist, relative paths
-    taken from ``root`` (the project directory, where Snakemake runs): the key, the path, where it was looked for,
-    the closest names in its folder, and the fix."""
+    """Return a message for every measured file (and CSV sidecar) the config names that does not exist.
+
+    Each message names the key, the path, where it was looked for, the closest names in its folder, and the fix.
+
+    Parameters
+    ----------
+    cfg
+        The workflow's config: the ``random_test`` block and each of ``load_cases`` (``source``, ``file``,
+        ``format``, ``sidecar``) are read.
+    root
+        The directory relative paths are taken from (the project directory, where Snakemake runs).
+
+    Returns
+    -------
+    errors : list[str]
+        One message per missing file; empty when every file exists.
+    """
     errors = []
     root = Path(root)
     for where, block in measured_records(cfg):
@@ -71,8 +120,24 @@ def missing_file_errors(cfg: Mapping, root: str | os.PathLike = ".") -> list[str
 
 
 def shared_file_errors(cfg: Mapping, root: str | os.PathLike = ".") -> list[str]:
-    """Two records read from one file: a copy-paste slip that would identify one record twice. Refused unless the
-    later load case says ``allow_shared_file: true``; the random test and a load case never share a file."""
+    """Return a message for every record that reads a file an earlier record reads already.
+
+    Two records read from one file: a copy-paste slip that would identify one record twice. Refused unless the later
+    load case says ``allow_shared_file: true``; the random test and a load case never share a file.
+
+    Parameters
+    ----------
+    cfg
+        The workflow's config: the ``random_test`` block and each of ``load_cases`` (``source``, ``file``,
+        ``allow_shared_file``) are read.
+    root
+        The directory relative paths are taken from (the project directory, where Snakemake runs).
+
+    Returns
+    -------
+    errors : list[str]
+        One message per shared file, with the fix; empty when no two records share one.
+    """
     errors, seen = [], {}
     root = Path(root)
     for where, block in measured_records(cfg):
@@ -102,9 +167,25 @@ def _stamp(st: os.stat_result) -> list:
 
 
 def file_sha256(path: str | os.PathLike, cache: str | os.PathLike | None = None) -> str:
-    """The sha256 of a file's content (hex). With ``cache`` (a JSON file), a digest is reused while the file's size,
-    modification time, status-change time and inode are those it was computed at; any write to the file changes its
-    status-change time, so a replaced file is read again whatever its modification time says."""
+    """Return the sha256 of a file's content.
+
+    With ``cache`` (a JSON file), a digest is reused while the file's size, modification time, status-change time
+    and inode are those it was computed at; any write to the file changes its status-change time, so a replaced file
+    is read again whatever its modification time says.
+
+    Parameters
+    ----------
+    path
+        The file (symbolic links are resolved).
+    cache
+        The JSON file of digests to reuse and update (None: no cache; a cache that cannot be read or written is left
+        as it is).
+
+    Returns
+    -------
+    digest : str
+        The sha256 in hexadecimal.
+    """
     from .io import file_digest
 
     path = os.path.realpath(path)
@@ -131,9 +212,27 @@ def file_sha256(path: str | os.PathLike, cache: str | os.PathLike | None = None)
     return digest
 
 
-def measured_digests(paths, measured: set[str], cache: str | os.PathLike | None = None) -> dict[str, str]:
-    """{path: sha256} of those of ``paths`` (one path or a list) that are measured files (in ``measured``): the
-    parameter that makes a rule reading them run again when their content changes. Files the workflow writes
-    itself (the rig's records, imported records) are left out: their rules' own inputs decide."""
+def measured_digests(
+    paths: str | os.PathLike | Iterable[str | os.PathLike], measured: set[str], cache: str | os.PathLike | None = None
+) -> dict[str, str]:
+    """Return {path: sha256} of those of ``paths`` that are measured files.
+
+    The parameter that makes a rule reading them run again when their content changes. Files the workflow writes
+    itself (the rig's records, imported records) are left out: their rules' own inputs decide.
+
+    Parameters
+    ----------
+    paths
+        One path or several: a rule's input files.
+    measured
+        The paths of the measured files, as the config names them.
+    cache
+        The JSON file of digests (``file_sha256``; None: no cache).
+
+    Returns
+    -------
+    digests : dict[str, str]
+        The sha256 in hexadecimal of each of ``paths`` that is in ``measured`` and is a file, keyed by its path.
+    """
     paths = [paths] if isinstance(paths, (str, os.PathLike)) else list(paths)
     return {str(p): file_sha256(p, cache) for p in paths if str(p) in measured and os.path.isfile(p)}

@@ -23,6 +23,7 @@ Each check is a dict {check, value, limit, passed, message} (the stiffness fit's
 from __future__ import annotations
 
 import math
+from typing import Mapping
 
 # What a failed check means, said once for the rule logs (plain text) and the report (LaTeX, ``contactid.latex``):
 # the finding, then its consequence; {k_t}, {k_n} and {S} are the symbols as each medium writes them
@@ -43,9 +44,26 @@ PLAIN = {"k_t": "k_t", "k_n": "k_n", "S": "S"}
 
 
 def stiffness_fit_check(chi2_min: float, n_frequencies: int, confidence: float) -> dict | None:
-    """The stiffness fit's consistency: ``chi2_min`` (the weighted misfit's minimum over k_t, k_n) against the
-    ``confidence`` quantile of chi^2 with ``n_frequencies`` - 2 degrees of freedom. None where the fit has no
-    degree of freedom left (two frequencies or fewer: k_t and k_n fit any two)."""
+    """Check the stiffness fit's consistency: its minimum chi^2 against the quantile of the chi^2 law it follows.
+
+    ``chi2_min`` (the weighted misfit's minimum over k_t, k_n) is compared with the ``confidence`` quantile of chi^2
+    with ``n_frequencies`` - 2 degrees of freedom.
+
+    Parameters
+    ----------
+    chi2_min
+        The weighted misfit's minimum over k_t and k_n (residuals in units of the frequencies' uncertainty) [-].
+    n_frequencies
+        How many identified natural frequencies the fit weighs.
+    confidence
+        The quantile the limit is taken at (e.g. 0.95) [-].
+
+    Returns
+    -------
+    check : dict | None
+        {check: "stiffness_fit", value, limit, dof, passed, p_value, message}; None where the fit has no degree of
+        freedom left (two frequencies or fewer: k_t and k_n fit any two).
+    """
     dof = int(n_frequencies) - 2
     if dof < 1:
         return None
@@ -78,8 +96,23 @@ def stiffness_fit_check(chi2_min: float, n_frequencies: int, confidence: float) 
 
 
 def friction_fit_check(misfit_nrmse: float, misfit_floor: float) -> dict:
-    """The friction fit's consistency: its misfit (NRMSE of the law against the identified S) against the relative
-    accuracy its profile-likelihood intervals assume for that S (``friction.misfit_floor``)."""
+    """Check the friction fit's consistency: its misfit against the accuracy its intervals assume.
+
+    The misfit (NRMSE of the law against the identified S) is compared with the relative accuracy the fit's
+    profile-likelihood intervals assume for that S (``friction.misfit_floor``).
+
+    Parameters
+    ----------
+    misfit_nrmse
+        The fit's NRMSE of S, relative to the rms of the identified S [-] (a ratio, not %; NaN fails).
+    misfit_floor
+        The relative accuracy the intervals assume for S (config ``friction.misfit_floor``) [-].
+
+    Returns
+    -------
+    check : dict
+        {check: "friction_fit", value, limit, passed, message}.
+    """
     value, limit = float(misfit_nrmse), float(misfit_floor)
     passed = bool(math.isfinite(value) and value <= limit)
     head = f"friction fit: the law fits the identified S to {100 * value:.3g} % (NRMSE)"
@@ -94,11 +127,25 @@ def friction_fit_check(misfit_nrmse: float, misfit_floor: float) -> dict:
     return {"check": "friction_fit", "value": value, "limit": limit, "passed": passed, "message": message}
 
 
-def model_checks(stiction_attrs, n_frequencies: int, fit_attrs=None) -> list[dict]:
-    """Every model check the results allow: the stiffness fit's (from the stiction dataset's attributes
-    ``chi2_min`` and ``confidence``, ``n_frequencies`` identified frequencies) and, where the friction law was
-    fitted (``fit_attrs``, the fit dataset's attributes), the friction fit's: ``misfit_nrmse`` against the fit's
-    ``misfit_floor`` (a fit written before it kept one: the schema's default)."""
+def model_checks(stiction_attrs: Mapping, n_frequencies: int, fit_attrs: Mapping | None = None) -> list[dict]:
+    """Return every model check the results allow: the stiffness fit's and, for a fitted law, the friction fit's.
+
+    Parameters
+    ----------
+    stiction_attrs
+        The stiction dataset's attributes: ``chi2_min`` and ``confidence`` (default 0.95) are read.
+    n_frequencies
+        How many identified natural frequencies the stiffness fit weighs.
+    fit_attrs
+        The friction fit dataset's attributes: ``misfit_nrmse`` and ``misfit_floor`` (a fit written before it kept
+        one: the schema's default) are read; None where the friction law was not fitted.
+
+    Returns
+    -------
+    checks : list[dict]
+        The stiffness fit's check (``stiffness_fit_check``; left out where it has no degree of freedom) and the
+        friction fit's (``friction_fit_check``).
+    """
     out = []
     stiff = stiffness_fit_check(
         float(stiction_attrs["chi2_min"]), n_frequencies, float(stiction_attrs.get("confidence", 0.95))

@@ -1,5 +1,7 @@
-"""Tables and headline numbers for people (Tables 1, 3 and 4, summary.json); the figures are in paper_figures and
-modal_figures."""
+"""Tables and headline numbers for people: Tables 1, 3 and 4, and summary.json's blocks.
+
+The figures are in paper_figures and modal_figures.
+"""
 
 from __future__ import annotations
 
@@ -21,7 +23,23 @@ def _pct(a, b):
 
 
 def table1(modal: xr.Dataset, truth: xr.Dataset | None) -> pd.DataFrame:
-    """Table 1: natural frequencies, identified vs paper vs rig truth (Hz, %)."""
+    """Return Table 1: natural frequencies, identified vs paper vs rig truth.
+
+    Parameters
+    ----------
+    modal
+        The modal fit's dataset (modal.nc): ``natural_frequency`` [Hz], ``natural_frequency_std`` [Hz] and
+        ``damping_ratio`` [-] along ``mode``.
+    truth
+        The virtual rig's truth of the random test (data/truth/random_test.nc): ``natural_frequency`` [Hz]; None on
+        measured data.
+
+    Returns
+    -------
+    table : pd.DataFrame
+        One row per identified mode: mode, identified_hz, std_hz, damping_ratio, paper_hz, truth_hz (Hz; NaN where
+        there is none) and diff_vs_paper_pct, diff_vs_truth_pct (%).
+    """
     rows = []
     for i, f in enumerate(modal["natural_frequency"].values):
         paper = TABLE1_HZ[i] if i < len(TABLE1_HZ) else np.nan
@@ -42,7 +60,24 @@ def table1(modal: xr.Dataset, truth: xr.Dataset | None) -> pd.DataFrame:
 
 
 def table3(stiction: xr.Dataset, truth: xr.Dataset | None) -> pd.DataFrame:
-    """Table 3: contact stiffness at stiction, identified (or bound) vs paper vs truth (N/m, %)."""
+    """Return Table 3: contact stiffness at stiction, identified (or bound) vs paper vs truth.
+
+    Parameters
+    ----------
+    stiction
+        The stiffness fit's dataset: ``k_t``, ``k_n`` [N/m] and their ``k_t_interval``, ``k_n_interval`` (low, high)
+        [N/m] (an infinite upper end: only a lower bound).
+    truth
+        The virtual rig's truth of the random test (data/truth/random_test.nc): ``k_t`` and ``k_n`` [N/m]; None on
+        measured data.
+
+    Returns
+    -------
+    table : pd.DataFrame
+        Rows k_t and k_n: identified_n_per_m (NaN where only bounded), interval_low_n_per_m, interval_high_n_per_m,
+        reported_as ("value" or "lower bound"), paper_n_per_m, truth_n_per_m (N/m), diff_vs_paper_pct,
+        diff_vs_truth_pct (%, of the lower bound where only bounded) and truth_inside_interval.
+    """
     rows = []
     for name in ("k_t", "k_n"):
         lo, hi = (float(v) for v in stiction[f"{name}_interval"].values)
@@ -67,7 +102,21 @@ def table3(stiction: xr.Dataset, truth: xr.Dataset | None) -> pd.DataFrame:
 
 
 def stiction_summary(stiction: xr.Dataset) -> dict:
-    """The ``stiction`` block of summary.json: k_t and k_n, or k_n_lower_bound; the structure's stiffness scale."""
+    """Return the ``stiction`` block of summary.json: k_t and k_n, or k_n_lower_bound; the structure's stiffness scale.
+
+    Parameters
+    ----------
+    stiction
+        The stiffness fit's dataset: ``k_t``, ``k_n``, ``k_t_interval``, ``k_n_interval`` [N/m] and, where Young's
+        modulus was fitted, ``stiffness_scale`` [-] (with the attribute ``stiffness_scale_sd``).
+
+    Returns
+    -------
+    block : dict
+        k_t and k_t_interval (N/m); k_n and k_n_interval, or k_n_lower_bound where the interval is open above (N/m);
+        stiffness_scale (Young's modulus over the config's) and stiffness_scale_sd (the sd of its prior; 0: held at 1)
+        where fitted.
+    """
     out = {"k_t": float(stiction["k_t"]), "k_t_interval": [float(v) for v in stiction["k_t_interval"].values]}
     if "stiffness_scale" in stiction:  # Young's modulus over the config's, and the sd of its prior (0: held at 1)
         out["stiffness_scale"] = float(stiction["stiffness_scale"])
@@ -82,8 +131,24 @@ def stiction_summary(stiction: xr.Dataset) -> dict:
 
 
 def linear_summary(modal: xr.Dataset, stiction: xr.Dataset, truth: xr.Dataset | None) -> dict:
-    """The linear part of summary.json: natural frequencies (Hz), damping ratios, the stiction block and, where a
-    truth is given, its frequencies, k_t and k_n (N/m)."""
+    """Return the linear part of summary.json: natural frequencies, damping ratios, the stiction block and the truth.
+
+    Parameters
+    ----------
+    modal
+        The modal fit's dataset (modal.nc): ``natural_frequency`` [Hz] and ``damping_ratio`` [-] along ``mode``.
+    stiction
+        The stiffness fit's dataset (``stiction_summary``).
+    truth
+        The virtual rig's truth of the random test (data/truth/random_test.nc): ``natural_frequency`` [Hz], ``k_t``
+        and ``k_n`` [N/m]; None on measured data.
+
+    Returns
+    -------
+    block : dict
+        natural_frequencies_hz (Hz), damping_ratios, stiction and, where a truth is given, truth: its first n_modes
+        natural_frequencies_hz (Hz) and stiction {k_t, k_n} (N/m).
+    """
     out = {
         "natural_frequencies_hz": [float(f) for f in modal["natural_frequency"].values],
         "damping_ratios": [float(z) for z in modal["damping_ratio"].values],
@@ -99,8 +164,27 @@ def linear_summary(modal: xr.Dataset, stiction: xr.Dataset, truth: xr.Dataset | 
 
 
 def load_case_summary(checks: Mapping[str, xr.Dataset], truths: Mapping[str, xr.Dataset]) -> dict:
-    """Per load case: the driving-point harmonics read off the raw record and the validation's
-    warnings (``data_warnings``), and (rig cases) the truth's force amplitudes and contact extremes."""
+    """Return, per load case, the driving-point harmonics read off the raw record and the validation's warnings.
+
+    On rig cases also the truth's force amplitudes and contact extremes.
+
+    Parameters
+    ----------
+    checks
+        The raw checks' datasets by load case: attributes ``A1_m_per_s2``, ``A2_m_per_s2``,
+        ``excitation_frequency_hz`` and ``warnings`` (a JSON list) are read.
+    truths
+        The virtual rig's truth datasets by load case (data/truth/<case>.nc; empty on measured data): ``N`` and ``S``
+        [N] over time and the attributes ``friction_mu``, ``F1_n``, ``F3_n``, ``energy_energy_residual``,
+        ``target_A1_m_per_s2`` and ``target_A2_m_per_s2``.
+
+    Returns
+    -------
+    blocks : dict
+        load_cases {case: {A1_m_per_s2, A2_m_per_s2 (m/s^2), excitation_frequency_hz (Hz)}}, data_warnings {case:
+        [warning, ...]} and, with truths, truth_load_cases {case: {F1_n, F3_n, N_min_n, N_max_n (N), max_S_over_mu_N,
+        energy_residual, target_A1_m_per_s2, target_A2_m_per_s2 (m/s^2)}}.
+    """
     out = {"load_cases": {}, "data_warnings": {}}
     for case, ds in checks.items():
         out["load_cases"][case] = {
@@ -129,7 +213,23 @@ def load_case_summary(checks: Mapping[str, xr.Dataset], truths: Mapping[str, xr.
 
 
 def contact_force_summary(forces: Mapping[str, xr.Dataset], nnms: Mapping[str, xr.Dataset]) -> dict:
-    """`contact_forces` (working method) and `contact_forces_paper` blocks of summary.json."""
+    """Return the `contact_forces` (working method) and `contact_forces_paper` blocks of summary.json.
+
+    Parameters
+    ----------
+    forces
+        The identified contact forces' datasets by load case: their attributes (eta_observable,
+        eta_spread_over_structures, normal_stiffness_from_n_eta_n_per_m, normal_hardening_n_per_m2, n_harmonics, the
+        NRMSEs ``<q>_nrmse`` and ``paper_<q>_nrmse`` of S, N, xi, eta, and the paper decomposition's) are read.
+    nnms
+        The nonlinear normal modes' datasets by load case: ``phase_spread`` [deg] and the attributes
+        ``complex_modes`` and ``reconstruction_nrmse``.
+
+    Returns
+    -------
+    blocks : dict
+        contact_forces {case: the working method's numbers} and contact_forces_paper {case: the paper chain's}.
+    """
     work, paper = {}, {}
     for case, ds in forces.items():
         a = ds.attrs
@@ -156,8 +256,29 @@ def contact_force_summary(forces: Mapping[str, xr.Dataset], nnms: Mapping[str, x
 
 
 def table4(fit: xr.Dataset, truth_friction: Mapping | None) -> pd.DataFrame:
-    """Table 4: fitted value and interval (working method), the paper's chain's fit beside it,
-    the paper's value and the rig truth, plus e_0 at the preload."""
+    """Return Table 4: fitted value and interval, the paper's chain's fit, the paper's value and the rig truth.
+
+    The working method's fitted value and interval of each friction parameter, the paper's chain's fit beside it,
+    the paper's value and the rig truth, plus e_0 at the preload.
+
+    Parameters
+    ----------
+    fit
+        The friction fit's dataset: the parameters along ``parameter`` (``friction_parameters.fitted_parameters`` and
+        ``fitted_intervals``; e_f, e_t [N/m], k_c [1/m], kappa, mu [-]), ``bounded_below``, ``bounded_above``, the
+        paper chain's ``paper_*`` where fitted, and the attributes ``e0_at_preload_n_per_m``, ``e0_interval_low``,
+        ``e0_interval_high``, ``paper_e0_at_preload_n_per_m`` and ``preload_n``.
+    truth_friction
+        The rig's true friction law (config ``rig.truth.friction``: e_f_n_per_m, k_c_per_m, e_t_n_per_m, kappa, mu);
+        None (or empty) on measured data.
+
+    Returns
+    -------
+    table : pd.DataFrame
+        One row per parameter and e0_at_preload: identified, interval_low, interval_high, reported_as ("value",
+        "upper bound", "lower bound" or "not determined"), paper_chain_fit, paper_value, truth (in the parameter's
+        unit), diff_vs_truth_pct (%; NaN for e_t) and truth_inside_interval.
+    """
     rows = []
     keys = {"e_f": "e_f_n_per_m", "k_c": "k_c_per_m", "e_t": "e_t_n_per_m", "kappa": "kappa", "mu": "mu"}
     values, intervals = fitted_parameters(fit), fitted_intervals(fit)
@@ -220,12 +341,41 @@ def table4(fit: xr.Dataset, truth_friction: Mapping | None) -> pd.DataFrame:
 
 
 def stiction_shear_stiffness_paper(preload: float) -> float:
-    """e_0 (N/m) of the paper's Table 4 law at the preload (N), Eq. 22."""
+    """Return e_0 of the paper's Table 4 law at the preload (Eq. 22).
+
+    Parameters
+    ----------
+    preload
+        The static normal preload N0 [N].
+
+    Returns
+    -------
+    e0 : float
+        The stiction shear stiffness e_0 = e_f (1 - exp(-k_c N0 / e_f)) [N/m].
+    """
     return float(stiction_shear_stiffness(preload, TABLE4["e_f"], TABLE4["k_c"]))
 
 
 def friction_summary(fit: xr.Dataset, validations: Mapping[str, xr.Dataset]) -> dict:
-    """`friction` and `validation_nrmse` blocks of summary.json."""
+    """Return the `friction` and `validation_nrmse` blocks of summary.json.
+
+    Parameters
+    ----------
+    fit
+        The friction fit's dataset: the parameters and intervals (``friction_parameters``), ``bounded_below``,
+        ``bounded_above``, ``correlation`` and the attributes ``e0_at_preload_n_per_m``, ``e0_interval_low``,
+        ``e0_interval_high``, ``misfit_nrmse`` and ``regularization``.
+    validations
+        The validation datasets by load case: attributes ``nrmse_vs_identified``, ``nrmse_other_regularization`` and
+        (rig cases) ``nrmse_vs_truth``.
+
+    Returns
+    -------
+    blocks : dict
+        friction (each parameter, e0_at_preload, intervals, only_bounded, misfit_nrmse, correlation_e_f_k_c,
+        regularization, S_change_other_regularization), validation_nrmse and, on rig cases,
+        validation_nrmse_vs_truth.
+    """
     p = dict(zip(fit["parameter"].values, (float(v) for v in fitted_parameters(fit))))
     intervals = {n: [float(lo), float(hi)] for n, (lo, hi) in zip(fit["parameter"].values, fitted_intervals(fit))}
     bounded_only = [
@@ -255,9 +405,20 @@ def friction_summary(fit: xr.Dataset, validations: Mapping[str, xr.Dataset]) -> 
 
 
 def model_form_summary(intervals: Mapping) -> dict:
-    """`friction.model_form_intervals` of summary.json from friction_intervals.json: the model the intervals are
-    for (``chain`` or ``updated``), the confidence and per parameter its value and interval with the model-form
-    term (``e0`` is e_0 at the preload)."""
+    """Return `friction.model_form_intervals` of summary.json from friction_intervals.json.
+
+    Parameters
+    ----------
+    intervals
+        friction_intervals.json's content: ``model`` and ``parameters`` (``confidence`` and, per parameter, its
+        ``value`` and ``interval``) are read.
+
+    Returns
+    -------
+    block : dict
+        The model the intervals are for (``chain`` or ``updated``), the confidence and per parameter its value and
+        interval with the model-form term (``e0`` is e_0 at the preload).
+    """
     par = intervals["parameters"]
     return {
         "model": intervals["model"],
@@ -266,10 +427,25 @@ def model_form_summary(intervals: Mapping) -> dict:
     }
 
 
-def records_check_summary(check: Mapping, data_warnings: dict) -> dict:
-    """`records_check` of summary.json from record_checks.json (``gap.record_checks.records_check``): passed, the
-    findings and each case's gap to the identified model; each finding's message is added to ``data_warnings`` under
-    its record (in place), so that every warning about a record is in one list."""
+def records_check_summary(check: Mapping, data_warnings: dict[str, list[str]]) -> dict:
+    """Return `records_check` of summary.json from record_checks.json (``gap.record_checks.records_check``).
+
+    Each finding's message is added to ``data_warnings`` under its record (in place), so that every warning about a
+    record is in one list.
+
+    Parameters
+    ----------
+    check
+        record_checks.json's content: ``passed``, ``findings`` (each with record, check and message), ``gaps`` and
+        ``calibration_case`` are read.
+    data_warnings
+        summary.json's warnings by record, added to in place.
+
+    Returns
+    -------
+    block : dict
+        passed, the findings, heldout_gap_to_model (each case's gap to the identified model) and calibration_case.
+    """
     for f in check.get("findings", []):
         data_warnings.setdefault(f["record"], []).append(f"records check ({f['check']}): {f['message']}")
     return {

@@ -1,7 +1,9 @@
-"""Write a raw record (netCDF format of ``contactid.io``) as a test rig would: a universal file
-with datasets 58 (pyuff), a TDMS file (nptdms) or a CSV with its sidecar YAML. Each writer
-returns the import block (format, file, channel map) that reads the record back, so the round
-trip is checked with the same libraries a rig's software uses."""
+"""Write a raw record (netCDF format of ``contactid.io``) as a test rig would: UFF 58, TDMS or CSV.
+
+A universal file with datasets 58 (pyuff), a TDMS file (nptdms) or a CSV with its sidecar YAML. Each writer returns
+the import block (format, file, channel map) that reads the record back, so the round trip is checked with the same
+libraries a rig's software uses.
+"""
 
 from __future__ import annotations
 
@@ -20,7 +22,7 @@ SI = {"force": ("N", None, None), "acceleration": ("m/s^2", None, None)}
 
 
 def _stored(values: np.ndarray, units: str, sens, sens_units, quantity: str) -> np.ndarray:
-    """SI values in the stored units (the inverse of ChannelSpec.factor)."""
+    """Return SI values in the stored units (the inverse of ChannelSpec.factor)."""
     phys = PHYSICAL[quantity]
     if units in phys:
         return values / phys[units]
@@ -44,7 +46,7 @@ def _channel_map(raw: xr.Dataset, names: Mapping, storage: Mapping) -> dict:
 
 
 def _series(raw: xr.Dataset, storage: Mapping):
-    """(role, channel label, stored values, units) of force and each sensor."""
+    """Yield (role, stored values, units) of the force and of each sensor."""
     units_f, sf, suf = storage.get("force", SI["force"])
     yield "force", _stored(raw["force"].values, units_f, sf, suf, "force"), units_f
     units_a, sa, sua = storage.get("acceleration", SI["acceleration"])
@@ -59,8 +61,31 @@ def _block(fmt, path, raw, names, storage) -> dict:
     return b
 
 
-def export_uff58(raw: xr.Dataset, path, storage: Mapping | None = None) -> dict:
-    """Datasets 58 (binary, double precision), one per channel, id1 = the channel's role."""
+def export_uff58(raw: xr.Dataset, path: str | os.PathLike, storage: Mapping | None = None) -> dict:
+    """Write ``raw`` as a universal file of datasets 58 (binary, double precision), one per channel.
+
+    Each dataset's id1 is the channel's role (force or the sensor's name); an existing file is replaced.
+
+    Parameters
+    ----------
+    raw
+        The raw record (netCDF format of ``contactid.io``): ``force`` [N] along time, ``acceleration`` [m/s^2] along
+        (sensor, time), the ``position`` of each sensor [m] and the attributes ``sampling_rate_hz`` and (dual-sine
+        records) ``excitation_frequency_hz``.
+    path
+        The universal file to write.
+    storage
+        How each quantity is stored, {quantity: (units, sensitivity, sensitivity_units)} for "force" and
+        "acceleration": e.g. ("g", None, None), or ("mV", 2.25, "mV/N") for a voltage with its sensitivity; a
+        quantity left out (or None) is stored in SI units.
+
+    Returns
+    -------
+    block : dict
+        The config block that reads the record back: source, format (uff58), file, channels (the channel map),
+        excitation_frequency_hz where the record has one, and sampling_rate_hz (the header keeps the increment to 6
+        digits only).
+    """
     import pyuff
 
     storage = dict(storage or {})
@@ -131,8 +156,32 @@ def export_uff58(raw: xr.Dataset, path, storage: Mapping | None = None) -> dict:
     return {**_block("uff58", path, raw, {r: r for r, _, _ in _series(raw, storage)}, storage), "sampling_rate_hz": fs}
 
 
-def export_tdms(raw: xr.Dataset, path, storage: Mapping | None = None, group: str = "dual_sine") -> dict:
-    """One TDMS group, a channel per signal with wf_increment and unit_string properties."""
+def export_tdms(
+    raw: xr.Dataset, path: str | os.PathLike, storage: Mapping | None = None, group: str = "dual_sine"
+) -> dict:
+    """Write ``raw`` as a TDMS file: one group, a channel per signal with wf_increment and unit_string properties.
+
+    Parameters
+    ----------
+    raw
+        The raw record (netCDF format of ``contactid.io``): ``force`` [N] along time, ``acceleration`` [m/s^2] along
+        (sensor, time), the ``position`` of each sensor [m] and the attributes ``sampling_rate_hz`` and (dual-sine
+        records) ``excitation_frequency_hz``.
+    path
+        The TDMS file to write.
+    storage
+        How each quantity is stored, {quantity: (units, sensitivity, sensitivity_units)} for "force" and
+        "acceleration": e.g. ("g", None, None), or ("mV", 2.25, "mV/N") for a voltage with its sensitivity; a
+        quantity left out (or None) is stored in SI units.
+    group
+        The TDMS group's name.
+
+    Returns
+    -------
+    block : dict
+        The config block that reads the record back: source, format (tdms), file, channels (the channel map, channels
+        named "<group>/<role>") and excitation_frequency_hz where the record has one.
+    """
     from nptdms import ChannelObject, TdmsWriter
 
     storage = dict(storage or {})
@@ -152,9 +201,31 @@ def export_tdms(raw: xr.Dataset, path, storage: Mapping | None = None, group: st
     return _block("tdms", path, raw, {r: f"{group}/{r}" for r, _, _ in _series(raw, storage)}, storage)
 
 
-def export_csv(raw: xr.Dataset, path, storage: Mapping | None = None) -> dict:
-    """A CSV (header: time, then one column per signal, 17 significant digits) and its sidecar YAML
-    beside it (same name, suffix .yaml) holding the channel map; returns the config block."""
+def export_csv(raw: xr.Dataset, path: str | os.PathLike, storage: Mapping | None = None) -> dict:
+    """Write ``raw`` as a CSV and its sidecar YAML beside it (same name, suffix .yaml) holding the channel map.
+
+    The CSV's header is time, then one column per signal ("<role> [<units>]"), values to 17 significant digits; the
+    sidecar holds sampling_rate_hz, time_column, the channel map and excitation_frequency_hz where the record has one.
+
+    Parameters
+    ----------
+    raw
+        The raw record (netCDF format of ``contactid.io``): ``force`` [N] along time, ``acceleration`` [m/s^2] along
+        (sensor, time), the ``position`` of each sensor [m] and the attributes ``sampling_rate_hz`` and (dual-sine
+        records) ``excitation_frequency_hz``.
+    path
+        The CSV file to write.
+    storage
+        How each quantity is stored, {quantity: (units, sensitivity, sensitivity_units)} for "force" and
+        "acceleration": e.g. ("g", None, None), or ("mV", 2.25, "mV/N") for a voltage with its sensitivity; a
+        quantity left out (or None) is stored in SI units.
+
+    Returns
+    -------
+    block : dict
+        The config block that reads the record back: source, format (csv) and file (the channel map is in the
+        sidecar).
+    """
     storage = dict(storage or {})
     path = Path(path)
     fs = float(raw.attrs["sampling_rate_hz"])
@@ -177,6 +248,26 @@ EXPORTERS = {"uff58": export_uff58, "tdms": export_tdms, "csv": export_csv}
 
 
 def export_record(raw: xr.Dataset, path: str | os.PathLike, fmt: str, storage: Mapping | None = None) -> dict:
-    """Write ``raw`` as ``fmt`` (uff58, tdms, csv); ``storage`` = {quantity: (units, sensitivity,
-    sensitivity_units)} stores, e.g., accelerations in g or the force in mV. Returns the config block."""
+    """Write ``raw`` as ``fmt`` (uff58, tdms, csv) with the writer of ``EXPORTERS``.
+
+    Parameters
+    ----------
+    raw
+        The raw record (netCDF format of ``contactid.io``): ``force`` [N] along time, ``acceleration`` [m/s^2] along
+        (sensor, time), the ``position`` of each sensor [m] and the attributes ``sampling_rate_hz`` and (dual-sine
+        records) ``excitation_frequency_hz``.
+    path
+        The file to write.
+    fmt
+        The format: "uff58", "tdms" or "csv".
+    storage
+        How each quantity is stored, e.g. accelerations in g or the force in mV: {quantity: (units, sensitivity,
+        sensitivity_units)} for "force" and "acceleration", e.g. ("g", None, None), or ("mV", 2.25, "mV/N") for a
+        voltage with its sensitivity; a quantity left out (or None) is stored in SI units.
+
+    Returns
+    -------
+    block : dict
+        The config block that reads the record back (``export_uff58``, ``export_tdms``, ``export_csv``).
+    """
     return EXPORTERS[fmt](raw, path, storage)
