@@ -1,11 +1,15 @@
-"""Where the gap lies: the gap by stage of the chain (accelerations, generalized coordinates, the contact forces
-identified from the records against the laws, the energy per cycle, the random test's FRF), by sensor, harmonic,
-part of the cycle and load case, and the stage evidence the place is told from (the records' drift and settling,
-the inverse identification's noise, how far the structures the random test allows move eta)."""
+"""Where the gap lies: by stage of the chain, by sensor, harmonic, part of the cycle and load case.
+
+The stages are the accelerations, the generalized coordinates, the contact forces identified from the records against
+the laws, the energy per cycle and the random test's FRF; with them, the stage evidence the place is told from (the
+records' drift and settling, the inverse identification's noise, how far the structures the random test allows move
+eta).
+"""
 
 from __future__ import annotations
 
 import logging
+from typing import TYPE_CHECKING, Mapping, Sequence
 
 import numpy as np
 import xarray as xr
@@ -19,18 +23,53 @@ from .refit import contact_grids, identified_forces, law_friction_force
 from .verdict import DEFAULT_PLACE, PlaceThresholds, open_fraction
 from .verdict import place as _place_of
 
+if TYPE_CHECKING:
+    from ..parameters import StructureParameters
+    from .calibration import Calibration
+    from .settings import GapSettings
+    from .simulation import SimResult
+
 log = logging.getLogger(__name__)
 
 
-def relative_difference(a, b) -> float:
-    """||a - b|| / ||b||: how far ``a`` is from ``b``, relative to ``b``."""
+def relative_difference(a: np.ndarray, b: np.ndarray) -> float:
+    """Return ||a - b|| / ||b||: how far ``a`` is from ``b``, relative to ``b``.
+
+    Parameters
+    ----------
+    a
+        The values compared [unit of b], shape (n_1, ..., n_k), any.
+    b
+        The reference [unit of a], shape (n_1, ..., n_k) as ``a``.
+
+    Returns
+    -------
+    difference : float
+        The relative difference (2-norm, Frobenius for matrices) [-].
+    """
     return float(np.linalg.norm(np.asarray(a) - np.asarray(b)) / max(np.linalg.norm(b), 1e-300))
 
 
 def cycle_parts(g: dict, k_t: float) -> dict:
-    """Masks of one period (identified motion and forces): velocity reversal (within 4 % of the
-    period of a sign change of dxi/dt), peak compression (N in the top 10 % of its range), slip
-    (tangent stiffness dS/dxi below half of k_t) and stick (the rest)."""
+    """Return masks of the parts of one period of the identified motion and forces.
+
+    Velocity reversal (within 4 % of the period of a sign change of dxi/dt), peak compression (N in the top 10 % of
+    its range), slip (tangent stiffness dS/dxi below half of k_t, outside the reversals) and stick (the rest).
+
+    Parameters
+    ----------
+    g
+        One period of the identified motion and forces (``refit.contact_grids``): xi [m], xi_dot [m/s], N [N] and S
+        [N], each of shape (m,).
+    k_t
+        The tangential contact stiffness at stiction [N/m].
+
+    Returns
+    -------
+    masks : dict
+        stick, slip, velocity_reversal and peak_compression: boolean arrays of shape (m,) (peak compression overlaps
+        the others).
+    """
     m = g["xi"].size
     xd = g["xi_dot"]
     rev_idx = np.flatnonzero(np.sign(xd) != np.sign(np.roll(xd, 1)))
@@ -47,8 +86,10 @@ def cycle_parts(g: dict, k_t: float) -> dict:
 
 
 def _response_gaps(fe, records: dict, sims: dict, H: int) -> dict:
-    """The gap of the accelerations and of the generalized coordinates (the sensors projected on the first
-    structural modes) per load case, and by sensor and by harmonic (rows: load cases)."""
+    """Return the gap of the accelerations and of the generalized coordinates per load case, by sensor and harmonic.
+
+    The generalized coordinates are the sensors projected on the first structural modes; rows are load cases.
+    """
     cases = list(records)
     phi_s = fe.sensor_vectors @ structural_modes(fe, min(3, len(records[cases[0]].sensors))).shapes
     pinv = np.linalg.pinv(phi_s)
@@ -68,10 +109,13 @@ CYCLE_PARTS = ("stick", "slip", "velocity_reversal", "peak_compression")
 def _contact_gaps(
     model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, sim, H: int, open_limit: float, memo: bool = True
 ):
-    """One load case's contact-force stage: the contact forces identified from the record (inverse) against the
-    laws at the identified motion, the inverse identification's residual and noise, the contact's open fraction,
-    the energy per cycle (J; identified, simulated), the driving-point residual by part of the cycle and the
-    force-state map of what the laws leave (``memo``: ``Numerics.memo``)."""
+    """Return one load case's contact-force stage.
+
+    The contact forces identified from the record (inverse) against the laws at the identified motion, the inverse
+    identification's residual and noise, the contact's open fraction, the energy per cycle (J; identified,
+    simulated), the driving-point residual by part of the cycle and the force-state map of what the laws leave
+    (``memo``: ``Numerics.memo``).
+    """
     forces = identified_forces(model, aug, rec, memo=memo)
     g = contact_grids(forces, rec.f0, model.preload, 256)
     S_law = law_friction_force(g["xi"], g["xi_dot"], g["N"], np.asarray(model.friction), aug, model.regularization)[0]
@@ -109,20 +153,60 @@ def _rms(x) -> float:
 
 def localise(
     model: IdentifiedModel,
-    records: dict,
-    sims: dict,
+    records: dict[str, RecordHarmonics],
+    sims: dict[str, SimResult],
     n_harmonics: int,
     linear: dict | None = None,
     aug: Augmentation = NONE,
     eta_limit: float = 0.1,
-    structures=(),
+    structures: Sequence[StructureParameters] = (),
     thresholds: PlaceThresholds = DEFAULT_PLACE,
     memo: bool = True,
 ) -> tuple[dict, dict]:
-    """The gap by stage, sensor, harmonic, part of the cycle and load level (the identified model
-    as the chain left it, or with the effects ``aug`` added), the records' drift and whether each settled
-    (``record_periodicity``); ``memo``: the inverse identifications memoised (``Numerics.memo``). Returns (summary for
-    diagnosis.json, arrays for gap.nc)."""
+    """Return the gap by stage, sensor, harmonic, part of the cycle and load level, and the place it lies in.
+
+    The identified model is taken as the chain left it, or with the effects ``aug`` added; with the gap, the records'
+    drift and whether each settled (``record_periodicity``), the inverse identification's residual and noise and
+    how far the structures the data allow move eta.
+
+    Parameters
+    ----------
+    model
+        The identified model.
+    records
+        The load cases' records in harmonics, by case.
+    sims
+        The simulations of the records by the model (with ``aug``), by case.
+    n_harmonics
+        H, the harmonics compared.
+    linear
+        The random test's stage (``linear_stage``: frf_frequency, frf_peak_amplitude), added to the stages; None:
+        none.
+    aug
+        The effects added to the model (``NONE``: as the chain left it).
+    eta_limit
+        The largest relative change of eta over ``structures`` for eta to count as observable (config
+        ``gap.eta_observability_limit``) [-].
+    structures
+        The structures the data allow: the model's structure moved by one posterior standard deviation of each
+        updated parameter (``updating.posterior_structures``); empty: none.
+    thresholds
+        The place's thresholds (config ``gap.place``).
+    memo
+        Whether the inverse identifications are memoised (``Numerics.memo``).
+
+    Returns
+    -------
+    summary : dict
+        For diagnosis.json's ``where``: stage (the gap of each stage), largest_stage, direction, by_sensor,
+        worst_sensor, by_harmonic, worst_harmonic, even_share, harmonic_class, by_cycle_part, worst_cycle_part,
+        by_load_case, load_exponent, drift {case: {change, z}}, periodicity, identification_residual,
+        identification_noise, eta_observability, place and place_reason.
+    arrays : dict
+        For gap.nc: gap_by_sensor (n_cases, n_sensors), gap_by_harmonic (n_cases, H), gap_by_cycle_part
+        (n_cases, 4), relative; energy_tangential and energy_normal (n_cases, 2: identified, simulated) in J;
+        force_state_map (n_cases, 6, 256): xi, xi_dot, S - S_law, eta, eta_dot, N - N_law in SI units.
+    """
     H = n_harmonics
     cases = list(records)
     resp = _response_gaps(fe_model(model, aug), records, sims, H)
@@ -178,9 +262,12 @@ def localise(
 
 
 def _gap_patterns(stage: dict, arrays: dict, records: dict, acc_gap, thresholds: PlaceThresholds) -> dict:
-    """Where the gap lies: the largest stage, the direction (normal when the normal contact force's gap exceeds
-    ``thresholds.normal_limit`` or the contact opens), by sensor, harmonic (odd or even), part of the cycle and
-    load case, and the gap's growth with the load (the exponent of gap ~ A1^n over the load cases)."""
+    """Return where the gap lies: the largest stage, the direction, by sensor, harmonic, part of the cycle, load case.
+
+    The direction is normal when the normal contact force's gap exceeds ``thresholds.normal_limit`` or the contact
+    opens; the harmonics are classed odd or even; the gap's growth with the load is the exponent of gap ~ A1^n over
+    the load cases.
+    """
     cases = list(records)
     ph = np.mean(arrays["gap_by_harmonic"] ** 2, axis=0)
     odd, even = float(np.sum(ph[0::2])), float(np.sum(ph[1::2]))
@@ -211,8 +298,23 @@ def _gap_patterns(stage: dict, arrays: dict, records: dict, acc_gap, thresholds:
 
 
 def record_drift(rec: RecordHarmonics, H: int) -> tuple[float, float]:
-    """Linear trend of the block harmonics over the record: (relative change over the record, its size in
-    units of its own standard error from the scatter about the trend; about 1 for a stationary record)."""
+    """Return the linear trend of the block harmonics over the record: its relative change and its size in errors.
+
+    Parameters
+    ----------
+    rec
+        One load case's record in harmonics.
+    H
+        The harmonics the trend is taken over (1..H).
+
+    Returns
+    -------
+    change : float
+        The trend's change over the record relative to the record's harmonics [-].
+    z : float
+        The trend's size in units of its own standard error from the scatter about the trend (about 1 for a
+        stationary record) [-].
+    """
     A = rec.block_acceleration[:, :, :H].reshape(rec.block_acceleration.shape[0], -1)
     b = np.arange(A.shape[0]) - 0.5 * (A.shape[0] - 1)
     slope = (b @ A) / (b @ b)
@@ -222,11 +324,26 @@ def record_drift(rec: RecordHarmonics, H: int) -> tuple[float, float]:
     return change, float(np.linalg.norm(slope) * np.sqrt(b @ b) / max(sigma, 1e-300))
 
 
-def record_periodicity(records: dict, limit: float) -> dict:
-    """Per load case: the share of the response that is not periodic at the drive (``RecordHarmonics.aperiodic``,
-    the worst accelerometer and each one) and whether the record settled (that share at most ``limit``). A record
-    that does not settle (impacts, chaos) has harmonics that are averages of a motion that never repeats: the gap
-    compares those averages, and a candidate, compared on harmonics, cannot be expected to explain it."""
+def record_periodicity(records: Mapping[str, RecordHarmonics], limit: float) -> dict:
+    """Return, per load case, the share of the response that is not periodic at the drive and whether it settled.
+
+    The share is ``RecordHarmonics.aperiodic``'s, the worst accelerometer's and each one's; the record settled when
+    that share is at most ``limit``. A record that does not settle (impacts, chaos) has harmonics that are averages
+    of a motion that never repeats: the gap compares those averages, and a candidate, compared on harmonics, cannot
+    be expected to explain it.
+
+    Parameters
+    ----------
+    records
+        The load cases' records in harmonics, by case (those without ``aperiodic`` are left out).
+    limit
+        The largest non-periodic share of a settled record (config ``gap.place.aperiodic_limit``) [-].
+
+    Returns
+    -------
+    periodicity : dict
+        {case: {aperiodic_share (the worst sensor's), by_sensor {sensor: share}, settled}}.
+    """
     out = {}
     for c, rec in records.items():
         a = getattr(rec, "aperiodic", None)
@@ -243,7 +360,22 @@ def record_periodicity(records: dict, limit: float) -> dict:
 
 
 def identification_noise(model: IdentifiedModel, rec: RecordHarmonics, memo: bool = True) -> float:
-    """Standard error of the inverse identification's sensor misfit (w and 3w) from the record's blocks."""
+    """Return the standard error of the inverse identification's sensor misfit (w and 3w) from the record's blocks.
+
+    Parameters
+    ----------
+    model
+        The identified model (as the chain left it, or a candidate's).
+    rec
+        One load case's record in harmonics.
+    memo
+        Whether the inverse identifications are memoised (``Numerics.memo``).
+
+    Returns
+    -------
+    noise : float
+        The standard error of the blocks' relative sensor misfit (rms over harmonics 1 and 3) [-].
+    """
     import dataclasses
 
     r = []
@@ -254,13 +386,36 @@ def identification_noise(model: IdentifiedModel, rec: RecordHarmonics, memo: boo
 
 
 def eta_model_spread(
-    model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, structures, memo: bool = True
+    model: IdentifiedModel,
+    aug: Augmentation,
+    rec: RecordHarmonics,
+    structures: Sequence[StructureParameters],
+    memo: bool = True,
 ) -> float:
-    """How far the identified normal motion eta moves over the structures the data allow: the largest relative
-    change (norm over the harmonics) of eta identified with each of ``structures`` (the model's structure moved
-    by one posterior standard deviation of each updated parameter, ``updating.posterior_structures``) against
-    eta with the model's own. The k_t, k_n intervals alone (the chain's test) miss the structure's own
-    uncertainty. NaN without structures."""
+    """Return how far the identified normal motion eta moves over the structures the data allow.
+
+    The largest relative change (norm over the harmonics) of eta identified with each of ``structures`` against eta
+    with the model's own. The k_t, k_n intervals alone (the chain's test) miss the structure's own uncertainty.
+
+    Parameters
+    ----------
+    model
+        The identified model (as the chain left it, or a candidate's).
+    aug
+        The effects added to the model (``NONE``: as the chain left it).
+    rec
+        One load case's record in harmonics.
+    structures
+        The structures the data allow: the model's structure moved by one posterior standard deviation of each
+        updated parameter (``updating.posterior_structures``); empty: none.
+    memo
+        Whether the inverse identifications are memoised (``Numerics.memo``).
+
+    Returns
+    -------
+    spread : float
+        The largest relative change of eta [-]; NaN without structures.
+    """
     import dataclasses
 
     if not structures:
@@ -278,8 +433,25 @@ def eta_model_spread(
 
 
 def random_test_delays(frf: xr.Dataset, modal: xr.Dataset) -> np.ndarray | None:
-    """Each accelerometer channel's delay on the force (s) from the random test's residue phases at its highest
-    identified mode (``modal_fit.residue_phase_delays``), None where the FRF or the modes do not allow it (logged)."""
+    """Return each accelerometer channel's delay on the force from the random test's residue phases.
+
+    The phases at its highest identified mode (``modal_fit.residue_phase_delays``).
+
+    Parameters
+    ----------
+    frf
+        The random test's FRFs (frf.nc): the ``frequency`` coordinate [Hz] and ``h1_real``, ``h1_imag`` [m/s^2/N]
+        along (sensor, frequency), the driving point first.
+    modal
+        The modal fit's dataset (modal.nc): ``natural_frequency`` [Hz] and ``damping_ratio`` [-] along ``mode``,
+        attributes ``band_low_hz`` and ``band_high_hz`` [Hz].
+
+    Returns
+    -------
+    delays : np.ndarray | None
+        Each sensor's delay on the force [s] (positive: late), shape (n_sensors,); None where the FRF or the modes do
+        not allow it (logged) or a delay is not finite.
+    """
     from ..linear_chain import complex_frf
     from ..modal_fit import residue_phase_delays
 
@@ -299,8 +471,25 @@ def random_test_delays(frf: xr.Dataset, modal: xr.Dataset) -> np.ndarray | None:
 
 
 def linear_stage(model: IdentifiedModel, frf: xr.Dataset, modal: xr.Dataset) -> dict:
-    """The random test's FRF against the identified model: natural frequencies (relative error) and
-    the driving-point |H1| at the identified peaks (relative error of the model's accelerance)."""
+    """Return the random test's FRF against the identified model: natural frequencies and peak accelerance.
+
+    Parameters
+    ----------
+    model
+        The identified model.
+    frf
+        The random test's FRFs (frf.nc): the ``frequency`` coordinate [Hz] and ``h1_real``, ``h1_imag`` [m/s^2/N]
+        along (sensor, frequency), the driving point first.
+    modal
+        The modal fit's dataset (modal.nc): ``natural_frequency`` [Hz] and ``damping_ratio`` [-] along ``mode``.
+
+    Returns
+    -------
+    stage : dict
+        frf_frequency: the rms relative error of the model's structural natural frequencies against the identified
+        ones; frf_peak_amplitude: the rms relative error of the model's driving-point accelerance against |H1| at the
+        lines nearest the identified frequencies.
+    """
     fe = fe_model(model)
     modes = all_modes(fe)
     zeta = modal_damping_vector(fe, np.asarray(model.damping))
@@ -323,9 +512,41 @@ def linear_stage(model: IdentifiedModel, frf: xr.Dataset, modal: xr.Dataset) -> 
     }
 
 
-def place_left(last, records, calibration_case, H, linear, structures, settings) -> dict | None:
-    """The localisation of what the explanation leaves, with its effects in the model (``last``: the last step's
-    calibration and held-out simulations); None where a simulation is missing."""
+def place_left(
+    last: tuple[Calibration, Mapping[str, SimResult | None]],
+    records: Mapping[str, RecordHarmonics],
+    calibration_case: str,
+    H: int,
+    linear: dict | None,
+    structures: Sequence[StructureParameters],
+    settings: GapSettings,
+) -> dict | None:
+    """Return the localisation of what the explanation leaves, with its effects in the model.
+
+    Parameters
+    ----------
+    last
+        The explanation's last step: its calibration (model, augmentation and the calibration case's simulation) and
+        its held-out simulations by case.
+    records
+        The load cases' records in harmonics, by case.
+    calibration_case
+        The load case the step was calibrated on.
+    H
+        The harmonics compared.
+    linear
+        The random test's stage (``linear_stage``); None: none.
+    structures
+        The structures the data allow: the model's structure moved by one posterior standard deviation of each
+        updated parameter (``updating.posterior_structures``); empty: none.
+    settings
+        The gap diagnosis's settings: eta_observability_limit, place and numerics.memo are read.
+
+    Returns
+    -------
+    summary : dict | None
+        ``localise``'s summary; None where a simulation is missing.
+    """
     cal, sims = last
     all_sims = {c: (cal.simulation if c == calibration_case else sims[c]) for c in records}
     if any(s is None for s in all_sims.values()):

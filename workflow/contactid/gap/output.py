@@ -4,11 +4,15 @@ from __future__ import annotations
 
 import json
 import math
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import xarray as xr
 
 from .diagnosis import Diagnosis
+
+if TYPE_CHECKING:
+    from .records import RecordHarmonics
 
 # the force-state maps, one variable per field (name, units, what): the identified motion and what the laws leave
 MAP_FIELDS = (
@@ -21,9 +25,21 @@ MAP_FIELDS = (
 )
 
 
-def json_ready(x):
-    """``x`` ready for json.dumps: numpy scalars as Python ones, non-finite floats as None (null), keys as
-    strings."""
+def json_ready(x: Any) -> Any:
+    """Return ``x`` ready for json.dumps: numpy scalars as Python ones, non-finite floats as None, keys as strings.
+
+    Dicts, lists and tuples are converted recursively (tuples become lists); non-finite floats become None (null).
+
+    Parameters
+    ----------
+    x
+        A value, or a nest of dicts, lists and tuples of values.
+
+    Returns
+    -------
+    ready : Any
+        The same value with numpy scalars as Python ones, non-finite floats as None and dict keys as strings.
+    """
     if isinstance(x, dict):
         return {str(k): json_ready(v) for k, v in x.items()}
     if isinstance(x, (list, tuple)):
@@ -38,20 +54,66 @@ def json_ready(x):
 
 
 def diagnosis_json(diag: Diagnosis, extra: dict | None = None) -> str:
-    """diagnosis.json: verdict, reason, ranking [{effect, heldout_gap_before, heldout_gap_after, score, ...}],
-    where (localisation summary), cases (non-finite numbers as null)."""
+    """Return diagnosis.json's text: verdict, reason, ranking, where (the localisation summary) and the cases.
+
+    The ranking is [{effect, heldout_gap_before, heldout_gap_after, score, ...}]; non-finite numbers are written as
+    null.
+
+    Parameters
+    ----------
+    diag
+        The diagnosis (``Diagnosis.summary`` is written).
+    extra
+        Further top-level entries (None: none).
+
+    Returns
+    -------
+    text : str
+        The JSON text, indented by 2.
+    """
     return json.dumps(json_ready({**diag.summary(), **(extra or {})}), indent=2)
 
 
 def updated_model_json(updated: dict, extra: dict | None = None) -> str:
-    """results/gap/updated_model.json: the model the explanation arrives at (``explain.updated_model_summary``),
-    non-finite numbers (a rigid clamp's stiffness) as null."""
+    """Return results/gap/updated_model.json's text: the model the explanation arrives at.
+
+    Non-finite numbers (a rigid clamp's stiffness) are written as null.
+
+    Parameters
+    ----------
+    updated
+        The updated model's summary (``explain.updated_model_summary``).
+    extra
+        Further top-level entries (None: none).
+
+    Returns
+    -------
+    text : str
+        The JSON text, indented by 2.
+    """
     return json.dumps(json_ready({**updated, **(extra or {})}), indent=2)
 
 
 def localisation_variables(a: dict) -> dict:
-    """The localisation arrays as dataset variables {name: (dims, values, attrs)}: the gap by sensor, harmonic and
-    part of the cycle (relative, 1), the energy dissipated per cycle (J) and the force-state maps (SI)."""
+    """Return the localisation arrays as dataset variables {name: (dims, values, attrs)}.
+
+    The gap by sensor, harmonic and part of the cycle (relative, 1), the energy dissipated per cycle (J) and the
+    force-state maps (SI: ``MAP_FIELDS``).
+
+    Parameters
+    ----------
+    a
+        The localisation's arrays (``localise.localise``): gap_by_sensor (n_cases, n_sensors), gap_by_harmonic
+        (n_cases, n_harmonics) and gap_by_cycle_part (n_cases, 4), relative; energy_tangential and energy_normal
+        (n_cases, 2: identified, simulated) in J; force_state_map (n_cases, 6, n_phase), the fields of
+        ``MAP_FIELDS`` in their units.
+
+    Returns
+    -------
+    variables : dict
+        gap_by_sensor, gap_by_harmonic, gap_by_cycle_part, energy_tangential, energy_normal and map_<field> for each
+        of ``MAP_FIELDS``, each (dims, values, attrs with units and long_name).
+    """
     return {
         "gap_by_sensor": (
             ("case", "sensor"),
@@ -92,9 +154,23 @@ def localisation_variables(a: dict) -> dict:
     }
 
 
-def record_variables(records: dict, n_harmonics: int) -> dict:
-    """The records' acceleration harmonics 1..H (m/s^2, force phase 0), real and imaginary parts, as dataset
-    variables {name: (dims, values, attrs)}."""
+def record_variables(records: dict[str, RecordHarmonics], n_harmonics: int) -> dict:
+    """Return the records' acceleration harmonics 1..H, real and imaginary parts, as dataset variables.
+
+    The harmonics are in m/s^2 with the force's phase 0; each variable is {name: (dims, values, attrs)}.
+
+    Parameters
+    ----------
+    records
+        The load cases' records in harmonics, by case (the order of the ``case`` dimension).
+    n_harmonics
+        H, the harmonics written.
+
+    Returns
+    -------
+    variables : dict
+        acceleration_record_real and acceleration_record_imag, dims (case, sensor, harmonic), in m/s^2.
+    """
     cases, H = list(records), n_harmonics
     return {
         "acceleration_record_real": (
@@ -110,9 +186,26 @@ def record_variables(records: dict, n_harmonics: int) -> dict:
     }
 
 
-def simulated_variables(diag: Diagnosis, records: dict, n_harmonics: int) -> dict:
-    """The simulated acceleration harmonics 1..H (m/s^2) of the base model, the winner and the runner-up, real and
-    imaginary parts (NaN where not simulated), as dataset variables {name: (dims, values, attrs)}."""
+def simulated_variables(diag: Diagnosis, records: dict[str, RecordHarmonics], n_harmonics: int) -> dict:
+    """Return the simulated acceleration harmonics 1..H of the base model, the winner and the runner-up.
+
+    Real and imaginary parts (m/s^2; NaN where not simulated), as dataset variables {name: (dims, values, attrs)}.
+
+    Parameters
+    ----------
+    diag
+        The diagnosis: its simulations (``sims``: "base" and each effect's, by case) and its ranking.
+    records
+        The load cases' records in harmonics, by case (the order of the ``case`` dimension).
+    n_harmonics
+        H, the harmonics written.
+
+    Returns
+    -------
+    variables : dict
+        acceleration_<label>_real and acceleration_<label>_imag for label base and the first two of the ranking,
+        dims (case, sensor, harmonic), in m/s^2.
+    """
     cases = list(records)
     sensors = list(records[cases[0]].sensors)
     H = n_harmonics
@@ -146,9 +239,21 @@ def simulated_variables(diag: Diagnosis, records: dict, n_harmonics: int) -> dic
     return data
 
 
-def ranking_variables(ranking: list) -> dict:
-    """The candidates' held-out gap after (relative, 1) with its bootstrap 95 % interval and their scores, along
-    ``effect``, as dataset variables {name: (dims, values, attrs)}."""
+def ranking_variables(ranking: list[dict]) -> dict:
+    """Return the candidates' held-out gap after, with its bootstrap 95 % interval, and their scores.
+
+    Each along ``effect``, as dataset variables {name: (dims, values, attrs)}; the gaps are relative (units 1).
+
+    Parameters
+    ----------
+    ranking
+        The diagnosis's ranking rows: heldout_gap_after, heldout_gap_after_interval (low, high) and score are read.
+
+    Returns
+    -------
+    variables : dict
+        heldout_gap_after, heldout_gap_after_low, heldout_gap_after_high and score.
+    """
     return {
         "heldout_gap_after": (
             "effect",
@@ -173,8 +278,27 @@ def ranking_variables(ranking: list) -> dict:
     }
 
 
-def gap_dataset(diag: Diagnosis, records: dict, n_harmonics: int) -> xr.Dataset:
-    """The localisation arrays and the measured and simulated harmonics (base model, winner, runner-up)."""
+def gap_dataset(diag: Diagnosis, records: dict[str, RecordHarmonics], n_harmonics: int) -> xr.Dataset:
+    """Return results/gap/gap.nc: the localisation arrays, the measured and simulated harmonics, the ranking.
+
+    The simulated harmonics are the base model's, the winner's and the runner-up's.
+
+    Parameters
+    ----------
+    diag
+        The diagnosis: its arrays, simulations, ranking, verdict, reason, calibration case and where.
+    records
+        The load cases' records in harmonics, by case (the order of the ``case`` dimension).
+    n_harmonics
+        H, the harmonics written.
+
+    Returns
+    -------
+    dataset : xr.Dataset
+        The variables of ``localisation_variables``, ``record_variables``, ``simulated_variables`` and
+        ``ranking_variables`` on the coordinates case, sensor, harmonic, cycle_part, source, phase and effect;
+        attributes verdict, reason, calibration_case and heldout_gap_before.
+    """
     cases = list(records)
     sensors = list(records[cases[0]].sensors)
     H = n_harmonics

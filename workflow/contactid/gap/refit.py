@@ -9,6 +9,8 @@ Iwan share), then the forward simulation (``evaluate``). The search for theta is
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, Any, Sequence
+
 import numpy as np
 from numba import njit
 
@@ -23,14 +25,37 @@ from .numerics import DEFAULT, Numerics
 from .records import RecordHarmonics
 from .simulation import SimResult, simulate
 
+if TYPE_CHECKING:
+    from collections.abc import Callable, Hashable
+
+    from ..beam_model import FEModel
+
 # ------------------------------------------------------------------------------------------
 # the gap
 # ------------------------------------------------------------------------------------------
 
 
 def gap_residual(sim: SimResult, rec: RecordHarmonics, n_harmonics: int) -> np.ndarray:
-    """Residual (complex, scaled by the record's rms acceleration harmonic norm): the sensors'
-    harmonics 1..H of the whole record, and the change from the first to the last third (drift)."""
+    """Return the residual between a simulation and a record, scaled by the record's acceleration harmonics' norm.
+
+    The sensors' harmonics 1..H of the whole record, and the change from the first to the last third (drift); both
+    divided by the norm of the record's acceleration harmonics 1..H.
+
+    Parameters
+    ----------
+    sim
+        The simulation of the record (its ``first`` and ``last`` thirds; ``first`` None: the simulation has no drift).
+    rec
+        One load case's record in harmonics.
+    n_harmonics
+        H, the harmonics compared.
+
+    Returns
+    -------
+    residual : np.ndarray
+        The complex scaled residual [-], shape (2 n_sensors H,): (A_sim - A_rec) over sensors and harmonics 1..H
+        (sensor-major), then the simulated minus the recorded drift, likewise.
+    """
     H = n_harmonics
     scale = np.linalg.norm(rec.acceleration[:, :H])
     r = [(sim.acceleration[:, :H] - rec.acceleration[:, :H]).ravel()]
@@ -41,8 +66,20 @@ def gap_residual(sim: SimResult, rec: RecordHarmonics, n_harmonics: int) -> np.n
 
 
 def gap_value(residual: np.ndarray) -> float:
-    """The gap: rms of the scaled residual over its entries' norm, i.e. ||A_sim - A_rec|| / ||A_rec||
-    (with the drift part added in quadrature)."""
+    """Return the gap: the norm of the scaled residual, i.e. ||A_sim - A_rec|| / ||A_rec||.
+
+    The drift part is added in quadrature.
+
+    Parameters
+    ----------
+    residual
+        The scaled residual (``gap_residual``) [-], shape (n_r,), complex.
+
+    Returns
+    -------
+    gap : float
+        The gap [-].
+    """
     return float(np.linalg.norm(residual))
 
 
@@ -51,17 +88,48 @@ def gap_value(residual: np.ndarray) -> float:
 # ------------------------------------------------------------------------------------------
 
 
-def augmented_zeta(fe, damping, extra: float) -> np.ndarray:
-    """Damping ratio of every FE mode (``modal_damping_vector``) plus ``extra`` on the structural (beam) modes."""
+def augmented_zeta(fe: FEModel, damping: Sequence[float], extra: float) -> np.ndarray:
+    """Return the damping ratio of every FE mode (``modal_damping_vector``) plus ``extra`` on the structural modes.
+
+    The structural (beam) modes are those with less than half their kinetic energy in the block.
+
+    Parameters
+    ----------
+    fe
+        The assembled FE model.
+    damping
+        The identified structural modes' damping ratios, by order [-].
+    extra
+        The damping ratio added to the structural modes [-].
+
+    Returns
+    -------
+    zeta : np.ndarray
+        The damping ratio of every FE mode, sorted by frequency [-], shape (n_dof,).
+    """
     zeta = modal_damping_vector(fe, np.asarray(damping))
     if extra:
         zeta[all_modes(fe).block_energy_fraction < 0.5] += extra
     return zeta
 
 
-def deskewed(rec: RecordHarmonics, delays, gains=()) -> np.ndarray:
-    """The record's acceleration harmonics with per-channel delays (s) and sensitivity factors (``gains``: each channel
-    reads g times its acceleration) removed."""
+def deskewed(rec: RecordHarmonics, delays: Sequence[float], gains: Sequence[float] = ()) -> np.ndarray:
+    """Return the record's acceleration harmonics with per-channel delays and sensitivity factors removed.
+
+    Parameters
+    ----------
+    rec
+        One load case's record in harmonics.
+    delays
+        Each acceleration channel's delay on the force [s], one per sensor; empty: none.
+    gains
+        Each channel's sensitivity factor (it reads g times its acceleration) [-], one per sensor; empty: none.
+
+    Returns
+    -------
+    acceleration : np.ndarray
+        The corrected complex acceleration harmonics [m/s^2], shape (n_sensors, n_h), n_h the record's harmonics.
+    """
     A = rec.acceleration
     if len(delays):
         h = np.arange(1, A.shape[1] + 1)
@@ -72,15 +140,36 @@ def deskewed(rec: RecordHarmonics, delays, gains=()) -> np.ndarray:
 
 
 class _Memo:
-    """A small memo of pure results keyed by value, plus objects (records, forces) that the key names by
-    identity: the entry keeps them alive, so an id is never reused while its entry exists."""
+    """A small memo of pure results keyed by value, plus objects (records, forces) that the key names by identity.
+
+    The entry keeps those objects alive, so an id is never reused while its entry exists.
+
+    Parameters
+    ----------
+    size
+        How many entries it keeps (the oldest is dropped first).
+    """
 
     def __init__(self, size: int = 64):
         self.size, self.store = size, {}
 
-    def get(self, key, compute, enabled: bool = True):
-        """The result of ``compute`` (which returns (result, objects the key names)), from the memo where ``enabled``
-        (``Numerics.memo``); otherwise computed anew and not stored."""
+    def get(self, key: Hashable, compute: Callable[[], tuple[Any, Any]], enabled: bool = True) -> Any:
+        """Return the result of ``compute``, from the memo where ``enabled``; otherwise computed anew and not stored.
+
+        Parameters
+        ----------
+        key
+            The entry's key.
+        compute
+            Returns (result, the objects the key names by identity).
+        enabled
+            Whether to use the memo (``Numerics.memo``).
+
+        Returns
+        -------
+        result : Any
+            The first element of what ``compute`` returns.
+        """
         if not enabled:
             return compute()[0]
         hit = self.store.get(key)
@@ -98,8 +187,27 @@ _FRICTION = _Memo()
 def identified_forces(
     model: IdentifiedModel, aug: Augmentation, rec: RecordHarmonics, memo: bool = True
 ) -> InverseHarmonics:
-    """Contact forces of a record by inverse identification with the augmented model (memoised where ``memo``,
-    ``Numerics.memo``: the candidates that leave the structure, its damping and the channels as they are reuse it)."""
+    """Return the contact forces of a record by inverse identification with the augmented model.
+
+    Memoised where ``memo`` (``Numerics.memo``): the candidates that leave the structure, its damping and the channels
+    as they are reuse it.
+
+    Parameters
+    ----------
+    model
+        The identified model (the chain's, or a candidate's).
+    aug
+        The effects added to the model (``NONE``: as the chain left it).
+    rec
+        One load case's record in harmonics.
+    memo
+        Whether to memoise (``Numerics.memo``).
+
+    Returns
+    -------
+    forces : InverseHarmonics
+        The identified contact forces and motion, in harmonics.
+    """
     key = (
         model.structure_with(aug),
         model.test_damping,
@@ -134,10 +242,31 @@ def _iwan_periodic(xi, N, e_f, k_c, mu, weights, periods):
     return out
 
 
-def law_friction_force(xi, xi_dot, N, params, aug: Augmentation, regularization: str) -> np.ndarray:
-    """S (N) of the (augmented) friction law over one period: (1 - s) Valanis + s Iwan + sigma_2 dxi/dt
-    (params: e_f, k_c, e_t, kappa, mu; N total, clipped at 1 mN where the contact would open; regularization:
-    the reading of Eq. 21, see ``contactid.friction``)."""
+def law_friction_force(
+    xi: np.ndarray, xi_dot: np.ndarray, N: np.ndarray, params: np.ndarray, aug: Augmentation, regularization: str
+) -> np.ndarray:
+    """Return S of the (augmented) friction law over one period: (1 - s) Valanis + s Iwan + sigma_2 dxi/dt.
+
+    Parameters
+    ----------
+    xi
+        The tangential motion over one period [m], shape (m,).
+    xi_dot
+        Its rate [m/s], shape (m,).
+    N
+        The total normal force [N], shape (m,); the Valanis law sees it clipped at 1 mN where the contact would open.
+    params
+        The law's parameters e_f, k_c, e_t, kappa, mu [N/m, 1/m, N/m, -, -], shape (5,) or (n_sets, 5).
+    aug
+        The augmentation: its Iwan share s and viscous coefficient sigma_2 are read.
+    regularization
+        The reading of Eq. 21 (see ``contactid.friction``).
+
+    Returns
+    -------
+    S : np.ndarray
+        The friction force [N], shape (n_sets, m) (n_sets 1 for one parameter set).
+    """
     Nc = np.maximum(N, 1e-3)
     S = valanis_friction_force(xi, Nc, np.atleast_2d(params), regularization=regularization)
     if aug.iwan_share:
@@ -161,7 +290,24 @@ class _AugmentedProblem(FitProblem):
 
 
 def contact_grids(forces: InverseHarmonics, f0: float, preload: float, m: int) -> dict:
-    """One period of the identified xi, xi_dot, N (total) and S (mean removed) on m points."""
+    """Return one period of the identified xi, xi_dot, N (total), S (mean removed), eta and eta_dot on m points.
+
+    Parameters
+    ----------
+    forces
+        The identified contact forces and motion, in harmonics.
+    f0
+        The drive frequency [Hz].
+    preload
+        The static normal preload N0 [N], added to the dynamic normal force.
+    m
+        The points of the period.
+
+    Returns
+    -------
+    grids : dict
+        xi [m], xi_dot [m/s], N [N], S [N], eta [m] and eta_dot [m/s], each of shape (m,).
+    """
     return {
         "xi": periodic_grid(forces.xi, f0, m)[0],
         "xi_dot": periodic_grid(forces.xi_dot, f0, m)[0],
@@ -177,13 +323,40 @@ def refit_friction(
     aug: Augmentation,
     forces: InverseHarmonics,
     f0: float,
-    bounds,
+    bounds: Sequence[Sequence[float]],
     grid: int = 512,
     memo: bool = True,
 ) -> tuple[np.ndarray, float]:
-    """The friction law (with the augmentation's terms) polished from the chain's fit to the
-    identified forces; returns (e_f, k_c, e_t, kappa, mu) and the NRMSE of S (memoised where ``memo``,
-    ``Numerics.memo``: a candidate that changes neither the forces nor the law gets the same polish)."""
+    """Polish the friction law (with the augmentation's terms) from the chain's fit to the identified forces.
+
+    Memoised where ``memo`` (``Numerics.memo``): a candidate that changes neither the forces nor the law gets the same
+    polish.
+
+    Parameters
+    ----------
+    model
+        The identified model (the chain's, or a candidate's): its friction law is the start.
+    aug
+        The effects added to the model (``NONE``: as the chain left it).
+    forces
+        The identified contact forces and motion, in harmonics (``identified_forces``).
+    f0
+        The drive frequency [Hz].
+    bounds
+        The search bounds (low, high) of e_f, k_c, e_t, kappa, mu [N/m, 1/m, N/m, -, -], shape (5, 2) (config
+        ``friction.bounds``, ``FitSettings.bounds``).
+    grid
+        The points of the period the law is fitted on.
+    memo
+        Whether to memoise (``Numerics.memo``).
+
+    Returns
+    -------
+    params : np.ndarray
+        The polished e_f, k_c, e_t, kappa, mu [N/m, 1/m, N/m, -, -], shape (5,).
+    nrmse : float
+        The NRMSE of S, relative to the rms of the identified S [-].
+    """
     law = (aug.iwan_share, aug.viscous, aug.preload_drift)
     key = (
         model.friction,
@@ -218,17 +391,48 @@ def evaluate(
     model: IdentifiedModel,
     aug: Augmentation,
     rec: RecordHarmonics,
-    bounds,
+    bounds: Sequence[Sequence[float]] | None,
     n_harmonics: int,
     refit: bool = True,
     start: SimResult | None = None,
     polish: bool = True,
     numerics: Numerics = DEFAULT,
-):
-    """Redo the chain with ``aug`` on one record: (gap, model with refitted friction, simulation, misfit).
-    ``start``: a neighbouring simulation of the record to warm-start the steady state from; ``polish``: see
-    ``simulate`` (False: the harmonic-balance state itself, where it converges); ``numerics``: the steady state's
-    method and settling tolerance and the memos (``numerics.Numerics``)."""
+) -> tuple[float, IdentifiedModel, SimResult, float]:
+    """Redo the chain with ``aug`` on one record: the gap, the model with refitted friction, its simulation, the misfit.
+
+    Parameters
+    ----------
+    model
+        The identified model (the chain's, or a candidate's).
+    aug
+        The effects added to the model (``NONE``: as the chain left it).
+    rec
+        One load case's record in harmonics.
+    bounds
+        The search bounds (low, high) of e_f, k_c, e_t, kappa, mu [N/m, 1/m, N/m, -, -], shape (5, 2) (config
+        ``friction.bounds``, ``FitSettings.bounds``); None without ``refit``.
+    n_harmonics
+        H, the harmonics compared (the harmonic balance uses 2 H).
+    refit
+        Whether to redo the inverse identification and refit the friction law (False: the model's law as it is).
+    start
+        A neighbouring simulation of the record to warm-start the steady state from (None: none).
+    polish
+        See ``simulate`` (False: the harmonic-balance state itself, where it converges).
+    numerics
+        The steady state's method and settling tolerance and the memos (``numerics.Numerics``).
+
+    Returns
+    -------
+    gap : float
+        The gap ``gap_value`` [-].
+    model : IdentifiedModel
+        The model with the refitted friction law (``model`` itself without ``refit``).
+    sim : SimResult
+        The simulation of the record.
+    misfit : float
+        The refit's NRMSE of S [-]; NaN without ``refit``.
+    """
     misfit = float("nan")
     if refit:
         forces = identified_forces(model, aug, rec, memo=numerics.memo)
@@ -241,6 +445,25 @@ def evaluate(
 def baseline(
     model: IdentifiedModel, rec: RecordHarmonics, n_harmonics: int, numerics: Numerics = DEFAULT
 ) -> tuple[float, SimResult]:
-    """The identified model as the chain left it (no effect, no refit) on one record."""
+    """Return the gap and the simulation of the identified model as the chain left it (no effect, no refit) on a record.
+
+    Parameters
+    ----------
+    model
+        The identified model (the chain's, or a candidate's).
+    rec
+        One load case's record in harmonics.
+    n_harmonics
+        H, the harmonics compared.
+    numerics
+        The steady state's method and settling tolerance and the memos (``numerics.Numerics``).
+
+    Returns
+    -------
+    gap : float
+        The gap ``gap_value`` [-].
+    sim : SimResult
+        The simulation of the record.
+    """
     g, _, sim, _ = evaluate(model, NONE, rec, None, n_harmonics, refit=False, numerics=numerics)
     return g, sim
