@@ -35,6 +35,10 @@ def test_the_command_line_documents_itself(tmp_path):
 
     out = run("--help")
     assert out.returncode == 0 and "audit" in out.stdout and "check-config" in out.stdout
+    for command in ("check-config", "compile-kernels"):  # the docstring's prose, not its numpydoc sections
+        out = run(command, "--help")
+        assert out.returncode == 0 and ("Validate a config" in out.stdout or command != "check-config")
+        assert "Parameters" not in out.stdout and "Returns" not in out.stdout and "----" not in out.stdout
     for cfg in ("config/config.yaml", ".test/config_small.yaml"):
         assert run("check-config", cfg).returncode == 0
     bad = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())

@@ -8,9 +8,31 @@ compile-kernels  numba's kernels compiled into the workflow's cache ahead of its
 """
 
 import argparse
+import inspect
 import os
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+
+
+def command_help(command: Callable[..., int]) -> str:
+    """Return a command's help text: its docstring's prose, without the numpydoc sections.
+
+    Parameters
+    ----------
+    command
+        The function that runs the command (its docstring opens with the summary line, then the prose).
+
+    Returns
+    -------
+    text : str
+        The docstring up to its first section heading (``Parameters``, ``Returns``, ...).
+    """
+    text = inspect.cleandoc(command.__doc__ or "")
+    lines = text.splitlines()
+    for i in range(len(lines) - 1):
+        if lines[i + 1].strip() and set(lines[i + 1].strip()) == {"-"} and len(lines[i + 1]) == len(lines[i]):
+            return "\n".join(lines[:i]).rstrip()
+    return text
 
 
 def check_config_main(argv: Sequence[str]) -> int:
@@ -38,7 +60,7 @@ def check_config_main(argv: Sequence[str]) -> int:
     from .config import check_config, duplicate_key_errors
     from .schema import SCHEMA, ConfigError, load_schema, merged_over, numbers_written_as_text, with_defaults
 
-    parser = argparse.ArgumentParser(prog="contactid check-config", description=check_config_main.__doc__)
+    parser = argparse.ArgumentParser(prog="contactid check-config", description=command_help(check_config_main))
     parser.add_argument("config", nargs="?", default="config/config.yaml", help="the config file (YAML)")
     parser.add_argument("--base", default="config/config.yaml", help="the config the file is merged over")
     parser.add_argument("--alone", action="store_true", help="check the file alone, not merged over the base")
@@ -104,7 +126,7 @@ def compile_kernels_main(argv: Sequence[str]) -> int:
     from . import use_numba_cache_under
     from .kernels import KERNEL_GROUPS, compile_kernels
 
-    parser = argparse.ArgumentParser(prog="contactid compile-kernels", description=compile_kernels_main.__doc__)
+    parser = argparse.ArgumentParser(prog="contactid compile-kernels", description=command_help(compile_kernels_main))
     parser.add_argument("config", nargs="?", default="config/config.yaml", help="the config file (YAML)")
     parser.add_argument(
         "--group", choices=sorted(KERNEL_GROUPS), action="append", help="only these kernels (default: all)"
