@@ -1,12 +1,15 @@
-"""The additive explanation of the held-out gap: the candidates added one at a time (or in pairs) while each
-shrinks what is left materially, with each step's refitted parameters, whether its model opens the contact and
-settles where the records do; the accepted model update as the explanation's step 0 (and the verdict it may carry);
-and the model the explanation arrives at (results/gap/updated_model.json)."""
+"""The additive explanation of the held-out gap, its step 0 (the model update) and the model it arrives at.
+
+The candidates are added one at a time (or in pairs) while each shrinks what is left materially, with each step's
+refitted parameters, whether its model opens the contact and settles where the records do; the accepted model update
+is the explanation's step 0 (and the verdict it may carry); and the model the explanation arrives at is
+results/gap/updated_model.json.
+"""
 
 from __future__ import annotations
 
 import logging
-from typing import TYPE_CHECKING, Mapping, Sequence
+from typing import TYPE_CHECKING, Callable, Collection, Mapping, Sequence
 
 import numpy as np
 
@@ -28,14 +31,33 @@ from .verdict import (
 )
 
 if TYPE_CHECKING:
+    from ..updating_result import UpdatingResult
+    from .calibration import Calibration
+    from .records import RecordHarmonics
     from .settings import GapSettings
+    from .simulation import SimResult
 
 log = logging.getLogger(__name__)
 
 
-def parameter_values(name: str, cal=None, theta=None) -> dict:
-    """{parameter name: refitted value} of a calibrated candidate, or of ``theta`` (per-channel ones numbered by
-    channel)."""
+def parameter_values(name: str, cal: Calibration | None = None, theta: np.ndarray | None = None) -> dict:
+    """Return a calibrated candidate's refitted parameters by name.
+
+    Parameters
+    ----------
+    name
+        The candidate's name in the library.
+    cal
+        Its calibration: its ``theta`` is read where ``theta`` is None.
+    theta
+        The candidate's parameter values, each in its ``Parameter.unit`` [unit of Parameter.unit],
+        shape (n_parameters,) (per channel: one per accelerometer channel); None: ``cal.theta``.
+
+    Returns
+    -------
+    values : dict
+        {parameter name: value}, per-channel ones numbered by channel (``delay_0``, ``delay_1``, ...).
+    """
     cand = LIBRARY[name]
     theta = np.atleast_1d(cal.theta if theta is None else theta)
     return {
@@ -44,12 +66,28 @@ def parameter_values(name: str, cal=None, theta=None) -> dict:
     }
 
 
-def contact_opens(cal, sims: Mapping, open_limit: float) -> bool | None:
-    """Whether a calibrated candidate's model opens the contact anywhere: its N falls to ``open_limit`` x the
-    preload or below over the period, in the calibration case's simulation or a scored case's (None: no simulation
-    to tell). A normal law that may open (contact_separation) but never does in these simulations acts as a stiffer
-    or harder normal law than Eq. 13's spring: model form, not separation (the compound benchmark's hardening rigs,
-    docs/gap.md)."""
+def contact_opens(cal: Calibration, sims: Mapping[str, SimResult], open_limit: float) -> bool | None:
+    """Judge whether a calibrated candidate's model opens the contact anywhere.
+
+    Open: its N falls to ``open_limit`` x the preload or below over the period, in the calibration case's simulation
+    or a scored case's. A normal law that may open (contact_separation) but never does in these simulations acts as
+    a stiffer or harder normal law than Eq. 13's spring: model form, not separation (the compound benchmark's
+    hardening rigs, docs/gap.md).
+
+    Parameters
+    ----------
+    cal
+        The candidate's calibration (its ``simulation`` and ``model``).
+    sims
+        The scored cases' simulations, by case.
+    open_limit
+        The share of the preload at or below which the contact is open [-] (``gap.place.open_limit``).
+
+    Returns
+    -------
+    opens : bool | None
+        Whether it opens; None: no simulation (or no model) to tell.
+    """
     runs = [getattr(cal, "simulation", None), *sims.values()]
     grids = [sim.grid["N"] for sim in runs if isinstance(getattr(sim, "grid", None), dict) and "N" in sim.grid]
     if not grids or getattr(cal, "model", None) is None:
@@ -57,13 +95,41 @@ def contact_opens(cal, sims: Mapping, open_limit: float) -> bool | None:
     return any(bool(np.min(N) <= open_limit * cal.model.preload) for N in grids)
 
 
-def model_periodicity(cal, sims: Mapping, records: Mapping, calibration_case: str, limit: float) -> dict:
-    """Whether a calibrated candidate's model settles where the records do: per case (the calibration case's
-    simulation ``cal.simulation`` and the scored ones ``sims``), the largest share of the model's sensor response
-    that is not periodic (0 for a periodic state or a settled march; a drifting record's is left out), and the cases
-    where the model settles and the record does not, or the other way round (each judged by ``limit``,
-    ``gap.place.aperiodic_limit``). A law whose model impacts on a record that settled (or settles on one that did
-    not) is wrong in form, whatever its harmonic gap: the harmonics of a response that never repeats are averages."""
+def model_periodicity(
+    cal: Calibration,
+    sims: Mapping[str, SimResult],
+    records: Mapping[str, RecordHarmonics],
+    calibration_case: str,
+    limit: float,
+) -> dict:
+    """Judge whether a calibrated candidate's model settles where the records do.
+
+    Per case (the calibration case's simulation ``cal.simulation`` and the scored ones ``sims``), the largest share
+    of the model's sensor response that is not periodic (0 for a periodic state or a settled march; a drifting
+    record's is left out), and the cases where the model settles and the record does not, or the other way round
+    (each judged by ``limit``). A law whose model impacts on a record that settled (or settles on one that did not)
+    is wrong in form, whatever its harmonic gap: the harmonics of a response that never repeats are averages.
+
+    Parameters
+    ----------
+    cal
+        The candidate's calibration (its ``simulation``, the calibration case's).
+    sims
+        The scored cases' simulations, by case.
+    records
+        The records' harmonics, by case (their ``aperiodic`` shares).
+    calibration_case
+        The calibration case's name.
+    limit
+        The share of a response's rms not periodic above which it does not settle [-]
+        (``gap.place.aperiodic_limit``).
+
+    Returns
+    -------
+    periodicity : dict
+        ``aperiodic_by_case`` ({case: the model's largest aperiodic share, as a fraction}) and
+        ``settles_unlike_records`` (the cases where model and record differ).
+    """
     runs = {}
     for c in records:
         sim = getattr(cal, "simulation", None) if c == calibration_case else sims.get(c)
@@ -85,35 +151,67 @@ def explain(  # noqa: C901
     before: float,
     scatter: float,
     settings: GapSettings,
-    heldout_gap,
-    next_pass,
+    heldout_gap: Callable[[Mapping[str, SimResult]], float],
+    next_pass: Callable[[list, Calibration], dict],
     later: list | None = None,
-    periodicity=None,
-    seeded=None,
+    periodicity: Callable[[Calibration, Mapping[str, SimResult]], dict] | None = None,
+    seeded: Callable[[list], dict] | None = None,
 ) -> tuple[list, float, tuple | None]:
-    """The additive explanation of the held-out gap: add the candidate that leaves the smallest held-out gap
-    (its refit included), then try the remaining candidates on top of it (``next_pass(remaining, calibration)``
-    gives their results), and so on; stop when no candidate shrinks what is left materially
-    (``verdict.explains_materially``) or what is left is at the identification's floor (``verdict.at_floor``).
-    Where what is left exceeds ``settings.pair_lookahead`` times the floor (0: never) and the best candidate shrinks
-    it beyond the records' scatter but not materially, the next pass is tried on top of it: two effects that each
-    leave most of the gap may together explain it (a preload drift and a normal dashpot, 36 % and 24 % alone); the
-    pair is added when together they shrink it materially and the second shrinks it further beyond the scatter.
-    Before any step (and unless the lookahead is 0), ``seeded(remaining)`` ({seed: (its result, the next pass on top
-    of it)}, or None) offers more first halves of a pair: an effect measured elsewhere and held there (the random
+    """Explain the held-out gap additively: candidates added one at a time, or in pairs, while each shrinks it.
+
+    Add the candidate that leaves the smallest held-out gap (its refit included), then try the remaining candidates on
+    top of it (``next_pass(remaining, calibration)`` gives their results), and so on; stop when no candidate shrinks
+    what is left materially (``verdict.explains_materially``) or what is left is at the identification's floor
+    (``verdict.at_floor``). Where what is left exceeds ``settings.pair_lookahead`` times the floor (0: never) and the
+    best candidate shrinks it beyond the records' scatter but not materially, the next pass is tried on top of it: two
+    effects that each leave most of the gap may together explain it (a preload drift and a normal dashpot, 36 % and 24 %
+    alone); the pair is added when together they shrink it materially and the second shrinks it further beyond the
+    scatter. Before any step (and unless the lookahead is 0), ``seeded(remaining)`` ({seed: (its result, the next pass
+    on top of it)}, or None) offers more first halves of a pair: an effect measured elsewhere and held there (the random
     test's channel delays), which alone may widen the gap by exposing a second effect it masks (a channel skew of 10-30
     us and a normal dashpot of 400 s/m: the dashpot refitted to zero, the skew searched away from its delays; held at
     them, the dashpot took 2.54 to 0.44 %). Held, it adds no parameter the records fit, so its pair competes with the
     pass's best alone as well: it is added where it leaves less than that best and than the seed alone, beyond the
     scatter, and explains materially. The pair that leaves the least is added.
 
-    first: {name: (calibration, sims, residuals)} of the first pass; heldout_gap(sims) the held-out gap of a
-    model's simulations; later: the candidates tried after the first pass (``verdict.retried``; None: all);
-    periodicity(cal, sims): a step's ``model_periodicity`` (None: not reported).
-    Returns (steps [{effect, parameters, heldout_gap_before, heldout_gap_after, alternatives, share}], the gap left,
-    (calibration, sims) of the last step or None). share: the part of the held-out gap's power (its square) the step
-    removes; the shares and the remaining share sum to 1. alternatives: the candidates of the step's pass that the
-    records cannot tell from its effect (``verdict.indistinguishable``), closest first."""
+    Parameters
+    ----------
+    first
+        {name: (calibration, sims, residuals)} of the first pass.
+    names
+        The candidates' names, in the library's order (ties go to the earlier).
+    before
+        The held-out gap before any step [-] (a relative residual norm).
+    scatter
+        The records' scatter of the held-out gap [-] (its bootstrap sd).
+    settings
+        The diagnosis's settings (``noise_factor``, ``pair_lookahead``, ``min_gap``, the verdict's thresholds,
+        ``place.open_limit``).
+    heldout_gap
+        heldout_gap(sims): the held-out gap [-] of a model's simulations by case.
+    next_pass
+        next_pass(remaining, calibration): the remaining candidates' results on top of the last step's calibration,
+        {name: (calibration, sims, residuals)}.
+    later
+        The candidates tried after the first pass (``verdict.retried``); None: all.
+    periodicity
+        periodicity(cal, sims): a step's ``model_periodicity``; None: not reported.
+    seeded
+        seeded(remaining): {seed: (its result, the next pass on top of it)}, the seeds' pairs; None: no seeds.
+
+    Returns
+    -------
+    steps : list
+        [{effect, parameters, heldout_gap_before, heldout_gap_after, alternatives, share, contact_opens, ...}]:
+        share, the part of the held-out gap's power (its square) the step removes (the shares and the remaining
+        share sum to 1); alternatives, the candidates of the step's pass that the records cannot tell from its
+        effect (``verdict.indistinguishable``), closest first; ``held`` and ``pair_first`` where they apply, the
+        periodicity's keys where reported, and ``_fit`` (calibration, sims), not written.
+    gap : float
+        The held-out gap left [-].
+    last : tuple | None
+        (calibration, sims) of the last step; None: no step.
+    """
     steps, gap, last, results, remaining = [], before, None, first, list(names)
     held_step = None  # a seed's effect added at the values measured elsewhere
     beyond_scatter = settings.noise_factor * scatter
@@ -208,9 +306,25 @@ def explain(  # noqa: C901
     return steps, gap, last
 
 
-def updating_summary(updating, model: IdentifiedModel) -> dict:
-    """diagnosis.json's model_updating block: the update's summary and the friction law the candidates start
-    from (refitted with the updated structure when the update is accepted)."""
+def updating_summary(updating: UpdatingResult, model: IdentifiedModel) -> dict:
+    """Return diagnosis.json's model_updating block.
+
+    The update's summary and the friction law the candidates start from (refitted with the updated structure when
+    the update is accepted).
+
+    Parameters
+    ----------
+    updating
+        The model update.
+    model
+        The model the candidates start from (its friction law and preload).
+
+    Returns
+    -------
+    block : dict
+        The update's ``summary()`` with ``friction``: e_f, k_c, e_t, kappa, mu (in their units,
+        ``friction_parameters.PARAMETER_UNITS``) and e0_at_preload (N/m).
+    """
     e_f, k_c, e_t, kappa, mu = model.friction
     return {
         **updating.summary(),
@@ -225,10 +339,27 @@ def updating_summary(updating, model: IdentifiedModel) -> dict:
     }
 
 
-def updating_step(updating, gap_before: float, gap_after: float) -> dict:
-    """The explanation's step 0 when the model updating was accepted: the factors (and the clamp's stiffness in N m/rad
-    where the data bind its compliance, which a test engineer reads more easily than the factor) and the held-out gap
-    it took away."""
+def updating_step(updating: UpdatingResult, gap_before: float, gap_after: float) -> dict:
+    """Return the explanation's step 0 when the model updating was accepted.
+
+    The factors (and the clamp's stiffness in N m/rad where the data bind its compliance, which a test engineer reads
+    more easily than the factor) and the held-out gap it took away.
+
+    Parameters
+    ----------
+    updating
+        The accepted model update.
+    gap_before
+        The identified model's held-out gap [-].
+    gap_after
+        The updated model's held-out gap [-].
+
+    Returns
+    -------
+    step : dict
+        {effect: "model_updating", parameters (the factors, k_t and k_n in N/m, the clamp's stiffness in N m/rad
+        where bound), heldout_gap_before, heldout_gap_after}.
+    """
     k_clamp = updating.structure.clamp_rotational_stiffness
     bound = (updating.identifiability.get("clamp_compliance_scale") or {}).get("bound_by_data", False)
     clamp = {"clamp_rotational_stiffness_nm_per_rad": k_clamp} if bound and np.isfinite(k_clamp) else {}
@@ -240,10 +371,43 @@ def updating_step(updating, gap_before: float, gap_after: float) -> dict:
     }
 
 
-def updating_verdict(updating, names, gap_before, gap_after, shares, scatter, settings) -> tuple[str, str] | None:
-    """(verdict, reason) when the accepted update explains most of the gap (the largest share, and min_reduction of
-    the whole gap as a candidate's verdict needs: ``verdict.explains_most``) and amounts to one effect of the library
-    in use; otherwise None."""
+def updating_verdict(
+    updating: UpdatingResult,
+    names: Collection[str],
+    gap_before: float,
+    gap_after: float,
+    shares: Sequence[float],
+    scatter: float,
+    settings: GapSettings,
+) -> tuple[str, str] | None:
+    """Return the accepted update's verdict and reason where it explains most of the gap as one effect.
+
+    Most of the gap: the largest share, and min_reduction of the whole gap as a candidate's verdict needs
+    (``verdict.explains_most``); one effect: of the library in use (``verdict.updating_effect``).
+
+    Parameters
+    ----------
+    updating
+        The accepted model update.
+    names
+        The library in use: the candidates' names.
+    gap_before
+        The identified model's held-out gap [-].
+    gap_after
+        The updated model's held-out gap [-].
+    shares
+        The explanation's steps' shares of the gap's power, the update's first [-].
+    scatter
+        The records' scatter of the held-out gap [-].
+    settings
+        The diagnosis's settings.
+
+    Returns
+    -------
+    verdict : tuple[str, str] | None
+        (the effect's name, the reason); None where the update does not explain most of the gap or amounts to no
+        effect of the library.
+    """
     if shares[0] != max(shares) or not explains_most(gap_before, gap_after, scatter, settings):
         return None
     by_records = getattr(updating, "accepted_by", "") == "records"
@@ -277,11 +441,33 @@ def _friction_dict(friction, preload: float) -> dict:
     }
 
 
-def updated_model_summary(chain: IdentifiedModel, base: IdentifiedModel, last, steps: list, left: float) -> dict:
-    """results/gap/updated_model.json: the model the explanation arrives at, the structure and the friction law
-    refitted with the explained effects (``last``: the last effect step's calibration and simulations; None: the model
-    diagnosed, updated or the chain's), beside the chain's own law. ``steps``: the explanation kept; ``left``: the
-    held-out gap it leaves."""
+def updated_model_summary(
+    chain: IdentifiedModel, base: IdentifiedModel, last: tuple | None, steps: list, left: float
+) -> dict:
+    """Return results/gap/updated_model.json: the model the explanation arrives at.
+
+    The structure and the friction law refitted with the explained effects, beside the chain's own law.
+
+    Parameters
+    ----------
+    chain
+        The chain's identified model (its own law).
+    base
+        The model diagnosed (updated or the chain's), used where no effect was explained.
+    last
+        The last effect step's (calibration, sims); None: no effect step.
+    steps
+        The explanation kept.
+    left
+        The held-out gap it leaves [-].
+
+    Returns
+    -------
+    summary : dict
+        what, effects, model_updating, friction, friction_chain, structure (stiffnesses in N/m, Young's modulus in
+        Pa, lever arm in m, masses in kg, the clamp's stiffness in N m/rad, the extra damping ratio),
+        calibration_gap and heldout_gap.
+    """
     cal = last[0] if last is not None else None
     model = cal.model if cal is not None else base
     friction = cal.friction if cal is not None else model.friction
@@ -318,12 +504,33 @@ def updated_model_summary(chain: IdentifiedModel, base: IdentifiedModel, last, s
 def with_damping_at_test_level(
     updated: dict, test_damping: Mapping | None, explanation: Sequence, preload: float
 ) -> dict:
-    """results/gap/updated_model.json with the damping at test level (summary.json's ``friction.test_damping``, rule
-    test_damping) where the records call for it and nothing else explains their gap: the held-out load cases confirmed
-    the factor (``accepted``), the explanation names no effect (``story.effect_steps``; an effect's refit is the
-    model then) and the diagnosed model is the chain's (the factor was weighed on the chain's structure, not an update
-    of it). The model then carries the factor, the friction law fitted with it and the held-out gap it leaves; otherwise
-    ``damping_at_test_level`` says why it is not applied."""
+    """Return results/gap/updated_model.json with the damping at test level where the records call for it.
+
+    The damping at test level is summary.json's ``friction.test_damping`` (rule test_damping). It is applied where
+    the records call for it and nothing else explains their gap: the held-out load cases confirmed the factor
+    (``accepted``), the explanation names no effect (``story.effect_steps``; an effect's refit is the model then) and
+    the diagnosed model is the chain's (the factor was weighed on the chain's structure, not an update of it). The
+    model then carries the factor, the friction law fitted with it and the held-out gap it leaves; otherwise
+    ``damping_at_test_level`` says why it is not applied.
+
+    Parameters
+    ----------
+    updated
+        updated_model.json as ``updated_model_summary`` writes it.
+    test_damping
+        summary.json's ``friction.test_damping``: reads ``accepted``, ``law`` ({parameter: value}), ``reason`` and
+        ``heldout_gap_test_damping``; None or empty: not profiled.
+    explanation
+        The explanation's steps.
+    preload
+        The preload N0 [N].
+
+    Returns
+    -------
+    updated : dict
+        ``updated`` unchanged where there is no test damping, with ``damping_at_test_level`` added (applied or why
+        not) otherwise.
+    """
     from .story import effect_steps
 
     if not test_damping:

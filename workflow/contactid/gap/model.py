@@ -15,31 +15,48 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import Mapping
+from typing import Mapping, Sequence
 
 import numpy as np
 import xarray as xr
 
-from ..beam_model import assemble
+from ..beam_model import FEModel, assemble
 from ..friction_parameters import fitted_parameters
 from ..parameters import StructureParameters, identified_structure
-from ..rig.nonlinear import reduced_model
+from ..rig.nonlinear import ReducedModel, reduced_model
 
 
 @dataclass(frozen=True)
 class Augmentation:
     """Effects added to the identified model (all off by default; SI units).
 
-    extra_damping: modal damping ratio added to the beam's modes; hunt_crossley: alpha (s/m) of
-    N (1 - alpha deta/dt); viscous: sigma_2 (N s/m) of S + sigma_2 dxi/dt; iwan_share: share of the
-    tangential contact carried by a Maxwell-slip (Iwan) element; mass_error: relative error of
-    every transducer mass; delays: (j,) s, acceleration channels late on the force; gains: (j,) each acceleration
-    channel reads g times its acceleration (a sensitivity error);
-    unilateral_exponent: 0 = the linear bilateral spring N0 - k_n eta, p >= 1 = the unilateral
-    power law N0 ((delta0 - eta)/delta0)^p with delta0 = p N0 / (c k_n) (the contact may open), c the
-    normal_stiffness_factor on the linear chain's k_n (poorly determined by frequencies);
-    preload_drift: relative change of the preload over the record; shortening_change: relative change of the beam's
-    shortening in the slip (Eq. 9's integral scaled by 1 + shortening_change; -1: linear kinematics).
+    Attributes
+    ----------
+    extra_damping
+        Modal damping ratio added to the beam's modes [-].
+    hunt_crossley
+        alpha of the normal force N (1 - alpha deta/dt) [s/m].
+    viscous
+        sigma_2 of the tangential force S + sigma_2 dxi/dt [N*s/m].
+    iwan_share
+        Share of the tangential contact carried by a Maxwell-slip (Iwan) element [-].
+    mass_error
+        Relative error of every transducer mass [-].
+    delays
+        Each acceleration channel's delay on the force [s], j of them (one per accelerometer; empty: none).
+    gains
+        Each acceleration channel reads g times its acceleration (a sensitivity error), g [-], j of them (empty:
+        none).
+    unilateral_exponent
+        0 = the linear bilateral spring N0 - k_n eta, p >= 1 = the unilateral power law
+        N0 ((delta0 - eta)/delta0)^p with delta0 = p N0 / (c k_n) (the contact may open) [-].
+    normal_stiffness_factor
+        c, the factor on the linear chain's k_n in the unilateral law (poorly determined by frequencies) [-].
+    preload_drift
+        Relative change of the preload over the record [-].
+    shortening_change
+        Relative change of the beam's shortening in the slip [-] (Eq. 9's integral scaled by
+        1 + shortening_change; -1: linear kinematics).
     """
 
     extra_damping: float = 0.0
@@ -55,7 +72,18 @@ class Augmentation:
     shortening_change: float = 0.0
 
     def merge(self, other: "Augmentation") -> "Augmentation":
-        """Both augmentations' effects (other's non-default fields win)."""
+        """Return both augmentations' effects in one.
+
+        Parameters
+        ----------
+        other
+            The augmentation merged over this one: its non-default fields win.
+
+        Returns
+        -------
+        merged : Augmentation
+            This augmentation with ``other``'s non-default fields.
+        """
         changes = {
             f.name: getattr(other, f.name) for f in dataclasses.fields(other) if getattr(other, f.name) != f.default
         }
@@ -67,15 +95,41 @@ NONE = Augmentation()
 
 @dataclass(frozen=True)
 class IdentifiedModel:
-    """The chain's identified model: structure (with identified k_t, k_n), damping ratios of the
-    identified structural modes (by order), friction parameters (e_f, k_c, e_t, kappa, mu), preload
-    N0 (N), the number of stuck modes kept and the integration oversampling; the reading of Eq. 21
-    the friction law was fitted with (``regularization``, from friction_fit.nc). The chain's stiffness fit, for
-    a candidate that redoes it (``structure_with``): the identified natural frequencies (Hz), their weights
-    ``frequency_sigma`` (Hz; empty: relative residuals), the prior sd of ln(E / ``config_modulus``)
-    (``stiffness_scale_sd``; 0: E held), the config's Young's modulus ``config_modulus`` (Pa), and whether the
-    frequencies bound k_n (``k_n_bounded``: the linear modes use the fit's k_n; otherwise they use the prior, and a
-    refit holds it)."""
+    """The chain's identified model, and the chain's stiffness fit for a candidate that redoes it.
+
+    The stiffness fit's fields (``frequencies`` to ``k_n_bounded``) serve a candidate that redoes the fit
+    (``structure_with``).
+
+    Attributes
+    ----------
+    structure
+        The structure, with the identified k_t and k_n.
+    damping
+        Damping ratios of the identified structural modes, by order [-].
+    friction
+        Friction parameters (e_f [N/m], k_c [1/m], e_t [N/m], kappa [-], mu [-]).
+    preload
+        Preload N0 [N].
+    n_modes
+        Number of stuck modes kept.
+    oversampling
+        The integration's oversampling.
+    frequencies
+        The identified natural frequencies [Hz].
+    regularization
+        The reading of Eq. 21 the friction law was fitted with (from friction_fit.nc).
+    frequency_sigma
+        The frequencies' weights [Hz]; empty: relative residuals.
+    stiffness_scale_sd
+        The prior sd of ln(E / ``config_modulus``) [-]; 0: E held.
+    config_modulus
+        The config's Young's modulus [Pa].
+    k_n_bounded
+        Whether the frequencies bound k_n: the linear modes use the fit's k_n; otherwise they use the prior, and a
+        refit holds it.
+    test_damping_ratios
+        The identified modes' damping ratios in the dual-sine tests [-]; empty: the random test's (``damping``).
+    """
 
     structure: StructureParameters
     damping: tuple
@@ -93,16 +147,35 @@ class IdentifiedModel:
 
     @property
     def test_damping(self) -> tuple:
-        """The identified modes' damping ratios in the dual-sine tests: ``test_damping_ratios`` where given (the model
-        at a factor of ``contactid.test_damping``, weighed by ``gap.pipeline.confirmed_test_damping``), else the random
-        test's (``damping``), as the chain identifies them."""
+        """The identified modes' damping ratios in the dual-sine tests [-].
+
+        ``test_damping_ratios`` where given (the model at a factor of ``contactid.test_damping``, weighed by
+        ``gap.pipeline.confirmed_test_damping``), else the random test's (``damping``), as the chain identifies them.
+
+        Returns
+        -------
+        ratios : tuple
+            The damping ratios, by mode [-].
+        """
         return tuple(self.test_damping_ratios) or tuple(self.damping)
 
     def structure_with(self, aug: Augmentation) -> StructureParameters:
-        """The structure with the augmentation's changes; changed masses re-fit k_t and k_n to the identified
-        natural frequencies, and Young's modulus with them where the chain's stiffness fit freed it (the linear
-        chain's stiffness fit redone with the effect in the model, ``_refit_contact``); a changed shortening leaves
-        them (a second-order term: the linear chain does not see it)."""
+        """Return the structure with the augmentation's changes.
+
+        Changed masses re-fit k_t and k_n to the identified natural frequencies, and Young's modulus with them where
+        the chain's stiffness fit freed it (the linear chain's stiffness fit redone with the effect in the model,
+        ``_refit_contact``); a changed shortening leaves them (a second-order term: the linear chain does not see it).
+
+        Parameters
+        ----------
+        aug
+            The augmentation: its ``shortening_change`` and ``mass_error`` act on the structure.
+
+        Returns
+        -------
+        structure : StructureParameters
+            The changed structure.
+        """
         p = self.structure
         if aug.shortening_change:
             p = p.replace(shortening_scale=p.shortening_scale * (1.0 + aug.shortening_change))
@@ -115,10 +188,24 @@ class IdentifiedModel:
         return p
 
     def refit_stiffness(self, structure: StructureParameters, free_modulus: bool = True) -> StructureParameters:
-        """``structure`` with the chain's stiffness fit redone on it (``_refit_contact``): k_t and k_n fitted to the
-        identified natural frequencies with the chain's weights, Young's modulus with them under the chain's prior
-        where ``free_modulus`` and the chain freed it (otherwise as ``structure`` has it), and k_n held where the
-        chain's modes use the prior k_n. Without identified frequencies, ``structure`` as it is."""
+        """Return a structure with the chain's stiffness fit redone on it (``_refit_contact``).
+
+        k_t and k_n fitted to the identified natural frequencies with the chain's weights, Young's modulus with them
+        under the chain's prior where ``free_modulus`` and the chain freed it (otherwise as ``structure`` has it),
+        and k_n held where the chain's modes use the prior k_n.
+
+        Parameters
+        ----------
+        structure
+            The structure to refit.
+        free_modulus
+            Whether Young's modulus may be refitted (where the chain freed it).
+
+        Returns
+        -------
+        structure : StructureParameters
+            The refitted structure; without identified frequencies, ``structure`` as it is.
+        """
         if not self.frequencies:
             return structure
         return _refit_contact(
@@ -130,8 +217,19 @@ class IdentifiedModel:
             self.k_n_bounded,
         )
 
-    def with_friction(self, friction) -> "IdentifiedModel":
-        """The model with its friction parameters (e_f, k_c, e_t, kappa, mu) replaced by ``friction``."""
+    def with_friction(self, friction: Sequence[float]) -> "IdentifiedModel":
+        """Return the model with its friction parameters replaced.
+
+        Parameters
+        ----------
+        friction
+            The friction parameters (e_f [N/m], k_c [1/m], e_t [N/m], kappa [-], mu [-]).
+
+        Returns
+        -------
+        model : IdentifiedModel
+            The model with them.
+        """
         return dataclasses.replace(self, friction=tuple(float(x) for x in friction))
 
 
@@ -143,9 +241,33 @@ def identified_model(
     n_modes: int = 8,
     oversampling: int = 8,
 ) -> IdentifiedModel:
-    """The identified model from the chain's datasets (linear_modes.nc, modal.nc, friction_fit.nc); the stiffness
-    fit's prior and weights from linear_modes.nc's attributes where it has them (otherwise E held, relative
-    residuals: the fit of datasets written before they were kept)."""
+    """Return the identified model from the chain's datasets.
+
+    The stiffness fit's prior and weights come from linear_modes.nc's attributes where it has them (otherwise E
+    held, relative residuals: the fit of datasets written before they were kept).
+
+    Parameters
+    ----------
+    structure_cfg
+        The config's ``structure`` block: reads ``preload_n`` [N] and what ``parameters.identified_structure``
+        reads.
+    linear_modes
+        linear_modes.nc: reads ``k_t``, ``k_n``, ``stiffness_scale`` and the attributes ``frequency_sigma_hz``,
+        ``stiffness_scale_sd`` and ``k_n_choice``.
+    modal
+        modal.nc: reads ``damping_ratio`` and ``natural_frequency`` (mode).
+    friction_fit
+        friction_fit.nc: reads the law's parameters and the attribute ``regularization``.
+    n_modes
+        Number of stuck modes kept.
+    oversampling
+        The integration's oversampling.
+
+    Returns
+    -------
+    model : IdentifiedModel
+        The identified model.
+    """
     params = identified_structure(structure_cfg, linear_modes)
     scale = float(linear_modes["stiffness_scale"]) if "stiffness_scale" in linear_modes else 1.0
     attrs = getattr(linear_modes, "attrs", {})
@@ -179,10 +301,11 @@ def _refit_contact(
     config_modulus: float = 0.0,
     refit_k_n: bool = True,
 ) -> StructureParameters:
-    """k_t and k_n (and, with ``scale_sd`` > 0, Young's modulus) that best fit the identified natural frequencies
-    (Hz): the stiffness fit of the linear chain (``stiction.stiction_stiffness``), redone from the current values
-    (with its Jacobian, ``stiction.JACOBIAN``); k_t within two decades of its value, k_n from two decades below to
-    ``KN_REFIT_ABOVE`` decades above.
+    """Refit k_t and k_n (and, with ``scale_sd`` > 0, Young's modulus) to the identified natural frequencies.
+
+    The frequencies are in Hz. The stiffness fit of the linear chain (``stiction.stiction_stiffness``), redone from
+    the current values (with its Jacobian, ``stiction.JACOBIAN``); k_t within two decades of its value, k_n from two
+    decades below to ``KN_REFIT_ABOVE`` decades above.
 
     Residuals (f - f_id) / ``sigma`` (the chain's weights, Hz; empty: relative residuals f / f_id - 1) and, with
     ``scale_sd`` > 0, the chain's prior ln(E / ``config_modulus``) / ``scale_sd`` on a free E within
@@ -202,7 +325,8 @@ def _refit_contact(
     to that bound, 100 times the chain's value, at a transducer-mass error of 10 % or more, for a misfit smaller by
     a few 1e-4 (the frequency floor is 1e-3), and the reduced model got a normal mode at 34-36 kHz instead of 3.8 kHz,
     which the integrator then resolved with 3.5 times the steps (``simulator``). Capped, the misfit is within 2e-4 of
-    that and the mode at most sqrt(10) times the chain's (11 kHz: 9 steps per sample instead of 8)."""
+    that and the mode at most sqrt(10) times the chain's (11 kHz: 9 steps per sample instead of 8).
+    """
     from scipy.optimize import least_squares
 
     from ..beam_model import ContactFrequencyMap
@@ -251,13 +375,42 @@ def _refit_contact(
 
 
 @lru_cache(maxsize=32)
-def reduced(params: StructureParameters, n_modes: int):
-    """The FE model of ``params`` and its reduced model on the lowest ``n_modes`` stuck modes
-    (``rig.nonlinear.reduced_model``), as a pair; the last 32 are cached."""
+def reduced(params: StructureParameters, n_modes: int) -> tuple[FEModel, ReducedModel]:
+    """Return the FE model of a structure and its reduced model on the lowest stuck modes.
+
+    The reduced model is ``rig.nonlinear.reduced_model``'s; the last 32 pairs are cached.
+
+    Parameters
+    ----------
+    params
+        The structure.
+    n_modes
+        Number of stuck modes the reduced model keeps.
+
+    Returns
+    -------
+    model : FEModel
+        The FE model.
+    reduced : ReducedModel
+        Its reduced model.
+    """
     model = assemble(params)
     return model, reduced_model(model, n_modes)
 
 
-def fe_model(model: IdentifiedModel, aug: Augmentation = NONE):
-    """The FE model (with the augmentation's structural changes)."""
+def fe_model(model: IdentifiedModel, aug: Augmentation = NONE) -> FEModel:
+    """Return the identified model's FE model, with the augmentation's structural changes.
+
+    Parameters
+    ----------
+    model
+        The identified model.
+    aug
+        The augmentation (``IdentifiedModel.structure_with``).
+
+    Returns
+    -------
+    fe : FEModel
+        The FE model.
+    """
     return reduced(model.structure_with(aug), model.n_modes)[0]

@@ -1,5 +1,7 @@
-"""The gap section's paragraphs on the benchmarks (text generated from benchmark.json): the blind benchmark, the
-compound one when built, the accuracy per effect; a note when the benchmark was not built."""
+"""The gap section's paragraphs on the benchmarks, text generated from benchmark.json.
+
+The blind benchmark, the compound one when built, the accuracy per effect; a note when the benchmark was not built.
+"""
 
 from __future__ import annotations
 
@@ -10,7 +12,7 @@ from .report_format import pct
 
 
 def _bound_text(c: dict) -> str:
-    """The compound benchmark's errors of what the data bind (mu a, e_0 a^2), when scored."""
+    """Return the compound benchmark's errors of what the data bind (mu a, e_0 a^2), when scored."""
     b = c.get("perturbation_only_median_abs_bound_error")
     if not b or any(v is None for v in b.values()):
         return ""
@@ -24,7 +26,7 @@ def _bound_text(c: dict) -> str:
 
 
 def _coverage_text(c: dict) -> str:
-    """The compound benchmark's interval coverage (intervals with the model-form term), when scored."""
+    """Return the compound benchmark's interval coverage (intervals with the model-form term), when scored."""
     cov, hw = c.get("perturbation_only_interval_coverage"), c.get("perturbation_only_median_interval_halfwidth")
     if not cov or not hw or any(cov.get(k) is None for k in ("mu", "kappa", "e0")):
         return ""
@@ -47,8 +49,23 @@ NO_BENCHMARK = (
 
 
 def blind_paragraph(bench: dict) -> str:
-    """The blind benchmark in words: top-1 accuracy, false alarms, shrink of the correctly named effects (%), the
-    left-out items and the median diagnosis time (s)."""
+    """Return the blind benchmark in words.
+
+    Top-1 accuracy, false alarms, shrink of the correctly named effects (%), the left-out items and the median
+    diagnosis time (s).
+
+    Parameters
+    ----------
+    bench
+        benchmark.json: reads ``n_blind``, ``top1_accuracy``, ``false_alarms``, ``n_effect_free``,
+        ``shrink_of_correct`` (``min``, ``median``), ``leave_out`` (``n``, ``verdict_none``, ``place_right``) and
+        ``diagnosis_seconds`` (``median``, in s); fractions as 0-1.
+
+    Returns
+    -------
+    text : str
+        The paragraph, in LaTeX.
+    """
     lo = bench["leave_out"]
     return (
         "\n\\paragraph{Blind benchmark.} " + str(bench["n_blind"]) + r" rig data sets, each with one effect on at a "
@@ -75,8 +92,25 @@ def blind_paragraph(bench: dict) -> str:
 
 
 def compound_paragraph(c: dict) -> str:
-    """The compound benchmark in words: effects named (%), the remaining held-out gap and the friction law's errors
-    after updating (%), with what the data bind and the intervals' coverage when scored."""
+    """Return the compound benchmark in words.
+
+    Effects named (%), the remaining held-out gap and the friction law's errors after updating (%), with what the
+    data bind and the intervals' coverage when scored.
+
+    Parameters
+    ----------
+    c
+        benchmark.json's ``compound`` block: reads ``n``, ``n_by_effect_count``, the shares
+        ``perturbation_only_no_contact_effect``, ``one_effect_named``, ``one_effect_no_absent_contact_effect``,
+        ``two_effects_both_named``, ``two_effects_one_named``, ``remaining_gap_median``,
+        ``perturbation_only_median_abs_error`` (``mu``, ``kappa``, ``e0``) and, when scored, the bound errors and the
+        intervals' coverage and half-widths; fractions as 0-1.
+
+    Returns
+    -------
+    text : str
+        The paragraph, in LaTeX.
+    """
     err = c["perturbation_only_median_abs_error"]
     return (
         "\n\\paragraph{Compound benchmark.} " + str(c["n"]) + r" rig data sets whose structure (E, transducer "
@@ -109,7 +143,18 @@ def compound_paragraph(c: dict) -> str:
 
 
 def accuracy_table(bench: dict) -> str:
-    """The blind benchmark's top-1 accuracy per effect (%) as a table, and the confusion matrix's figure."""
+    """Return the blind benchmark's top-1 accuracy per effect (%) as a table, and the confusion matrix's figure.
+
+    Parameters
+    ----------
+    bench
+        benchmark.json: reads ``per_effect_accuracy`` ({effect: accuracy as 0-1}).
+
+    Returns
+    -------
+    text : str
+        The table and the figure (confusion.png), in LaTeX.
+    """
     acc = pd.DataFrame([{"effect": e, "accuracy": 100 * a} for e, a in bench["per_effect_accuracy"].items()])
     return tabular(
         acc, {"effect": "effect", "accuracy": "top-1 (\\%)"}, "Blind benchmark: accuracy per effect.", "tab:bench"
@@ -120,8 +165,20 @@ def accuracy_table(bench: dict) -> str:
 
 
 def benchmark_text(bench: dict | None) -> str:
-    """The benchmarks' part of the section: the blind benchmark, the compound one when built, the accuracy table;
-    a note when the benchmark was not built (``bench`` None)."""
+    """Return the benchmarks' part of the section.
+
+    The blind benchmark, the compound one when built, the accuracy table; a note when the benchmark was not built.
+
+    Parameters
+    ----------
+    bench
+        benchmark.json (``blind_paragraph``, ``compound_paragraph``, ``accuracy_table``); None: not built.
+
+    Returns
+    -------
+    text : str
+        The text, in LaTeX.
+    """
     if bench is None:
         return NO_BENCHMARK
     out = blind_paragraph(bench)
