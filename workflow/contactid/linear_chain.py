@@ -7,7 +7,7 @@ the next step's dataset, so the rule scripts stay a few lines long.
 from __future__ import annotations
 
 import logging
-from typing import Mapping
+from typing import Collection, Mapping, Sequence
 
 import numpy as np
 import xarray as xr
@@ -23,7 +23,24 @@ log = logging.getLogger(__name__)
 
 
 def check_sensor_layout(raw: xr.Dataset, structure_cfg: Mapping, path: str, tol_m: float = 1e-3) -> None:
-    """The raw record's sensor positions must be those of the structure model."""
+    """Check that the raw record's sensor positions are those of the structure model.
+
+    Parameters
+    ----------
+    raw
+        The raw record: reads its coordinate ``position`` (sensor) [m].
+    structure_cfg
+        The config's ``structure`` block: reads ``sensors.positions_m`` [m].
+    path
+        The record's path, for the message.
+    tol_m
+        How far a position may lie from the model's [m].
+
+    Raises
+    ------
+    RawDataError
+        When the record has another number of sensors or a sensor lies more than ``tol_m`` from the model's.
+    """
     pos = np.asarray(raw["position"].values, dtype=float)
     want = np.asarray(structure_cfg["sensors"]["positions_m"], dtype=float)
     if pos.shape != want.shape or np.max(np.abs(pos - want)) > tol_m:
@@ -34,9 +51,37 @@ def check_sensor_layout(raw: xr.Dataset, structure_cfg: Mapping, path: str, tol_
 
 
 def frf_dataset(raw: xr.Dataset, segment_length: int, overlap: float, window: str, blocks: int) -> xr.Dataset:
-    """H1 and coherence of every accelerometer over the force for the whole
-    record, plus H1 of ``blocks`` consecutive sub-records (for the modal
-    fit's statistical uncertainty)."""
+    """Return H1 and coherence of every accelerometer over the force, for the record and for sub-records.
+
+    H1 and coherence are those of the whole record, plus H1 of ``blocks`` consecutive sub-records (for the modal
+    fit's statistical uncertainty), interpolated onto the whole record's frequencies; a sub-record shorter than two
+    segments is analysed with segments of half its length.
+
+    Parameters
+    ----------
+    raw
+        The random test's raw record: ``force`` (time) [N], ``acceleration`` (sensor, time) [m/s^2], the coordinates
+        ``sensor`` and ``position`` [m], the attribute ``sampling_rate_hz`` [Hz].
+    segment_length
+        Welch segment length [samples] (config ``frf.segment_length``).
+    overlap
+        Overlap of consecutive segments, a fraction of the segment length [-] (``frf.overlap``).
+    window
+        The segments' window, a scipy.signal window name (``frf.window``).
+    blocks
+        Number of consecutive sub-records (``modal.uncertainty_blocks``).
+
+    Returns
+    -------
+    frf : xr.Dataset
+        The FRF dataset (results/linear/frf.nc) of ``frf_result_dataset``, its attributes the averages, the
+        settings, the sampling rate and the driving-point sensor (the first).
+
+    Raises
+    ------
+    RawDataError
+        When the record is shorter than two segments.
+    """
     fs = float(raw.attrs["sampling_rate_hz"])
     force = raw["force"].values
     acc = raw["acceleration"].values
@@ -81,11 +126,44 @@ def frf_dataset(raw: xr.Dataset, segment_length: int, overlap: float, window: st
     )
 
 
-def frf_result_dataset(frequency_hz, h1, coherence, block_h1, sensors, positions_m, attrs: Mapping) -> xr.Dataset:
-    """The FRF dataset (results/linear/frf.nc) the modal fit reads: H1 accelerance (sensor, frequency) complex in
-    m/s^2/N, ordinary coherence (1), H1 of sub-records (block, sensor, frequency; the block dimension may be
-    empty: no sub-records), frequency (Hz), sensor names and positions (m), and ``attrs``. One home of the
-    variables, units and names, for the FRF from a time record and the FRF imported from a file."""
+def frf_result_dataset(
+    frequency_hz: np.ndarray,
+    h1: np.ndarray,
+    coherence: np.ndarray,
+    block_h1: np.ndarray,
+    sensors: Collection[str],
+    positions_m: np.ndarray | Sequence[float],
+    attrs: Mapping,
+) -> xr.Dataset:
+    """Return the FRF dataset (results/linear/frf.nc) the modal fit reads.
+
+    The dataset holds H1 accelerance (sensor, frequency) as real and imaginary parts in m/s^2/N, the ordinary
+    coherence (1), H1 of sub-records (block, sensor, frequency; the block dimension may be empty: no sub-records),
+    frequency (Hz), sensor names and positions (m), and ``attrs``. One home of the variables, units and names, for
+    the FRF from a time record and the FRF imported from a file.
+
+    Parameters
+    ----------
+    frequency_hz
+        Frequency lines [Hz], shape (n_f,).
+    h1
+        Complex H1 accelerance of each sensor over the force [m/s^2/N], shape (n_sensors, n_f).
+    coherence
+        Ordinary coherence of each sensor with the force [-], shape (n_sensors, n_f).
+    block_h1
+        Complex H1 of the consecutive sub-records [m/s^2/N], shape (n_blocks, n_sensors, n_f); n_blocks may be 0.
+    sensors
+        The sensors' names, n_sensors of them.
+    positions_m
+        The sensors' distances from the clamp [m], shape (n_sensors,).
+    attrs
+        The dataset's attributes (copied).
+
+    Returns
+    -------
+    frf : xr.Dataset
+        The FRF dataset.
+    """
     block_h1 = np.asarray(block_h1, dtype=complex).reshape(-1, *np.shape(h1))
     return xr.Dataset(
         {
@@ -130,13 +208,30 @@ def frf_result_dataset(frequency_hz, h1, coherence, block_h1, sensors, positions
 
 
 def complex_frf(ds: xr.Dataset, prefix: str = "h1") -> np.ndarray:
-    """Complex FRF from the dataset's ``{prefix}_real`` and ``{prefix}_imag`` variables, in their shape (m/s^2/N)."""
+    """Return the complex FRF from the dataset's ``{prefix}_real`` and ``{prefix}_imag`` variables.
+
+    Parameters
+    ----------
+    ds
+        An FRF dataset (``frf_result_dataset``).
+    prefix
+        The variables' prefix: "h1" (the whole record's) or "block_h1" (the sub-records').
+
+    Returns
+    -------
+    frf : np.ndarray
+        The complex FRF [m/s^2/N], in the variables' shape: shape (n_sensors, n_f) for "h1",
+        (n_blocks, n_sensors, n_f) for "block_h1".
+    """
     return ds[f"{prefix}_real"].values + 1j * ds[f"{prefix}_imag"].values
 
 
 def _sub_record_uncertainties(f, frf: xr.Dataset, n_modes: int, band_hz, order: int) -> tuple:
-    """(standard uncertainty of the natural frequencies (Hz), of the damping ratios, sub-records fitted) from the
-    spread of the sub-records' fits (batch means: std / sqrt(n_blocks)); NaN with fewer than two fitted."""
+    """Return the standard uncertainties of the natural frequencies and damping ratios from the sub-records' fits.
+
+    (standard uncertainty of the natural frequencies (Hz), of the damping ratios, sub-records fitted) from the
+    spread of the sub-records' fits (batch means: std / sqrt(n_blocks)); NaN with fewer than two fitted.
+    """
     blocks_f, blocks_z = [], []
     bh = complex_frf(frf, "block_h1")
     for b in range(bh.shape[0]):
@@ -157,8 +252,11 @@ def _sub_record_uncertainties(f, frf: xr.Dataset, n_modes: int, band_hz, order: 
 
 
 def _order_spread(f, frf: xr.Dataset, est, n_modes: int, band_hz, order: int) -> np.ndarray:
-    """(n_modes,) largest change of the natural frequencies (Hz) of ``est`` at model order +-2 (the poles must agree
-    with neighbouring model orders: stabilisation check); NaN where no neighbouring order could be fitted."""
+    """Return the largest change of the natural frequencies of ``est`` at model order +-2.
+
+    (n_modes,), in Hz: the poles must agree with neighbouring model orders (stabilisation check); NaN where no
+    neighbouring order could be fitted.
+    """
     spread = []
     for o in (order - 2, order + 2):
         try:
@@ -173,10 +271,29 @@ def _order_spread(f, frf: xr.Dataset, est, n_modes: int, band_hz, order: int) ->
     return np.max(spread, axis=0) if spread else np.full(n_modes, np.nan)
 
 
-def modal_dataset(frf: xr.Dataset, n_modes: int, band_hz, order: int) -> xr.Dataset:
-    """Natural frequencies and damping ratios of the first ``n_modes`` modes
-    (LSCF poles + LSFD residues), with standard uncertainties from the spread
-    of the sub-record estimates (batch means: std / sqrt(n_blocks))."""
+def modal_dataset(frf: xr.Dataset, n_modes: int, band_hz: Sequence[float], order: int) -> xr.Dataset:
+    """Return the natural frequencies and damping ratios of the first modes, with standard uncertainties.
+
+    LSCF poles + LSFD residues; the standard uncertainties come from the spread of the sub-record estimates (batch
+    means: std / sqrt(n_blocks)), and the order spread from the fits at model order +-2.
+
+    Parameters
+    ----------
+    frf
+        The FRF dataset (results/linear/frf.nc, ``frf_result_dataset``).
+    n_modes
+        Number of modes to identify (config ``modal.n_modes``).
+    band_hz
+        The analysis band (low, high) [Hz] (``modal.band_hz``).
+    order
+        LSCF model order (``modal.order``).
+
+    Returns
+    -------
+    modal : xr.Dataset
+        The modal dataset (results/linear/modal.nc): natural frequencies, their standard uncertainties and order
+        spread (Hz), damping ratios and their standard uncertainties (1), the residues' magnitudes (sensor, mode).
+    """
     f = frf["frequency"].values
     est = fit_modes(f, complex_frf(frf), n_modes, tuple(band_hz), order)
     sf, sz, n_blocks = _sub_record_uncertainties(f, frf, n_modes, band_hz, order)
@@ -234,8 +351,26 @@ def modal_dataset(frf: xr.Dataset, n_modes: int, band_hz, order: int) -> xr.Data
 
 
 def stiction_dataset(modal: xr.Dataset, structure_cfg: Mapping, stiction_cfg: Mapping) -> xr.Dataset:
-    """k_t and k_n of Eq. (13) fitted to the identified frequencies, with
-    confidence intervals and the profile misfits."""
+    """Return k_t and k_n of Eq. (13) fitted to the identified frequencies, with confidence intervals and profiles.
+
+    Parameters
+    ----------
+    modal
+        The modal dataset (results/linear/modal.nc): reads ``natural_frequency`` and ``natural_frequency_std``
+        [Hz] (mode).
+    structure_cfg
+        The config's ``structure`` block (``parameters.structure_from_config``).
+    stiction_cfg
+        The config's ``stiction`` block: reads ``frequency_uncertainty_floor``, ``confidence``,
+        ``stiffness_scale_sd``, ``k_t_bounds_n_per_m`` and ``k_n_bounds_n_per_m`` [N/m].
+
+    Returns
+    -------
+    stiction : xr.Dataset
+        The stiffness dataset (results/linear/stiction.nc): k_t, k_n and their intervals (N/m), the stiffness
+        scale, the model's and the identified frequencies and their weights (Hz), the profile misfits over their
+        grids, and the fit's flags and notes as attributes.
+    """
     f_id = modal["natural_frequency"].values
     sigma = frequency_sigma(
         f_id, modal["natural_frequency_std"].values, float(stiction_cfg["frequency_uncertainty_floor"])
@@ -317,9 +452,27 @@ def stiction_dataset(modal: xr.Dataset, structure_cfg: Mapping, stiction_cfg: Ma
 
 
 def contact_stiffness_for_modes(stiction: xr.Dataset, k_n_prior: float) -> tuple[float, float, str]:
-    """(k_t, k_n, how k_n was chosen) for the linear modes: the best fit where
-    the data bound k_n on both sides; otherwise the prior, raised to the
-    lower bound if it lies below it."""
+    """Return the contact stiffnesses for the linear modes and how k_n was chosen.
+
+    k_n is the best fit where the data bound k_n on both sides; otherwise the prior, raised to the lower bound if it
+    lies below it.
+
+    Parameters
+    ----------
+    stiction
+        The stiffness dataset (``stiction_dataset``).
+    k_n_prior
+        The prior normal contact stiffness [N/m] (config ``stiction.k_n_prior_n_per_m``).
+
+    Returns
+    -------
+    k_t : float
+        Tangential contact stiffness, the best fit [N/m].
+    k_n : float
+        Normal contact stiffness [N/m].
+    how : str
+        How k_n was chosen: "best fit" or the prior's note.
+    """
     k_t = float(stiction["k_t"])
     if int(stiction.attrs["k_n_bounded_above"]) and int(stiction.attrs["k_n_bounded_below"]):
         return k_t, float(stiction["k_n"]), "best fit"
@@ -330,9 +483,31 @@ def contact_stiffness_for_modes(stiction: xr.Dataset, k_n_prior: float) -> tuple
 def linear_modes_dataset(
     stiction: xr.Dataset, structure_cfg: Mapping, n_modes: int, grid_points: int, k_n_prior: float
 ) -> xr.Dataset:
-    """Mass-normalised linear modes (Eq. 14): phi_i(x) on a grid, its slope,
-    u_i, y_si, theta_si, the contact coordinates xi_i, eta_i and the values at
-    the sensors and the driving point."""
+    """Return the mass-normalised linear modes (Eq. 14) of the identified linear model.
+
+    phi_i(x) on a grid, its slope, u_i, y_si, theta_si, the contact coordinates xi_i, eta_i and the values at the
+    sensors and the driving point, with k_t, k_n (``contact_stiffness_for_modes``) and the stiffness scale used, and
+    the stiffness fit's prior and weights as attributes (for a diagnosis that redoes the fit).
+
+    Parameters
+    ----------
+    stiction
+        The stiffness dataset (``stiction_dataset``).
+    structure_cfg
+        The config's ``structure`` block (reads ``sensors.names`` and what ``parameters.identified_structure``
+        reads).
+    n_modes
+        Number of modes (config ``linear_modes.n_modes``).
+    grid_points
+        Number of points of the grid along the beam (``linear_modes.grid_points``).
+    k_n_prior
+        The prior normal contact stiffness [N/m] (``stiction.k_n_prior_n_per_m``).
+
+    Returns
+    -------
+    modes : xr.Dataset
+        The linear modes' dataset (results/linear/linear_modes.nc).
+    """
     k_t, k_n, how = contact_stiffness_for_modes(stiction, k_n_prior)
     scale = float(stiction["stiffness_scale"]) if "stiffness_scale" in stiction else 1.0
     params = identified_structure(structure_cfg, {"k_t": k_t, "k_n": k_n, "stiffness_scale": scale})

@@ -1,12 +1,14 @@
-"""Checks of a dual-sine record before identification. Its harmonic content at the excitation frequency and its
-stationarity (first against last third of the record), its validation (dead channels, clipping, the sampling rate and
-excitation frequency, offsets, stationarity) and its level against the random test's FRF, each check a small function
-of the record's numbers whose thresholds follow from the physics and statistics of the records (the constants of
-``raw_checks``) or from the config's raw_checks."""
+"""Checks of a dual-sine record before identification.
+
+Its harmonic content at the excitation frequency and its stationarity (first against last third of the record), its
+validation (dead channels, clipping, the sampling rate and excitation frequency, offsets, stationarity) and its level
+against the random test's FRF, each check a small function of the record's numbers whose thresholds follow from the
+physics and statistics of the records (the constants of ``raw_checks``) or from the config's raw_checks.
+"""
 
 from __future__ import annotations
 
-from typing import Mapping
+from typing import Mapping, Sequence
 
 import numpy as np
 import xarray as xr
@@ -29,7 +31,29 @@ from .raw_checks import (
 
 
 def driving_point_index(raw: xr.Dataset, excitation_position_m: float, path: str, tol_m: float = 1e-3) -> int:
-    """Index of the accelerometer at the driving point d_p."""
+    """Return the index of the accelerometer at the driving point d_p.
+
+    Parameters
+    ----------
+    raw
+        A raw record: reads its coordinate ``position`` (sensor) [m].
+    excitation_position_m
+        The driving point's distance from the clamp [m] (config ``structure.excitation_position_m``).
+    path
+        The record's path, for the message.
+    tol_m
+        How far the nearest accelerometer may lie from the driving point [m].
+
+    Returns
+    -------
+    index : int
+        The accelerometer's index along the record's sensor dimension.
+
+    Raises
+    ------
+    RawDataError
+        When no accelerometer lies within ``tol_m`` of the driving point.
+    """
     pos = np.asarray(raw["position"].values, dtype=float)
     i = int(np.argmin(np.abs(pos - excitation_position_m)))
     if abs(pos[i] - excitation_position_m) > tol_m:
@@ -41,9 +65,30 @@ def driving_point_index(raw: xr.Dataset, excitation_position_m: float, path: str
 
 
 def dual_sine_check_dataset(raw: xr.Dataset, structure_cfg: Mapping, path: str, max_harmonic: int) -> xr.Dataset:
-    """Harmonic amplitudes of every channel at h f0 (h = 1..max_harmonic), the driving-point
-    A1 (at f0) and A2 (at 3 f0) of Table 2, and their change between the record's first and
-    last thirds."""
+    """Return the harmonic amplitudes of every channel and the driving point's A1 and A2 with their change.
+
+    Harmonic amplitudes and phases of every channel at h f0 (h = 1..max_harmonic), the driving-point A1 (at f0) and
+    A2 (at 3 f0) of Table 2, and their change between the record's first and last thirds.
+
+    Parameters
+    ----------
+    raw
+        The dual-sine record: ``force`` (time) [N], ``acceleration`` (sensor, time) [m/s^2], the coordinates
+        ``sensor`` and ``position`` [m], the attributes ``sampling_rate_hz`` and ``excitation_frequency_hz`` [Hz].
+    structure_cfg
+        The config's ``structure`` block: reads ``excitation_position_m`` [m].
+    path
+        The record's path, for messages.
+    max_harmonic
+        The highest harmonic of f0 (config ``raw_checks.max_harmonic``).
+
+    Returns
+    -------
+    check : xr.Dataset
+        The amplitudes (m/s^2, N), phases (rad) and stationarity change (1), with the attributes A1_m_per_s2,
+        A2_m_per_s2 (NaN below three harmonics), the excitation frequency, the number of periods and the
+        driving-point sensor.
+    """
     fs = float(raw.attrs["sampling_rate_hz"])
     f0 = float(raw.attrs["excitation_frequency_hz"])
     h = np.arange(1, max_harmonic + 1)
@@ -95,7 +140,7 @@ def dual_sine_check_dataset(raw: xr.Dataset, structure_cfg: Mapping, path: str, 
 
 
 def _spectrum(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The Hann-windowed, mean-free record and its DFT magnitude (no DC bin)."""
+    """Return the Hann-windowed, mean-free record and its DFT magnitude (no DC bin)."""
     y = (x - x.mean()) * np.hanning(x.size)
     spec = np.abs(np.fft.rfft(y))
     spec[0] = 0.0
@@ -103,7 +148,7 @@ def _spectrum(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _refine(y: np.ndarray, fs: float, k: int) -> float:
-    """The frequency (Hz) near bin ``k`` at which the windowed record ``y``'s DFT magnitude peaks."""
+    """Return the frequency (Hz) near bin ``k`` at which the windowed record ``y``'s DFT magnitude peaks."""
     from scipy.optimize import minimize_scalar
 
     n = y.size
@@ -123,9 +168,11 @@ def _refine(y: np.ndarray, fs: float, k: int) -> float:
 
 
 def _line_at(spec: np.ndarray, bin_: float, floor: float) -> float:
-    """The magnitude of the line at (fractional) bin ``bin_`` of ``spec``: the largest bin within one of it where
-    it stands ``LINE_FACTOR`` times above ``floor`` and twice above the bins three away on both sides (a line's
-    main lobe, not another line's leakage, which falls off steadily); else 0."""
+    """Return the magnitude of the line at (fractional) bin ``bin_`` of ``spec``, 0 where there is none.
+
+    The largest bin within one of it where it stands ``LINE_FACTOR`` times above ``floor`` and twice above the bins
+    three away on both sides (a line's main lobe, not another line's leakage, which falls off steadily); else 0.
+    """
     j0 = int(round(bin_))
     if j0 < 1 or j0 + 1 >= spec.size:
         return 0.0
@@ -135,12 +182,29 @@ def _line_at(spec: np.ndarray, bin_: float, floor: float) -> float:
 
 
 def excitation_lines(x: np.ndarray, fs: float, declared_hz: float) -> dict:
-    """The dual-sine excitation a force record shows: its strongest spectral line (Hann window, refined by maximising
-    the windowed DFT magnitude) and whether it is the record's w or 3 w, by the line standing out at three times it
-    or at a third of it (the stronger of the two where both do). Returns ``frequency_hz`` (the record's w),
-    ``harmonic`` (1 or 3: the strongest line's), ``strongest_hz``, ``paired`` (the other line found) and
-    ``line_to_floor`` (the strongest bin against the spectrum's median). With no partner line the strongest is taken
-    as the 3 w of the declared frequency when within ``RATE_FACTOR_LIMIT`` of it, else as w."""
+    """Return the dual-sine excitation a force record shows.
+
+    Its strongest spectral line (Hann window, refined by maximising the windowed DFT magnitude) and whether it is the
+    record's w or 3 w, by the line standing out at three times it or at a third of it (the stronger of the two where
+    both do). With no partner line the strongest is taken as the 3 w of the declared frequency when within
+    ``RATE_FACTOR_LIMIT`` of it, else as w.
+
+    Parameters
+    ----------
+    x
+        The force record [N], shape (n_t,): n_t samples.
+    fs
+        Sampling rate [Hz].
+    declared_hz
+        The declared excitation frequency w [Hz].
+
+    Returns
+    -------
+    lines : dict
+        ``frequency_hz`` (the record's w, in Hz), ``harmonic`` (1 or 3: the strongest line's), ``strongest_hz`` (the
+        strongest line's frequency, in Hz), ``paired`` (the other line found) and ``line_to_floor`` (the strongest
+        bin against the spectrum's median; inf where the median is 0).
+    """
     y, spec = _spectrum(x)
     df = fs / x.size
     floor = float(np.median(spec[1:])) if spec.size > 1 else 0.0
@@ -163,16 +227,60 @@ def excitation_lines(x: np.ndarray, fs: float, declared_hz: float) -> dict:
 
 
 def recovered_frequency(x: np.ndarray, fs: float, declared_hz: float) -> tuple[float, int]:
-    """The excitation frequency found in a dual-sine record (``excitation_lines``): (frequency in Hz, the harmonic
-    number, 1 or 3, of the record's strongest line)."""
+    """Return the excitation frequency found in a dual-sine record (``excitation_lines``).
+
+    Parameters
+    ----------
+    x
+        The force record [N], shape (n_t,): n_t samples.
+    fs
+        Sampling rate [Hz].
+    declared_hz
+        The declared excitation frequency [Hz].
+
+    Returns
+    -------
+    frequency : float
+        The record's excitation frequency w [Hz].
+    harmonic : int
+        The harmonic number, 1 or 3, of the record's strongest line.
+    """
     lines = excitation_lines(x, fs, declared_hz)
     return float(lines["frequency_hz"]), int(lines["harmonic"])
 
 
 def excitation_frequency_check(force: np.ndarray, fs: float, f0: float, path: str, tolerance_cycles: float) -> list:
-    """Refuse a force record with no excitation line, one whose lines sit at r f0 and 3 r f0 (a wrong sampling rate or
-    excitation frequency), or one whose excitation drifts more than ``tolerance_cycles`` cycles from the declared
-    ``f0`` over the record; warn from half the tolerance."""
+    """Refuse a force record whose excitation is not the declared one; warn from half the tolerance.
+
+    Refused: a force record with no excitation line, one whose lines sit at r f0 and 3 r f0 (a wrong sampling rate
+    or excitation frequency), or one whose excitation drifts more than ``tolerance_cycles`` cycles from the declared
+    ``f0`` over the record.
+
+    Parameters
+    ----------
+    force
+        The force record [N], shape (n_t,): n_t samples.
+    fs
+        Sampling rate [Hz].
+    f0
+        The declared excitation frequency [Hz].
+    path
+        The record's path, for messages.
+    tolerance_cycles
+        How many cycles the excitation may drift from f0 over the record [cycles] (config
+        ``raw_checks.frequency_tolerance_cycles``).
+
+    Returns
+    -------
+    warnings : list
+        One warning (str) where the drift exceeds half the tolerance; empty otherwise.
+
+    Raises
+    ------
+    RawDataError
+        When the force shows no line, its lines are off by a factor beyond ``RATE_FACTOR_LIMIT``, or it drifts more
+        than the tolerance.
+    """
     lines = excitation_lines(force, fs, f0)
     if lines["line_to_floor"] < LINE_FACTOR:
         raise RawDataError(
@@ -213,9 +321,30 @@ def excitation_frequency_check(force: np.ndarray, fs: float, f0: float, path: st
 
 
 def drive_lines(x: np.ndarray, fs: float, f0: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Each row's amplitudes at w and 3 w (k, 2), its mean (k,) and its noise (k,: the rms of what the mean and the
-    harmonics of f0 below 0.45 fs, the first 50 at most, leave), fitted together by least squares over the whole
-    record (partial periods included)."""
+    """Return each channel's amplitudes at w and 3 w, its mean and its noise.
+
+    The mean and the harmonics of f0 below 0.45 fs (the first 50 at most, at least 3) are fitted together by least
+    squares over the whole record (partial periods included); the noise is the rms of what they leave.
+
+    Parameters
+    ----------
+    x
+        The channels' records, shape (k, n_t): k channels of n_t samples (a single record of shape (n_t,) is taken
+        as one row); in ``validate_dual_sine`` the force [N] first, then the accelerometers [m/s^2].
+    fs
+        Sampling rate [Hz].
+    f0
+        Excitation frequency w / 2 pi [Hz].
+
+    Returns
+    -------
+    lines : np.ndarray
+        Each row's amplitudes at w and 3 w [unit of x], shape (k, 2).
+    mean : np.ndarray
+        Each row's mean [unit of x], shape (k,).
+    noise : np.ndarray
+        Each row's noise, rms [unit of x], shape (k,).
+    """
     x = np.atleast_2d(np.asarray(x, dtype=float))
     n = x.shape[1]
     t = np.arange(n) / fs
@@ -228,10 +357,31 @@ def drive_lines(x: np.ndarray, fs: float, f0: float) -> tuple[np.ndarray, np.nda
     return np.abs(c[:, [0, 2]]), mean, noise
 
 
-def dead_channel_check(names, lines: np.ndarray, noise: np.ndarray, n: int, path: str) -> None:
-    """Refuse a channel that records no response at the drive's lines: an accelerometer whose larger line (w or 3 w,
-    ``lines`` (k, 2), the force's first) is below ``DEAD_LEVEL`` of the strongest accelerometer's, or any channel
-    whose lines do not stand ``LINE_SNR`` standard errors out of its own ``noise`` (rms, over ``n`` samples)."""
+def dead_channel_check(names: Sequence[str], lines: np.ndarray, noise: np.ndarray, n: int, path: str) -> None:
+    """Refuse a channel that records no response at the drive's lines.
+
+    Refused: an accelerometer whose larger line (w or 3 w) is below ``DEAD_LEVEL`` of the strongest accelerometer's,
+    or any channel whose lines do not stand ``LINE_SNR`` standard errors out of its own noise.
+
+    Parameters
+    ----------
+    names
+        The channels' names, the force first (``raw_checks.channels_of``), k of them.
+    lines
+        Each channel's amplitudes at w and 3 w (``drive_lines``), shape (k, 2): [N] in the force's row, [m/s^2] in
+        the accelerometers'.
+    noise
+        Each channel's noise, rms (``drive_lines``), shape (k,): [N] for the force, [m/s^2] for an accelerometer.
+    n
+        Number of samples of the record.
+    path
+        The record's path, for messages.
+
+    Raises
+    ------
+    RawDataError
+        When an accelerometer is dead against the others, or a channel's lines do not stand out of its noise.
+    """
     level = lines.max(axis=1)
     acc = level[1:]
     top = 1 + int(np.argmax(acc)) if acc.size else 0
@@ -254,8 +404,35 @@ def dead_channel_check(names, lines: np.ndarray, noise: np.ndarray, n: int, path
 
 
 def validate_dual_sine(raw: xr.Dataset, path: str, checks: Mapping) -> list[str]:
-    """Dead channels, clipping, the sampling rate and excitation frequency, offsets and stationarity of a dual-sine
-    record; raises RawDataError on the first failure, returns the warnings."""
+    """Validate a dual-sine record: dead channels, clipping, rates, offsets and stationarity.
+
+    The checks: the channels' magnitude and flatness, clipping, the sampling rate and excitation frequency
+    (``excitation_frequency_check``), dead channels, offsets, and stationarity: the amplitudes at w and 3 w in the
+    record's first and last thirds, a change beyond the tolerance kept (with a warning) only where it is a steady
+    drift (``steady_drift``) within the drift tolerance.
+
+    Parameters
+    ----------
+    raw
+        The dual-sine record: ``force`` (time) [N], ``acceleration`` (sensor, time) [m/s^2], the attributes
+        ``sampling_rate_hz`` and ``excitation_frequency_hz`` [Hz].
+    path
+        The record's path, for messages.
+    checks
+        The config's ``raw_checks`` block (missing keys take the schema's defaults): reads ``clip_samples``,
+        ``frequency_tolerance_cycles``, ``stationarity_tolerance`` and ``drift_tolerance``.
+
+    Returns
+    -------
+    warnings : list[str]
+        The warnings.
+
+    Raises
+    ------
+    RawDataError
+        On the first failed check (here: a change beyond the stationarity tolerance that is not a steady drift, or a
+        drift beyond the drift tolerance; the other checks raise it themselves).
+    """
     c = check_settings(checks)
     fs = float(raw.attrs["sampling_rate_hz"])
     f0 = float(raw.attrs["excitation_frequency_hz"])
@@ -307,10 +484,26 @@ def validate_dual_sine(raw: xr.Dataset, path: str, checks: Mapping) -> list[str]
 
 
 def steady_drift(first: float, middle: float, last: float) -> bool:
-    """Whether an amplitude's change over a record's thirds (``first``, ``middle``, ``last``) is a steady drift: both
-    steps the same way and within a factor 2 of each other, as a slowly drifting preload gives (the rig's drifts of
-    0.1-0.2: steps within 10 % of each other). A transient decays (its first step larger), an unsettled motion
-    wanders."""
+    """Judge whether an amplitude's change over a record's thirds is a steady drift.
+
+    Steady: both steps the same way and within a factor 2 of each other, as a slowly drifting preload gives (the
+    rig's drifts of 0.1-0.2: steps within 10 % of each other). A transient decays (its first step larger), an
+    unsettled motion wanders.
+
+    Parameters
+    ----------
+    first
+        The amplitude over the record's first third [N] for the force, [m/s^2] for an accelerometer.
+    middle
+        The amplitude over its middle third [unit of first].
+    last
+        The amplitude over its last third [unit of first].
+
+    Returns
+    -------
+    steady : bool
+        Whether the change is a steady drift.
+    """
     d1, d2 = middle - first, last - middle
     if d1 * d2 <= 0.0:
         return False
@@ -326,7 +519,7 @@ LEVEL_FACTOR_LIMIT = 50.0
 
 
 def _units_cause(factor: float) -> str:
-    """What a record ``factor`` times off its expected level most likely has (``units_factors``)."""
+    """Return what a record ``factor`` times off its expected level most likely has (``units_factors``)."""
     from .units_factors import units_error
 
     hit = units_error(factor, 0.3)  # the level against the stuck FRF scatters by the contact's state
@@ -335,10 +528,31 @@ def _units_cause(factor: float) -> str:
 
 
 def frf_level_check(check: xr.Dataset, frf: xr.Dataset, path: str) -> float:
-    """Refuse a dual-sine record (its ``dual_sine_check_dataset``) whose accelerance at the drive is more than
-    ``LEVEL_FACTOR_LIMIT`` times off the random test's FRF (either way); returns the factor (the median over the
-    sensors both files hold, matched by position within 1 mm, and harmonics 1 and 3), or nan where they share no
-    sensor or the FRF does not reach 3 f0."""
+    """Refuse a dual-sine record whose accelerance at the drive is far off the random test's FRF; return the factor.
+
+    Refused where it is more than ``LEVEL_FACTOR_LIMIT`` times off (either way).
+
+    Parameters
+    ----------
+    check
+        The record's ``dual_sine_check_dataset``.
+    frf
+        The random test's FRF dataset (results/linear/frf.nc).
+    path
+        The record's path, for the message.
+
+    Returns
+    -------
+    factor : float
+        The record's accelerance over the FRF's [-]: the median (taken on the logs) over the sensors both files
+        hold (matched by position within 1 mm) and harmonics 1 and 3; NaN where they share no sensor or the FRF
+        covers neither f0 nor 3 f0.
+
+    Raises
+    ------
+    RawDataError
+        When the factor is beyond ``LEVEL_FACTOR_LIMIT`` either way.
+    """
     f0 = float(check.attrs["excitation_frequency_hz"])
     f = frf["frequency"].values
     h = frf["h1_real"].values + 1j * frf["h1_imag"].values

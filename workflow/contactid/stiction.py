@@ -1,32 +1,58 @@
-"""Contact stiffness at stiction (Section 4, Table 3): k_t and k_n of Eq. (13)
-fitted to identified natural frequencies by weighted least squares, with
-profile-likelihood confidence intervals that say when the data bound a
-parameter from one side only.
+"""Contact stiffness at stiction (Section 4, Table 3): k_t and k_n of Eq. (13) fitted to natural frequencies.
+
+k_t and k_n are fitted to identified natural frequencies by weighted least squares, with profile-likelihood
+confidence intervals that say when the data bound a parameter from one side only.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Callable, Mapping
 
 import numpy as np
 
 from .beam_model import ContactFrequencyMap
 from .parameters import StructureParameters
 
+if TYPE_CHECKING:
+    import xarray as xr
+
 
 @dataclass(frozen=True)
 class StiffnessFit:
-    """Result of the stiction-stiffness fit (N/m).
+    """Result of the stiction-stiffness fit.
 
-    k_t, k_n: best fit; k_t_interval, k_n_interval: profile-likelihood
-    confidence intervals (lower, upper), with ``inf`` / the search bound where
-    the data do not bound the parameter; k_n_bounded_above: False when the
-    data only give a lower bound on k_n (then ``k_n_lower_bound`` holds it);
-    model_frequencies_hz: frequencies at the best fit; chi2_min: minimum of the
-    weighted misfit; profiles: dict of (grid, chi2) arrays per parameter;
-    notes: {parameter: why a side is not bounded} (empty where both are);
-    stiffness_scale: the structure's Young's modulus over the model's at the best fit (1 where the fit
-    keeps the structure, ``stiffness_scale_sd`` 0).
+    Attributes
+    ----------
+    k_t
+        Tangential contact stiffness, best fit [N/m].
+    k_n
+        Normal contact stiffness, best fit [N/m].
+    k_t_interval
+        Profile-likelihood confidence interval of k_t, (lower, upper) [N/m]: the search bound (lower) or ``inf``
+        (upper) where the data do not bound it on that side.
+    k_n_interval
+        Profile-likelihood confidence interval of k_n, (lower, upper) [N/m], as ``k_t_interval``.
+    k_t_bounded
+        Whether the data bound k_t on both sides.
+    k_n_bounded_above
+        False when the data only give a lower bound on k_n (then ``k_n_lower_bound`` holds it).
+    k_n_bounded_below
+        Whether the data bound k_n from below.
+    model_frequencies_hz
+        The model's natural frequencies at the best fit [Hz], shape (n_modes,): n_modes the number of identified
+        frequencies.
+    chi2_min
+        Minimum of the weighted misfit chi^2 [-].
+    confidence
+        Confidence level of the intervals [-] (config ``stiction.confidence``).
+    profiles
+        {parameter: (grid [N/m], profiled chi^2 [-])}, each array of shape (n_grid,), for "k_t" and "k_n".
+    notes
+        {parameter: why a side is not bounded} (empty where both are).
+    stiffness_scale
+        The structure's Young's modulus over the model's at the best fit [-] (1 where the fit keeps the structure,
+        ``stiffness_scale_sd`` 0).
     """
 
     k_t: float
@@ -45,14 +71,36 @@ class StiffnessFit:
 
     @property
     def k_n_lower_bound(self) -> float:
-        """Lower end of the k_n interval (N/m)."""
+        """Lower end of the k_n interval.
+
+        Returns
+        -------
+        k_n_lower : float
+            The interval's lower end [N/m].
+        """
         return self.k_n_interval[0]
 
 
 def frequency_sigma(freqs_hz: np.ndarray, stat_sigma_hz: np.ndarray, relative_floor: float) -> np.ndarray:
-    """Standard uncertainty of each identified frequency (Hz): the statistical
-    part combined with a relative floor for model and estimator bias. A frequency without a statistical
-    estimate (NaN: an imported FRF has no sub-records to compare) has the floor alone."""
+    """Return the standard uncertainty of each identified frequency.
+
+    The statistical part combined (in quadrature) with a relative floor for model and estimator bias. A frequency
+    without a statistical estimate (NaN: an imported FRF has no sub-records to compare) has the floor alone.
+
+    Parameters
+    ----------
+    freqs_hz
+        Identified natural frequencies [Hz], shape (n_modes,).
+    stat_sigma_hz
+        Their statistical standard uncertainties [Hz], shape (n_modes,); NaN where there is none.
+    relative_floor
+        The floor, relative to the frequency [-] (config ``stiction.frequency_uncertainty_floor``).
+
+    Returns
+    -------
+    sigma : np.ndarray
+        Standard uncertainty of each frequency [Hz], shape (n_modes,).
+    """
     stat = np.nan_to_num(np.asarray(stat_sigma_hz, dtype=float), nan=0.0)
     return np.sqrt(stat**2 + (relative_floor * np.asarray(freqs_hz)) ** 2)
 
@@ -72,8 +120,10 @@ LN_SCALE_BOUNDS = (float(np.log(0.5)), float(np.log(2.0)))
 
 
 def _residuals(fmap: ContactFrequencyMap, f_id, sigma, log_kt, log_kn, ln_s=None, s_sd=0.0):
-    """Weighted frequency residuals at (log10 k_t, log10 k_n), and with ``ln_s`` (the log stiffness scale) the
-    prior's residual ln s / ``s_sd`` after them."""
+    """Return the weighted frequency residuals at (log10 k_t, log10 k_n).
+
+    With ``ln_s`` (the log stiffness scale), the prior's residual ln s / ``s_sd`` after them.
+    """
     if ln_s is None:
         return (fmap(10.0**log_kt, 10.0**log_kn) - f_id) / sigma
     r = (fmap(10.0**log_kt, 10.0**log_kn, float(np.exp(ln_s))) - f_id) / sigma
@@ -81,8 +131,10 @@ def _residuals(fmap: ContactFrequencyMap, f_id, sigma, log_kt, log_kn, ln_s=None
 
 
 def _fit_one(params, f_id, sigma, fixed_name, fixed_log, start, bounds, s_sd=0.0, start_s=0.0):
-    """Fit the free log-stiffness (and, with ``s_sd`` > 0, the log stiffness scale from ``start_s``) with the other
-    stiffness fixed; returns (the free stiffness's log10, chi2, ln s)."""
+    """Fit the free log-stiffness with the other stiffness fixed.
+
+    With ``s_sd`` > 0, the log stiffness scale too, from ``start_s``. Returns (the free stiffness's log10, chi2, ln s).
+    """
     scaled = s_sd > 0
 
     def res(x):
@@ -107,8 +159,10 @@ def _fit_one(params, f_id, sigma, fixed_name, fixed_log, start, bounds, s_sd=0.0
 
 
 def _joint_fit(params, f_id, sigma, x0, lt, ln, s_sd=0.0):
-    """Least-squares fit of (log10 k_t, log10 k_n) from x0, and with ``s_sd`` > 0 of the log stiffness scale too
-    (x0 then has three entries); returns (x, chi2)."""
+    """Fit (log10 k_t, log10 k_n) from x0 by least squares.
+
+    With ``s_sd`` > 0, the log stiffness scale too (x0 then has three entries); returns (x, chi2).
+    """
     # scipy.optimize (0.3 s to import) where the fits use it: most jobs of the linear chain (the FRFs, the modal fit,
     # the raw checks) import this module through contactid.linear_chain without fitting anything
     from scipy.optimize import least_squares
@@ -128,8 +182,11 @@ def _joint_fit(params, f_id, sigma, x0, lt, ln, s_sd=0.0):
 
 
 def _profiles(params, f_id, sigma, best, lt, ln, n_profile, s_sd=0.0):
-    """Profile misfit of each parameter on a log grid (the other, and the stiffness scale where it is free, refitted
-    from the joint best): {name: (log grid, chi2, the other parameter's fitted log value, the fitted ln s)}."""
+    """Return the profile misfit of each parameter on a log grid.
+
+    The other parameter, and the stiffness scale where it is free, are refitted from the joint best:
+    {name: (log grid, chi2, the other parameter's fitted log value, the fitted ln s)}.
+    """
     out = {}
     ln_s = float(best[2]) if s_sd > 0 else 0.0
     for name, rng, idx, other_rng in (("k_n", ln, 1, lt), ("k_t", lt, 0, ln)):
@@ -140,13 +197,47 @@ def _profiles(params, f_id, sigma, best, lt, ln, n_profile, s_sd=0.0):
     return out
 
 
-def interval_edge(profile, grid, chi2_prof, i_min, direction, chi2_min, threshold):
-    """One edge (log10) of a profile-likelihood interval: where the profiled chi2 crosses
-    ``chi2_min + threshold``, walking from grid point ``i_min`` in ``direction`` (-1 or +1).
+def interval_edge(
+    profile: Callable[[float], float],
+    grid: np.ndarray,
+    chi2_prof: np.ndarray,
+    i_min: int,
+    direction: int,
+    chi2_min: float,
+    threshold: float,
+) -> tuple[float | None, str]:
+    """Return one edge of a profile-likelihood interval, or why the data do not bound that side.
 
-    Returns (edge, reason): edge None with the reason where the data do not bound the parameter
-    on that side, either because the crossing lies beyond the search range or because no
-    crossing can be bracketed (the profile does not come down to the threshold there)."""
+    The edge is where the profiled chi2 crosses ``chi2_min + threshold``, walking from grid point ``i_min`` in
+    ``direction``; it is bracketed on the grid and then found by Brent's method on ``profile``. The data do not bound
+    the parameter on that side either because the crossing lies beyond the search range or because no crossing can
+    be bracketed (the profile does not come down to the threshold there).
+
+    Parameters
+    ----------
+    profile
+        The profiled chi2 [-] as a function of the parameter's log10 (log10 of a stiffness in N/m in the stiffness
+        fit).
+    grid
+        The parameter's log10 on the grid [-], shape (n_grid,), ascending.
+    chi2_prof
+        The profiled chi2 on the grid [-], shape (n_grid,).
+    i_min
+        Index of the grid point to walk from (the profile's minimum).
+    direction
+        -1 (the lower edge) or +1 (the upper edge).
+    chi2_min
+        The fit's minimum chi2 [-].
+    threshold
+        The chi2 rise that bounds the interval [-] (chi2_1(confidence)).
+
+    Returns
+    -------
+    edge : float | None
+        The edge, the parameter's log10 [-]; None where the data do not bound that side.
+    reason : str
+        Why the side is not bounded; empty where it is.
+    """
     j = i_min
     while 0 <= j + direction < len(grid) and chi2_prof[j + direction] - chi2_min <= threshold:
         j += direction
@@ -169,15 +260,15 @@ def interval_edge(profile, grid, chi2_prof, i_min, direction, chi2_min, threshol
 
 def stiction_stiffness(
     params: StructureParameters,
-    f_id_hz,
-    sigma_hz,
-    k_t_bounds=(1e5, 1e9),
-    k_n_bounds=(1e5, 1e11),
+    f_id_hz: np.ndarray,
+    sigma_hz: np.ndarray,
+    k_t_bounds: tuple[float, float] = (1e5, 1e9),
+    k_n_bounds: tuple[float, float] = (1e5, 1e11),
     confidence: float = 0.95,
     n_profile: int = 25,
     stiffness_scale_sd: float = 0.0,
 ) -> StiffnessFit:
-    """Fit k_t and k_n (N/m) of Eq. (13) to the identified natural frequencies.
+    """Fit k_t and k_n of Eq. (13) to the identified natural frequencies.
 
     Misfit chi2 = sum_i ((f_i(k_t, k_n) - f_id,i) / sigma_i)^2 over the first
     len(f_id) structural modes. A parameter's confidence interval is the set
@@ -193,6 +284,35 @@ def stiction_stiffness(
     sqrt(s)); held at s = 1, the fit gives that error to k_t and k_n: on a beam 3 % softer than the model, k_t 20 %
     low and k_n 6.6 times too soft with an interval that excluded the truth (docs/measurements.md, "A rig whose beam
     is softer than the model"). With sd 0 the structure is the model's (s = 1), the fit as before.
+
+    Parameters
+    ----------
+    params
+        The described structure (its k_t and k_n are not used).
+    f_id_hz
+        Identified natural frequencies [Hz], shape (n_modes,): the first n_modes structural modes.
+    sigma_hz
+        Their standard uncertainties, the weights [Hz], shape (n_modes,) (``frequency_sigma``).
+    k_t_bounds
+        Search bounds of k_t (low, high) [N/m].
+    k_n_bounds
+        Search bounds of k_n (low, high) [N/m].
+    confidence
+        Confidence level of the intervals [-].
+    n_profile
+        Number of grid points of each profile (the best fit is added).
+    stiffness_scale_sd
+        Standard deviation of the Gaussian prior on ln s [-]; 0: the model's Young's modulus.
+
+    Returns
+    -------
+    fit : StiffnessFit
+        The best fit, its intervals, profiles and notes.
+
+    Raises
+    ------
+    ValueError
+        When ``stiffness_scale_sd`` is negative or NaN.
     """
     f_id = np.asarray(f_id_hz, dtype=float)
     sigma = np.asarray(sigma_hz, dtype=float)
@@ -276,13 +396,30 @@ _SIMPLE_FACTORS = (2, 3, 4, 5, 8, 10, 1000)
 class Reachability:
     """Whether the identified frequencies are ones the described structure can have (``reachability``).
 
-    ranges_hz (n, 2): each mode's lowest and highest frequency over the stiffness bounds (and the stiffness scale's
-    where it is free); outside_sigmas (n,): how far each frequency lies beyond its range, in sigma (+ above, - below,
-    0 within); at_bound: the stiffnesses whose best fit sits at a search bound, as text; chi2_min and dof of the
-    fit; where refused, factor_range: the factors c for which the lowest frequency divided by c lies within the
-    first mode's range and every other within the structure's span (None: none does), factor: the simplest such
-    factor (``_SIMPLE_FACTORS`` or its reciprocal; None) with chi2_factor, the fit's misfit at f / factor; reasons:
-    why the record is refused (empty: reachable)."""
+    Attributes
+    ----------
+    ranges_hz
+        Each mode's lowest and highest frequency over the stiffness bounds (and the stiffness scale's where it is
+        free) [Hz], shape (n_modes, 2).
+    outside_sigmas
+        How far each frequency lies beyond its range, in its standard uncertainties [-] (+ above, - below,
+        0 within), shape (n_modes,).
+    at_bound
+        The stiffnesses whose best fit sits at a search bound, as text.
+    chi2_min
+        The stiffness fit's minimum chi^2 [-].
+    dof
+        The fit's degrees of freedom (the number of frequencies less 2, at least 1).
+    factor_range
+        Where refused: the factors c (low, high) [-] for which the lowest frequency divided by c lies within the
+        first mode's range and every other within the structure's span; None: none does (or not refused).
+    factor
+        The simplest such factor [-] (``_SIMPLE_FACTORS`` or its reciprocal); None: none.
+    chi2_factor
+        The fit's misfit chi^2 at f / factor [-]; None where there is no factor.
+    reasons
+        Why the record is refused (empty: reachable).
+    """
 
     ranges_hz: np.ndarray
     outside_sigmas: np.ndarray
@@ -301,11 +438,36 @@ class Reachability:
 
 
 def frequency_ranges(
-    params: StructureParameters, n_modes: int, k_t_bounds, k_n_bounds, scale_bounds=(1.0, 1.0)
+    params: StructureParameters | ContactFrequencyMap,
+    n_modes: int,
+    k_t_bounds: tuple[float, float],
+    k_n_bounds: tuple[float, float],
+    scale_bounds: tuple[float, float] = (1.0, 1.0),
 ) -> np.ndarray:
-    """(n_modes, 2): each structural mode's frequency (Hz) with both contact springs at their lower bounds (and
-    Young's modulus at ``scale_bounds[0]`` times the structure's) and at their upper bounds (``scale_bounds[1]``):
-    the range the structure can have, every natural frequency rising with every stiffness (Rayleigh)."""
+    """Return the range of each structural mode's frequency the structure can have between the stiffness bounds.
+
+    Each mode's frequency with both contact springs at their lower bounds (and Young's modulus at
+    ``scale_bounds[0]`` times the structure's) and at their upper bounds (``scale_bounds[1]``): the range the
+    structure can have, every natural frequency rising with every stiffness (Rayleigh).
+
+    Parameters
+    ----------
+    params
+        The described structure, or its ``ContactFrequencyMap`` (then used as it is).
+    n_modes
+        Number of structural modes (where ``params`` is a structure).
+    k_t_bounds
+        Bounds of k_t (low, high) [N/m].
+    k_n_bounds
+        Bounds of k_n (low, high) [N/m].
+    scale_bounds
+        Bounds of Young's modulus over the structure's (low, high) [-].
+
+    Returns
+    -------
+    ranges : np.ndarray
+        Each mode's lowest and highest frequency [Hz], shape (n_modes, 2).
+    """
     fmap = params if isinstance(params, ContactFrequencyMap) else ContactFrequencyMap(params, int(n_modes))
     lo = fmap(float(k_t_bounds[0]), float(k_n_bounds[0]), float(scale_bounds[0]))
     hi = fmap(float(k_t_bounds[1]), float(k_n_bounds[1]), float(scale_bounds[1]))
@@ -313,8 +475,10 @@ def frequency_ranges(
 
 
 def _quick_chi2(fmap, f_id, sigma, lt, ln, s_sd) -> float:
-    """The stiffness fit's misfit minimum from its coarse start (no profiles): what a factor on the frequencies
-    would leave."""
+    """Return the stiffness fit's misfit minimum from its coarse start (no profiles).
+
+    What a factor on the frequencies would leave.
+    """
     grid_t = np.linspace(lt[0], lt[1], 17)
     c0 = [np.sum(_residuals(fmap, f_id, sigma, g, ln.mean()) ** 2) for g in grid_t]
     x0 = [grid_t[int(np.argmin(c0))], ln.mean()] + ([0.0] if s_sd > 0 else [])
@@ -323,22 +487,50 @@ def _quick_chi2(fmap, f_id, sigma, lt, ln, s_sd) -> float:
 
 def reachability(
     params: StructureParameters,
-    f_id_hz,
-    sigma_hz,
+    f_id_hz: np.ndarray,
+    sigma_hz: np.ndarray,
     k_t: float,
     k_n: float,
     chi2_min: float,
-    k_t_bounds=(1e5, 1e9),
-    k_n_bounds=(1e5, 1e11),
+    k_t_bounds: tuple[float, float] = (1e5, 1e9),
+    k_n_bounds: tuple[float, float] = (1e5, 1e11),
     stiffness_scale_sd: float = 0.0,
 ) -> Reachability:
-    """Whether the described structure can have the identified frequencies at any contact stiffness within the
-    bounds (and, where the fit frees it, Young's modulus within ``LN_SCALE_BOUNDS``): refused (``reasons``) where a
-    frequency lies more than ``UNREACHABLE_SIGMAS`` sigma beyond the range the structure has between its bounds
-    (``frequency_ranges``), or where the best fit (k_t, k_n, ``chi2_min``) sits at a search bound with a misfit per
-    degree of freedom above ``UNREACHABLE_SIGMAS`` squared. Where refused, the factors that would bring the
-    frequencies within the structure's ranges (a sampling rate off by a factor moves them all by it) and the
-    simplest of them."""
+    """Judge whether the described structure can have the identified frequencies at any stiffness within the bounds.
+
+    Any contact stiffness within the bounds and, where the fit frees it, Young's modulus within ``LN_SCALE_BOUNDS``.
+    Refused (``reasons``) where a frequency lies more than ``UNREACHABLE_SIGMAS`` sigma beyond the range the
+    structure has between its bounds (``frequency_ranges``), or where the best fit (k_t, k_n, ``chi2_min``) sits at
+    a search bound with a misfit per degree of freedom above ``UNREACHABLE_SIGMAS`` squared. Where refused, the
+    factors that would bring the frequencies within the structure's ranges (a sampling rate off by a factor moves
+    them all by it) and the simplest of them.
+
+    Parameters
+    ----------
+    params
+        The described structure.
+    f_id_hz
+        Identified natural frequencies [Hz], shape (n_modes,).
+    sigma_hz
+        Their standard uncertainties [Hz], shape (n_modes,) (``frequency_sigma``).
+    k_t
+        The fit's tangential contact stiffness [N/m].
+    k_n
+        The fit's normal contact stiffness [N/m].
+    chi2_min
+        The fit's minimum chi^2 [-].
+    k_t_bounds
+        Search bounds of k_t (low, high) [N/m].
+    k_n_bounds
+        Search bounds of k_n (low, high) [N/m].
+    stiffness_scale_sd
+        Standard deviation of the fit's prior on ln s [-]; > 0: Young's modulus free within ``LN_SCALE_BOUNDS``.
+
+    Returns
+    -------
+    reach : Reachability
+        The verdict, its reasons and, where refused, the factors.
+    """
     f_id = np.asarray(f_id_hz, dtype=float)
     sigma = np.asarray(sigma_hz, dtype=float)
     s_sd = float(stiffness_scale_sd)
@@ -397,9 +589,30 @@ def _factor_text(c: float) -> str:
     return f"{c:g}" if c >= 1 else f"1/{1 / c:g}"
 
 
-def unreachable_message(reach: Reachability, f_id_hz, source: str, sampling_rate_hz: float | None = None) -> str:
-    """The stiffness step's refusal of a random test (``source``: its file) whose frequencies the structure cannot
-    have (``reachability``): the frequencies, the ranges the structure allows, why, and the likely causes in order."""
+def unreachable_message(
+    reach: Reachability, f_id_hz: np.ndarray, source: str, sampling_rate_hz: float | None = None
+) -> str:
+    """Return the stiffness step's refusal of a random test whose frequencies the structure cannot have.
+
+    The message names the frequencies, the ranges the structure allows, why (``reachability``), and the likely causes
+    in order.
+
+    Parameters
+    ----------
+    reach
+        The refusing ``reachability``.
+    f_id_hz
+        Identified natural frequencies [Hz], shape (n_modes,).
+    source
+        The random test's file, as the message names it.
+    sampling_rate_hz
+        The random test's sampling rate [Hz]; None: not known.
+
+    Returns
+    -------
+    message : str
+        The refusal.
+    """
     f_id = np.asarray(f_id_hz, dtype=float)
     ranges = ", ".join(f"{lo:.4g}-{hi:.4g}" for lo, hi in reach.ranges_hz)
     freqs = ", ".join(f"{f:.4g}" for f in f_id)
@@ -447,17 +660,47 @@ def unreachable_message(reach: Reachability, f_id_hz, source: str, sampling_rate
 
 def refuse_unreachable(
     params: StructureParameters,
-    stiction,
-    stiction_cfg,
+    stiction: xr.Dataset,
+    stiction_cfg: Mapping,
     source: str,
     sampling_rate_hz: float | None = None,
-    residue_abs=None,
+    residue_abs: np.ndarray | None = None,
 ) -> Reachability:
-    """Raise ``io.RawDataError`` where the stiffness fit's dataset (stiction.nc's variables) holds frequencies the
-    structure cannot have (``reachability``, with the config's bounds and stiffness scale prior as
-    ``linear_chain.stiction_dataset`` fits them; ``unreachable_message``), or where the random test's FRF amplitudes
-    (``residue_abs``, modal.nc's (sensor, mode) residues; None: not checked) lie beyond ``AMPLITUDE_FACTOR_LIMIT``
-    of the fitted structure's (``amplitude_ratio``; ``amplitude_message``); otherwise return the Reachability."""
+    """Refuse a random test whose frequencies or FRF amplitudes the described structure cannot have.
+
+    Refused where the stiffness fit's dataset holds frequencies the structure cannot have (``reachability``, with the
+    config's bounds and stiffness scale prior as ``linear_chain.stiction_dataset`` fits them;
+    ``unreachable_message``), or where the random test's FRF amplitudes lie beyond ``AMPLITUDE_FACTOR_LIMIT`` of the
+    fitted structure's (``amplitude_ratio``; ``amplitude_message``).
+
+    Parameters
+    ----------
+    params
+        The described structure.
+    stiction
+        The stiffness fit's dataset (stiction.nc's variables): reads ``identified_frequency`` and
+        ``frequency_sigma`` [Hz], ``k_t``, ``k_n`` [N/m], ``stiffness_scale`` and the attribute ``chi2_min``.
+    stiction_cfg
+        The config's ``stiction`` block: reads ``k_t_bounds_n_per_m``, ``k_n_bounds_n_per_m`` [N/m] and
+        ``stiffness_scale_sd``.
+    source
+        The random test's file, as the messages name it.
+    sampling_rate_hz
+        The random test's sampling rate [Hz]; None: not known.
+    residue_abs
+        modal.nc's residue magnitudes, accelerance (m/s^2/N) over rad/s [m/(N*s)], shape (n_sensors, n_modes);
+        None: the amplitudes are not checked.
+
+    Returns
+    -------
+    reach : Reachability
+        The frequencies' ``reachability`` (reachable).
+
+    Raises
+    ------
+    RawDataError
+        When the frequencies are out of the structure's reach, or the amplitudes beyond ``AMPLITUDE_FACTOR_LIMIT``.
+    """
     reach = reachability(
         params,
         stiction["identified_frequency"].values,
@@ -495,10 +738,32 @@ five foreign record sets. The smallest common unit confusion, accelerations in g
 g taken per m/s^2), makes 9.81, a kN force 1000; a factor 3 lies far from both."""
 
 
-def amplitude_ratio(params: StructureParameters, residue_abs, k_t: float, k_n: float, stiffness_scale: float = 1.0):
-    """The median over sensors and modes of the measured residues (``residue_abs`` (sensor, mode), modal.nc's) over
-    those of the described structure at the fitted k_t, k_n and stiffness scale (``updating_model.modal_predictions``);
-    None where the shapes do not match (another sensor layout)."""
+def amplitude_ratio(
+    params: StructureParameters, residue_abs: np.ndarray, k_t: float, k_n: float, stiffness_scale: float = 1.0
+) -> float | None:
+    """Return the measured residues over those of the described structure: the median over sensors and modes.
+
+    The structure's at the fitted k_t, k_n and stiffness scale (``updating_model.modal_predictions``).
+
+    Parameters
+    ----------
+    params
+        The described structure.
+    residue_abs
+        modal.nc's residue magnitudes, accelerance (m/s^2/N) over rad/s [m/(N*s)], shape (n_sensors, n_modes).
+    k_t
+        The fitted tangential contact stiffness [N/m].
+    k_n
+        The fitted normal contact stiffness [N/m].
+    stiffness_scale
+        The fitted Young's modulus over the structure's [-].
+
+    Returns
+    -------
+    ratio : float | None
+        The median ratio [-] over the finite, positive ones; None where the shapes do not match (another sensor
+        layout) or no ratio is finite and positive.
+    """
     from .updating_model import modal_predictions
 
     measured = np.asarray(residue_abs, dtype=float)
@@ -514,7 +779,20 @@ def amplitude_ratio(params: StructureParameters, residue_abs, k_t: float, k_n: f
 
 
 def amplitude_message(ratio: float, source: str) -> str:
-    """The stiffness step's refusal of a random test whose FRF amplitudes are ``ratio`` times the structure's."""
+    """Return the stiffness step's refusal of a random test whose FRF amplitudes are off the structure's.
+
+    Parameters
+    ----------
+    ratio
+        The amplitudes over the structure's (``amplitude_ratio``) [-].
+    source
+        The random test's file, as the message names it.
+
+    Returns
+    -------
+    message : str
+        The refusal, with the likely causes in order (a units error ``units_factors`` names first, where one fits).
+    """
     from .units_factors import units_error
 
     causes = []
@@ -534,10 +812,27 @@ def amplitude_message(ratio: float, source: str) -> str:
     )
 
 
-def random_test_source(modal, block) -> tuple[str, float | None]:
-    """(the random test's file as the user gave it in its config ``block``, and as the chain read it where that
-    differs; its sampling rate in Hz or None), from the provenance modal.nc -> frf.nc keeps: for the refusal's
-    message."""
+def random_test_source(modal: xr.Dataset, block: Mapping) -> tuple[str, float | None]:
+    """Return the random test's file and sampling rate, for the refusal's message.
+
+    From the provenance modal.nc -> frf.nc keeps.
+
+    Parameters
+    ----------
+    modal
+        The modal dataset: reads its attribute ``input_frf`` (the FRF file, opened where it exists for its
+        ``input_raw`` or ``input_file`` and ``sampling_rate_hz``).
+    block
+        The config's ``random_test`` block: reads ``source`` and ``file``.
+
+    Returns
+    -------
+    name : str
+        The file as the user gave it in the config (and as the chain read it, where that differs), else as the
+        chain read it, else data/raw/random_test.nc.
+    sampling_rate_hz : float | None
+        Its sampling rate [Hz]; None where the FRF file does not tell.
+    """
     import os
 
     import xarray as xr

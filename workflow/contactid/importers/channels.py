@@ -1,9 +1,9 @@
-"""The channel map of an import: which channel of the file is the force and which are the
-accelerometers, in which units, with which sensitivity and at which position.
+"""The channel map of an import: which channel is the force, which the accelerometers, their units and positions.
 
-Nothing is guessed: every channel names its units; a channel stored as a voltage (``V`` or
-``mV``) needs its sensitivity and the sensitivity's units (``mV/N``, ``mV/g``, ``V/(m/s^2)``...).
-Where the file also states a unit, it must agree with the map.
+The map says which channel of the file is the force and which are the accelerometers, in which units, with which
+sensitivity and at which position. Nothing is guessed: every channel names its units; a channel stored as a voltage
+(``V`` or ``mV``) needs its sensitivity and the sensitivity's units (``mV/N``, ``mV/g``, ``V/(m/s^2)``...). Where the
+file also states a unit, it must agree with the map.
 """
 
 from __future__ import annotations
@@ -43,15 +43,42 @@ FORMATS = ("netcdf", "uff58", "tdms", "csv")
 
 
 def canonical_unit(label: str) -> str:
-    """A unit label as written in a file, in the spelling of PHYSICAL / ELECTRICAL."""
+    """Return a unit label as written in a file in the spelling of PHYSICAL / ELECTRICAL.
+
+    Parameters
+    ----------
+    label
+        The unit as a file or a channel map writes it ("m/s2", "newton", "mv", ...).
+
+    Returns
+    -------
+    unit : str
+        Its spelling in ``ALIASES``' targets, or the label stripped where it has no alias.
+    """
     s = str(label).strip()
     return ALIASES.get(s, ALIASES.get(s.lower(), s))
 
 
 @dataclass(frozen=True)
 class ChannelSpec:
-    """One channel of the file: its role ("force" or a sensor name), its name in the file (UFF58
-    id1, TDMS "group/channel", CSV column), units, sensitivity (for voltages) and position (sensors)."""
+    """One channel of the file: its role, its name in the file, units, sensitivity and position.
+
+    Attributes
+    ----------
+    role
+        "force", or the sensor's name.
+    channel
+        The channel's name in the file: UFF58 id1, TDMS "group/channel", CSV column.
+    units
+        The units the file stores it in, canonical (``canonical_unit``): a key of PHYSICAL's quantity or of
+        ELECTRICAL.
+    sensitivity
+        For a channel stored as a voltage: its sensitivity [unit of sensitivity_units]; None otherwise.
+    sensitivity_units
+        The sensitivity's units, "<V or mV>/<physical unit>" (``mV/N``, ``mV/g``); None where no sensitivity.
+    position_m
+        A sensor's distance from the clamp [m]; None for the force.
+    """
 
     role: str
     channel: str
@@ -66,7 +93,13 @@ class ChannelSpec:
         return "force" if self.role == "force" else "acceleration"
 
     def factor(self) -> float:
-        """Factor from the file's numbers to SI (N or m/s^2)."""
+        """Return the factor from the file's numbers to SI (N or m/s^2).
+
+        Returns
+        -------
+        factor : float
+            SI value per file number: [N/unit of units] for the force, [m/s^2/unit of units] for an accelerometer.
+        """
         phys = PHYSICAL[self.quantity]
         if self.units in phys:
             return phys[self.units]
@@ -77,9 +110,27 @@ class ChannelSpec:
 
 @dataclass(frozen=True)
 class ImportSpec:
-    """What to import and how: format, file, channel map (force first), declared sampling rate and
-    excitation frequency (either may be None where the file states it), CSV time column, and where
-    the map was written (for messages)."""
+    """What to import and how: format, file, channel map, declared rates, CSV time column and the map's place.
+
+    Attributes
+    ----------
+    format
+        The file's format, one of ``FORMATS``.
+    file
+        The file's path.
+    channels
+        The channel map (``ChannelSpec``), the force first, then the accelerometers.
+    sampling_rate_hz
+        The declared sampling rate [Hz]; None where the file states it.
+    excitation_frequency_hz
+        The declared excitation frequency [Hz]; None where the file states it.
+    time_column
+        The CSV's time column; None where the map names none.
+    where
+        Where the map was written, for messages.
+    time_units
+        The CSV time column's unit: s, ms or us (contactid.io's time units).
+    """
 
     format: str
     file: str
@@ -167,9 +218,33 @@ def _positive_or_none(block: Mapping, key: str, where: str) -> float | None:
 
 
 def import_spec(block: Mapping, where: str, fmt: str, file: str) -> ImportSpec:
-    """Parse a channel map (the config block of a UFF58 or TDMS import, or a CSV's sidecar):
-    ``channels: {force: {...}, sensors: [{name, channel, units, position_m, ...}, ...]}``,
-    ``sampling_rate_hz``, ``excitation_frequency_hz``, ``time_column`` (CSV)."""
+    """Parse a channel map: the config block of a UFF58 or TDMS import, or a CSV's sidecar.
+
+    Parameters
+    ----------
+    block
+        The channel map: reads ``channels: {force: {...}, sensors: [{name, channel, units, position_m, ...}, ...]}``
+        (each channel's ``channel``, ``units``, ``sensitivity``, ``sensitivity_units``, ``position_m`` [m]),
+        ``sampling_rate_hz`` [Hz], ``excitation_frequency_hz`` [Hz], ``time_column`` and ``time_units`` (CSV).
+    where
+        Where the map was written, for messages.
+    fmt
+        The file's format: "uff58", "tdms" or "csv".
+    file
+        The file's path.
+
+    Returns
+    -------
+    spec : ImportSpec
+        The parsed map.
+
+    Raises
+    ------
+    RawDataError
+        When the format is not one of them, the map is not a mapping, gives no force or sensors, a sensor has no
+        name, names or channels repeat, the time units are not s, ms or us, or a channel's entry is incomplete or
+        inconsistent (units, sensitivity, position), or a rate is not a positive number.
+    """
     if fmt not in FORMATS[1:]:
         raise RawDataError(f"{where}: format = {fmt!r}; give one of {', '.join(FORMATS)}")
     if not isinstance(block, Mapping):
@@ -211,8 +286,25 @@ def import_spec(block: Mapping, where: str, fmt: str, file: str) -> ImportSpec:
     )
 
 
-def check_file_unit(spec: ChannelSpec, label, path: str) -> None:
-    """A unit stated in the file must agree with the map's (an empty or absent label says nothing)."""
+def check_file_unit(spec: ChannelSpec, label: str | None, path: str) -> None:
+    """Check that a unit stated in the file agrees with the map's.
+
+    An empty or absent label says nothing.
+
+    Parameters
+    ----------
+    spec
+        The channel's entry in the map.
+    label
+        The unit the file states for the channel; None (or empty, "NONE", "-") where it states none.
+    path
+        The file's path, for the message.
+
+    Raises
+    ------
+    RawDataError
+        When the file's unit differs from the map's.
+    """
     if label is None or str(label).strip() in ("", "NONE", "none", "-"):
         return
     found = canonical_unit(label)
