@@ -29,8 +29,21 @@ class ConfigError(ValueError):
 _EXPONENT_NUMBER = re.compile(r"^[-+]?(\d+|\d+\.\d*|\.\d+)[eE][-+]?\d+$")
 
 
-def load_schema(schema) -> dict:
-    """The schema as a mapping: ``schema`` itself where it is one, else a copy of the file at that path."""
+def load_schema(schema: Mapping | Path | str) -> dict:
+    """Return the schema as a mapping.
+
+    ``schema`` itself where it is one, else a copy of the file at that path (the file is read once and cached).
+
+    Parameters
+    ----------
+    schema
+        The schema as a mapping, or the path of its YAML file.
+
+    Returns
+    -------
+    schema : dict
+        The schema (a shallow copy of a mapping given; a deep copy of the cached file's).
+    """
     if isinstance(schema, Mapping):
         return dict(schema)
     return copy.deepcopy(_schema_file(str(Path(schema).resolve())))
@@ -44,11 +57,26 @@ def _schema_file(path: str) -> dict:
         return yaml.load(fh, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
 
 
-def with_defaults(cfg: Mapping, schema=SCHEMA) -> dict:
-    """A copy of ``cfg`` with the schema's defaults filled in where keys are left out, as the Snakefile's
-    validation fills them (a block's own keys too, where the block is left out), so that code run outside
-    Snakemake (tests, benchmarks, the blind benchmark's items) uses the values the workflow would. A config that
-    is already complete comes back equal. Validation errors are not raised here (the Snakefile's check does)."""
+def with_defaults(cfg: Mapping, schema: Mapping | Path | str = SCHEMA) -> dict:
+    """Return a copy of a config with the schema's defaults filled in where keys are left out.
+
+    The defaults are filled in as the Snakefile's validation fills them (a block's own keys too, where the block is
+    left out), so that code run outside Snakemake (tests, benchmarks, the blind benchmark's items) uses the values
+    the workflow would. A config that is already complete comes back equal. Validation errors are not raised here
+    (the Snakefile's check does).
+
+    Parameters
+    ----------
+    cfg
+        The configuration (any subset of the schema's blocks and keys); not changed.
+    schema
+        The schema as a mapping or the path of its YAML file; by default the workflow's.
+
+    Returns
+    -------
+    filled : dict
+        A deep copy of ``cfg`` with the defaults filled in.
+    """
     import jsonschema
 
     base = jsonschema.Draft202012Validator
@@ -68,24 +96,57 @@ def with_defaults(cfg: Mapping, schema=SCHEMA) -> dict:
 
 @functools.lru_cache(maxsize=None)
 def filled_defaults() -> dict:
-    """The schema's defaults of every key (the config a user who gives nothing gets): cached, do not change it."""
+    """Return the schema's defaults of every key: the config a user who gives nothing gets.
+
+    Returns
+    -------
+    defaults : dict
+        The defaults; cached and shared by every caller: do not change it.
+    """
     return with_defaults({})
 
 
 def schema_defaults(*path: str) -> dict:
-    """The schema's defaults of the block at ``path`` (for example "rig", "dual_sine"), for code that merges a
-    block's keys over its defaults: a copy, read from the schema, the one home of the defaults."""
+    """Return the schema's defaults of the block at a path, for code that merges a block's keys over them.
+
+    A copy, read from the schema, the one home of the defaults.
+
+    Parameters
+    ----------
+    *path
+        The block's keys from the config's top, for example "rig" or "rig", "true_damping".
+
+    Returns
+    -------
+    defaults : dict
+        A deep copy of the block's defaults.
+    """
     node = filled_defaults()
     for key in path:
         node = node[key]
     return copy.deepcopy(node)
 
 
-def numbers_written_as_text(cfg: dict, schema) -> list:
-    """Make numbers, in place, of the values YAML 1.1 read as text where the schema (a path or a mapping) wants a
-    number: ``channel_time_skew: 4e-05`` is the text '4e-05' to PyYAML (it wants 4.0e-05), which the schema would
-    refuse as "not of type 'number'". Returns [(dotted key, number)] of the values changed. Only values of that
-    form where a number is wanted: a name or a path that looks like one elsewhere stays text."""
+def numbers_written_as_text(cfg: dict, schema: Mapping | Path | str) -> list:
+    """Make numbers, in place, of the values YAML 1.1 read as text where the schema wants a number.
+
+    ``channel_time_skew: 4e-05`` is the text '4e-05' to PyYAML (it wants 4.0e-05), which the schema would refuse as
+    "not of type 'number'". Only values of that form where a number is wanted are changed: a name or a path that
+    looks like one elsewhere stays text.
+
+    Parameters
+    ----------
+    cfg
+        The configuration as read; changed in place.
+    schema
+        The schema as a mapping or the path of its YAML file.
+
+    Returns
+    -------
+    changed : list
+        [(dotted key, number)] of the values changed (an int where the schema wants an integer), each number in the
+        unit of its key; empty where nothing changed.
+    """
 
     def texts(node):
         if isinstance(node, str):
@@ -127,8 +188,22 @@ def numbers_written_as_text(cfg: dict, schema) -> list:
 
 
 def merged_over(base: Mapping, overlay: Mapping) -> dict:
-    """``overlay`` merged over ``base`` as Snakemake merges a --configfile over the Snakefile's configfile: blocks
-    key by key, recursively; any other value (a list, a number) replaced whole."""
+    """Return one config merged over another, as Snakemake merges a --configfile over the Snakefile's configfile.
+
+    Blocks are merged key by key, recursively; any other value (a list, a number) is replaced whole.
+
+    Parameters
+    ----------
+    base
+        The config merged over; not changed.
+    overlay
+        The config whose values win; not changed.
+
+    Returns
+    -------
+    merged : dict
+        A deep copy of ``base`` with ``overlay`` merged over it.
+    """
     out = copy.deepcopy(dict(base))
     for key, value in overlay.items():
         if isinstance(value, Mapping) and isinstance(out.get(key), Mapping):

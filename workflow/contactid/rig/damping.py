@@ -31,8 +31,34 @@ MIN_FRACTION = 0.2  # ... and floored at this fraction of the reference ratio: m
 # some damping up there
 
 
-def damping_ratios(frequencies_hz, ratio: float, form: str = "modal", reference_hz: float = 54.4) -> np.ndarray:
-    """Damping ratio (1) of each mode at undamped frequency f_i (Hz), for the damping form (see the module)."""
+def damping_ratios(
+    frequencies_hz: np.ndarray, ratio: float, form: str = "modal", reference_hz: float = 54.4
+) -> np.ndarray:
+    """Return the damping ratio of each mode for a damping form.
+
+    The forms are the module's; the ratios are kept within [MIN_FRACTION ratio, MAX_RATIO].
+
+    Parameters
+    ----------
+    frequencies_hz
+        Undamped natural frequency f_i of each mode [Hz], shape (n_modes,) (any shape: the result has it).
+    ratio
+        Damping ratio at the reference frequency, zeta_ref [-].
+    form
+        The damping form, one of ``FORMS``.
+    reference_hz
+        Reference frequency f_ref at which the ratio holds [Hz].
+
+    Returns
+    -------
+    ratios : np.ndarray
+        Damping ratio zeta_i of each mode [-], shape (n_modes,) (that of ``frequencies_hz``).
+
+    Raises
+    ------
+    ValueError
+        When ``form`` is not one of ``FORMS``.
+    """
     f = np.asarray(frequencies_hz, dtype=float)
     if form == "modal":
         z = np.full(f.shape, float(ratio))
@@ -48,8 +74,24 @@ def damping_ratios(frequencies_hz, ratio: float, form: str = "modal", reference_
     return np.clip(z, MIN_FRACTION * float(ratio), MAX_RATIO)
 
 
-def rig_damping_ratios(rig_cfg: Mapping, frequencies_hz) -> np.ndarray:
-    """The rig's damping ratio of each mode (rig.modal_damping_ratio spread by rig.true_damping)."""
+def rig_damping_ratios(rig_cfg: Mapping, frequencies_hz: np.ndarray) -> np.ndarray:
+    """Return the rig's damping ratio of each mode: rig.modal_damping_ratio spread by rig.true_damping.
+
+    Keys ``rig_cfg`` leaves out take the schema's defaults.
+
+    Parameters
+    ----------
+    rig_cfg
+        The config's ``rig`` block: reads ``modal_damping_ratio`` and ``true_damping`` (``form``,
+        ``reference_frequency_hz``).
+    frequencies_hz
+        Undamped natural frequency of each mode [Hz], shape (n_modes,).
+
+    Returns
+    -------
+    ratios : np.ndarray
+        Damping ratio of each mode [-], shape (n_modes,).
+    """
     from ..schema import schema_defaults
 
     defaults = schema_defaults("rig")  # where rig_cfg leaves keys out
@@ -58,9 +100,24 @@ def rig_damping_ratios(rig_cfg: Mapping, frequencies_hz) -> np.ndarray:
     return damping_ratios(frequencies_hz, float(ratio), td["form"], float(td["reference_frequency_hz"]))
 
 
-def dual_sine_damping_ratios(rig_cfg: Mapping, frequencies_hz) -> np.ndarray:
-    """The rig's damping ratio of each mode in the dual-sine tests: ``rig_damping_ratios`` times
-    rig.true_damping.dual_sine_factor."""
+def dual_sine_damping_ratios(rig_cfg: Mapping, frequencies_hz: np.ndarray) -> np.ndarray:
+    """Return the rig's damping ratio of each mode in the dual-sine tests.
+
+    ``rig_damping_ratios`` times rig.true_damping.dual_sine_factor.
+
+    Parameters
+    ----------
+    rig_cfg
+        The config's ``rig`` block: reads ``modal_damping_ratio`` and ``true_damping`` (``form``,
+        ``reference_frequency_hz``, ``dual_sine_factor``).
+    frequencies_hz
+        Undamped natural frequency of each mode [Hz], shape (n_modes,).
+
+    Returns
+    -------
+    ratios : np.ndarray
+        Damping ratio of each mode in the dual-sine tests [-], shape (n_modes,).
+    """
     from ..schema import schema_defaults
 
     td = {**schema_defaults("rig")["true_damping"], **(rig_cfg.get("true_damping") or {})}
