@@ -336,7 +336,7 @@ def modal_dataset(frf: xr.Dataset, n_modes: int, band_hz: Sequence[float], order
             "residue_abs": (
                 ("sensor", "mode"),
                 np.abs(est.residues),
-                {"units": "m/s^2/N rad/s", "long_name": "|accelerance residue|"},
+                {"units": "m/(N s)", "long_name": "|residue R of the accelerance sum_r (iw)^2 R_r/(iw - s_r) + c.c.|"},
             ),
         },
         coords={"mode": np.arange(1, n_modes + 1), "sensor": frf["sensor"].values},
