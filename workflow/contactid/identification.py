@@ -24,6 +24,7 @@ mean-removed.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -37,13 +38,29 @@ class IdentificationError(ValueError):
 
 
 def _column_forms(q: np.ndarray, G: np.ndarray, p: np.ndarray) -> np.ndarray:
-    """q[:, t]^T G p[:, t] for every column t, (n_t,), through one matrix product (the three-operand einsum it
-    replaces does not use BLAS: one case's contact_forces_dataset took 4.2 s instead of 1.4 s)."""
+    """Return q[:, t]^T G p[:, t] for every column t, (n_t,), through one matrix product.
+
+    The three-operand einsum it replaces does not use BLAS: one case's contact_forces_dataset took 4.2 s instead of
+    1.4 s.
+    """
     return np.einsum("it,it->t", q, G @ p)
 
 
 def nrmse(estimate: np.ndarray, truth: np.ndarray) -> float:
-    """rms(error) / rms(truth), both mean-removed (the contract's NRMSE)."""
+    """Return rms(error) / rms(truth), both mean-removed (the contract's NRMSE).
+
+    Parameters
+    ----------
+    estimate
+        The estimated signal [unit of truth], shape (n_t,) (any shape, the same as ``truth``'s), n_t samples.
+    truth
+        The reference signal, in any unit (N, m, m/s^2...) [unit of estimate], shape (n_t,) as ``estimate``.
+
+    Returns
+    -------
+    nrmse : float
+        rms of the mean-removed error over rms of the mean-removed truth [-].
+    """
     e = estimate - np.mean(estimate) - (truth - np.mean(truth))
     return float(np.sqrt(np.mean(e**2)) / np.sqrt(np.mean((truth - np.mean(truth)) ** 2)))
 
@@ -56,10 +73,34 @@ def nrmse(estimate: np.ndarray, truth: np.ndarray) -> float:
 def generalized_coordinates(
     phi_sensor: np.ndarray, acceleration: np.ndarray, fs: float, f0: float, n_harmonics: int
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Generalized accelerations p''(t) = Phi^+ w''(t) (Eq. 15) and their K harmonics (Eq. 16).
+    """Return the generalized accelerations p''(t) = Phi^+ w''(t) (Eq. 15) and their K harmonics (Eq. 16).
 
-    phi_sensor: (j, m) linear mode shapes at the j sensors; acceleration: (j, n_t) m/s^2.
-    Returns (p'' raw (m, n_t), coefficients (m, K)). Refuses m > j."""
+    Parameters
+    ----------
+    phi_sensor
+        The m linear mode shapes at the j sensors, mass-normalised [kg^-0.5], shape (j, m).
+    acceleration
+        The sensors' accelerations [m/s^2], shape (j, n_t), n_t samples from t = 0.
+    fs
+        Sampling rate [Hz].
+    f0
+        Excitation frequency [Hz].
+    n_harmonics
+        Harmonics K of f0 in the Fourier series.
+
+    Returns
+    -------
+    p_ddot : np.ndarray
+        The generalized accelerations as measured [kg^0.5 m/s^2], shape (m, n_t).
+    coefficients : np.ndarray
+        Their complex harmonics c_h, h = 1..K (p'' ~ mean + sum Im(c_h e^{i h w t}), ``harmonics``)
+        [kg^0.5 m/s^2], shape (m, K).
+
+    Raises
+    ------
+    IdentificationError
+        When m > j: fewer sensors than modes (Eq. 15 needs j >= m).
+    """
     j, m = phi_sensor.shape
     if m > j:
         raise IdentificationError(
@@ -71,10 +112,31 @@ def generalized_coordinates(
 
 
 def nonlinear_mode_coefficients(p_coef: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Eq. 20: coefficients (2, m) of the two real NNMs on the linear modes, from the amplitudes
-    of harmonics 1 and 3 of the generalized accelerations, signed by their phase relative to
-    the dominant term; and the largest phase deviation (degrees) from 0 or 180 among the terms of
-    each frequency (the paper's check that the NNMs are real)."""
+    """Return the coefficients of the two real NNMs on the linear modes (Eq. 20) and their phase spread.
+
+    The coefficients are the amplitudes of harmonics 1 and 3 of the generalized accelerations, signed by their phase
+    relative to the dominant term; the spread is the largest phase deviation from 0 or 180 degrees among the terms of
+    each frequency (the paper's check that the NNMs are real).
+
+    Parameters
+    ----------
+    p_coef
+        Complex harmonics h = 1..K of the m generalized accelerations (``generalized_coordinates``)
+        [kg^0.5 m/s^2], shape (m, K), K >= 3.
+
+    Returns
+    -------
+    coefficients : np.ndarray
+        The NNMs at w and 3 w on the linear modes, each of unit norm [-], shape (2, m).
+    spread : np.ndarray
+        Each NNM's largest phase deviation from 0 or 180 degrees among its terms above 1 % of its largest [deg],
+        shape (2,).
+
+    Raises
+    ------
+    IdentificationError
+        When K < 3 (the NNMs use harmonics 1 and 3).
+    """
     if p_coef.shape[1] < 3:
         raise IdentificationError("the NNMs use harmonics 1 and 3: K must be at least 3")
     coef = np.empty((2, p_coef.shape[0]))
@@ -92,22 +154,69 @@ def nonlinear_mode_coefficients(p_coef: np.ndarray) -> tuple[np.ndarray, np.ndar
     return coef, spread
 
 
-def nnm_coordinates(psi_sensor: np.ndarray, acceleration: np.ndarray, fs: float, f0: float, n_harmonics: int):
-    """NNM coordinates from the accelerations: q'' = Psi^+ w'' at the sensors, K harmonics,
-    analytic double integration (Eq. 17). Returns (q, q'') on the record's time axis, (2, n_t)."""
+def nnm_coordinates(
+    psi_sensor: np.ndarray, acceleration: np.ndarray, fs: float, f0: float, n_harmonics: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """Return the NNM coordinates and their accelerations from the sensors' accelerations.
+
+    q'' = Psi^+ w'' at the sensors, kept to K harmonics, and q by analytic double integration (Eq. 17), on the
+    record's time axis.
+
+    Parameters
+    ----------
+    psi_sensor
+        The NNMs at the j sensors [kg^-0.5], shape (j, n_nnm) (n_nnm = 2: the NNMs at w and 3 w).
+    acceleration
+        The sensors' accelerations [m/s^2], shape (j, n_t), n_t samples from t = 0.
+    fs
+        Sampling rate [Hz].
+    f0
+        Excitation frequency [Hz].
+    n_harmonics
+        Harmonics K of f0 kept.
+
+    Returns
+    -------
+    q : np.ndarray
+        NNM coordinates [kg^0.5 m], shape (n_nnm, n_t).
+    q_ddot : np.ndarray
+        NNM accelerations [kg^0.5 m/s^2], shape (n_nnm, n_t).
+    """
     t = np.arange(acceleration.shape[1]) / fs
     coef = fourier_series(np.linalg.pinv(psi_sensor) @ acceleration, fs, f0, n_harmonics)
     return synthesize(coef, f0, t, -2), synthesize(coef, f0, t, 0)
 
 
-def galerkin_contact_forces(model: FEModel, nnm: np.ndarray, q: np.ndarray, qdd: np.ndarray, force: np.ndarray):
-    """S(t), N(t) - N0 by the force-state mapping on the Galerkin reduced model (Eqs. 10-12):
+def galerkin_contact_forces(model: FEModel, nnm: np.ndarray, q: np.ndarray, qdd: np.ndarray, force: np.ndarray) -> dict:
+    """Return S(t), N(t) - N0 by the force-state mapping on the Galerkin reduced model (Eqs. 10-12).
+
+    At each instant, the least-squares solve of
 
         F_ext - M q'' - K q = [dxi/dq, -deta/dq] [S; N - N0]
 
     with M = Psi^T M Psi, K = Psi^T K_0 Psi (no contact springs), xi with the shortening term.
-    nnm: (n_dof, n) trial vectors; q, qdd: (n, n_t); force: (n_t,) N.
-    Returns dict of S, N_dyn, xi, eta (n_t,) and the reduced matrices."""
+
+    Parameters
+    ----------
+    model
+        The identified linear FE model (its stiffness without the contact springs is used).
+    nnm
+        The n trial vectors (the NNMs) on the FE coordinates, mass-normalised shapes' combinations [kg^-0.5],
+        shape (n_dof, n).
+    q
+        The NNM coordinates [kg^0.5 m], shape (n, n_t).
+    qdd
+        The NNM accelerations [kg^0.5 m/s^2], shape (n, n_t).
+    force
+        The driving force [N], shape (n_t,).
+
+    Returns
+    -------
+    forces : dict
+        ``S`` (friction force [N]), ``N_dyn`` (N - N0 [N]), ``xi``, ``eta`` (contact motions [m]), each of shape
+        (n_t,); ``reduced_mass`` ([-], shape (n, n)), ``reduced_stiffness`` ([1/s^2], shape (n, n)) and
+        ``reduced_force`` (generalized force of a unit force at the driving point [kg^-0.5], shape (n,)).
+    """
     k0 = model.stiffness_without_contact
     Mr = nnm.T @ model.mass @ nnm
     Kr = nnm.T @ k0 @ nnm
@@ -134,9 +243,37 @@ def galerkin_contact_forces(model: FEModel, nnm: np.ndarray, q: np.ndarray, qdd:
 
 @dataclass(frozen=True)
 class InverseResult:
-    """Per-harmonic inverse identification (SI units): S, N_dyn, xi, eta, xi_dot, eta_dot (n_t,)
-    mean-removed; S_coef etc. (K,) complex harmonics; residual_rms: (K,) rms misfit of the sensor
-    accelerations per harmonic relative to their rms (m/s^2 per m/s^2)."""
+    """Per-harmonic inverse identification's result: the contact's forces and motions in time and in harmonics.
+
+    Time signals on the record's n_t samples (S, N_dyn, xi, eta mean-removed; the rates carry harmonics 1..K, no
+    mean); complex harmonics h = 1..K in the convention of Eq. 16 (``harmonics``).
+
+    Attributes
+    ----------
+    S
+        Friction force S(t), mean removed [N], shape (n_t,).
+    N_dyn
+        Dynamic normal force N(t) - N0, mean removed [N], shape (n_t,).
+    xi
+        Tangential contact motion xi(t) (with the beam shortening's term), mean removed [m], shape (n_t,).
+    eta
+        Normal contact motion eta(t), positive when the contact opens, mean removed [m], shape (n_t,).
+    xi_dot
+        d xi/dt [m/s], shape (n_t,).
+    eta_dot
+        d eta/dt [m/s], shape (n_t,).
+    S_coef
+        Harmonics of S [N], shape (K,), complex.
+    N_coef
+        Harmonics of N_dyn [N], shape (K,), complex.
+    xi_coef
+        Harmonics of xi's linear part (xi_vector q, without the beam shortening's) [m], shape (K,), complex.
+    eta_coef
+        Harmonics of eta [m], shape (K,), complex.
+    residual
+        Misfit of the sensor accelerations per harmonic relative to their size (norm over the sensors) [-],
+        shape (K,).
+    """
 
     S: np.ndarray
     N_dyn: np.ndarray
@@ -155,10 +292,25 @@ class InverseResult:
 MAX_EXTRAPOLATED_ZETA = 2.0
 
 
-def damping_exponent(frequencies_hz, zeta) -> float:
-    """gamma (1) of zeta ~ f^gamma fitted to identified modes (least squares on log zeta against log f), kept in
-    [0, 1]: 0 where the ratios do not grow with frequency (modal damping, the identified model's form), 1 for
-    stiffness-proportional damping (zeta_i = beta omega_i / 2). Needs two modes or more (else 0)."""
+def damping_exponent(frequencies_hz: np.ndarray | Sequence[float], zeta: np.ndarray | Sequence[float]) -> float:
+    """Return the exponent gamma of zeta ~ f^gamma fitted to identified modes, kept in [0, 1].
+
+    Least squares on log zeta against log f: 0 where the ratios do not grow with frequency (modal damping, the
+    identified model's form), 1 for stiffness-proportional damping (zeta_i = beta omega_i / 2). Needs two modes or
+    more (else 0); a mode whose frequency or ratio is not positive and finite is left out.
+
+    Parameters
+    ----------
+    frequencies_hz
+        The identified modes' natural frequencies [Hz], shape (n_id,).
+    zeta
+        Their damping ratios [-], shape (n_id,).
+
+    Returns
+    -------
+    gamma : float
+        The exponent, within [0, 1] [-].
+    """
     f, z = _positive(frequencies_hz, zeta)
     if f.size < 2 or np.ptp(np.log(f)) < 1e-6:
         return 0.0
@@ -166,9 +318,28 @@ def damping_exponent(frequencies_hz, zeta) -> float:
     return float(np.clip(gamma, 0.0, 1.0))
 
 
-def rayleigh_coefficients(frequencies_hz, zeta) -> tuple[float, float]:
-    """(alpha (1/s), beta (s)) >= 0 of Rayleigh damping C = alpha M + beta K, zeta_i = alpha / (2 omega_i) +
-    beta omega_i / 2, fitted to identified modes (non-negative least squares on the relative misfit)."""
+def rayleigh_coefficients(
+    frequencies_hz: np.ndarray | Sequence[float], zeta: np.ndarray | Sequence[float]
+) -> tuple[float, float]:
+    """Return the coefficients of Rayleigh damping C = alpha M + beta K fitted to identified modes.
+
+    zeta_i = alpha / (2 omega_i) + beta omega_i / 2, fitted by non-negative least squares on the relative misfit;
+    both are 0 with fewer than two modes (a mode whose frequency or ratio is not positive and finite is left out).
+
+    Parameters
+    ----------
+    frequencies_hz
+        The identified modes' natural frequencies [Hz], shape (n_id,).
+    zeta
+        Their damping ratios [-], shape (n_id,).
+
+    Returns
+    -------
+    alpha : float
+        The mass-proportional coefficient, >= 0 [1/s].
+    beta : float
+        The stiffness-proportional coefficient, >= 0 [s].
+    """
     from scipy.optimize import nnls
 
     f, z = _positive(frequencies_hz, zeta)
@@ -185,15 +356,34 @@ def _positive(frequencies_hz, zeta):
     return f[ok], z[ok]
 
 
-def extrapolated_damping(frequencies_hz, zeta, f_above) -> np.ndarray:
-    """Damping ratios at frequencies ``f_above`` (Hz) above identified modes (``frequencies_hz``, ``zeta``): the
-    trend of the identified ratios carried on, never below the last identified ratio, at most
-    MAX_EXTRAPOLATED_ZETA. The trend is the power law zeta_last (f / f_last)^gamma (``damping_exponent``: modal
-    gamma = 0, stiffness-proportional 1), or Rayleigh damping (``rayleigh_coefficients``) where its relative rms
-    misfit is at most half the power law's and its stiffness term carries half the last ratio or more: its ratios
-    grow as beta omega / 2 once the mass term has faded (a structure with both terms, as many FE simulators damp
-    theirs, shows a slope under 1 over the identified modes and would be damped too little above them by the power
-    law)."""
+def extrapolated_damping(
+    frequencies_hz: np.ndarray | Sequence[float],
+    zeta: np.ndarray | Sequence[float],
+    f_above: np.ndarray | Sequence[float],
+) -> np.ndarray:
+    """Return damping ratios at frequencies above the identified modes: the identified ratios' trend carried on.
+
+    Never below the last identified ratio, at most MAX_EXTRAPOLATED_ZETA. The trend is the power law
+    zeta_last (f / f_last)^gamma (``damping_exponent``: modal gamma = 0, stiffness-proportional 1), or Rayleigh
+    damping (``rayleigh_coefficients``) where its relative rms misfit is at most half the power law's and its
+    stiffness term carries half the last ratio or more: its ratios grow as beta omega / 2 once the mass term has
+    faded (a structure with both terms, as many FE simulators damp theirs, shows a slope under 1 over the identified
+    modes and would be damped too little above them by the power law).
+
+    Parameters
+    ----------
+    frequencies_hz
+        The identified modes' natural frequencies, ascending (the last is f_last) [Hz], shape (n_id,).
+    zeta
+        Their damping ratios [-], shape (n_id,).
+    f_above
+        The frequencies to give a ratio [Hz], shape (n_above,).
+
+    Returns
+    -------
+    zeta_above : np.ndarray
+        The damping ratios at ``f_above`` [-], shape (n_above,).
+    """
     f, z = np.asarray(frequencies_hz, dtype=float), np.asarray(zeta, dtype=float)
     f_above = np.asarray(f_above, dtype=float)
     last = float(z[-1])
@@ -210,15 +400,37 @@ def extrapolated_damping(frequencies_hz, zeta, f_above) -> np.ndarray:
     return np.minimum(np.maximum(best(f_above), last), MAX_EXTRAPOLATED_ZETA)
 
 
-def damping_by_mode(structural: np.ndarray, identified_zeta, frequencies_hz=None) -> np.ndarray:
-    """Damping ratio of every mode of a model whose modes ``structural`` (bool, ascending frequency) marks as the
-    beam's: the identified ratios for the structural modes in order, and the first for the other modes (the
-    block's suspension). Above the identified modes (the higher beam modes and the static contact shapes, which
-    the random test does not measure): the last identified ratio, grown with frequency as the identified ratios
-    grow (``extrapolated_damping`` over the structural modes' ``frequencies_hz``, Hz, when given). A modally
-    damped structure keeps the last ratio; a stiffness-proportionally or Rayleigh-damped one damps its static
-    contact shapes as strongly as it does, which shapes the identified contact forces' phase (kappa was 17-38 %
-    low on stiffness-proportional rigs of the compound benchmark, docs/identification.md)."""
+def damping_by_mode(
+    structural: np.ndarray,
+    identified_zeta: np.ndarray | Sequence[float],
+    frequencies_hz: np.ndarray | None = None,
+) -> np.ndarray:
+    """Return the damping ratio of every mode of a model, from the ratios identified on its beam modes.
+
+    The identified ratios go to the structural modes in order, and the first to the other modes (the block's
+    suspension). Above the identified modes (the higher beam modes and the static contact shapes, which the random
+    test does not measure): the last identified ratio, grown with frequency as the identified ratios grow
+    (``extrapolated_damping`` over the structural modes' ``frequencies_hz``, when given). A modally damped structure
+    keeps the last ratio; a stiffness-proportionally or Rayleigh-damped one damps its static contact shapes as
+    strongly as it does, which shapes the identified contact forces' phase (kappa was 17-38 % low on
+    stiffness-proportional rigs of the compound benchmark, docs/identification.md).
+
+    Parameters
+    ----------
+    structural
+        Whether each mode is the beam's (True) or the block's suspension (False), modes in ascending frequency
+        (bool [-]), shape (n_modes,).
+    identified_zeta
+        The damping ratios identified on the lowest structural modes, in order [-], shape (n_id,).
+    frequencies_hz
+        Every mode's natural frequency [Hz], shape (n_modes,); None: the modes above the identified ones keep the
+        last identified ratio.
+
+    Returns
+    -------
+    zeta : np.ndarray
+        The damping ratio of every mode [-], shape (n_modes,).
+    """
     zeta = np.full(np.size(structural), float(identified_zeta[0]))
     beam = np.flatnonzero(structural)
     n_id = len(identified_zeta)
@@ -231,14 +443,45 @@ def damping_by_mode(structural: np.ndarray, identified_zeta, frequencies_hz=None
 
 
 def modal_damping_vector(model: FEModel, identified_zeta: np.ndarray) -> np.ndarray:
-    """Damping ratio of every FE mode (``damping_by_mode``; structural: less than half the energy in the block)."""
+    """Return the damping ratio of every FE mode (``damping_by_mode``).
+
+    A mode is structural (the beam's) where less than half of its kinetic energy lies in the block.
+
+    Parameters
+    ----------
+    model
+        The linear FE model; all its undamped modes (``beam_model.all_modes``) are given a ratio.
+    identified_zeta
+        The damping ratios identified on the lowest structural modes, in order (the modal fit's
+        ``damping_ratio``) [-], shape (n_id,).
+
+    Returns
+    -------
+    zeta : np.ndarray
+        The damping ratio of every FE mode, ascending frequency [-], shape (n_dof,).
+    """
     modes = all_modes(model)
     return damping_by_mode(modes.block_energy_fraction < 0.5, identified_zeta, modes.frequencies_hz)
 
 
 def period_coefficients(x_grid: np.ndarray, n_harmonics: int) -> np.ndarray:
-    """Harmonics c_h (h = 1..K) of periodic rows sampled at M points over one period,
-    x ~ mean + sum Im(c_h e^{i h w t}) (exact for M > 2K)."""
+    """Return the harmonics c_h (h = 1..K) of periodic rows sampled at M points over one period.
+
+    x ~ mean + sum Im(c_h e^{i h w t}), with t = n / (M f0) (exact for M > 2K).
+
+    Parameters
+    ----------
+    x_grid
+        Periodic signals in any unit, sampled over one period along the last axis [unit of x_grid],
+        shape (..., M).
+    n_harmonics
+        Harmonics K to return.
+
+    Returns
+    -------
+    coefficients : np.ndarray
+        Their complex harmonics [unit of x_grid], shape (..., K).
+    """
     M = x_grid.shape[-1]
     X = positive_spectrum(x_grid, n_harmonics)
     return 2j * X / M
@@ -246,10 +489,31 @@ def period_coefficients(x_grid: np.ndarray, n_harmonics: int) -> np.ndarray:
 
 @dataclass(frozen=True)
 class InverseHarmonics:
-    """Harmonic-level result of the inverse identification (complex, h = 1..K): S, N_dyn, xi
-    (with the beam shortening's harmonics), eta, their rates, the stuck-system coordinates q
-    (n_dof, K), the unknown inputs r = (S - k_t xi_lin, N_dyn + k_n eta) and the relative sensor
-    misfit per harmonic."""
+    """Harmonic-level result of the inverse identification (complex harmonics h = 1..K, convention of Eq. 16).
+
+    Attributes
+    ----------
+    S
+        Harmonics of the friction force S [N], shape (K,).
+    N_dyn
+        Harmonics of the dynamic normal force N - N0 [N], shape (K,).
+    xi
+        Harmonics of the tangential contact motion xi, with the beam shortening's harmonics [m], shape (K,).
+    eta
+        Harmonics of the normal contact motion eta [m], shape (K,).
+    xi_dot
+        Harmonics of d xi/dt [m/s], shape (K,).
+    eta_dot
+        Harmonics of d eta/dt [m/s], shape (K,).
+    q
+        Harmonics of the stuck system's FE coordinates [m] (translations) and [rad] (rotations),
+        shape (n_dof, K).
+    r
+        Harmonics of the unknown inputs r_xi = S - k_t xi_lin and r_eta = N_dyn + k_n eta [N], shape (2, K).
+    residual
+        Misfit of the sensor accelerations per harmonic relative to their size (norm over the sensors) [-],
+        shape (K,).
+    """
 
     S: np.ndarray
     N_dyn: np.ndarray
@@ -271,11 +535,41 @@ def inverse_harmonics(
     n_iterations: int = 8,
     grid_factor: int = 4,
 ) -> InverseHarmonics:
-    """Per-harmonic inverse identification from the force harmonics F_coef (K,) and the sensor
-    acceleration harmonics A_coef (j, K) (convention of Eq. 16). The axial-force term of Eq. 1
-    (G q S) mixes harmonics; it is moved to the known side and updated by fixed-point iteration, its products
-    evaluated on ``grid_factor`` x K points of one period (at least 4: above 3K the bins 1..K take no alias;
-    benchmarks/identification_kernels.py times 4 against the 8 of before)."""
+    """Identify the contact forces harmonic by harmonic from the force's and the sensors' harmonics.
+
+    The axial-force term of Eq. 1 (G q S) mixes harmonics; it is moved to the known side and updated by fixed-point
+    iteration, its products evaluated on ``grid_factor`` x K points of one period (at least 4: above 3K the bins 1..K
+    take no alias; benchmarks/identification_kernels.py times 4 against the 8 of before).
+
+    Parameters
+    ----------
+    model
+        The identified linear FE model, with its stuck contact springs k_t, k_n.
+    zeta
+        The damping ratio of every FE mode (``modal_damping_vector``) [-], shape (n_dof,).
+    F_coef
+        The force's complex harmonics h = 1..K (convention of Eq. 16) [N], shape (K,) (a longer array: its first
+        K).
+    A_coef
+        The sensors' acceleration harmonics h = 1..K [m/s^2], shape (j, K); K is taken from it.
+    f0
+        Excitation frequency [Hz].
+    n_iterations
+        Most fixed-point iterations on the axial-force term (they stop where it changes by less than 1e-8,
+        relative); 1 or less: one pass without it.
+    grid_factor
+        Points of the one-period grid per harmonic (grid_factor x K points), 4 or more.
+
+    Returns
+    -------
+    harmonics : InverseHarmonics
+        The contact's forces and motions, the coordinates, the unknown inputs and the sensor misfit per harmonic.
+
+    Raises
+    ------
+    ValueError
+        When ``grid_factor`` is below 4 (3K points alias).
+    """
     modes = all_modes(model)
     phi = modes.shapes
     wn = 2 * np.pi * modes.frequencies_hz
@@ -348,8 +642,34 @@ def inverse_identification(
     n_harmonics: int,
     n_iterations: int = 8,
 ) -> InverseResult:
-    """Contact forces as unknown inputs, harmonic by harmonic, with the stuck linear model
-    (:func:`inverse_harmonics` on the record's K harmonics, then the time signals)."""
+    """Identify the contact forces as unknown inputs, harmonic by harmonic, with the stuck linear model.
+
+    :func:`inverse_harmonics` on the record's K harmonics, then the time signals.
+
+    Parameters
+    ----------
+    model
+        The identified linear FE model, with its stuck contact springs k_t, k_n.
+    zeta
+        The damping ratio of every FE mode (``modal_damping_vector``) [-], shape (n_dof,).
+    force
+        The driving force [N], shape (n_t,), n_t samples from t = 0.
+    acceleration
+        The sensors' accelerations [m/s^2], shape (j, n_t).
+    fs
+        Sampling rate [Hz].
+    f0
+        Excitation frequency [Hz].
+    n_harmonics
+        Harmonics K of f0 identified.
+    n_iterations
+        Most fixed-point iterations on the axial-force term (``inverse_harmonics``).
+
+    Returns
+    -------
+    result : InverseResult
+        The contact's forces and motions on the record's time axis and their harmonics, and the sensor misfit.
+    """
     p = model.params
     K = n_harmonics
     A_coef = fourier_series(acceleration, fs, f0, K)  # (j, K)

@@ -1,4 +1,4 @@
-"""numba's kernels compiled ahead of the workflow (``make env`` runs ``python -m contactid compile-kernels``).
+"""Numba's kernels compiled ahead of the workflow (``make env`` runs ``python -m contactid compile-kernels``).
 
 Every kernel is ``@njit(cache=True)`` and cached per code digest (``contactid.NUMBA_CACHE_DIR``); without this
 step the workflow's first jobs compile them (about 28 s of CPU, 10-13 s of the first run's wall time on two
@@ -9,7 +9,7 @@ signatures the acceptance run (the default target) compiles are among them.
 """
 
 import dataclasses
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 
 import numpy as np
 
@@ -22,7 +22,7 @@ def _structure_and_rig(config: Mapping) -> tuple[dict, dict]:
 
 
 def _simulator(structure: Mapping, rig: Mapping):
-    """The rig's dual-sine simulator of ``structure`` and ``rig`` and its excitation frequency (rad/s)."""
+    """Return the rig's dual-sine simulator of ``structure`` and ``rig`` and its excitation frequency (rad/s)."""
     from .rig.dual_sine import build_simulator, dual_sine_settings
 
     settings = dual_sine_settings(rig, {}, 5120.0)
@@ -30,7 +30,7 @@ def _simulator(structure: Mapping, rig: Mapping):
 
 
 def _rig_kernels(structure: Mapping, rig: Mapping) -> None:
-    """The rig's time integrator (``integrate`` and its callees) and its random test's modal filter."""
+    """Compile the rig's time integrator (``integrate`` and its callees) and its random test's modal filter."""
     from .beam_model import assemble
     from .rig.random_test import modal_acceleration_filters, modal_acceleration_sum
     from .rig.structure import rig_structure
@@ -44,7 +44,7 @@ def _rig_kernels(structure: Mapping, rig: Mapping) -> None:
 
 
 def _harmonic_balance_kernels(structure: Mapping, rig: Mapping) -> None:
-    """Harmonic balance's contact paths and tangents (the gap diagnosis and the friction intervals)."""
+    """Compile harmonic balance's contact paths and tangents (the gap diagnosis and the friction intervals)."""
     from .rig.harmonic_balance import HarmonicBalance
     from .rig.nonlinear import force_coefficients
 
@@ -56,7 +56,7 @@ def _harmonic_balance_kernels(structure: Mapping, rig: Mapping) -> None:
 
 
 def _friction_kernels() -> None:
-    """The friction law over a population (the fit) and the gap's Iwan-augmented law, and Eq. 22 on arrays."""
+    """Compile the friction law over a population (the fit), the gap's Iwan-augmented law, and Eq. 22 on arrays."""
     from .contact_laws import stiction_shear_stiffness
     from .gap.model import Augmentation
     from .gap.refit import law_friction_force
@@ -79,10 +79,20 @@ def _contact_kernels(structure: Mapping, rig: Mapping) -> None:
 KERNEL_GROUPS = {"rig": _rig_kernels, "contact": _contact_kernels}
 
 
-def compile_kernels(config: Mapping, groups=None) -> None:
-    """Compile (or load from numba's cache) every kernel the workflow's jobs call, for the structure and rig of
-    ``config`` (a config as the Snakefile reads it; the schema's defaults fill what it leaves out); ``groups``:
-    names of ``KERNEL_GROUPS`` (default: all)."""
+def compile_kernels(config: Mapping, groups: Iterable[str] | None = None) -> None:
+    """Compile (or load from numba's cache) every kernel the workflow's jobs call.
+
+    The kernels are called on a problem a few steps long built from the structure and rig of ``config``, so that
+    numba compiles the signatures the jobs use.
+
+    Parameters
+    ----------
+    config
+        A config as the Snakefile reads it (the whole config file); its ``structure`` and ``rig`` blocks are read,
+        the schema's defaults filling what it leaves out.
+    groups
+        Names of ``KERNEL_GROUPS`` ("rig", "contact") to compile; None for all of them.
+    """
     structure, rig = _structure_and_rig(config)
     for name in groups or KERNEL_GROUPS:
         KERNEL_GROUPS[name](structure, rig)

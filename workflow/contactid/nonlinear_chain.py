@@ -1,10 +1,12 @@
-"""The nonlinear chain's datasets, one per step and load case (Sections 4-5):
-generalized coordinates -> nonlinear modes -> reduced model (the paper's S, N) -> contact forces
-(both methods side by side, scored against the rig truth where it exists)."""
+"""The nonlinear chain's datasets, one per step and load case (Sections 4-5).
+
+Generalized coordinates -> nonlinear modes -> reduced model (the paper's S, N) -> contact forces (both methods side by
+side, scored against the rig truth where it exists).
+"""
 
 from __future__ import annotations
 
-from typing import Mapping
+from typing import Iterable, Mapping, Sequence
 
 import numpy as np
 import xarray as xr
@@ -21,12 +23,26 @@ from .identification import (
     nonlinear_mode_coefficients,
     nrmse,
 )
-from .parameters import identified_structure
+from .parameters import StructureParameters, identified_structure
 from .raw_checks_dual_sine import driving_point_index
 
 
 def linear_model(structure_cfg: Mapping, linear_modes: xr.Dataset) -> FEModel:
-    """The identified linear FE model (the stiffnesses the linear chain chose)."""
+    """Return the identified linear FE model (the stiffnesses the linear chain chose).
+
+    Parameters
+    ----------
+    structure_cfg
+        The config's ``structure`` block.
+    linear_modes
+        The linear chain's modes (results/linear/linear_modes.nc): its ``k_t``, ``k_n`` [N/m] and, where
+        present, ``stiffness_scale`` are read.
+
+    Returns
+    -------
+    model : FEModel
+        The structure of ``structure_cfg`` with those stiffnesses, assembled.
+    """
     return assemble(identified_structure(structure_cfg, linear_modes))
 
 
@@ -40,7 +56,27 @@ def _record(raw: xr.Dataset):
 
 
 def generalized_coordinates_dataset(raw: xr.Dataset, linear_modes: xr.Dataset, n_harmonics: int) -> xr.Dataset:
-    """Eqs. 15-17: p''(t) from the sensors, its K-harmonic Fourier series and p(t) by analytic integration."""
+    """Return the generalized coordinates' dataset (Eqs. 15-17).
+
+    p''(t) from the sensors, its K-harmonic Fourier series and p(t) by analytic integration.
+
+    Parameters
+    ----------
+    raw
+        The load case's dual-sine record (``io.read_raw``): ``force`` [N] and ``acceleration`` [m/s^2] over
+        ``time`` [s], the attributes ``sampling_rate_hz`` and ``excitation_frequency_hz``.
+    linear_modes
+        The linear chain's modes (results/linear/linear_modes.nc): its ``phi_sensor`` (the mass-normalised shapes at
+        the sensors) and ``mode`` are read.
+    n_harmonics
+        Harmonics K of the excitation frequency in the Fourier series.
+
+    Returns
+    -------
+    gc : xr.Dataset
+        ``p_ddot_measured``, ``p_ddot`` [kg^0.5 m/s^2] and ``p`` [kg^0.5 m] over (``mode``, ``time``), the harmonics'
+        ``amplitude`` [kg^0.5 m/s^2] and ``phase`` [rad] over (``mode``, ``harmonic``).
+    """
     force, acc, fs, f0 = _record(raw)
     phi_s = linear_modes["phi_sensor"].values
     pdd, coef = generalized_coordinates(phi_s, acc, fs, f0, n_harmonics)
@@ -86,8 +122,35 @@ def nonlinear_modes_dataset(
     n_harmonics: int,
     phase_limit_deg: float,
 ) -> xr.Dataset:
-    """Eq. 20's two real NNMs, the phase check, the NNM coordinates and the reconstruction of the
-    driving-point acceleration (Fig. 5)."""
+    """Return the nonlinear modes' dataset: Eq. 20's two real NNMs, the phase check and the NNM coordinates.
+
+    With the reconstruction of the driving-point acceleration from the NNMs (Fig. 5) and its NRMSE.
+
+    Parameters
+    ----------
+    gc
+        The generalized coordinates' dataset (``generalized_coordinates_dataset``): its ``amplitude`` and ``phase``
+        are read.
+    linear_modes
+        The linear chain's modes (results/linear/linear_modes.nc): ``phi_sensor``, ``phi``, ``u``, ``y_s``,
+        ``theta_s``, ``mode`` and ``x`` are read.
+    raw
+        The load case's dual-sine record (``io.read_raw``): ``force`` [N] and ``acceleration`` [m/s^2] over
+        ``time`` [s], the attributes ``sampling_rate_hz`` and ``excitation_frequency_hz``.
+    structure_cfg
+        The config's ``structure`` block; its ``excitation_position_m`` [m] (the driving point) is read.
+    n_harmonics
+        Harmonics K of the excitation frequency kept in the NNM coordinates.
+    phase_limit_deg
+        Largest phase spread of a real NNM's terms (nonlinear.phase_limit_deg); beyond it the attribute
+        ``complex_modes`` is 1 [deg].
+
+    Returns
+    -------
+    nnm : xr.Dataset
+        The NNMs' coefficients on the linear modes, their phase spread, shapes and coordinates ``q``, ``q_ddot``
+        over (``nnm``, ``time``), the measured and reconstructed driving-point accelerations [m/s^2].
+    """
     force, acc, fs, f0 = _record(raw)
     coef_c = gc["amplitude"].values * np.exp(1j * gc["phase"].values)
     coef, spread = nonlinear_mode_coefficients(coef_c)
@@ -140,7 +203,29 @@ def nonlinear_modes_dataset(
 def reduced_model_dataset(
     nnm: xr.Dataset, linear_modes: xr.Dataset, raw: xr.Dataset, structure_cfg: Mapping, n_harmonics: int
 ) -> xr.Dataset:
-    """The Galerkin reduced model on the NNMs (Eqs. 10-12) and the paper's S(t), N(t) by force-state mapping."""
+    """Return the Galerkin reduced model on the NNMs (Eqs. 10-12) and the paper's S(t), N(t) by force-state mapping.
+
+    Parameters
+    ----------
+    nnm
+        The nonlinear modes' dataset (``nonlinear_modes_dataset``): ``coefficient``, ``q`` and ``q_ddot`` are read.
+    linear_modes
+        The linear chain's modes (results/linear/linear_modes.nc): the stiffnesses of ``linear_model`` and the
+        number of modes.
+    raw
+        The load case's dual-sine record (``io.read_raw``): ``force`` [N] and ``acceleration`` [m/s^2] over
+        ``time`` [s], the attributes ``sampling_rate_hz`` and ``excitation_frequency_hz``.
+    structure_cfg
+        The config's ``structure`` block.
+    n_harmonics
+        Harmonics K of the excitation frequency kept of the force.
+
+    Returns
+    -------
+    reduced : xr.Dataset
+        The reduced mass, stiffness and force over ``nnm``, and S, N_dyn [N], xi, eta [m] over ``time``, mean
+        removed.
+    """
     force, acc, fs, f0 = _record(raw)
     model = linear_model(structure_cfg, linear_modes)
     phi = structural_modes(model, linear_modes.sizes["mode"]).shapes
@@ -187,9 +272,12 @@ def reduced_model_dataset(
 def _stiffness_interval_spreads(
     model: FEModel, modal: xr.Dataset, stiction: xr.Dataset, k_t: float, k_n: float, record, n_harmonics: int
 ) -> dict:
-    """{"k_n" | "k_t": {quantity: NRMSE}}: how far S, N_dyn, xi and eta move between the two ends of the linear
-    chain's stiffness interval (N/m) of k_n (an open upper end: 10 x the larger of k_n and the lower end) and of k_t,
-    the other stiffness held; ``record``: (force, acceleration, fs, f0) of ``_record``."""
+    """Return {"k_n" | "k_t": {quantity: NRMSE}}: how far S, N_dyn, xi and eta move over a stiffness interval.
+
+    Between the two ends of the linear chain's stiffness interval (N/m) of k_n (an open upper end: 10 x the larger of
+    k_n and the lower end) and of k_t, the other stiffness held; ``record``: (force, acceleration, fs, f0) of
+    ``_record``.
+    """
     force, acc, fs, f0 = record
     lo_n, hi_n = (float(v) for v in stiction["k_n_interval"].values)
     hi_n = hi_n if np.isfinite(hi_n) else 10 * max(k_n, lo_n)
@@ -209,9 +297,11 @@ def _stiffness_interval_spreads(
 
 
 def _structure_spreads(inv, structures, modal: xr.Dataset, record, n_harmonics: int) -> dict:
-    """{quantity: largest relative change} of S, N_dyn, xi and eta over ``structures`` (StructureParameters),
-    on the harmonics (the relative norm of the coefficients is the NRMSE of the periodic signals; no time synthesis
-    needed); empty without structures."""
+    """Return {quantity: largest relative change} of S, N_dyn, xi and eta over ``structures`` (StructureParameters).
+
+    On the harmonics (the relative norm of the coefficients is the NRMSE of the periodic signals; no time synthesis
+    needed); empty without structures.
+    """
     structure_spread = {}
     if structures:
         force, acc, fs, f0 = record
@@ -229,16 +319,20 @@ def _structure_spreads(inv, structures, modal: xr.Dataset, record, n_harmonics: 
 
 
 def _normal_stiffness_and_hardening(inv) -> tuple[float, float]:
-    """(k1 in N/m, k2 in N/m^2) of the N-eta relation N_dyn = -k1 eta + k2 eta^2 (eta^2 mean removed), least
-    squares."""
+    """Return (k1 in N/m, k2 in N/m^2) of the N-eta relation N_dyn = -k1 eta + k2 eta^2 (eta^2 mean removed).
+
+    Fitted by least squares.
+    """
     A = np.column_stack([-inv.eta, inv.eta**2 - np.mean(inv.eta**2)])
     k1, k2 = np.linalg.lstsq(A, inv.N_dyn, rcond=None)[0]
     return k1, k2
 
 
 def _contact_force_variables(inv, paper: xr.Dataset, k_t: float, k_n: float, dxi, deta) -> dict:
-    """The dataset's variables: both methods' S, N_dyn (N), xi, eta (m), the working method's rates, the paper's
-    error terms k_t dxi and k_n deta (N) and the sensor misfit per harmonic."""
+    """Return the contact forces dataset's variables: both methods' S, N_dyn (N), xi, eta (m), and more.
+
+    The working method's rates, the paper's error terms k_t dxi and k_n deta (N) and the sensor misfit per harmonic.
+    """
     return {
         "S": ("time", inv.S, {"units": "N", "long_name": "friction force S(t), working method, mean removed"}),
         "N_dyn": (
@@ -261,8 +355,10 @@ def _contact_force_variables(inv, paper: xr.Dataset, k_t: float, k_n: float, dxi
 
 
 def _truth_scores(inv, paper: xr.Dataset, truth: xr.Dataset) -> tuple[dict, dict]:
-    """(attributes, variables) against the rig's truth: both methods' NRMSE of S, N, xi and eta, and the true S,
-    N - N0 (N), xi and eta (m) with their means removed."""
+    """Return (attributes, variables) against the rig's truth.
+
+    Both methods' NRMSE of S, N, xi and eta, and the true S, N - N0 (N), xi and eta (m) with their means removed.
+    """
     attrs = {}
     tS, tN, txi, teta = (truth[k].values for k in ("S", "N", "xi", "eta"))
     for method, (S, N, xi, eta) in {
@@ -296,14 +392,51 @@ def contact_forces_dataset(
     n_harmonics: int,
     truth: xr.Dataset | None,
     observability_limit: float = 0.1,
-    structures=(),
+    structures: Sequence[StructureParameters] = (),
 ) -> xr.Dataset:
-    """Both methods side by side: the working method (per-harmonic inverse identification) and the
-    paper's chain; the paper's error decomposed into k_t dxi and k_n deta; the working method's
-    sensitivity to the linear chain's stiffness intervals and to ``structures`` (the structures the random test
-    allows, ``UpdatingResult.posterior_structures``: E, masses, transducers and lever arm within their posterior,
-    which the k_t, k_n intervals alone miss); eta is called unobservable when it moves by more than
-    ``observability_limit`` NRMSE across them; errors against the truth."""
+    """Return the contact forces of both methods side by side, with their sensitivity and their errors.
+
+    The working method (per-harmonic inverse identification) and the paper's chain; the paper's error decomposed into
+    k_t dxi and k_n deta; the working method's sensitivity to the linear chain's stiffness intervals and to
+    ``structures`` (the structures the random test allows, ``UpdatingResult.posterior_structures``: E, masses,
+    transducers and lever arm within their posterior, which the k_t, k_n intervals alone miss); eta is called
+    unobservable when it moves by more than ``observability_limit`` NRMSE across them; errors against the truth.
+
+    Parameters
+    ----------
+    raw
+        The load case's dual-sine record (``io.read_raw``): ``force`` [N] and ``acceleration`` [m/s^2] over
+        ``time`` [s], the attributes ``sampling_rate_hz`` and ``excitation_frequency_hz``.
+    paper
+        The paper's chain's reduced-model dataset (``reduced_model_dataset``): its ``S``, ``N_dyn``, ``xi`` and
+        ``eta`` are read.
+    linear_modes
+        The linear chain's modes (results/linear/linear_modes.nc): ``k_t``, ``k_n`` [N/m] and the stiffnesses of
+        ``linear_model``.
+    modal
+        The modal fit's dataset (results/linear/modal.nc): its ``damping_ratio`` per identified mode is read.
+    stiction
+        The stiffness fit's dataset (results/linear/stiction.nc): ``k_t_interval`` (both ends finite) and
+        ``k_n_interval`` (an open upper end allowed) [N/m] are read.
+    structure_cfg
+        The config's ``structure`` block.
+    n_harmonics
+        Harmonics K of the excitation frequency identified.
+    truth
+        The rig's truth of the record (``S``, ``N``, ``xi``, ``eta`` over ``time``), or None for a measured record.
+    observability_limit
+        The largest NRMSE by which eta may move over the stiffness intervals and ``structures`` and still be called
+        observable (nonlinear.observability_limit) [-].
+    structures
+        The structures the random test allows (model updating's posterior); empty for none.
+
+    Returns
+    -------
+    forces : xr.Dataset
+        Both methods' S, N_dyn [N], xi, eta [m] over ``time``, the working method's rates [m/s], the paper's error
+        terms and the sensor misfit over ``harmonic``; the truth's signals where given; the attributes hold the
+        spreads, the N-eta fit and the NRMSEs.
+    """
     record = _record(raw)
     force, acc, fs, f0 = record
     model = linear_model(structure_cfg, linear_modes)
@@ -347,10 +480,39 @@ def contact_forces_dataset(
 
 
 def harmonic_study(
-    raw: xr.Dataset, truth: xr.Dataset, linear_modes: xr.Dataset, modal: xr.Dataset, structure_cfg: Mapping, counts
+    raw: xr.Dataset,
+    truth: xr.Dataset,
+    linear_modes: xr.Dataset,
+    modal: xr.Dataset,
+    structure_cfg: Mapping,
+    counts: Iterable[int],
 ) -> "pandas.DataFrame":  # noqa: F821
-    """Errors of the working method against the truth for several harmonic counts K, beside the
-    truth's own truncation floor (its S kept to K harmonics)."""
+    """Return the working method's errors against the truth for several harmonic counts K.
+
+    Beside the truth's own truncation floor (its S kept to K harmonics).
+
+    Parameters
+    ----------
+    raw
+        The load case's dual-sine record (``io.read_raw``): ``force`` [N] and ``acceleration`` [m/s^2] over
+        ``time`` [s], the attributes ``sampling_rate_hz`` and ``excitation_frequency_hz``.
+    truth
+        The rig's truth of the record: ``S``, ``N``, ``xi`` and ``eta`` over ``time``.
+    linear_modes
+        The linear chain's modes (results/linear/linear_modes.nc): the stiffnesses of ``linear_model``.
+    modal
+        The modal fit's dataset (results/linear/modal.nc): its ``damping_ratio`` per identified mode is read.
+    structure_cfg
+        The config's ``structure`` block.
+    counts
+        The harmonic counts K to try.
+
+    Returns
+    -------
+    errors : pandas.DataFrame
+        One row per K: ``K``, the NRMSE of S, N, xi and eta (``S_nrmse``...) and ``S_truncation_floor``, all
+        relative.
+    """
     import pandas as pd
 
     force, acc, fs, f0 = _record(raw)
