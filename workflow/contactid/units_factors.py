@@ -1,6 +1,8 @@
-"""The factors by which a vibration record written in other units than its labels is off, and what each means: one
-table for every check that names a units error (the raw checks' level against the FRF, the stiffness step's FRF
-amplitudes, the records' check)."""
+"""The factors by which a vibration record written in other units than its labels is off, and what each means.
+
+One table for every check that names a units error (the raw checks' level against the FRF, the stiffness step's FRF
+amplitudes, the records' check).
+"""
 
 from __future__ import annotations
 
@@ -22,8 +24,26 @@ UNIT_FACTORS = (
 
 
 def units_error(ratio: float, tolerance: float) -> tuple[float, str] | None:
-    """(the units factor, what it means) for an accelerance ``ratio`` (record over expectation) within ``tolerance``
-    (relative) of a units factor or its inverse, else None."""
+    """Return the units factor an accelerance ratio is near, and what it means.
+
+    The ratio is matched against every factor of ``UNIT_FACTORS`` and its inverse, in the table's order; the first
+    within ``tolerance`` is named.
+
+    Parameters
+    ----------
+    ratio
+        An accelerance of the record over the expected one [-].
+    tolerance
+        Relative distance from a units factor (on a log scale: within a factor 1 + tolerance) that still counts as
+        that factor [-].
+
+    Returns
+    -------
+    factor : float
+        The units factor or its inverse that ``ratio`` is near [-]; the whole result is None where none is.
+    meaning : str
+        What a record off by that factor has (for example "the force in kgf labelled N").
+    """
     for factor, larger, smaller in UNIT_FACTORS:
         for value, meaning in ((factor, larger), (1.0 / factor, smaller)):
             if ratio > 0 and abs(np.log(ratio / value)) <= np.log1p(tolerance):
@@ -32,5 +52,19 @@ def units_error(ratio: float, tolerance: float) -> tuple[float, str] | None:
 
 
 def near_units(ratio: float, tolerance: float) -> bool:
-    """Whether ``ratio`` is within ``tolerance`` of a units factor or its inverse (``units_error``)."""
+    """Return whether a ratio is within a tolerance of a units factor or its inverse (``units_error``).
+
+    Parameters
+    ----------
+    ratio
+        An accelerance of the record over the expected one [-].
+    tolerance
+        Relative distance from a units factor (on a log scale: within a factor 1 + tolerance) that still counts as
+        that factor [-].
+
+    Returns
+    -------
+    near : bool
+        True where ``units_error`` names a factor.
+    """
     return units_error(ratio, tolerance) is not None

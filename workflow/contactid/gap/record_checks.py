@@ -1,5 +1,6 @@
-"""Plausibility of the records against each other and against the identified model: a units factor, a flipped sign,
-a swapped channel, a gross disagreement.
+"""Plausibility of the records against each other and against the identified model.
+
+What is looked for: a units factor, a flipped sign, a swapped channel, a gross disagreement.
 
 Each record passed its own checks (``raw_checks``); these look at what no single record shows. Evidence first (pure
 numbers from the records and the identified model's predictions at each record's measured force), then the
@@ -27,7 +28,7 @@ from __future__ import annotations
 
 import itertools
 from dataclasses import dataclass
-from typing import Mapping
+from typing import Mapping, Sequence
 
 import numpy as np
 
@@ -38,12 +39,24 @@ from ..units_factors import near_units, units_error
 class Thresholds:
     """The tests' limits (config ``gap.record_checks``).
 
-    level_factor: a case's accelerance this many times off the cases' median (or its inverse) is named;
-    explained_share: a transformation (scale, sign, channel order) explains a disagreement when it leaves at most
-    this share of the gap; gross_ratio, signature_gap: a held-out case leaving more than gross_ratio times the
-    calibration case's gap and more than signature_gap is looked at for a transformation; gross_gap: beyond it (and
-    gross_ratio times the calibration case's) with none, a gross disagreement of unknown cause; unit_tolerance: a factor
-    within this relative distance of a units factor is named as that factor."""
+    Attributes
+    ----------
+    level_factor
+        A case's accelerance this many times off the cases' median (or its inverse) is named [-].
+    explained_share
+        A transformation (scale, sign, channel order) explains a disagreement when it leaves at most this share of
+        the gap [-].
+    gross_ratio
+        A held-out case leaving more than gross_ratio times the calibration case's gap (and more than
+        signature_gap) is looked at for a transformation [-].
+    signature_gap
+        The held-out gap (relative) below which no record is looked at for a transformation [-].
+    gross_gap
+        Beyond this gap (relative; and, held out, gross_ratio times the calibration case's) with no transformation,
+        a gross disagreement of unknown cause [-].
+    unit_tolerance
+        A factor within this relative distance of a units factor is named as that factor [-].
+    """
 
     level_factor: float = 3.0
     explained_share: float = 0.35
@@ -54,7 +67,18 @@ class Thresholds:
 
     @classmethod
     def from_config(cls, block: Mapping | None) -> "Thresholds":
-        """From the ``gap.record_checks`` block (keys left out: the defaults), as ``verdict.PlaceThresholds``."""
+        """Return the thresholds of the ``gap.record_checks`` block, as ``verdict.PlaceThresholds`` does.
+
+        Parameters
+        ----------
+        block
+            The config's ``gap.record_checks`` block (keys left out: the defaults); None for every default.
+
+        Returns
+        -------
+        thresholds : Thresholds
+            The block's values as floats.
+        """
         return cls(**{k: float(v) for k, v in (block or {}).items()})
 
 
@@ -64,8 +88,22 @@ class Thresholds:
 
 
 def accelerance_levels(checks: Mapping[str, Mapping]) -> dict:
-    """{case: (f0 in Hz, (j, 2) complex accelerance at w and 3 w)} of every sensor from the records' harmonics
-    ``checks`` {case: {"f0": Hz, "acceleration": (j, H) complex, "force": (H,) complex}}."""
+    """Return every case's drive frequency and the accelerance of every sensor at w and 3 w.
+
+    Computed from the records' harmonics: each sensor's harmonic over the force's.
+
+    Parameters
+    ----------
+    checks
+        {case: {"f0": drive frequency [Hz], "acceleration": the sensors' complex harmonics h = 1..H [m/s^2] of
+        shape (j, H), "force": the force's complex harmonics [N] of shape (H,)}}.
+
+    Returns
+    -------
+    levels : dict
+        {case: (f0 [Hz], complex accelerance [m/s^2/N] of shape (j, 2): at w and 3 w)}; a harmonic the force
+        lacks (beyond H, or zero) is left out, leaving fewer columns.
+    """
     out = {}
     for case, c in checks.items():
         A, F = np.asarray(c["acceleration"]), np.asarray(c["force"])
@@ -79,8 +117,20 @@ SAME_DRIVE = 0.005
 
 
 def same_drive_groups(levels: Mapping[str, tuple]) -> list[list[str]]:
-    """The cases of ``levels`` (``accelerance_levels``) grouped by drive frequency (within ``SAME_DRIVE``): the
-    accelerance of one structure depends on the frequency, so only cases driven alike are compared."""
+    """Return the cases grouped by drive frequency (within ``SAME_DRIVE``, relative).
+
+    The accelerance of one structure depends on the frequency, so only cases driven alike are compared.
+
+    Parameters
+    ----------
+    levels
+        {case: (f0 [Hz], accelerance)} (``accelerance_levels``).
+
+    Returns
+    -------
+    groups : list[list[str]]
+        The cases by ascending drive frequency, each group within ``SAME_DRIVE`` of its first case's frequency.
+    """
     groups: list[list[str]] = []
     for case in sorted(levels, key=lambda c: levels[c][0]):
         if groups and abs(levels[case][0] / levels[groups[-1][0]][0] - 1.0) <= SAME_DRIVE:
@@ -91,7 +141,7 @@ def same_drive_groups(levels: Mapping[str, tuple]) -> list[list[str]]:
 
 
 def _ls_scale(pred: np.ndarray, meas: np.ndarray) -> complex:
-    """The complex factor a minimising |a pred - meas|."""
+    """Return the complex factor a minimising |a pred - meas|."""
     den = np.vdot(pred, pred)
     return complex(np.vdot(pred, meas) / den) if abs(den) > 0 else 0j
 
@@ -102,9 +152,34 @@ def _rel(a: np.ndarray, b: np.ndarray) -> float:
 
 @dataclass(frozen=True)
 class ModelEvidence:
-    """One record against the identified model's prediction at its measured force (harmonics 1..H of every sensor):
-    the gap; the common complex factor of prediction onto record and the gap it leaves; each sensor's factor and gap;
-    the channel permutation that fits best (sensor order) and the gap it leaves."""
+    """One record against the identified model's prediction at its measured force (harmonics 1..H of every sensor).
+
+    The gap; the common complex factor of prediction onto record and the gap it leaves; each sensor's factor and gap;
+    the channel permutation that fits best (sensor order) and the gap it leaves. A gap is the norm of prediction
+    minus record relative to the record's norm.
+
+    Attributes
+    ----------
+    case
+        The load case.
+    sensors
+        The sensors' names, j of them, in the order of the harmonics' rows.
+    gap
+        The prediction's gap to the record [-].
+    scale
+        The common complex factor a (least squares) that takes the prediction onto the record [-].
+    gap_scaled
+        The gap of a times the prediction [-].
+    sensor_scale
+        Each sensor's own complex factor of prediction onto record [-], j of them.
+    sensor_gap
+        Each sensor's gap [-], j of them.
+    permutation
+        The order of the predicted rows that fits the record best (the identity where none fits better, or where
+        more than six sensors leave the test out).
+    gap_permuted
+        The gap of the prediction in that order [-].
+    """
 
     case: str
     sensors: tuple
@@ -117,8 +192,25 @@ class ModelEvidence:
     gap_permuted: float
 
 
-def model_evidence(case: str, sensors, measured: np.ndarray, predicted: np.ndarray) -> ModelEvidence:
-    """``measured`` and ``predicted``: (j, H) complex accelerations of one record and of the model at its force."""
+def model_evidence(case: str, sensors: Sequence[str], measured: np.ndarray, predicted: np.ndarray) -> ModelEvidence:
+    """Return the evidence of one record against the model's prediction at its force.
+
+    Parameters
+    ----------
+    case
+        The load case.
+    sensors
+        The sensors' names, j of them, in the order of the rows.
+    measured
+        The record's complex acceleration harmonics h = 1..H [m/s^2], shape (j, H).
+    predicted
+        The identified model's at the record's measured force [m/s^2], shape (j, H).
+
+    Returns
+    -------
+    evidence : ModelEvidence
+        The gaps, the common and per-sensor factors and the best channel order.
+    """
     A, P = np.asarray(measured), np.asarray(predicted)
     a = _ls_scale(P.ravel(), A.ravel())
     per = [_ls_scale(P[i], A[i]) for i in range(A.shape[0])]
@@ -149,8 +241,22 @@ def model_evidence(case: str, sensors, measured: np.ndarray, predicted: np.ndarr
 
 
 def named_factor(factor: float, tol: float) -> str:
-    """A magnitude ratio (record over expectation) and what it most likely means: the units factor it is near, either
-    way (``units_factors``), or a sensitivity."""
+    """Return a magnitude ratio (record over expectation) in words, with what it most likely means.
+
+    The units factor it is near, either way (``units_factors``), or a sensitivity.
+
+    Parameters
+    ----------
+    factor
+        The magnitude ratio, record over expectation [-].
+    tol
+        Relative distance from a units factor within which the ratio is named as that factor [-].
+
+    Returns
+    -------
+    text : str
+        "x times (near f: likely ...)" or "x times (likely a wrong sensitivity or gain in the channel map)".
+    """
     hit = units_error(factor, tol)
     if hit is not None:
         value, meaning = hit
@@ -164,13 +270,26 @@ def _trace(test: str, value: float, threshold: float, passed: bool, case: str) -
 
 
 def _finding(case: str, check: str, message: str, signature: bool) -> dict:
-    """``signature``: the cause is a transformation of the record (units, sign, channel order), not a guess."""
+    """Return a finding; ``signature``: the cause is a transformation of the record (units, sign, channel order)."""
     return {"record": case, "check": check, "message": message, "signature": signature}
 
 
 def level_factors(levels: Mapping[str, tuple]) -> dict:
-    """{case: its accelerance over the median of its drive group's (``same_drive_groups``; the geometric median over
-    sensors and harmonics)} for every case that shares its drive with another; with two, each over the other."""
+    """Return each case's accelerance over the median of its drive group's (``same_drive_groups``).
+
+    The geometric median over sensors and harmonics of the case's accelerance over the group's median, for every
+    case that shares its drive with another; with two, each over the other.
+
+    Parameters
+    ----------
+    levels
+        {case: (f0 [Hz], accelerance)} (``accelerance_levels``).
+
+    Returns
+    -------
+    factors : dict
+        {case: its accelerance over its peers' [-]}; a case alone at its drive is left out.
+    """
     out = {}
     for cases in same_drive_groups(levels):
         if len(cases) < 2:
@@ -184,10 +303,26 @@ def level_factors(levels: Mapping[str, tuple]) -> dict:
 
 
 def level_tests(levels: Mapping[str, tuple], th: Thresholds) -> tuple[list, list]:
-    """Each case's accelerance (``accelerance_levels``) against the median of every case's driven at its frequency
-    (``level_factors``): (findings, trace). Needs three cases at a drive to say which one is off; with two, a ratio
-    beyond the limit names both. A units factor is named within twice ``unit_tolerance`` here: the cases' own
-    accelerances differ by their levels' nonlinearity."""
+    """Test each case's accelerance against the median of every case's driven at its frequency (``level_factors``).
+
+    Needs three cases at a drive to say which one is off; with two, a ratio beyond the limit names both. A units
+    factor is named within twice ``unit_tolerance`` here: the cases' own accelerances differ by their levels'
+    nonlinearity.
+
+    Parameters
+    ----------
+    levels
+        {case: (f0 [Hz], accelerance)} (``accelerance_levels``).
+    th
+        The tests' limits.
+
+    Returns
+    -------
+    findings : list
+        A finding (record, check, message, signature) per case off beyond ``level_factor``.
+    trace : list
+        Each test made: test, case, value, threshold, passed.
+    """
     findings, trace = [], []
     factors = level_factors(levels)
     for cases in same_drive_groups(levels):
@@ -217,17 +352,38 @@ def level_tests(levels: Mapping[str, tuple], th: Thresholds) -> tuple[list, list
 def model_tests(
     evidence: Mapping[str, ModelEvidence], calibration_case: str, th: Thresholds, levels: Mapping | None = None
 ) -> tuple[list, list]:
-    """Each record against the model's prediction at its force. A held-out record is looked at where its gap exceeds
-    ``gross_ratio`` times the calibration case's and ``signature_gap``; any record, the calibration case's included,
-    where it exceeds ``gross_gap`` (a model that leaves that much on the record it was fitted to has failed on it,
-    and the held-out records are then no worse than it).
-    Looked at, in this order: a common factor that explains the disagreement (leaves at most ``explained_share`` of
-    it) and is a flipped sign, or a units factor that the record's level among its peers (``levels``, from
-    ``level_factors``) shows too (a factor of any other size, or one the peers do not show, is the model's: an effect
-    it lacks at that level); a channel order that explains it (the channel
-    map); one sensor off by its own factor while the others agree (its sensitivity or sign). With none of these, a
-    gap beyond ``gross_gap`` (and, held out, ``gross_ratio`` times the calibration case's) is a gross disagreement of
-    unknown cause (no signature: the verdict is not taken from it). Returns (findings, trace)."""
+    """Test each record against the model's prediction at its force.
+
+    A held-out record is looked at where its gap exceeds ``gross_ratio`` times the calibration case's and
+    ``signature_gap``; any record, the calibration case's included, where it exceeds ``gross_gap`` (a model that
+    leaves that much on the record it was fitted to has failed on it, and the held-out records are then no worse
+    than it). Looked at, in this order: a common factor that explains the disagreement (leaves at most
+    ``explained_share`` of it) and is a flipped sign, or a units factor that the record's level among its peers
+    (``levels``, from ``level_factors``) shows too (a factor of any other size, or one the peers do not show, is the
+    model's: an effect it lacks at that level); a channel order that explains it (the channel map); one sensor off by
+    its own factor while the others agree (its sensitivity or sign). With none of these, a gap beyond ``gross_gap``
+    (and, held out, ``gross_ratio`` times the calibration case's) is a gross disagreement of unknown cause (no
+    signature: the verdict is not taken from it).
+
+    Parameters
+    ----------
+    evidence
+        {case: ModelEvidence} of every record.
+    calibration_case
+        The case the friction law was fitted on.
+    th
+        The tests' limits.
+    levels
+        {case: the record's accelerance over its peers' [-]} (``level_factors``); None, or a case left out: no peer
+        to ask.
+
+    Returns
+    -------
+    findings : list
+        A finding (record, check, message, signature) per record that disagrees with a signature or grossly.
+    trace : list
+        Each test made: test, case, value, threshold, passed.
+    """
     findings, trace = [], []
     cal = evidence.get(calibration_case)
     base = cal.gap if cal is not None else 0.0
@@ -266,8 +422,10 @@ def model_tests(
 
 
 def _signature(ev: ModelEvidence, th: Thresholds, head: str, trace: list, level: float | None) -> dict | None:
-    """The first transformation of the record that explains its disagreement with the prediction, as a finding;
-    ``level``: the record's accelerance over its peers' (``level_factors``), None where it has none."""
+    """Return the first transformation of the record that explains its disagreement with the prediction, as a finding.
+
+    ``level``: the record's accelerance over its peers' (``level_factors``), None where it has none.
+    """
     case, n = ev.case, len(ev.sensors)
     mag, phase = abs(ev.scale), float(np.degrees(abs(np.angle(ev.scale))))
     left = ev.gap_scaled / ev.gap
@@ -336,11 +494,30 @@ def _signature(ev: ModelEvidence, th: Thresholds, head: str, trace: list, level:
 
 
 def records_check(
-    levels: Mapping[str, np.ndarray], evidence: Mapping[str, ModelEvidence], calibration_case: str, th: Thresholds
+    levels: Mapping[str, tuple], evidence: Mapping[str, ModelEvidence], calibration_case: str, th: Thresholds
 ) -> dict:
-    """The whole check: {"passed", "findings": [{record, check, message, signature}], "trace": [...], "gaps": {case:
-    gap}}; ``passed`` is False where a finding has a signature (a units factor, a sign, a channel order: the records,
-    not the model, are wrong)."""
+    """Run the whole check: the records' levels against each other, then each record against the model.
+
+    ``passed`` is False where a finding has a signature (a units factor, a sign, a channel order: the records, not
+    the model, are wrong).
+
+    Parameters
+    ----------
+    levels
+        {case: (f0 [Hz], accelerance)} (``accelerance_levels``).
+    evidence
+        {case: ModelEvidence} of every record.
+    calibration_case
+        The case the friction law was fitted on.
+    th
+        The tests' limits.
+
+    Returns
+    -------
+    check : dict
+        {"passed", "findings": [{record, check, message, signature}], "trace": [...], "gaps": {case: gap},
+        "calibration_case"}.
+    """
     f1, t1 = level_tests(levels, th)
     f2, t2 = model_tests(evidence, calibration_case, th, level_factors(levels))
     return {
@@ -357,10 +534,33 @@ RECORDS_DISAGREE = "records_disagree"
 
 
 def diagnosis_outcome(verdict: str, reason: str, explanation: list, check: Mapping) -> tuple[str, str, list]:
-    """The gap diagnosis's (verdict, reason, explanation) given the records' check: where a record fails with a
-    signature (units, sign, channel order), verdict ``records_disagree``, the reason naming each such record and its
-    fix, and no explanation (no effect is to be looked for in records that contradict each other); a gross
-    disagreement of unknown cause is said first in the reason, the verdict kept; otherwise unchanged."""
+    """Return the gap diagnosis's (verdict, reason, explanation) given the records' check.
+
+    Where a record fails with a signature (units, sign, channel order), verdict ``records_disagree``, the reason
+    naming each such record and its fix, and no explanation (no effect is to be looked for in records that contradict
+    each other); a gross disagreement of unknown cause is said first in the reason, the verdict kept; otherwise
+    unchanged.
+
+    Parameters
+    ----------
+    verdict
+        The diagnosis's verdict (an effect's name or "none").
+    reason
+        The diagnosis's reason, in words.
+    explanation
+        The diagnosis's explanation, its steps.
+    check
+        The records' check (``records_check``).
+
+    Returns
+    -------
+    verdict : str
+        ``RECORDS_DISAGREE`` or the verdict given.
+    reason : str
+        The reason, with the findings said.
+    explanation : list
+        The explanation given, or empty where the records disagree.
+    """
     hard = [f for f in check.get("findings", []) if f.get("signature")]
     soft = [f for f in check.get("findings", []) if not f.get("signature")]
     if hard:

@@ -1,6 +1,8 @@
-"""The gap section's paragraph 'The base model': the structure updated from the random test (chi^2 before and after
-against its bar, accepted or not and by what, what the data bind, the channels' relative gains), from diagnosis.json's
-``where.model_updating``."""
+"""The gap section's paragraph 'The base model': the structure updated from the random test.
+
+Chi^2 before and after against its bar, accepted or not and by what, what the data bind, the channels' relative
+gains, from diagnosis.json's ``where.model_updating``.
+"""
 
 from __future__ import annotations
 
@@ -15,7 +17,7 @@ def _factor_list(factors: dict) -> str:
 
 
 def _records_verdict(rt: dict | None) -> str:
-    """The dual-sine records' test of an update (``records_test``) in words, or "" where it was not run."""
+    """Return the dual-sine records' test of an update (``records_test``) in words, or "" where it was not run."""
     if not rt:
         return ""
     return (
@@ -30,8 +32,10 @@ def _records_verdict(rt: dict | None) -> str:
 
 
 def _why_not(rt: dict, floor) -> str:
-    """Why the dual-sine records did not accept an update: nothing above the floor to explain, or too little
-    explained (``verdict.records_accept_update``)."""
+    """Return why the dual-sine records did not accept an update.
+
+    Nothing above the floor to explain, or too little explained (``verdict.records_accept_update``).
+    """
     gap = rt.get("heldout_gap_chain")
     if gap is not None and floor is not None and at_floor(float(gap), {"min_gap": float(floor)}):
         return r": the nominal structure's gap lies at the identification's floor, gap.min\_gap " + pct(floor)
@@ -39,7 +43,10 @@ def _why_not(rt: dict, floor) -> str:
 
 
 def _identifiability_text(ident: dict) -> str:
-    """What the random test binds (each factor's posterior sd, on its log: relative) and what it leaves at its prior."""
+    """Return what the random test binds and what it leaves at its prior.
+
+    Each bound factor with its posterior sd, on its log: relative.
+    """
     factors = {k: v for k, v in ident.items() if k not in ("k_t", "k_n") and isinstance(v, dict)}
     bound = [(k, v) for k, v in factors.items() if v.get("bound_by_data")]
     free = [k for k, v in factors.items() if not v.get("bound_by_data")]
@@ -62,7 +69,7 @@ def _identifiability_text(ident: dict) -> str:
 
 
 def _channel_gains_text(upd: dict) -> str:
-    """The accelerometer channels' sensitivities relative to one another (the random test's residues) in words."""
+    """Return the accelerometer channels' sensitivities relative to one another (the random test's residues)."""
     gains, sd = upd.get("channel_gains") or [], upd.get("channel_gain_sd") or []
     if not gains:
         return ""
@@ -87,8 +94,11 @@ def _channel_gains_text(upd: dict) -> str:
 
 
 def _gains_versus_structure_text(test: dict | None) -> str:
-    """Where the random test could not tell the channels' gains from the structure's factors: what the dual-sine
-    records chose (``evidence.records_test_of_gains``)."""
+    """Return what the dual-sine records chose where the random test could not tell gains from structure.
+
+    The random test could not tell the channels' gains from the structure's factors; the records' test is
+    ``evidence.records_test_of_gains``.
+    """
     if not test:
         return ""
     return (
@@ -108,8 +118,22 @@ def _gains_versus_structure_text(test: dict | None) -> str:
 
 
 def updating_paragraph(diag: dict) -> str:
-    """The paragraph 'The base model': the structure updated from the random test (chi^2 before and after against
-    its bar, accepted or not and by what, what the data bind, the channels' relative gains); "" without an update."""
+    """Return the paragraph 'The base model': the structure updated from the random test.
+
+    Chi^2 before and after against its bar, accepted or not and by what, what the data bind, the channels' relative
+    gains.
+
+    Parameters
+    ----------
+    diag
+        The gap diagnosis (diagnosis.json as a dict): its ``where.model_updating`` and ``remaining_gap.floor`` are
+        read.
+
+    Returns
+    -------
+    paragraph : str
+        The paragraph in LaTeX; "" without an update.
+    """
     upd = (diag.get("where") or {}).get("model_updating")
     if not upd:
         return ""

@@ -1,6 +1,9 @@
-"""The gap section's diagnosis in words (text generated from diagnosis.json): the comparison, where the gap lies,
-which effect, the resolution, the damping at test level, the decisions in order and the additive explanation step by
-step with the measured floor; the base model's paragraph is ``report_base_model``'s."""
+"""The gap section's diagnosis in words (text generated from diagnosis.json).
+
+The comparison, where the gap lies, which effect, the resolution, the damping at test level, the decisions in order
+and the additive explanation step by step with the measured floor; the base model's paragraph is
+``report_base_model``'s.
+"""
 
 from __future__ import annotations
 
@@ -13,7 +16,7 @@ from .verdict import never_opens
 
 
 def _law_note(step: dict) -> str:
-    """For a contact-separation step whose law never opens the contact: what it stands for instead."""
+    """Return, for a contact-separation step whose law never opens the contact, what it stands for instead."""
     if never_opens(step):
         return (
             r" (its law never opens the contact here: it stands for a stiffer or harder normal law than "
@@ -23,7 +26,7 @@ def _law_note(step: dict) -> str:
 
 
 def _periodicity_note(step: dict, periodicity: dict) -> str:
-    """For a step whose model settles unlike the records (``settles_unlike_records``): where, and which way."""
+    """Return, for a step whose model settles unlike the records (``settles_unlike_records``), where and which way."""
     unlike = step.get("settles_unlike_records") or []
     if not unlike:
         return ""
@@ -43,8 +46,11 @@ def _periodicity_note(step: dict, periodicity: dict) -> str:
 
 
 def _updating_note(step: dict, diag: dict) -> str:
-    """Why a model update was accepted, when the dual-sine records accepted it (the random test alone did not; records
-    that drift are compared with the drift refitted, ``evidence.records_test_of_update``)."""
+    """Return why a model update was accepted, when the dual-sine records accepted it.
+
+    The random test alone did not; records that drift are compared with the drift refitted
+    (``evidence.records_test_of_update``).
+    """
     upd = (diag.get("where") or {}).get("model_updating") or {}
     if step.get("effect") != "model_updating" or upd.get("accepted_by") != "records":
         return ""
@@ -63,7 +69,7 @@ def _updating_note(step: dict, diag: dict) -> str:
 
 
 def _alternatives_note(step: dict) -> str:
-    """The step's alternatives in words: the candidates the records cannot tell from its effect."""
+    """Return the step's alternatives in words: the candidates the records cannot tell from its effect."""
     alt = step.get("alternatives") or []
     if not alt:
         return ""
@@ -71,13 +77,28 @@ def _alternatives_note(step: dict) -> str:
 
 
 def _kind_note(step: dict) -> str:
-    """A step that is not an effect, said: model form (a form candidate the library leaves out, a separation law that
-    never opened) or an update that names no effect (story.tell's kinds)."""
+    """Return what a step that is not an effect is, in words.
+
+    Model form (a form candidate the library leaves out, a separation law that never opened) or an update that names
+    no effect (story.tell's kinds).
+    """
     return {"model_form": r" (model form, not an effect)", "update": ""}.get(step.get("kind", "effect"), "")
 
 
 def explanation_text(diag: dict) -> str:
-    """The additive explanation in words (Fig. gap_explanation)."""
+    """Return the additive explanation in words (Fig. gap_explanation).
+
+    Parameters
+    ----------
+    diag
+        The gap diagnosis (diagnosis.json as a dict): its ``explanation``, ``remaining_gap``, ``trace``,
+        ``where`` (``periodicity``, ``model_updating``) and ``measured_floor`` are read.
+
+    Returns
+    -------
+    text : str
+        The explanation step by step, what remains and the measured floor, in LaTeX.
+    """
     steps, left = diag.get("explanation") or [], diag.get("remaining_gap") or {}
     ended = next(
         (t for t in diag.get("trace") or [] if not t["passed"] and t["test"] not in ("records_agree", "held_out")), None
@@ -142,8 +163,20 @@ def explanation_text(diag: dict) -> str:
 
 
 def measured_floor_text(diag: dict) -> str:
-    """Where gap.min_gap is measured (gap.measure_floor, ``gap.floor``): what the rig without effects left at the
-    records' drive."""
+    """Return where gap.min_gap is measured (gap.measure_floor, ``gap.floor``), in words.
+
+    What the rig without effects left at the records' drive.
+
+    Parameters
+    ----------
+    diag
+        The gap diagnosis (diagnosis.json as a dict): its ``measured_floor`` and ``remaining_gap.floor`` are read.
+
+    Returns
+    -------
+    text : str
+        One or two sentences in LaTeX; "" where the diagnosis has no measured floor.
+    """
     m = diag.get("measured_floor")
     if not m:
         return ""
@@ -169,7 +202,18 @@ def measured_floor_text(diag: dict) -> str:
 
 
 def comparison_lines(diag: dict) -> list[str]:
-    """The section's opening lines: what is compared with what, and the calibration case."""
+    """Return the section's opening lines: what is compared with what, and the calibration case.
+
+    Parameters
+    ----------
+    diag
+        The gap diagnosis (diagnosis.json as a dict): its ``calibration_case`` and ``heldout_cases`` are read.
+
+    Returns
+    -------
+    lines : list[str]
+        The lines in LaTeX.
+    """
     return [
         r"The identified model (linear stiffnesses and damping of the linear chain, the fitted friction law, the",
         r"linear normal spring of Eq.~13) is simulated under each load case's measured force and compared with the",
@@ -184,7 +228,19 @@ def comparison_lines(diag: dict) -> list[str]:
 
 
 def periodicity_text(w: dict) -> str:
-    """Whether each record settled (``where.periodicity``): one sentence, empty where the diagnosis has none."""
+    """Return whether each record settled (``where.periodicity``): one sentence, empty where the diagnosis has none.
+
+    Parameters
+    ----------
+    w
+        The diagnosis's ``where`` section: its ``periodicity`` ({case: {settled, aperiodic_share, by_sensor}}) and
+        ``place`` are read.
+
+    Returns
+    -------
+    text : str
+        The sentence in LaTeX, with a leading space; "" without periodicity.
+    """
     per = w.get("periodicity") or {}
     if not per:
         return ""
@@ -219,8 +275,21 @@ def periodicity_text(w: dict) -> str:
 
 
 def where_paragraph(diag: dict) -> str:
-    """The paragraph 'Where the gap lies': the held-out gap (%), by stage, the worst sensor, harmonic and part of
-    the cycle, and the place the localisation names."""
+    """Return the paragraph 'Where the gap lies'.
+
+    The held-out gap (%), by stage, the worst sensor, harmonic and part of the cycle, and the place the localisation
+    names.
+
+    Parameters
+    ----------
+    diag
+        The gap diagnosis (diagnosis.json as a dict): its ``where`` section is read.
+
+    Returns
+    -------
+    text : str
+        The paragraph in LaTeX.
+    """
     w = diag["where"]
     st = w["stage"]
     return (
@@ -267,9 +336,21 @@ def where_paragraph(diag: dict) -> str:
 
 
 def damping_at_test_level_text(diag: dict) -> str:
-    """What became of the damping at test level (diagnosis.json's ``damping_at_test_level``, rule test_damping): the
-    factor the calibration record binds, the other load cases' test and whether the diagnosed model carries it; ""
-    where the law misfits least at the random test's ratios."""
+    """Return what became of the damping at test level (diagnosis.json's ``damping_at_test_level``).
+
+    From rule test_damping: the factor the calibration record binds, the other load cases' test and whether the
+    diagnosed model carries it.
+
+    Parameters
+    ----------
+    diag
+        The gap diagnosis (diagnosis.json as a dict): its ``damping_at_test_level`` is read.
+
+    Returns
+    -------
+    text : str
+        The paragraph in LaTeX; "" where the law misfits least at the random test's ratios.
+    """
     td = diag.get("damping_at_test_level") or {}
     if not td or abs(float(td.get("scale", 1.0)) - 1.0) < 1e-9:
         return ""
@@ -292,8 +373,22 @@ def damping_at_test_level_text(diag: dict) -> str:
 
 
 def diagnosis_paragraphs(diag: dict) -> str:
-    """The diagnosis in words (newline-terminated lines): the comparison, where the gap lies, the base model's update
-    from the random test, which effect, and the additive explanation step by step."""
+    """Return the diagnosis in words (newline-terminated lines).
+
+    The comparison, where the gap lies, the base model's update from the random test, which effect, and the additive
+    explanation step by step.
+
+    Parameters
+    ----------
+    diag
+        The gap diagnosis (diagnosis.json as a dict): the whole of it is read (``verdict``, ``reason``, ``where``,
+        ``resolution``, ``damping_at_test_level``, ``trace``, ``explanation``...).
+
+    Returns
+    -------
+    text : str
+        The paragraphs in LaTeX, newline-terminated lines.
+    """
     base = updating_paragraph(diag)
     lines = [
         *comparison_lines(diag),
@@ -313,7 +408,18 @@ def diagnosis_paragraphs(diag: dict) -> str:
 
 
 def resolution_text(diag: dict) -> str:
-    """What these records can attribute to an effect (diagnosis.json's resolution), in words."""
+    """Return what these records can attribute to an effect (diagnosis.json's resolution), in words.
+
+    Parameters
+    ----------
+    diag
+        The gap diagnosis (diagnosis.json as a dict): its ``resolution`` (``how``, ``isolability``) is read.
+
+    Returns
+    -------
+    text : str
+        The paragraph in LaTeX.
+    """
     r = diag["resolution"]
     iso = r.get("isolability") or {}
     pairs = iso.get("pairs") or []
@@ -345,8 +451,20 @@ def _trace_value(v) -> str:
 
 
 def trace_text(diag: dict) -> str:
-    """The decisions the verdict was told by, in order (diagnosis.json's trace): test, the step it judged, value
-    against threshold, passed or not."""
+    """Return the decisions the verdict was told by, in order (diagnosis.json's trace).
+
+    Each: test, the step it judged, value against threshold, passed or not.
+
+    Parameters
+    ----------
+    diag
+        The gap diagnosis (diagnosis.json as a dict): its ``trace`` is read.
+
+    Returns
+    -------
+    text : str
+        The paragraph in LaTeX.
+    """
     items = [
         _t(t["test"])
         + (r" (" + _t(t["step"]) + ")" if t.get("step") else "")
