@@ -1,11 +1,13 @@
-"""Checks of the random test before identification. Its record (dead channels, clipping, offsets, the record's length
-and the FRF's resolution) and its FRF (the coherence in the modal band, the lines' spacing, the driving point's sign),
-thresholds from the physics and statistics of the records (the constants of ``raw_checks``) or from the config's
-raw_checks."""
+"""Checks of the random test before identification.
+
+Its record (dead channels, clipping, offsets, the record's length and the FRF's resolution) and its FRF (the
+coherence in the modal band, the lines' spacing, the driving point's sign), thresholds from the physics and
+statistics of the records (the constants of ``raw_checks``) or from the config's raw_checks.
+"""
 
 from __future__ import annotations
 
-from typing import Mapping
+from typing import Mapping, Sequence
 
 import numpy as np
 import xarray as xr
@@ -23,8 +25,39 @@ from .raw_checks import (
 
 
 def validate_random_test(raw: xr.Dataset, path: str, checks: Mapping, segment_length: int, blocks: int) -> list[str]:
-    """Dead channels, clipping, offsets, record length and frequency resolution of the random test (before the FRF;
-    a sensor that records noise alone is refused by the coherence check after it)."""
+    """Check the random test's record: dead channels, clipping, offsets, record length and frequency resolution.
+
+    Run before the FRF; a sensor that records noise alone is refused by the coherence check after it
+    (``validate_coherence``). A flat or clipped channel is refused by ``raw_checks``' checks, with a
+    ``RawDataError``.
+
+    Parameters
+    ----------
+    raw
+        The random test's record (``io.read_raw``): ``force`` [N] and ``acceleration`` [m/s^2] over ``time``, the
+        attribute ``sampling_rate_hz``.
+    path
+        The record's file, named in the messages.
+    checks
+        The config's ``raw_checks`` block (``clip_samples``, ``max_frf_resolution_hz`` read; the schema's defaults
+        where left out).
+    segment_length
+        Samples per FRF segment (frf.segment_length).
+    blocks
+        Sub-records the modal fit's uncertainty needs (modal.uncertainty_blocks).
+
+    Returns
+    -------
+    warnings : list[str]
+        Messages on nearly clipped channels and channels with an offset.
+
+    Raises
+    ------
+    RawDataError
+        When an accelerometer is dead (its rms below ``raw_checks.DEAD_LEVEL`` of the strongest one's), the record
+        holds fewer than 2 x segment_length x blocks samples, or the FRF's lines would be further apart than
+        raw_checks.max_frf_resolution_hz.
+    """
     c = check_settings(checks)
     fs = float(raw.attrs["sampling_rate_hz"])
     n = raw.sizes["time"]
@@ -62,12 +95,30 @@ def validate_random_test(raw: xr.Dataset, path: str, checks: Mapping, segment_le
     return warnings
 
 
-def driving_point_sign_warnings(frf: xr.Dataset, excitation_position_m: float, band_hz) -> list[str]:
-    """The driving point's accelerance is positive-imaginary at its resonances for any passive structure (its residues
-    are phi_d^2 > 0: H = i phi_d^2 / (2 zeta) at resonance). Negative there, at most of its strongest peaks in
-    ``band_hz``, the force's or the driving-point accelerometer's sign is flipped: a warning (the linear chain reads
-    the modes' magnitudes and is not affected; the same channels of the dual-sine records are worth checking). No
-    sensor at the driving point (within 1 mm): nothing to say."""
+def driving_point_sign_warnings(frf: xr.Dataset, excitation_position_m: float, band_hz: Sequence[float]) -> list[str]:
+    """Warn where the driving point's accelerance has the sign of a flipped force or accelerometer.
+
+    The driving point's accelerance is positive-imaginary at its resonances for any passive structure (its residues
+    are phi_d^2 > 0: H = i phi_d^2 / (2 zeta) at resonance). Negative there, at most of its strongest peaks (up to
+    three) in ``band_hz``, the force's or the driving-point accelerometer's sign is flipped: a warning (the linear
+    chain reads the modes' magnitudes and is not affected; the same channels of the dual-sine records are worth
+    checking). No sensor at the driving point (within 1 mm): nothing to say.
+
+    Parameters
+    ----------
+    frf
+        The FRF dataset (results/linear/frf.nc): ``h1_real``, ``h1_imag`` [m/s^2/N] over (``sensor``,
+        ``frequency`` [Hz]), the coordinate ``position`` [m] of each sensor.
+    excitation_position_m
+        Position of the driving point along the beam [m].
+    band_hz
+        The modal band (modal.band_hz): lowest and highest frequency [Hz].
+
+    Returns
+    -------
+    warnings : list[str]
+        One message where the sign looks flipped, else none.
+    """
     pos = np.asarray(frf["position"].values, float) if "position" in frf.coords else np.array([])
     if pos.size == 0 or np.min(np.abs(pos - excitation_position_m)) > 1e-3:
         return []
@@ -92,9 +143,33 @@ def driving_point_sign_warnings(frf: xr.Dataset, excitation_position_m: float, b
     ]
 
 
-def validate_coherence(frf: xr.Dataset, band_hz, path: str, checks: Mapping) -> tuple[dict, list[str]]:
-    """Share of the FRF lines in ``band_hz`` whose coherence reaches raw_checks.min_coherence, per
-    channel; raises RawDataError when a channel's share is below raw_checks.coherence_fraction."""
+def validate_coherence(frf: xr.Dataset, band_hz: Sequence[float], path: str, checks: Mapping) -> tuple[dict, list[str]]:
+    """Return the share of the FRF lines in the band whose coherence reaches raw_checks.min_coherence, per channel.
+
+    Parameters
+    ----------
+    frf
+        The FRF dataset (results/linear/frf.nc): ``coherence`` over (``sensor``, ``frequency`` [Hz]).
+    band_hz
+        The modal band (modal.band_hz): lowest and highest frequency [Hz].
+    path
+        The file the FRFs come from, named in the messages.
+    checks
+        The config's ``raw_checks`` block (``min_coherence``, ``coherence_fraction`` read; the schema's defaults
+        where left out).
+
+    Returns
+    -------
+    shares : dict
+        {sensor: share of the band's lines whose coherence reaches raw_checks.min_coherence} (fractions in [0, 1]).
+    warnings : list[str]
+        Messages on the channels whose share lies below halfway from raw_checks.coherence_fraction to 1.
+
+    Raises
+    ------
+    RawDataError
+        When a channel's share is below raw_checks.coherence_fraction.
+    """
     c = check_settings(checks)
     f = frf["frequency"].values
     band = (f >= band_hz[0]) & (f <= band_hz[1])
@@ -115,8 +190,30 @@ def validate_coherence(frf: xr.Dataset, band_hz, path: str, checks: Mapping) -> 
 
 
 def validate_frf_resolution(frf: xr.Dataset, path: str, checks: Mapping) -> list[str]:
-    """The spacing of an FRF's lines (Hz) against raw_checks.max_frf_resolution_hz, for FRFs given as such (an FRF
-    file: no record length or segment to check); a spacing beyond half of the limit is a warning."""
+    """Check the spacing of an FRF's lines against raw_checks.max_frf_resolution_hz.
+
+    For FRFs given as such (an FRF file: no record length or segment to check); a spacing beyond half of the limit
+    is a warning.
+
+    Parameters
+    ----------
+    frf
+        The FRF dataset (results/linear/frf.nc) over evenly spaced ``frequency`` lines [Hz].
+    path
+        The file the FRFs come from, named in the messages.
+    checks
+        The config's ``raw_checks`` block (``max_frf_resolution_hz`` read; the schema's default where left out).
+
+    Returns
+    -------
+    warnings : list[str]
+        One message where the lines lie more than half the limit apart, else none.
+
+    Raises
+    ------
+    RawDataError
+        When the lines lie further apart than raw_checks.max_frf_resolution_hz.
+    """
     c = check_settings(checks)
     f = frf["frequency"].values
     df = float((f[-1] - f[0]) / (f.size - 1))

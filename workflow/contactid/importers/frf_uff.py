@@ -1,5 +1,7 @@
-"""Frequency response functions in universal files (datasets 58): FRFs a lab hands over read in as the linear
-chain's FRF dataset (results/linear/frf.nc), and the chain's measured and LSFD-synthesised FRFs written out.
+"""Frequency response functions in universal files (datasets 58), read in and written out.
+
+FRFs a lab hands over are read in as the linear chain's FRF dataset (results/linear/frf.nc), and the chain's
+measured and LSFD-synthesised FRFs written out.
 
 In a dataset 58 an FRF is function type 4 (complex ordinate) and a coherence function type 6 ("Coherence" in
 the dataset's description; type 9 is a power spectral density). The FRFs must be force-normalised accelerance
@@ -15,7 +17,7 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Mapping
+from typing import Iterable, Mapping, Sequence
 
 import numpy as np
 import xarray as xr
@@ -60,8 +62,24 @@ _NO_LABEL = ("", "NONE", "none", "-")
 
 @dataclass(frozen=True)
 class FrfSensor:
-    """One sensor of the FRF file: its name and position (m, structure.sensors), the FRF dataset that holds it
-    (``channel`` = id1, or response ``node`` and ``direction``) and the units the map states (or None)."""
+    """One sensor of the FRF file: its name and position, the FRF dataset that holds it and the units the map states.
+
+    Attributes
+    ----------
+    name
+        The sensor's name (structure.sensors.names).
+    position_m
+        Its distance from the clamp (structure.sensors.positions_m) [m].
+    channel
+        ID line 1 (id1) of the FRF dataset that holds it; None where it is found by its node.
+    node
+        Response node of the FRF dataset that holds it; None where it is found by its id1.
+    direction
+        Response direction of that dataset; None for any.
+    units
+        The units the channel map states for its FRF, in the spelling of ``ACCELERANCE_UNITS``; None where the map
+        states none.
+    """
 
     name: str
     position_m: float
@@ -71,14 +89,33 @@ class FrfSensor:
     units: str | None = None
 
     def describe(self) -> str:
-        """The FRF dataset that holds the sensor, in words for messages: its id1, or its response node and direction."""
+        """Return the FRF dataset that holds the sensor, in words for messages: its id1, or its response node.
+
+        Returns
+        -------
+        description : str
+            ``id1 'name'``, or ``response node n`` with ``direction d`` where one is given.
+        """
         if self.channel is not None:
             return f"id1 {self.channel!r}"
         return f"response node {self.node}" + ("" if self.direction is None else f" direction {self.direction}")
 
 
-def accelerance_unit(label) -> str | None:
-    """A unit label of an FRF in the spelling of ACCELERANCE_UNITS / OTHER_KINDS (None for no label)."""
+def accelerance_unit(label: str | None) -> str | None:
+    """Return a unit label of an FRF in the spelling of ACCELERANCE_UNITS / OTHER_KINDS (None for no label).
+
+    Parameters
+    ----------
+    label
+        A unit label as a file or a channel map writes it (``m/s2/N``, ``(m/s^2)/N``, ``g0/N``...); None, empty,
+        ``NONE`` or ``-`` for no label.
+
+    Returns
+    -------
+    unit : str | None
+        The label with its white space normalised and known spellings mapped to the table's (an unknown label comes
+        back as it is); None for no label.
+    """
     if label is None or str(label).strip() in _NO_LABEL:
         return None
     s = " ".join(str(label).split())
@@ -119,8 +156,32 @@ def _map_entry(entry, i: int, names: list, positions: list, where: str) -> FrfSe
 
 
 def frf_sensor_map(block: Mapping, where: str, structure_cfg: Mapping) -> tuple:
-    """The FrfSensor of every structure sensor, in structure order: from ``channels.sensors`` of the config
-    block, or, without a map, the FRF whose id1 is the sensor's name."""
+    """Return the FrfSensor of every structure sensor, in structure order.
+
+    From ``channels.sensors`` of the config block, or, without a map, the FRF whose id1 is the sensor's name.
+
+    Parameters
+    ----------
+    block
+        The config block of the FRF file (``random_test``); its ``channels`` (``{sensors: [{name, channel or node,
+        direction, units, position_m}]}``) is read.
+    where
+        The block's name in the config, named in the messages.
+    structure_cfg
+        The config's ``structure`` block; ``sensors.names`` and ``sensors.positions_m`` [m] are read.
+
+    Returns
+    -------
+    sensors : tuple
+        One FrfSensor per sensor of ``structure_cfg``, in its order.
+
+    Raises
+    ------
+    RawDataError
+        When the channel map is not of that form (or names a force), maps a sensor twice, or leaves one out; an
+        entry that names no known sensor, a position other than the structure's, both or neither of channel and
+        node, or units other than accelerance is refused too.
+    """
     names = [str(n) for n in structure_cfg["sensors"]["names"]]
     positions = [float(x) for x in structure_cfg["sensors"]["positions_m"]]
     chans = block.get("channels")
@@ -147,7 +208,23 @@ def frf_sensor_map(block: Mapping, where: str, structure_cfg: Mapping) -> tuple:
 
 
 def uff58_sets(path: str) -> list:
-    """Every dataset 58 of a universal file (pyuff's dicts), with errors that name the file."""
+    """Return every dataset 58 of a universal file (pyuff's dicts), with errors that name the file.
+
+    Parameters
+    ----------
+    path
+        The universal file.
+
+    Returns
+    -------
+    sets : list
+        pyuff's dict of every dataset 58 of the file, in its order.
+
+    Raises
+    ------
+    RawDataError
+        When the file does not exist or is empty (and, from the reader, when pyuff cannot read it).
+    """
     if not os.path.exists(path):
         raise RawDataError(f"random_test: file {path!r} not found; correct 'file:'")
     if os.path.getsize(path) == 0:
@@ -170,8 +247,29 @@ def _matches(sensor: FrfSensor, s: Mapping) -> bool:
 
 
 def frf_set(sets: list, sensor: FrfSensor, path: str) -> dict:
-    """The one function-type-4 dataset of ``sensor``; a missing or doubled FRF names the file, the sensor and
-    what the file holds."""
+    """Return the one function-type-4 dataset of ``sensor``.
+
+    A missing or doubled FRF names the file, the sensor and what the file holds.
+
+    Parameters
+    ----------
+    sets
+        The file's datasets 58 (``uff58_sets``).
+    sensor
+        The sensor, with the id1 or the response node and direction of its FRF.
+    path
+        The file, named in the messages.
+
+    Returns
+    -------
+    frf : dict
+        pyuff's dict of the sensor's FRF.
+
+    Raises
+    ------
+    RawDataError
+        When several FRFs match the sensor, when its only datasets have another function type, or when none does.
+    """
     frfs = [s for s in sets if s.get("func_type") == FRF_FUNCTION]
     found = [s for s in frfs if _matches(sensor, s)]
     if len(found) == 1:
@@ -195,8 +293,29 @@ def frf_set(sets: list, sensor: FrfSensor, path: str) -> dict:
 
 
 def coherence_set(sets: list, frf: Mapping, path: str) -> dict | None:
-    """The function-type-6 dataset of the same response and reference DOF as ``frf`` (by id1 where several
-    share it), or None when the file holds none."""
+    """Return the function-type-6 dataset of the same response and reference DOF as ``frf``, or None.
+
+    Where several share the DOF, the one with the FRF's id1 is taken.
+
+    Parameters
+    ----------
+    sets
+        The file's datasets 58 (``uff58_sets``).
+    frf
+        pyuff's dict of an FRF (``frf_set``).
+    path
+        The file, named in the messages.
+
+    Returns
+    -------
+    coherence : dict | None
+        pyuff's dict of the FRF's coherence; None where the file holds none.
+
+    Raises
+    ------
+    RawDataError
+        When more than one coherence belongs to the FRF.
+    """
     found = [s for s in sets if s.get("func_type") == COHERENCE_FUNCTION and _dof(s) == _dof(frf)]
     if len(found) > 1:
         found = [s for s in found if str(s.get("id1", "")).strip() == str(frf.get("id1", "")).strip()]
@@ -208,8 +327,34 @@ def coherence_set(sets: list, frf: Mapping, path: str) -> dict | None:
 
 
 def frf_units(s: Mapping, sensor: FrfSensor, path: str) -> tuple[str, float]:
-    """(units, factor to m/s^2/N) of an FRF dataset: its unit labels (numerator over denominator) and its
-    specific data types against the map's units; refuses receptance, mobility and anything but accelerance."""
+    """Return the units of an FRF dataset and their factor to m/s^2/N.
+
+    From its unit labels (numerator over denominator) and its specific data types against the map's units; refuses
+    receptance, mobility and anything but accelerance.
+
+    Parameters
+    ----------
+    s
+        pyuff's dict of the FRF (``frf_set``).
+    sensor
+        The sensor it belongs to, with the units its channel map states (or None).
+    path
+        The file, named in the messages.
+
+    Returns
+    -------
+    units : str
+        The FRF's units, one of ``ACCELERANCE_UNITS``.
+    factor : float
+        The factor that turns values in ``units`` into m/s^2/N (m/s^2/N per unit of ``units``: 1, 9.80665 or
+        1e-3) [-].
+
+    Raises
+    ------
+    RawDataError
+        When the FRF is not force-normalised accelerance (by its specific data types or its labels), when neither
+        the file nor the map states its units, or when the two disagree.
+    """
     what = f"{path}: the FRF {_label(s)} of sensor {sensor.name}"
     kind = SPEC_KINDS.get(int(s.get("ordinate_spec_data_type") or 0))
     if kind is None and int(s.get("orddenom_spec_data_type") or 0) not in FORCE_SPEC_TYPES:
@@ -239,7 +384,7 @@ def frf_units(s: Mapping, sensor: FrfSensor, path: str) -> tuple[str, float]:
 
 
 def _abscissa(s: Mapping, path: str) -> np.ndarray:
-    """The frequency lines (Hz) of one dataset 58."""
+    """Return the frequency lines (Hz) of one dataset 58."""
     data, x = s.get("data"), s.get("x")
     if data is None or x is None or len(data) < 2:
         raise RawDataError(f"{path}: dataset 58 {_label(s)} holds fewer than two lines")
@@ -251,9 +396,32 @@ def _abscissa(s: Mapping, path: str) -> np.ndarray:
     return np.asarray(x, dtype=float)
 
 
-def frequency_axis(sets: list, path: str, band_hz) -> np.ndarray:
-    """The frequency lines (Hz) every FRF and coherence of the file shares: evenly spaced, increasing, and
-    covering ``band_hz`` (modal.band_hz)."""
+def frequency_axis(sets: list, path: str, band_hz: Sequence[float]) -> np.ndarray:
+    """Return the frequency lines every FRF and coherence of the file shares.
+
+    They must be evenly spaced, increasing, and cover ``band_hz`` (modal.band_hz).
+
+    Parameters
+    ----------
+    sets
+        pyuff's dicts of the FRFs and coherences read (not empty).
+    path
+        The file, named in the messages.
+    band_hz
+        The modal band (modal.band_hz): lowest and highest frequency [Hz].
+
+    Returns
+    -------
+    frequencies : np.ndarray
+        The frequency lines [Hz], shape (n_f,) with n_f the lines of each dataset.
+
+    Raises
+    ------
+    RawDataError
+        When a dataset's lines differ from the first's, when the lines are not evenly spaced and increasing, or when
+        they do not cover ``band_hz`` (and, from reading a dataset's abscissa, when one holds fewer than two lines or
+        an abscissa in other units than Hz).
+    """
     f = _abscissa(sets[0], path)
     for s in sets[1:]:
         g = _abscissa(s, path)
@@ -287,7 +455,30 @@ def _finite(values: np.ndarray, f: np.ndarray, what: str) -> np.ndarray:
 
 
 def accelerance(s: Mapping, sensor: FrfSensor, f: np.ndarray, path: str) -> np.ndarray:
-    """The FRF of ``sensor`` in m/s^2/N (complex, one value per line of ``f``)."""
+    """Return the FRF of ``sensor`` in m/s^2/N.
+
+    Parameters
+    ----------
+    s
+        pyuff's dict of the FRF (``frf_set``).
+    sensor
+        The sensor it belongs to.
+    f
+        The file's frequency lines (``frequency_axis``), named in the messages [Hz], shape (n_f,).
+    path
+        The file, named in the messages.
+
+    Returns
+    -------
+    accelerance : np.ndarray
+        The FRF, complex [m/s^2/N], shape (n_f,): one value per line of ``f``.
+
+    Raises
+    ------
+    RawDataError
+        When the FRF holds real numbers (and, from its checks, when its units are not accelerance's or a value is
+        not finite).
+    """
     units, factor = frf_units(s, sensor, path)
     data = np.asarray(s["data"])
     if not np.iscomplexobj(data):
@@ -299,7 +490,28 @@ def accelerance(s: Mapping, sensor: FrfSensor, f: np.ndarray, path: str) -> np.n
 
 
 def coherence_values(s: Mapping, f: np.ndarray, path: str) -> np.ndarray:
-    """A coherence (1) as read: real, finite, within [0, 1] (1e-6 of rounding above 1 clipped)."""
+    """Return a coherence as read: real, finite, within [0, 1] (1e-6 of rounding above 1 clipped).
+
+    Parameters
+    ----------
+    s
+        pyuff's dict of the coherence (``coherence_set``).
+    f
+        The file's frequency lines (``frequency_axis``), named in the messages [Hz], shape (n_f,).
+    path
+        The file, named in the messages.
+
+    Returns
+    -------
+    coherence : np.ndarray
+        The coherence [-], shape (n_f,): one value per line of ``f``.
+
+    Raises
+    ------
+    RawDataError
+        When it holds complex numbers with an imaginary part, or a value outside [0, 1] (and, from its checks, when
+        a value is not finite).
+    """
     data = np.asarray(s["data"])
     what = f"{path}: the coherence {_label(s)}"
     if np.iscomplexobj(data):
@@ -336,10 +548,37 @@ def _import_attrs(path: str, sensors: tuple, frfs: list, given: dict, f: np.ndar
     }
 
 
-def measured_frf_dataset(block: Mapping, where: str, structure_cfg: Mapping, band_hz) -> xr.Dataset:
-    """The FRF dataset of results/linear/frf.nc (``linear_chain.frf_result_dataset``) from a UFF58 file of
-    accelerance FRFs (function type 4) and their coherences (type 6), one per sensor of ``structure_cfg``;
-    coherence 1 where the file gives none (the attribute ``coherence_given`` says which); no sub-records."""
+def measured_frf_dataset(block: Mapping, where: str, structure_cfg: Mapping, band_hz: Sequence[float]) -> xr.Dataset:
+    """Return the FRF dataset of results/linear/frf.nc from a UFF58 file of accelerance FRFs.
+
+    The file holds accelerance FRFs (function type 4) and their coherences (type 6), one per sensor of
+    ``structure_cfg``; the dataset is ``linear_chain.frf_result_dataset``'s, with coherence 1 where the file gives
+    none (the attribute ``coherence_given`` says which) and no sub-records.
+
+    Parameters
+    ----------
+    block
+        The config block of the file (``random_test``): ``file`` (the UFF58 file) and ``channels`` (the channel
+        map, ``frf_sensor_map``) are read.
+    where
+        The block's name in the config, named in the messages.
+    structure_cfg
+        The config's ``structure`` block; ``sensors.names`` and ``sensors.positions_m`` are read.
+    band_hz
+        The modal band (modal.band_hz): lowest and highest frequency [Hz].
+
+    Returns
+    -------
+    frf : xr.Dataset
+        H1 accelerance [m/s^2/N] and coherence over (``sensor``, ``frequency`` [Hz]), the sensors' positions, an
+        empty ``block`` dimension and the import's attributes (source, conversion, ``coherence_given``).
+
+    Raises
+    ------
+    RawDataError
+        When ``block`` names no file or two sensors are mapped to one FRF (and, from the readers and checks it
+        calls, when the file, its datasets or the channel map are not as the chain needs).
+    """
     import json
 
     from ..linear_chain import frf_result_dataset
@@ -382,7 +621,7 @@ _SIX_DIGITS = "%13.5e"  # how a universal file's header keeps the abscissa minim
 
 
 def _even_axis(f: np.ndarray) -> bool:
-    """Does the header's 6-digit minimum and increment give back exactly the lines ``f`` (Hz)?"""
+    """Return whether the header's 6-digit minimum and increment give back exactly the lines ``f`` (Hz)."""
     inc = f[1] - f[0]
     x0, dx = float(_SIX_DIGITS % f[0]), float(_SIX_DIGITS % inc)
     return bool(np.array_equal(x0 + np.arange(f.size) * dx, f))
@@ -457,22 +696,48 @@ COHERENCE_LABELS = {
 
 
 def write_frf_uff58(
-    path,
-    frequency_hz,
-    frf,
-    sensors,
-    coherence=None,
+    path: Path | str,
+    frequency_hz: np.ndarray,
+    frf: np.ndarray,
+    sensors: Iterable[str],
+    coherence: np.ndarray | Sequence[np.ndarray | None] | None = None,
     description: str = "contactid FRF",
     reference: int = 0,
     labels: Mapping | None = None,
 ) -> dict:
-    """Write accelerance FRFs (complex, m/s^2/N, (sensor, frequency)) as datasets 58 of function type 4, binary
-    double precision, one per sensor (id1 = the sensor's name, response node = its number from 1, direction 3,
-    reference node = the number of sensor ``reference``, the driving point), and their coherences (1; ``coherence``
-    (sensor, frequency), or a list with None for a sensor without) as function type 6 of the same nodes. Lines
-    evenly spaced to the header's 6 digits are written as an even abscissa, any others with every line stored.
-    ``labels`` overrides fields of the FRF datasets (a file as another tool writes it: g/N, receptance...).
-    Replaces ``path`` whole; returns the random_test block that reads the file back."""
+    """Write accelerance FRFs and their coherences as datasets 58 of a universal file.
+
+    The FRFs go as function type 4, binary double precision, one per sensor (id1 = the sensor's name, response
+    node = its number from 1, direction 3, reference node = the number of sensor ``reference``, the driving point),
+    and their coherences as function type 6 of the same nodes. Lines evenly spaced to the header's 6 digits are
+    written as an even abscissa, any others with every line stored. Replaces ``path`` whole.
+
+    Parameters
+    ----------
+    path
+        The universal file to write.
+    frequency_hz
+        The frequency lines [Hz], shape (n_f,).
+    frf
+        The accelerance FRFs, complex [m/s^2/N] (or in the units ``labels`` states), shape (n_sensors, n_f).
+    sensors
+        The sensors' names, n_sensors of them, in the order of ``frf``'s rows.
+    coherence
+        Their coherences [-], shape (n_sensors, n_f), or a list with one row per sensor and None for a sensor
+        without; None to write no coherence.
+    description
+        ID line 2 of every dataset (", coherence" appended on the coherences').
+    reference
+        Index of the driving point's sensor among ``sensors`` (the datasets' reference node is its number).
+    labels
+        Fields that override the FRF datasets' own (a file as another tool writes it: g/N, receptance...); None
+        for none.
+
+    Returns
+    -------
+    block : dict
+        The random_test block that reads the file back (source measured, format uff58_frf, the file).
+    """
     import pyuff
 
     path = Path(path)
