@@ -38,7 +38,23 @@ MAX_SUBSTEPS = 256
 
 
 def slip_limit_flag(regularization: str) -> bool:
-    """True for ``slip_limit``, False for ``none`` (Eq. 21 as printed); ValueError for anything else."""
+    """Return whether a reading of the law is ``slip_limit``.
+
+    Parameters
+    ----------
+    regularization
+        The reading of Eq. 21 (``friction.regularization``): ``none`` (as printed) or ``slip_limit``.
+
+    Returns
+    -------
+    slip_limit : bool
+        True for ``slip_limit``, False for ``none`` (Eq. 21 as printed).
+
+    Raises
+    ------
+    ValueError
+        When ``regularization`` is neither of ``REGULARIZATIONS``.
+    """
     if regularization not in REGULARIZATIONS:
         raise ValueError(
             f"friction regularization {regularization!r} is not one of {REGULARIZATIONS}: "
@@ -48,17 +64,56 @@ def slip_limit_flag(regularization: str) -> bool:
 
 
 @njit(cache=True)
-def initial_stiffness(normal_force, e_f, k_c):
-    """e_0 (N/m), Eq. 22: e_f (1 - exp(-k_c N / e_f)) at total normal force N (N)."""
+def initial_stiffness(normal_force: float, e_f: float, k_c: float) -> float:
+    """Return the law's initial stiffness e_0 of Eq. 22, e_f (1 - exp(-k_c N / e_f)).
+
+    Parameters
+    ----------
+    normal_force
+        The total normal force N [N] (static preload and dynamic part, compression positive).
+    e_f
+        The law's parameter e_f, the limit of e_0 at large N [N/m].
+    k_c
+        The law's parameter k_c, e_0's slope over N at N = 0 [1/m].
+
+    Returns
+    -------
+    e0 : float
+        The initial stiffness e_0 [N/m].
+    """
     return e_f * (1.0 - np.exp(-k_c * normal_force / e_f))
 
 
 @njit(cache=True)
-def iwan_force(xi, anchors, weights, e0_total, mu_n, flags):
-    """The Iwan (Maxwell-slip) element's shear force (N) at the slip xi (m): n sliders of stiffness e_0 / n (Eq. 22's
-    e_0, N/m) and slip limits mu N w_i (weights w_i summing to 1), the multi-asperity friction candidate. A slider
-    that would exceed its limit slips: its anchor (m, ``anchors``, updated in place) follows xi. ``flags`` (int8,
-    one per slider, or empty): set to 0 where the slider sticks, 1 / -1 where it slips forwards / backwards."""
+def iwan_force(
+    xi: float, anchors: np.ndarray, weights: np.ndarray, e0_total: float, mu_n: float, flags: np.ndarray
+) -> float:
+    """Return the Iwan (Maxwell-slip) element's shear force at the slip xi.
+
+    The element, the multi-asperity friction candidate, has n sliders of stiffness e_0 / n (Eq. 22's e_0) and slip
+    limits mu N w_i (weights w_i summing to 1). A slider that would exceed its limit slips: its anchor follows xi.
+
+    Parameters
+    ----------
+    xi
+        The relative tangential displacement xi [m].
+    anchors
+        The sliders' anchor positions [m], shape (n_sliders,); updated in place where a slider slips.
+    weights
+        The sliders' shares w_i of the slip limit [-], shape (n_sliders,), summing to 1.
+    e0_total
+        The element's total stiffness e_0 [N/m], shared equally by the sliders.
+    mu_n
+        The element's total slip limit mu N [N].
+    flags
+        Int8 slip flags [-], shape (n_sliders,), or shape (0,) for none: set to 0 where the slider sticks, 1 / -1
+        where it slips forwards / backwards.
+
+    Returns
+    -------
+    force : float
+        The element's shear force [N], the sum over the sliders.
+    """
     total = 0.0
     n = weights.size
     for i in range(n):
@@ -81,16 +136,72 @@ def iwan_force(xi, anchors, weights, e0_total, mu_n, flags):
 
 
 @njit(cache=True)
-def slip_width(normal_force, e0, e_t, kappa, mu):
-    """alpha_0 (1 - kappa e_t / e_0) = e_0 / lambda (N), Eq. 21, with alpha_0 = mu N: the scale of
-    |S - e_t xi| (the slip-limit bound of the ``slip_limit`` reading)."""
+def slip_width(normal_force: float, e0: float, e_t: float, kappa: float, mu: float) -> float:
+    """Return the slip width alpha_0 (1 - kappa e_t / e_0) = e_0 / lambda of Eq. 21, with alpha_0 = mu N.
+
+    It is the scale of |S - e_t xi| (the slip-limit bound of the ``slip_limit`` reading).
+
+    Parameters
+    ----------
+    normal_force
+        The total normal force N [N].
+    e0
+        The initial stiffness e_0 at ``normal_force`` [N/m] (``initial_stiffness``).
+    e_t
+        The law's parameter e_t, the macro-slip stiffness [N/m].
+    kappa
+        The law's parameter kappa [-].
+    mu
+        The friction coefficient mu [-].
+
+    Returns
+    -------
+    width : float
+        The slip width [N].
+    """
     return mu * normal_force * (1.0 - kappa * e_t / e0)
 
 
 @njit(cache=True)
-def valanis_slope(S, xi, direction, normal_force, e_f, k_c, e_t, kappa, mu):
-    """dS/dxi (N/m) of Eq. 21 at friction force S (N), displacement xi (m), motion
-    direction +-1 and total normal force N (N)."""
+def valanis_slope(
+    S: float,
+    xi: float,
+    direction: float,
+    normal_force: float,
+    e_f: float,
+    k_c: float,
+    e_t: float,
+    kappa: float,
+    mu: float,
+) -> float:
+    """Return the slope dS/dxi of Eq. 21.
+
+    Parameters
+    ----------
+    S
+        The friction force S [N].
+    xi
+        The relative tangential displacement xi [m].
+    direction
+        The motion's direction sgn(xi'), +1 or -1 [-].
+    normal_force
+        The total normal force N [N].
+    e_f
+        The law's parameter e_f [N/m].
+    k_c
+        The law's parameter k_c [1/m].
+    e_t
+        The law's parameter e_t [N/m].
+    kappa
+        The law's parameter kappa [-].
+    mu
+        The friction coefficient mu [-].
+
+    Returns
+    -------
+    slope : float
+        dS/dxi [N/m].
+    """
     e0 = initial_stiffness(normal_force, e_f, k_c)  # Eq. 22
     return _slope(S, xi, direction, e0, slip_width(normal_force, e0, e_t, kappa, mu), e_t, kappa)
 
@@ -109,7 +220,7 @@ def _clamp(S, xi, width, e_t):
 
 @njit(cache=True)
 def _guard(S, xi, direction, width, e_t, kappa):
-    """S with d >= -SINGULAR_GUARD / kappa (Eq. 21 as printed, away from its singular point)."""
+    """Return S with d >= -SINGULAR_GUARD / kappa (Eq. 21 as printed, away from its singular point)."""
     if kappa <= 0.0:
         return S
     lim = SINGULAR_GUARD * width / kappa  # direction (S - e_t xi) <= lim
@@ -121,8 +232,10 @@ def _guard(S, xi, direction, width, e_t, kappa):
 
 @njit(cache=True)
 def _step_terms(S, xi0, xi1, e0a, wa, e0b, wb, e_t, kappa, slip_limit):
-    """S after xi moves from xi0 to xi1, with e_0 and the slip width at both ends (Heun's method in
-    xi; both linear over the step)."""
+    """Return S after xi moves from xi0 to xi1, with e_0 and the slip width given at both ends.
+
+    Heun's method in xi, e_0 and the slip width linear over the step.
+    """
     dxi = xi1 - xi0
     if slip_limit:
         S = _clamp(S, xi0, wa, e_t)
@@ -160,10 +273,57 @@ def _step_terms(S, xi0, xi1, e0a, wa, e0b, wb, e_t, kappa, slip_limit):
 
 
 @njit(cache=True)
-def valanis_step(S, xi0, xi1, n0, n1, e_f, k_c, e_t, kappa, mu, n_min, slip_limit):
-    """Friction force S (N) after xi moves from xi0 to xi1 (m) while N moves from n0 to n1 (N),
-    Eqs. 21-22 (Heun's method in xi; N linear over the step). slip_limit: the ``slip_limit``
-    reading (True) or Eq. 21 as printed (False)."""
+def valanis_step(
+    S: float,
+    xi0: float,
+    xi1: float,
+    n0: float,
+    n1: float,
+    e_f: float,
+    k_c: float,
+    e_t: float,
+    kappa: float,
+    mu: float,
+    n_min: float,
+    slip_limit: bool,
+) -> float:
+    """Return the friction force S after xi moves from xi0 to xi1 while N moves from n0 to n1 (Eqs. 21-22).
+
+    Heun's method in xi, N linear over the step. Where either normal force is at or below ``n_min`` the contact is
+    open, or closes again and sticks where it lands: S is 0.
+
+    Parameters
+    ----------
+    S
+        The friction force at the step's start [N].
+    xi0
+        The relative tangential displacement at the step's start [m].
+    xi1
+        The relative tangential displacement at the step's end [m].
+    n0
+        The total normal force at the step's start [N].
+    n1
+        The total normal force at the step's end [N].
+    e_f
+        The law's parameter e_f [N/m].
+    k_c
+        The law's parameter k_c [1/m].
+    e_t
+        The law's parameter e_t [N/m].
+    kappa
+        The law's parameter kappa [-].
+    mu
+        The friction coefficient mu [-].
+    n_min
+        The normal force at or below which the contact is open [N].
+    slip_limit
+        The ``slip_limit`` reading (True) or Eq. 21 as printed (False).
+
+    Returns
+    -------
+    S : float
+        The friction force at the step's end [N].
+    """
     if n1 <= n_min or n0 <= n_min:  # open, or re-contact: the contact sticks where it lands
         return 0.0
     e0a = initial_stiffness(n0, e_f, k_c)
@@ -172,9 +332,54 @@ def valanis_step(S, xi0, xi1, n0, n1, e_f, k_c, e_t, kappa, mu, n_min, slip_limi
 
 
 @njit(cache=True)
-def valanis_step_at(S, xi0, xi1, n0, n1, e0a, e0b, e_t, kappa, mu, slip_limit):
-    """``valanis_step`` with Eq. 22's e_0 at both ends given (e0a at n0, e0b at n1, N/m; a time stepper that
-    carries one step's e0b over as the next step's e0a saves an exponential a step); both forces above n_min."""
+def valanis_step_at(
+    S: float,
+    xi0: float,
+    xi1: float,
+    n0: float,
+    n1: float,
+    e0a: float,
+    e0b: float,
+    e_t: float,
+    kappa: float,
+    mu: float,
+    slip_limit: bool,
+) -> float:
+    """Return ``valanis_step``'s friction force with Eq. 22's e_0 given at both ends of the step.
+
+    A time stepper that carries one step's e0b over as the next step's e0a saves an exponential a step. Both normal
+    forces must be above n_min (the contact closed): this step does not check it.
+
+    Parameters
+    ----------
+    S
+        The friction force at the step's start [N].
+    xi0
+        The relative tangential displacement at the step's start [m].
+    xi1
+        The relative tangential displacement at the step's end [m].
+    n0
+        The total normal force at the step's start [N].
+    n1
+        The total normal force at the step's end [N].
+    e0a
+        Eq. 22's e_0 at ``n0`` [N/m].
+    e0b
+        Eq. 22's e_0 at ``n1`` [N/m].
+    e_t
+        The law's parameter e_t [N/m].
+    kappa
+        The law's parameter kappa [-].
+    mu
+        The friction coefficient mu [-].
+    slip_limit
+        The ``slip_limit`` reading (True) or Eq. 21 as printed (False).
+
+    Returns
+    -------
+    S : float
+        The friction force at the step's end [N].
+    """
     return _step_terms(
         S,
         xi0,
@@ -190,8 +395,24 @@ def valanis_step_at(S, xi0, xi1, n0, n1, e0a, e0b, e_t, kappa, mu, slip_limit):
 
 
 def check_parameters(params: np.ndarray) -> np.ndarray:
-    """Validate a (n_sets, 5) parameter array (e_f, k_c, e_t, kappa, mu); raise ValueError
-    naming the first invalid set and the rule it breaks."""
+    """Validate an array of the law's parameter sets and return it as a 2-D float array.
+
+    Parameters
+    ----------
+    params
+        Parameter sets, rows (e_f, k_c, e_t, kappa, mu) [N/m, 1/m, N/m, -, -], shape (n_sets, 5), or (5,) for one.
+
+    Returns
+    -------
+    params : np.ndarray
+        The same sets as floats [N/m, 1/m, N/m, -, -], shape (n_sets, 5).
+
+    Raises
+    ------
+    ValueError
+        When the array is not of shape (n_sets, 5), holds no set, or a set breaks a rule (all finite, e_f, k_c and
+        mu positive, e_t non-negative, kappa in [0, 1)); the message names the first invalid set and its rule.
+    """
     p = np.atleast_2d(np.asarray(params, dtype=float))
     if p.ndim != 2 or p.shape[1] != 5:
         raise ValueError(f"params must have shape (n_sets, 5) in the order {PARAMETER_NAMES}, got {p.shape}")
@@ -228,21 +449,47 @@ def _check_signals(xi, normal_force, n_min):
 
 
 def _step_python(S, xi0, xi1, n0, n1, e_f, k_c, e_t, kappa, mu, n_min, slip_limit):
-    """The per-sample step in plain Python (the jitted step's own Python source)."""
+    """Return ``valanis_step`` run in plain Python (the jitted step's own Python source)."""
     return valanis_step.py_func(S, xi0, xi1, n0, n1, e_f, k_c, e_t, kappa, mu, n_min, slip_limit)
 
 
 def valanis_friction_force_reference(
-    xi,
-    normal_force,
-    params,
+    xi: np.ndarray,
+    normal_force: np.ndarray,
+    params: np.ndarray,
     tol: float = 1e-7,
     max_periods: int = 200,
     n_min: float = 1e-6,
     regularization: str = "none",
 ) -> np.ndarray:
-    """Plain reference implementation of :func:`valanis_friction_force` (a Python loop per
-    sample and parameter set), used to test the fast kernel."""
+    """Return :func:`valanis_friction_force`'s friction force computed by a plain reference implementation.
+
+    A Python loop per sample and parameter set, used to test the fast kernel. Invalid parameters, an empty
+    population, non-finite signals or a normal force at or below ``n_min`` raise ValueError (in
+    ``check_parameters`` and the signals' check).
+
+    Parameters
+    ----------
+    xi
+        The relative tangential displacement [m], shape (n_samples,), over a whole number of periods.
+    normal_force
+        The total normal force [N], shape (n_samples,), compression positive, static preload included.
+    params
+        Parameter sets, rows (e_f, k_c, e_t, kappa, mu) [N/m, 1/m, N/m, -, -], shape (n_sets, 5).
+    tol
+        The periods repeat until S changes by less than ``tol`` x max |S| over a period [-].
+    max_periods
+        The most periods repeated.
+    n_min
+        The normal force at or below which the contact is open [N].
+    regularization
+        The reading of Eq. 21: ``none`` or ``slip_limit``.
+
+    Returns
+    -------
+    S : np.ndarray
+        The friction force at periodic steady state [N], shape (n_sets, n_samples).
+    """
     xi, n = _check_signals(xi, normal_force, n_min)
     p = check_parameters(params)
     slip_limit = slip_limit_flag(regularization)
@@ -266,8 +513,10 @@ def valanis_friction_force_reference(
 
 @njit(parallel=True, cache=True)
 def _population_kernel(xi, n, p, tol, max_periods, n_min, slip_limit, out, periods_used):
-    """valanis_step per sample with the normal-force terms (e_0 and the slip width) precomputed per
-    sample for each set: the same arithmetic, one exp per sample."""
+    """Run valanis_step per sample with the normal-force terms (e_0 and the slip width) precomputed per sample.
+
+    For each set: the same arithmetic, one exp per sample.
+    """
     n_sets = p.shape[0]
     m = xi.size
     for k in prange(n_sets):
@@ -298,30 +547,51 @@ def _population_kernel(xi, n, p, tol, max_periods, n_min, slip_limit, out, perio
 
 
 def valanis_friction_force(
-    xi,
-    normal_force,
-    params,
+    xi: np.ndarray,
+    normal_force: np.ndarray,
+    params: np.ndarray,
     tol: float = 1e-7,
     max_periods: int = 200,
     n_min: float = 1e-6,
     return_periods: bool = False,
     regularization: str = "none",
-):
-    """Friction force S (N) of the modified Valanis law (Eqs. 21-22) at periodic steady state.
-
-    xi: (n_samples,) tangential motion (m) over a whole number of periods (periodic: the last
-    sample is followed by the first); normal_force: (n_samples,) total normal force N (N),
-    compression positive, static preload included; params: (n_sets, 5) rows (e_f, k_c, e_t,
-    kappa, mu) in N/m, 1/m, N/m, -, -. Returns S of shape (n_sets, n_samples).
+) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
+    """Return the friction force S of the modified Valanis law (Eqs. 21-22) at periodic steady state.
 
     The law is stepped once per sample with Heun's method in xi: the samples must resolve the
     motion (about 256 per period give 0.5 % of max |S|; refine the grid by Fourier
     interpolation first). Periods are repeated from S = 0 until S changes by less than
     ``tol`` x max |S| over a period (at most ``max_periods``). Sets are evaluated in parallel.
-    regularization: ``none`` (Eq. 21 as printed, guarded only at its singular point) or
-    ``slip_limit`` (see the module's docstring).
-    Raises ValueError for invalid parameters, an empty population, non-finite signals, or a
-    normal force at or below ``n_min`` (the contact opens).
+    Invalid parameters, an empty population, non-finite signals, or a normal force at or below ``n_min`` (the
+    contact opens) raise ValueError (in ``check_parameters``, ``slip_limit_flag`` and the signals' check).
+
+    Parameters
+    ----------
+    xi
+        The relative tangential displacement [m], shape (n_samples,), over a whole number of periods (periodic:
+        the last sample is followed by the first).
+    normal_force
+        The total normal force N [N], shape (n_samples,), compression positive, static preload included.
+    params
+        Parameter sets, rows (e_f, k_c, e_t, kappa, mu) [N/m, 1/m, N/m, -, -], shape (n_sets, 5).
+    tol
+        The periods repeat until S changes by less than ``tol`` x max |S| over a period [-].
+    max_periods
+        The most periods repeated.
+    n_min
+        The normal force at or below which the contact is open [N]; the signals must stay above it.
+    return_periods
+        Whether to return the periods each set took too.
+    regularization
+        ``none`` (Eq. 21 as printed, guarded only at its singular point) or ``slip_limit`` (see the module's
+        docstring).
+
+    Returns
+    -------
+    S : np.ndarray
+        The friction force [N], shape (n_sets, n_samples); alone unless ``return_periods``.
+    periods : np.ndarray
+        With ``return_periods``: the periods each set was stepped [cycles], shape (n_sets,), int64.
     """
     xi, n = _check_signals(xi, normal_force, n_min)
     p = np.ascontiguousarray(check_parameters(params))

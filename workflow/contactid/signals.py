@@ -16,8 +16,11 @@ samples) 36 MiB: both in one batch, as before."""
 
 
 def _segment_bytes(n_channels: int, segment_length: int) -> int:
-    """Memory (bytes) of one segment's work in ``segment_spectra``: the detrended, windowed copy (8 bytes a sample)
-    and its one-sided spectrum (16 bytes a bin) of every channel."""
+    """Return the memory (bytes) of one segment's work in ``segment_spectra``.
+
+    It counts the detrended, windowed copy (8 bytes a sample) and its one-sided spectrum (16 bytes a bin) of every
+    channel.
+    """
     return int(n_channels) * (8 * int(segment_length) + 16 * (int(segment_length) // 2 + 1))
 
 
@@ -25,9 +28,18 @@ def _segment_bytes(n_channels: int, segment_length: int) -> int:
 class FRFEstimate:
     """H1 estimate of each response over the force.
 
-    frequency_hz: (n_f,); h1: (n_out, n_f) complex, response units per N;
-    coherence: (n_out, n_f) ordinary coherence (dimensionless);
-    n_averages: number of Welch segments.
+    Attributes
+    ----------
+    frequency_hz
+        Frequencies of the spectral lines [Hz], shape (n_f,), n_f = segment_length // 2 + 1 lines from 0 to half
+        the sampling rate.
+    h1
+        H1 estimate of each response over the force, complex, in the response's unit per newton (accelerances
+        [m/s^2/N] for accelerations), shape (n_out, n_f), n_out the responses.
+    coherence
+        Ordinary coherence of each response with the force [-], shape (n_out, n_f).
+    n_averages
+        Number of Welch segments averaged.
     """
 
     frequency_hz: np.ndarray
@@ -37,10 +49,29 @@ class FRFEstimate:
 
 
 def segment_spectra(x: np.ndarray, segment_length: int, step: int, window: str) -> np.ndarray:
-    """One-sided spectra (rfft) of Welch's segments of each row of ``x`` (n_channels, n): segments of
-    ``segment_length`` samples every ``step`` (the whole segments only, as scipy.signal.welch takes them), each less
-    its mean (``detrend="constant"``) and times ``window`` (``periodic_window``). Returns
-    (n_channels, n_segments, segment_length // 2 + 1), unscaled."""
+    """Return the one-sided spectra (rfft) of Welch's segments of each row of ``x``.
+
+    The segments are ``segment_length`` samples every ``step`` (the whole segments only, as scipy.signal.welch takes
+    them), each less its mean (``detrend="constant"``) and times ``window`` (``periodic_window``).
+
+    Parameters
+    ----------
+    x
+        Sampled signals, one channel per row, each in its own unit (e.g. [N] for a force, [m/s^2] for an
+        acceleration), shape (n_channels, n), n samples.
+    segment_length
+        Samples per segment.
+    step
+        Samples from one segment's start to the next's.
+    window
+        Name of the window (``scipy.signal.get_window``'s, e.g. ``hann``).
+
+    Returns
+    -------
+    spectra : np.ndarray
+        Unscaled complex spectra [unit of x], shape (n_channels, n_segments, segment_length // 2 + 1), n_segments
+        = 1 + (n - segment_length) // step.
+    """
     from numpy.lib.stride_tricks import sliding_window_view
 
     n_seg = 1 + (x.shape[-1] - segment_length) // step
@@ -51,8 +82,23 @@ def segment_spectra(x: np.ndarray, segment_length: int, step: int, window: str) 
 
 
 def periodic_window(window: str, n: int) -> np.ndarray:
-    """scipy.signal.get_window(window, n): the periodic window of Welch's segments; the Hann window (the config's
-    default) as 0.5 - 0.5 cos(2 pi k / n), within 2.3e-16 of scipy's, without importing scipy.signal (1.2 s here)."""
+    """Return scipy.signal.get_window(window, n), the periodic window of Welch's segments.
+
+    The Hann window (the config's default) is computed here as 0.5 - 0.5 cos(2 pi k / n), within 2.3e-16 of scipy's,
+    without importing scipy.signal (1.2 s here).
+
+    Parameters
+    ----------
+    window
+        Name of the window (``scipy.signal.get_window``'s, e.g. ``hann``).
+    n
+        Samples of the window (the segment length).
+
+    Returns
+    -------
+    weights : np.ndarray
+        The window's weights [-], shape (n,).
+    """
     if window == "hann":
         return 0.5 - 0.5 * np.cos(2 * np.pi * np.arange(n) / n)
     from scipy.signal import get_window
@@ -68,15 +114,40 @@ def h1_frf(
     overlap: float = 0.5,
     window: str = "hann",
 ) -> FRFEstimate:
-    """H1 = G_fx / G_ff and coherence |G_fx|^2 / (G_ff G_xx), Welch-averaged.
-
-    force: (n,) in N; responses: (n_out, n) in any unit; returns H1 in
-    response unit per N.
+    """Return the Welch-averaged H1 = G_fx / G_ff of each response and its coherence |G_fx|^2 / (G_ff G_xx).
 
     The auto and cross spectra are those of scipy.signal.welch and csd (mean over the segments); their common scaling
     (density, one-sided) cancels in H1 and the coherence, which are formed here from each channel's segment spectra
     computed once (``segment_spectra``) instead of once per spectrum that reads them (the force's four times for three
-    responses): the same numbers to rounding in 40 % of the time.
+    responses): the same numbers to rounding in 40 % of the time. A record whose segments' spectra would take more
+    than ``ARRAY_LIMIT_BYTES`` is transformed in batches below it.
+
+    Parameters
+    ----------
+    force
+        The excitation force [N], shape (n,), n samples.
+    responses
+        The responses, in any unit (accelerations [m/s^2] in the project), shape (n_out, n), or (n,) for one.
+    sampling_rate_hz
+        The records' sampling rate [Hz].
+    segment_length
+        Samples per Welch segment (``frf.segment_length``).
+    overlap
+        Overlap of consecutive segments, a fraction of ``segment_length`` [-] (``frf.overlap``).
+    window
+        Name of the window (``frf.window``; ``periodic_window``).
+
+    Returns
+    -------
+    estimate : FRFEstimate
+        H1 in the response's unit per newton and the coherence on the segments' lines, with the number of segments.
+
+    Raises
+    ------
+    ValueError
+        When ``segment_length`` exceeds the record's length.
+    WorkLimitError
+        When one segment's work of all channels exceeds ``ARRAY_LIMIT_BYTES`` (``io.WorkLimitError``).
     """
     force = np.asarray(force, dtype=float)
     responses = np.atleast_2d(np.asarray(responses, dtype=float))
