@@ -1,12 +1,11 @@
-"""The blind check of the diagnosis: rig data sets with one effect on at a random (seeded)
-magnitude, diagnosed from their raw records alone, and scored.
+"""The blind check of the diagnosis: rig data sets diagnosed from their raw records alone, and scored.
 
-Items (config ``gap_benchmark``): for every effect, ``magnitudes`` random magnitudes in its
-benchmark range for every seed in ``seeds``; one effect-free data set per seed (false alarms);
-and, with ``leave_out``, for every effect one data set at mid-range diagnosed with a library that
-lacks that effect (the verdict must be "none", the localisation must point at the right place);
-and ``compound`` items per seed: a rig whose structure, normal law and damping differ from the model's
-at random, with 0, 1 or 2 effects, diagnosed with model updating and scored on the additive explanation.
+The single-effect data sets have one effect on at a random (seeded) magnitude. Items (config ``gap_benchmark``): for
+every effect, ``magnitudes`` random magnitudes in its benchmark range for every seed in ``seeds``; one effect-free
+data set per seed (false alarms); and, with ``leave_out``, for every effect one data set at mid-range diagnosed with a
+library that lacks that effect (the verdict must be "none", the localisation must point at the right place); and
+``compound`` items per seed: a rig whose structure, normal law and damping differ from the model's at random, with 0,
+1 or 2 effects, diagnosed with model updating and scored on the additive explanation.
 
 This module runs one item: its rig records, the identification and diagnosis, and its result row. What the items are:
 ``bench_items``; how the result rows are scored: ``bench_scores``.
@@ -29,11 +28,29 @@ log = logging.getLogger(__name__)
 
 
 def refitted_magnitude(effect: str, parameters: Mapping | None) -> float | None:
-    """The rig magnitude a candidate's refitted parameters amount to (None where the two are not comparable:
-    contact separation's rig magnitude is a load factor, the candidate's a normal-law shape). Channel skew: the
-    rig delays channel k of n by m (k + 1) / n; m is the least-squares fit of the refitted per-channel delays.
-    Channel gains: the rig reads channel k of n with 1 + m (-1)^k (k + 1) / n; m is the least-squares fit of the
-    refitted gain errors."""
+    """Return the rig magnitude a candidate's refitted parameters amount to.
+
+    None where the two are not comparable: contact separation's rig magnitude is a load factor, the candidate's a
+    normal-law shape. Channel skew: the rig delays channel k of n by m (k + 1) / n; m is the least-squares fit of the
+    refitted per-channel delays. Channel gains: the rig reads channel k of n with 1 + m (-1)^k (k + 1) / n; m is the
+    least-squares fit of the refitted gain errors.
+
+    Parameters
+    ----------
+    effect
+        The effect's name (``rig.effects.EFFECTS``).
+    parameters
+        The candidate's refitted parameters {name: value} (per-channel ones numbered by channel, ``delay_0``, ...),
+        in the candidates' units; None or empty where not refitted.
+
+    Returns
+    -------
+    magnitude : float | None
+        The rig magnitude in the effect's unit (``rig.effects.EFFECTS``): [-] for structural_damping,
+        multi_asperity_friction, transducer_mass_error, channel_gain_error and preload_drift, [s/m] for
+        normal_contact_damping, [N s/m] for viscous_friction, [s] for channel_time_skew; None where not
+        comparable or not refitted.
+    """
     if not parameters:
         return None
     direct = {
@@ -56,8 +73,11 @@ def refitted_magnitude(effect: str, parameters: Mapping | None) -> float | None:
 
 
 def _refitted(effect, ranking: Mapping, updating) -> float | None:
-    """The rig magnitude the diagnosis refitted for ``effect`` (``refitted_magnitude`` of its candidate); an accepted
-    model update's transducer-mass factor counts for transducer_mass_error (the candidate refits what is left)."""
+    """Return the rig magnitude the diagnosis refitted for ``effect`` (``refitted_magnitude`` of its candidate).
+
+    An accepted model update's transducer-mass factor counts for transducer_mass_error (the candidate refits what is
+    left).
+    """
     if effect not in ranking:
         return None
     m = refitted_magnitude(effect, ranking[effect].get("parameters"))
@@ -67,7 +87,18 @@ def _refitted(effect, ranking: Mapping, updating) -> float | None:
 
 
 def nonfinite_records(recs: Mapping) -> list:
-    """The names of the rig records whose acceleration or force is not finite everywhere."""
+    """Return the names of the rig records whose acceleration or force is not finite everywhere.
+
+    Parameters
+    ----------
+    recs
+        {name: raw record} (``pipeline.rig_records``), each with ``acceleration`` and ``force``.
+
+    Returns
+    -------
+    names : list
+        The names of the records with a NaN or infinite sample.
+    """
     return [
         n
         for n, ds in recs.items()
@@ -75,8 +106,28 @@ def nonfinite_records(recs: Mapping) -> list:
     ]
 
 
-def failed_row(spec: Mapping, bad: list, converged, t_rig: float) -> dict:
-    """The result row of an item whose rig records are not finite (not diagnosed, scored apart); ``t_rig`` in s."""
+def failed_row(spec: Mapping, bad: list, converged: Mapping[str, int], t_rig: float) -> dict:
+    """Return the result row of an item whose rig records are not finite (not diagnosed, scored apart).
+
+    Parameters
+    ----------
+    spec
+        The item's spec (``bench_items``): ``kind`` (blind, effect_free, leave_out, ladder or compound), ``effect``,
+        ``magnitude`` (the effect's rig unit), ``seed``, ``library`` (None: the whole library) and, for a compound
+        item, ``effects`` and its perturbation.
+    bad
+        The names of the records that are not finite (``nonfinite_records``).
+    converged
+        {case: 1 where the rig's response control converged, else 0} (``pipeline.rig_records``).
+    t_rig
+        The time the rig's records took [s].
+
+    Returns
+    -------
+    row : dict
+        The spec with ``failed`` (why), ``verdict`` None, ``correct`` False, ``control_converged`` and
+        ``seconds``.
+    """
     return {
         **dict(spec),
         "failed": f"rig records not finite: {', '.join(bad)}",
@@ -89,9 +140,29 @@ def failed_row(spec: Mapping, bad: list, converged, t_rig: float) -> dict:
 
 @dataclass(frozen=True)
 class ItemDiagnosis:
-    """An item's identification and diagnosis: the diagnosis, the model it diagnosed (after model updating) and the
-    chain's, the model update (None: off), the records' harmonics {case: record}, the friction fit's settings; the
-    identification's time, the diagnosis' start (``time.perf_counter``) and its time, in s."""
+    """An item's identification and diagnosis.
+
+    Attributes
+    ----------
+    diag
+        The diagnosis (``diagnosis.Diagnosis``).
+    model
+        The model it diagnosed (``model.IdentifiedModel``, after model updating).
+    chain_model
+        The identification chain's own model (``model.IdentifiedModel``).
+    updating
+        The model update (``UpdatingResult``); None where model updating is off.
+    records
+        The records' harmonics {case: ``records.RecordHarmonics``}.
+    fit_settings
+        The friction fit's settings (``friction_fit.FitSettings``).
+    t_id
+        The identification's time [s].
+    t1
+        The diagnosis' start, a ``time.perf_counter`` reading [s].
+    t_diag
+        The diagnosis' time [s].
+    """
 
     diag: object
     model: object
@@ -105,8 +176,34 @@ class ItemDiagnosis:
 
 
 def diagnose_item(spec: Mapping, cfg: Mapping, recs: Mapping, cases: list, t0: float, t_rig: float) -> ItemDiagnosis:
-    """Identify the model from an item's rig records ``recs`` (the chain, then model updating) and diagnose it with
-    the item's library; ``t0`` the item's start (``time.perf_counter``, s), ``t_rig`` the rig's time (s)."""
+    """Identify the model from an item's rig records and diagnose it with the item's library.
+
+    The identification is the chain's (``pipeline.identify``), then model updating (``pipeline.updated_model``, the
+    load cases other than the calibration case held out).
+
+    Parameters
+    ----------
+    spec
+        The item's spec (``bench_items``): ``kind`` (blind, effect_free, leave_out, ladder or compound), ``effect``,
+        ``magnitude`` (the effect's rig unit), ``seed``, ``library`` (None: the whole library) and, for a compound
+        item, ``effects`` and its perturbation.
+    cfg
+        The item's config with the schema's defaults; ``nonlinear`` (calibration_case, n_harmonics), ``friction``,
+        ``gap`` and ``seed`` are read, and the chain's sections by ``pipeline.identify``.
+    recs
+        {``random_test`` or case: raw record} (``pipeline.rig_records``).
+    cases
+        The load cases to diagnose.
+    t0
+        The item's start, a ``time.perf_counter`` reading [s].
+    t_rig
+        The time the rig's records took [s].
+
+    Returns
+    -------
+    item : ItemDiagnosis
+        The diagnosis, the models, the update, the records' harmonics and the times.
+    """
     from ..friction_fit import settings_from_config
     from .diagnosis import diagnose
     from .localise import linear_stage, random_test_delays
@@ -150,9 +247,39 @@ def diagnose_item(spec: Mapping, cfg: Mapping, recs: Mapping, cases: list, t0: f
     return ItemDiagnosis(diag, model, chain_model, updating, records, fit_settings, t_id, t1, t_diag)
 
 
-def compound_row(spec: Mapping, cfg: Mapping, effects: Mapping, item: ItemDiagnosis, converged, t_rig: float) -> dict:
-    """A compound item's result row: the additive explanation scored against the hidden ``effects``, the friction
-    law's errors (relative) and its intervals with the model-form term; seconds of each step."""
+def compound_row(
+    spec: Mapping, cfg: Mapping, effects: Mapping, item: ItemDiagnosis, converged: Mapping[str, int], t_rig: float
+) -> dict:
+    """Return a compound item's result row.
+
+    The row holds the additive explanation scored against the hidden ``effects``, the friction law's errors
+    (relative) and its intervals with the model-form term (``uncertainty.friction_uncertainty``); seconds of each
+    step.
+
+    Parameters
+    ----------
+    spec
+        The item's spec (``bench_items``): ``kind`` (blind, effect_free, leave_out, ladder or compound), ``effect``,
+        ``magnitude`` (the effect's rig unit), ``seed``, ``library`` (None: the whole library) and, for a compound
+        item, ``effects`` and its perturbation.
+    cfg
+        The item's config; ``nonlinear.calibration_case``, ``structure.preload_n``, ``seed``, ``rig.truth.friction``
+        and ``rig.true_structure.contact_geometry.tangential_lever_arm_m`` are read.
+    effects
+        The effects the item's rig hides {effect: magnitude in its rig unit}.
+    item
+        The item's identification and diagnosis.
+    converged
+        {case: 1 where the rig's response control converged, else 0}.
+    t_rig
+        The time the rig's records took [s].
+
+    Returns
+    -------
+    row : dict
+        The spec with the verdict, the explanation, whether it names the hidden effects (``correct``), the held-out
+        gaps, the friction law's relative errors, intervals, coverage and half-widths, and ``seconds``.
+    """
     from .uncertainty import friction_uncertainty
 
     diag, model, updating = item.diag, item.model, item.updating
@@ -199,9 +326,31 @@ def compound_row(spec: Mapping, cfg: Mapping, effects: Mapping, item: ItemDiagno
     }
 
 
-def blind_row(spec: Mapping, item: ItemDiagnosis, converged, t_rig: float) -> dict:
-    """A single-effect (blind, effect-free, left-out or ladder) item's result row: the verdict against the hidden
-    effect, the true effect's held-out gap, refitted magnitude and shrink, the ranking; seconds of each step."""
+def blind_row(spec: Mapping, item: ItemDiagnosis, converged: Mapping[str, int], t_rig: float) -> dict:
+    """Return a single-effect (blind, effect-free, left-out or ladder) item's result row.
+
+    The row holds the verdict against the hidden effect, the true effect's held-out gap, refitted magnitude and
+    shrink, the ranking; seconds of each step.
+
+    Parameters
+    ----------
+    spec
+        The item's spec (``bench_items``): ``kind`` (blind, effect_free, leave_out, ladder or compound), ``effect``,
+        ``magnitude`` (the effect's rig unit), ``seed``, ``library`` (None: the whole library) and, for a compound
+        item, ``effects`` and its perturbation.
+    item
+        The item's identification and diagnosis.
+    converged
+        {case: 1 where the rig's response control converged, else 0}.
+    t_rig
+        The time the rig's records took [s].
+
+    Returns
+    -------
+    row : dict
+        The spec with the verdict, whether it is right (``correct``; a left-out item's must be "none"), the held-out
+        gaps, the refitted magnitude (``refitted_magnitude``), the ranking and ``seconds``.
+    """
     diag, true = item.diag, spec["effect"]
     by = {r["effect"]: r for r in diag.ranking}
     return {
@@ -229,11 +378,27 @@ def blind_row(spec: Mapping, item: ItemDiagnosis, converged, t_rig: float) -> di
 def write_item_diagnosis(
     outputs: Mapping, spec: Mapping, item: "ItemDiagnosis | None", n_harmonics: int, failed: str = ""
 ) -> None:
-    """An item's diagnosis as ``snakemake gap`` writes it: ``outputs["diagnosis"]`` (diagnosis.json, with the item's
-    spec under ``benchmark_item``) and ``outputs["dataset"]`` (gap.nc), from which ``gap_benchmark_figures`` draws
-    every gap figure and the report's gap section; ``n_harmonics``: the harmonics the diagnosis compares
-    (gap.n_harmonics). An item the rig could not simulate (``item`` None) gets a diagnosis.json that says so
-    (``failed``) and a gap.nc without variables."""
+    """Write an item's diagnosis as ``snakemake gap`` writes it.
+
+    ``gap_benchmark_figures`` draws every gap figure and the report's gap section from them. An item the rig could
+    not simulate (``item`` None) gets a diagnosis.json that says so (``failed``) and a gap.nc without variables.
+
+    Parameters
+    ----------
+    outputs
+        Where to write: ``outputs["diagnosis"]`` (diagnosis.json, with the item's spec under ``benchmark_item``) and
+        ``outputs["dataset"]`` (gap.nc).
+    spec
+        The item's spec (``bench_items``): ``kind`` (blind, effect_free, leave_out, ladder or compound), ``effect``,
+        ``magnitude`` (the effect's rig unit), ``seed``, ``library`` (None: the whole library) and, for a compound
+        item, ``effects`` and its perturbation.
+    item
+        The item's identification and diagnosis; None where the rig could not simulate it.
+    n_harmonics
+        The harmonics the diagnosis compares (gap.n_harmonics).
+    failed
+        Why the item was not diagnosed (with ``item`` None).
+    """
     import json
 
     import xarray as xr
@@ -253,9 +418,27 @@ def write_item_diagnosis(
 
 
 def run_item(spec: Mapping, cfg: Mapping, outputs: Mapping | None = None) -> dict:
-    """Generate the item's rig records, identify the model from them, diagnose; the result row. ``cfg``: the base
-    config (keys left out: the schema's defaults). ``outputs`` ({"diagnosis": path, "dataset": path}, optional):
-    where to write the item's diagnosis.json and gap.nc (``write_item_diagnosis``)."""
+    """Generate the item's rig records, identify the model from them, diagnose, and return the result row.
+
+    Parameters
+    ----------
+    spec
+        The item's spec (``bench_items``): ``kind`` (blind, effect_free, leave_out, ladder or compound), ``effect``,
+        ``magnitude`` (the effect's rig unit), ``seed``, ``library`` (None: the whole library) and, for a compound
+        item, ``effects`` and its perturbation.
+    cfg
+        The base config (keys left out: the schema's defaults); the item's rig is derived from it
+        (``bench_items.item_config``).
+    outputs
+        {"diagnosis": path, "dataset": path}: where to write the item's diagnosis.json and gap.nc
+        (``write_item_diagnosis``); None: not written.
+
+    Returns
+    -------
+    row : dict
+        The item's result row (``compound_row``, ``blind_row`` or ``failed_row``), with the records' check
+        (``records_check``) where diagnosed.
+    """
     from ..schema import with_defaults
     from .pipeline import rig_records
 
@@ -313,8 +496,10 @@ def run_item(spec: Mapping, cfg: Mapping, outputs: Mapping | None = None) -> dic
 
 
 def _records_check(cfg: Mapping, item: ItemDiagnosis) -> dict:
-    """The records' check (rule record_checks) of an item's records against its chain model: every rig record is
-    right, so a finding with a signature is a false alarm of the check ({passed, checks named})."""
+    """Return the records' check (rule record_checks) of an item's records against its chain model.
+
+    Every rig record is right, so a finding with a signature is a false alarm of the check ({passed, checks named}).
+    """
     from .pipeline import records_check_of
     from .record_checks import Thresholds
 

@@ -1,12 +1,14 @@
-"""The identification chain run in one process from raw records to the identified model, for
-data sets that do not go through the workflow's rules one by one (the blind benchmark). It calls
-the same package functions as the rules, with the same settings from the config."""
+"""The identification chain run in one process from raw records to the identified model.
+
+It serves data sets that do not go through the workflow's rules one by one (the blind benchmark). It calls the same
+package functions as the rules, with the same settings from the config.
+"""
 
 from __future__ import annotations
 
 import copy
 import dataclasses
-from typing import Mapping
+from typing import TYPE_CHECKING, Any, Iterable, Mapping, Sequence
 
 import numpy as np
 import xarray as xr
@@ -19,10 +21,42 @@ from .model import identified_model
 from .records import record_harmonics
 from .refit import identified_forces
 
+if TYPE_CHECKING:
+    import os
 
-def linear_chain(cfg: Mapping, raw_random: xr.Dataset, return_frf: bool = False):
-    """random test -> FRF -> modal -> stiction -> linear modes; returns (linear_modes, modal[, frf]). Settings left
-    out of ``cfg`` take the schema's defaults (``schema.with_defaults``), as in the workflow."""
+    from ..friction_fit import FitSettings
+    from ..parameters import StructureParameters
+    from ..test_damping import DampingProfile
+    from ..updating_result import UpdatingResult
+    from .model import IdentifiedModel
+    from .record_checks import Thresholds
+    from .records import RecordHarmonics
+    from .settings import GapSettings
+
+
+def linear_chain(cfg: Mapping, raw_random: xr.Dataset, return_frf: bool = False) -> tuple[xr.Dataset, ...]:
+    """Run the linear chain: random test -> FRF -> modal -> stiction -> linear modes.
+
+    Settings left out of ``cfg`` take the schema's defaults (``schema.with_defaults``), as in the workflow.
+
+    Parameters
+    ----------
+    cfg
+        The config; its ``frf``, ``modal``, ``stiction``, ``linear_modes`` and ``structure`` sections are read.
+    raw_random
+        The random test's raw record.
+    return_frf
+        Whether to return the FRF dataset too.
+
+    Returns
+    -------
+    linear_modes : xr.Dataset
+        The linear modes (linear_modes.nc's content).
+    modal : xr.Dataset
+        The modal fit (modal.nc's content).
+    frf : xr.Dataset
+        The FRF (frf.nc's content); only with ``return_frf``.
+    """
     cfg = with_defaults(cfg)
     f, m, st, lm = (cfg[k] for k in ("frf", "modal", "stiction", "linear_modes"))
     frf = frf_dataset(
@@ -36,10 +70,36 @@ def linear_chain(cfg: Mapping, raw_random: xr.Dataset, return_frf: bool = False)
     return (modes, modal, frf) if return_frf else (modes, modal)
 
 
-def identify(cfg: Mapping, raw_random: xr.Dataset, raw_calibration: xr.Dataset, n_modes: int = 8):
-    """The identified model from a random test and the calibration case's dual-sine record
-    (linear chain, inverse identification, GA fit of the friction law); returns
-    (model, linear_modes, modal, frf)."""
+def identify(
+    cfg: Mapping, raw_random: xr.Dataset, raw_calibration: xr.Dataset, n_modes: int = 8
+) -> tuple[IdentifiedModel, xr.Dataset, xr.Dataset, xr.Dataset]:
+    """Return the identified model from a random test and the calibration case's dual-sine record.
+
+    The chain is the linear chain, the inverse identification and the GA fit of the friction law (no intervals).
+
+    Parameters
+    ----------
+    cfg
+        The config (left-out keys: the schema's defaults); ``linear_chain``'s sections, ``nonlinear.n_harmonics``,
+        ``friction``, ``structure`` and ``seed`` are read.
+    raw_random
+        The random test's raw record.
+    raw_calibration
+        The calibration case's raw dual-sine record.
+    n_modes
+        The stuck modes the identified model keeps.
+
+    Returns
+    -------
+    model : IdentifiedModel
+        The identified model with its fitted friction law.
+    linear_modes : xr.Dataset
+        The linear modes.
+    modal : xr.Dataset
+        The modal fit.
+    frf : xr.Dataset
+        The FRF.
+    """
     from .model import NONE
 
     cfg = with_defaults(cfg)
@@ -56,12 +116,44 @@ def identify(cfg: Mapping, raw_random: xr.Dataset, raw_calibration: xr.Dataset, 
     return model.with_friction(fit.params), modes, modal, frf
 
 
-def test_level_damping(model, calibration, held_out: Mapping, fit_settings, settings, seed: int, scales):
-    """The damping at test level (``contactid.test_damping``): the friction law's misfit on the ``calibration`` record
-    (RecordHarmonics) profiled over ``scales`` with ``model``'s structure and random-test ratios, in each form of
-    ``test_damping.FORMS`` (the driven mode's ratio alone; every mode's), each confirmed or not by the ``held_out``
-    records (``confirmed_test_damping``), one of them chosen (``chosen_test_damping``). Returns the DampingProfile
-    (``test_damping.unprofiled`` where ``scales`` hold one factor)."""
+def test_level_damping(
+    model: IdentifiedModel,
+    calibration: RecordHarmonics,
+    held_out: Mapping[str, RecordHarmonics],
+    fit_settings: FitSettings,
+    settings: GapSettings,
+    seed: int,
+    scales: Sequence[float],
+) -> DampingProfile:
+    """Return the damping at test level (``contactid.test_damping``).
+
+    The friction law's misfit on the ``calibration`` record is profiled over ``scales`` with ``model``'s structure and
+    random-test ratios, in each form of ``test_damping.FORMS`` (the driven mode's ratio alone; every mode's), each
+    confirmed or not by the ``held_out`` records (``confirmed_test_damping``), one of them chosen
+    (``chosen_test_damping``), and the chosen one, where confirmed, given its law's intervals.
+
+    Parameters
+    ----------
+    model
+        The identified model (its structure, damping ratios, frequencies and preload are used).
+    calibration
+        The calibration record's harmonics.
+    held_out
+        {case: harmonics} of the other load cases.
+    fit_settings
+        The friction fit's settings (``friction_fit.FitSettings``).
+    settings
+        The gap's settings (``settings.GapSettings``).
+    seed
+        The fits' random seed.
+    scales
+        The factors on the damping ratios to profile [-] (``nonlinear.test_damping_scales`` with 1).
+
+    Returns
+    -------
+    profile : DampingProfile
+        The chosen profile; ``test_damping.unprofiled`` where ``scales`` hold one factor.
+    """
     from ..test_damping import FORMS, damping_profile, unprofiled, with_intervals
     from .model import NONE, fe_model
 
@@ -101,26 +193,66 @@ def test_level_damping(model, calibration, held_out: Mapping, fit_settings, sett
     )
 
 
-def chosen_test_damping(tested):
-    """Of the profiles of each form, each with the held-out records' test (``confirmed_test_damping``): the confirmed
-    one whose held-out gap is least, else (none confirmed) the one whose misfit is least, which then is not applied.
-    The held-out records choose among the forms, not the calibration record's misfit: a form can fit the calibration
-    record better and widen the held-out gap where the other form narrows it (the other simulator's records,
-    docs/measurements.md)."""
+def chosen_test_damping(tested: Sequence[DampingProfile]) -> DampingProfile:
+    """Return the profile chosen among the forms: the confirmed one whose held-out gap is least.
+
+    Where none is confirmed, it is the one whose misfit is least, which then is not applied. The held-out records
+    choose among the forms, not the calibration record's misfit: a form can fit the calibration record better and
+    widen the held-out gap where the other form narrows it (the other simulator's records, docs/measurements.md).
+
+    Parameters
+    ----------
+    tested
+        The profiles of each form, each with the held-out records' test (``confirmed_test_damping``).
+
+    Returns
+    -------
+    profile : DampingProfile
+        The chosen profile.
+    """
     confirmed = [p for p in tested if p.accepted]
     if confirmed:
         return min(confirmed, key=lambda p: float(p.check["heldout_gap_updated"]))
     return min(tested, key=lambda p: float(np.min(p.misfits)))
 
 
-def confirmed_test_damping(model, profile, calibration, held_out: Mapping, fit_settings, settings):
-    """``profile`` with the held-out records' test of its factor (``profile.check``): the model with the random test's
-    ratios and the model with the driven mode's ratio times ``profile.scale``, each with the law fitted at its factor,
-    weighed on the ``held_out`` records ({case: RecordHarmonics}) as an update of the structure is
+def confirmed_test_damping(
+    model: IdentifiedModel,
+    profile: DampingProfile,
+    calibration: RecordHarmonics,
+    held_out: Mapping[str, RecordHarmonics],
+    fit_settings: FitSettings,
+    settings: GapSettings,
+) -> DampingProfile:
+    """Return ``profile`` with the held-out records' test of its factor (``profile.check``).
+
+    The model with the random test's ratios and the model with the form's ratios times ``profile.scale``, each with
+    the law fitted at its factor, are weighed on the ``held_out`` records as an update of the structure is
     (``evidence.records_test_of_update``: the gap shrinks by min_reduction of it and beyond noise_factor x the records'
     scatter), with no floor below which the gap is left alone: the floor is measured with the chain's law (rule
     gap_floor), downstream of this choice, and a factor that halves the held-out gap is confirmed at any level. No test
-    where the factor is 1 or nothing is held out (the factor then is not applied)."""
+    where the factor is 1 or nothing is held out (the factor then is not applied).
+
+    Parameters
+    ----------
+    model
+        The identified model.
+    profile
+        The damping profile of one form.
+    calibration
+        The calibration record's harmonics.
+    held_out
+        {case: harmonics} of the other load cases.
+    fit_settings
+        The friction fit's settings (``friction_fit.FitSettings``).
+    settings
+        The gap's settings (``settings.GapSettings``).
+
+    Returns
+    -------
+    profile : DampingProfile
+        ``profile`` with ``check`` set where the test ran; ``profile`` itself otherwise.
+    """
     import logging
 
     from ..test_damping import check_reason
@@ -141,9 +273,34 @@ def confirmed_test_damping(model, profile, calibration, held_out: Mapping, fit_s
     return out
 
 
-def rig_records(cfg: Mapping, effects: Mapping, seed: int, cases, random_test: bool = True) -> tuple[dict, dict]:
-    """Raw records of the virtual rig with ``effects`` on, {'random_test': ds, case: ds, ...}, and apart
-    from them (truth, never in a raw record) whether each case's response control converged."""
+def rig_records(
+    cfg: Mapping, effects: Mapping, seed: int, cases: Iterable[str], random_test: bool = True
+) -> tuple[dict, dict]:
+    """Return raw records of the virtual rig with ``effects`` on, and whether each case's response control converged.
+
+    The convergence is truth, never in a raw record: it is returned apart from them.
+
+    Parameters
+    ----------
+    cfg
+        The config (left-out keys: the schema's defaults); ``rig``, ``structure``, ``random_test`` and
+        ``load_cases`` are read.
+    effects
+        {effect: magnitude in its rig unit} (``rig.effects``), replacing the config's.
+    seed
+        The rig's random seed.
+    cases
+        The load cases to simulate.
+    random_test
+        Whether to simulate the random test too.
+
+    Returns
+    -------
+    records : dict
+        {'random_test': raw dataset, case: raw dataset, ...}.
+    converged : dict
+        {case: 1 where the response control converged, else 0}.
+    """
     from ..rig.dual_sine import dual_sine_test
     from ..rig.random_test import random_test_datasets
     from ..rig.structure import random_test_rig_config
@@ -173,9 +330,23 @@ def rig_records(cfg: Mapping, effects: Mapping, seed: int, cases, random_test: b
     return out, converged
 
 
-def structure_update(structure, modal: xr.Dataset, settings):
-    """The base structure (StructureParameters with the chain's k_t, k_n) updated from the random test's modal
-    fit (``contactid.updating``), or None when gap.model_updating is off."""
+def structure_update(structure: StructureParameters, modal: xr.Dataset, settings: GapSettings) -> UpdatingResult | None:
+    """Return the base structure updated from the random test's modal fit (``contactid.updating``).
+
+    Parameters
+    ----------
+    structure
+        The base structure, with the chain's k_t and k_n.
+    modal
+        The modal fit (modal.nc's content: natural frequencies, their sd and the residues).
+    settings
+        The gap's settings (``settings.GapSettings``): model_updating and the updating's parameters.
+
+    Returns
+    -------
+    update : UpdatingResult | None
+        The update; None when gap.model_updating is off.
+    """
     from ..stiction import frequency_sigma
     from ..updating import update_structure
 
@@ -198,18 +369,51 @@ def structure_update(structure, modal: xr.Dataset, settings):
 
 def workflow_models(
     structure_cfg: Mapping,
-    inputs,
-    cases,
+    inputs: Any,
+    cases: Sequence[str],
     calibration_case: str,
     n_harmonics: int,
     friction_cfg: Mapping,
-    settings,
+    settings: GapSettings,
     seed: int,
-):
-    """What the gap's rules (gap_diagnosis, friction_intervals) read from the workflow's files: ``inputs`` names
-    modes, modal, fit, updating (model_updating.json) and raw (the load cases' records, in the order of
-    ``cases``). Returns (the records' harmonics (``n_harmonics``) by case, the friction fit's settings, modal.nc,
-    and ``diagnosed_model``'s chain model, model to diagnose and UpdatingResult or None)."""
+) -> tuple[dict, FitSettings, xr.Dataset, IdentifiedModel, IdentifiedModel, UpdatingResult | None]:
+    """Return what the gap's rules (gap_diagnosis, friction_intervals) read from the workflow's files.
+
+    Parameters
+    ----------
+    structure_cfg
+        The config's ``structure`` section.
+    inputs
+        The rule's inputs (Snakemake's ``input``), naming by attribute ``modes``, ``modal``, ``fit``, ``updating``
+        (model_updating.json) and ``raw`` (the load cases' records, in the order of ``cases``).
+    cases
+        The load cases.
+    calibration_case
+        The calibration case's name.
+    n_harmonics
+        The harmonics of each record compared.
+    friction_cfg
+        The config's ``friction`` section.
+    settings
+        The gap's settings (``settings.GapSettings``).
+    seed
+        The random seed.
+
+    Returns
+    -------
+    records : dict
+        {case: RecordHarmonics} of the load cases.
+    fit_settings : FitSettings
+        The friction fit's settings.
+    modal : xr.Dataset
+        modal.nc's content.
+    chain : IdentifiedModel
+        The chain's own model.
+    model : IdentifiedModel
+        The model to diagnose (``diagnosed_model``).
+    updating : UpdatingResult | None
+        The model update; None when updating is off.
+    """
     import json
 
     from ..io import load_dataset
@@ -239,17 +443,48 @@ def diagnosed_model(
     modes: xr.Dataset,
     modal: xr.Dataset,
     fit: xr.Dataset,
-    calibration,
+    calibration: RecordHarmonics,
     updating_summary: Mapping,
-    fit_settings,
-    settings,
+    fit_settings: FitSettings,
+    settings: GapSettings,
     seed: int,
-    held_out=None,
-):
-    """The models a diagnosis of the workflow's datasets works with: (the chain's own model from linear_modes.nc,
-    modal.nc and friction_fit.nc; the model to diagnose, the chain's updated by model_updating.json's summary
-    (``updated_model``, which the ``held_out`` records may also accept) or the chain's own when updating is off;
-    the UpdatingResult or None)."""
+    held_out: Mapping[str, RecordHarmonics] | None = None,
+) -> tuple[IdentifiedModel, IdentifiedModel, UpdatingResult | None]:
+    """Return the models a diagnosis of the workflow's datasets works with.
+
+    Parameters
+    ----------
+    structure_cfg
+        The config's ``structure`` section.
+    modes
+        linear_modes.nc's content.
+    modal
+        modal.nc's content.
+    fit
+        friction_fit.nc's content.
+    calibration
+        The calibration record's harmonics.
+    updating_summary
+        model_updating.json's summary (``UpdatingResult.summary``; ``enabled`` says whether updating is on).
+    fit_settings
+        The friction fit's settings (``friction_fit.FitSettings``).
+    settings
+        The gap's settings (``settings.GapSettings``).
+    seed
+        The random seed.
+    held_out
+        {case: harmonics} of the other load cases, which may also accept an update (None: none).
+
+    Returns
+    -------
+    chain : IdentifiedModel
+        The chain's own model from linear_modes.nc, modal.nc and friction_fit.nc.
+    model : IdentifiedModel
+        The model to diagnose: the chain's updated by the summary (``updated_model``), or the chain's own when
+        updating is off.
+    updating : UpdatingResult | None
+        The update; None when updating is off.
+    """
     from ..updating_result import UpdatingResult
 
     chain = identified_model(structure_cfg, modes, modal, fit)
@@ -260,13 +495,49 @@ def diagnosed_model(
     return chain, model, upd
 
 
-def updated_model(model, modal: xr.Dataset, calibration, fit_settings, settings, seed: int, upd=None, held_out=None):
-    """The base model updated from the random test before the candidates (``structure_update``, or ``upd`` when
-    already computed), settled by ``settled_update``. Where the accelerometer channels' gains took part in the update
-    but the random test cannot tell them from the structure's factors (``UpdatingResult.structure_alone``'s
-    ``gains_needed`` false), both updates are settled and the ``held_out`` records choose
-    (``evidence.records_test_of_gains``): the one without the gains unless the records call for them; the test is kept
-    in ``gains_versus_structure``. Returns (model to diagnose, UpdatingResult or None when updating is off)."""
+def updated_model(
+    model: IdentifiedModel,
+    modal: xr.Dataset,
+    calibration: RecordHarmonics | None,
+    fit_settings: FitSettings,
+    settings: GapSettings,
+    seed: int,
+    upd: UpdatingResult | None = None,
+    held_out: Mapping[str, RecordHarmonics] | None = None,
+) -> tuple[IdentifiedModel, UpdatingResult | None]:
+    """Return the base model updated from the random test before the candidates, settled by ``settled_update``.
+
+    Where the accelerometer channels' gains took part in the update but the random test cannot tell them from the
+    structure's factors (``UpdatingResult.structure_alone``'s ``gains_needed`` false), both updates are settled and
+    the ``held_out`` records choose (``evidence.records_test_of_gains``): the one without the gains unless the records
+    call for them; the test is kept in ``gains_versus_structure``.
+
+    Parameters
+    ----------
+    model
+        The base model (the chain's).
+    modal
+        The random test's modal fit (modal.nc's content).
+    calibration
+        The calibration record's harmonics (None: the gains are not weighed by the records).
+    fit_settings
+        The friction fit's settings (``friction_fit.FitSettings``).
+    settings
+        The gap's settings (``settings.GapSettings``).
+    seed
+        The random seed.
+    upd
+        The update when already computed (None: ``structure_update`` computes it).
+    held_out
+        {case: harmonics} of the other load cases (None: none).
+
+    Returns
+    -------
+    model : IdentifiedModel
+        The model to diagnose.
+    updating : UpdatingResult | None
+        The update; None when updating is off.
+    """
     import logging
 
     if upd is None:
@@ -301,14 +572,47 @@ def updated_model(model, modal: xr.Dataset, calibration, fit_settings, settings,
     return m_alone, dataclasses.replace(u_alone, gains_versus_structure=test)
 
 
-def settled_update(model, calibration, fit_settings, settings, seed: int, upd, held_out=None):
-    """The base model updated by ``upd`` (an UpdatingResult of the random test), with the inverse
-    identification and the friction fit redone on the calibration record (``calibration``: its RecordHarmonics).
-    Returns (model to diagnose, UpdatingResult); the model is the chain's own when the update is not accepted. An
+def settled_update(
+    model: IdentifiedModel,
+    calibration: RecordHarmonics,
+    fit_settings: FitSettings,
+    settings: GapSettings,
+    seed: int,
+    upd: UpdatingResult,
+    held_out: Mapping[str, RecordHarmonics] | None = None,
+) -> tuple[IdentifiedModel, UpdatingResult]:
+    """Return the base model updated by ``upd``, with the inverse identification and the friction fit redone.
+
+    They are redone on the calibration record. The model is the chain's own when the update is not accepted. An
     update the random test's chi^2 test did not accept (its ``proposal``) is accepted when the ``held_out`` records
-    ({case: RecordHarmonics}, the load cases other than the calibration case) show a held-out gap above the floor
-    that the update explains materially (``settings.updating_records_test``; ``evidence.records_test_of_update``);
-    the result then says ``accepted_by`` "records" and keeps the test in ``records_test``."""
+    show a held-out gap above the floor that the update explains materially (``settings.updating_records_test``;
+    ``evidence.records_test_of_update``); the result then says ``accepted_by`` "records" and keeps the test in
+    ``records_test``.
+
+    Parameters
+    ----------
+    model
+        The base model (the chain's).
+    calibration
+        The calibration record's harmonics.
+    fit_settings
+        The friction fit's settings (``friction_fit.FitSettings``).
+    settings
+        The gap's settings (``settings.GapSettings``).
+    seed
+        The random seed.
+    upd
+        The random test's update.
+    held_out
+        {case: RecordHarmonics} of the load cases other than the calibration case (None: none).
+
+    Returns
+    -------
+    model : IdentifiedModel
+        The model to diagnose.
+    updating : UpdatingResult
+        The update, accepted by the records where they did (with ``records_test``).
+    """
     import logging
 
     log = logging.getLogger(__name__)
@@ -381,9 +685,11 @@ def settled_update(model, calibration, fit_settings, settings, seed: int, upd, h
 
 
 def _without_factor(model, upd, factor: str):
-    """The structure of ``upd``'s proposal with ``factor`` at 1 (the others as proposed), its stiffness fit redone as
-    a mass candidate's is (``IdentifiedModel.refit_stiffness``: k_t and k_n refitted to the chain's frequencies, k_n
-    kept where the chain's modes use the prior k_n), E as the factors set it."""
+    """Return the structure of ``upd``'s proposal with ``factor`` at 1 (the others as proposed).
+
+    Its stiffness fit is redone as a mass candidate's is (``IdentifiedModel.refit_stiffness``: k_t and k_n refitted
+    to the chain's frequencies, k_n kept where the chain's modes use the prior k_n), E as the factors set it.
+    """
     from ..updating_model import apply_factors
 
     p = upd.proposal
@@ -393,8 +699,10 @@ def _without_factor(model, upd, factor: str):
 
 
 def _refitted(model, structure, calibration, fit_settings, seed: int):
-    """The model with ``structure``, its contact forces identified again from the calibration record and its
-    friction law fitted to them."""
+    """Return the model with ``structure``, its contact forces identified again and its friction law fitted to them.
+
+    The forces are identified from the calibration record.
+    """
     from .model import NONE
 
     m2 = dataclasses.replace(model, structure=structure)
@@ -414,10 +722,39 @@ def _refitted(model, structure, calibration, fit_settings, seed: int):
     return m2.with_friction(fit.params)
 
 
-def workflow_record_checks(structure_cfg: Mapping, inputs, cases, calibration_case: str, n_harmonics: int, thresholds):
-    """The records' check (``records_check_of``) from the workflow's files: ``inputs`` names modes, modal, fit and raw
-    (the load cases' records, in the order of ``cases``); the prediction is the chain's identified model (not
-    updated)."""
+def workflow_record_checks(
+    structure_cfg: Mapping,
+    inputs: Any,
+    cases: Sequence[str],
+    calibration_case: str,
+    n_harmonics: int,
+    thresholds: Thresholds,
+) -> dict:
+    """Return the records' check (``records_check_of``) from the workflow's files.
+
+    The prediction is the chain's identified model (not updated).
+
+    Parameters
+    ----------
+    structure_cfg
+        The config's ``structure`` section.
+    inputs
+        The rule's inputs (Snakemake's ``input``), naming by attribute ``modes``, ``modal``, ``fit`` and ``raw``
+        (the load cases' records, in the order of ``cases``).
+    cases
+        The load cases.
+    calibration_case
+        The calibration case's name.
+    n_harmonics
+        The harmonics of each record compared.
+    thresholds
+        The check's thresholds (gap.record_checks).
+
+    Returns
+    -------
+    check : dict
+        ``record_checks.records_check``'s result: passed, findings, trace, gaps, calibration_case.
+    """
     from ..io import load_dataset
     from .model import identified_model
 
@@ -428,18 +765,58 @@ def workflow_record_checks(structure_cfg: Mapping, inputs, cases, calibration_ca
     return records_check_of(model, records, calibration_case, n_harmonics, thresholds)
 
 
-def workflow_records(paths, cases, n_harmonics: int) -> dict:
-    """{case: RecordHarmonics} of the load cases' dual-sine records ``paths`` (in the order of ``cases``), harmonics
-    1..``n_harmonics``: what the gap's rules compare the model with."""
+def workflow_records(paths: Iterable[str | os.PathLike], cases: Iterable[str], n_harmonics: int) -> dict:
+    """Return the load cases' dual-sine records in harmonics: what the gap's rules compare the model with.
+
+    Parameters
+    ----------
+    paths
+        The records' files, in the order of ``cases``.
+    cases
+        The load cases.
+    n_harmonics
+        The harmonics 1..n_harmonics kept.
+
+    Returns
+    -------
+    records : dict
+        {case: RecordHarmonics}.
+    """
     from ..io import read_raw
 
     return {c: record_harmonics(read_raw(path, dual_sine=True), c, int(n_harmonics)) for c, path in zip(cases, paths)}
 
 
-def records_check_of(model, records: Mapping, calibration_case: str, n_harmonics: int, thresholds) -> dict:
-    """``record_checks.records_check`` of the records' harmonics ``records`` {case: RecordHarmonics}: their
-    accelerances at the drive, and each against ``model``'s prediction at its measured force (harmonics
-    1..``n_harmonics``)."""
+def records_check_of(
+    model: IdentifiedModel,
+    records: Mapping[str, RecordHarmonics],
+    calibration_case: str,
+    n_harmonics: int,
+    thresholds: Thresholds,
+) -> dict:
+    """Return ``record_checks.records_check`` of the records' harmonics.
+
+    It checks their accelerances at the drive, and each against ``model``'s prediction at its measured force
+    (harmonics 1..``n_harmonics``).
+
+    Parameters
+    ----------
+    model
+        The model whose prediction the records are checked against.
+    records
+        {case: RecordHarmonics}.
+    calibration_case
+        The calibration case's name.
+    n_harmonics
+        The harmonics compared.
+    thresholds
+        The check's thresholds (gap.record_checks).
+
+    Returns
+    -------
+    check : dict
+        ``record_checks.records_check``'s result: passed, findings, trace, gaps, calibration_case.
+    """
     from .model import NONE
     from .record_checks import accelerance_levels, model_evidence, records_check
     from .simulation import simulate

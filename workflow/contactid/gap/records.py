@@ -21,13 +21,44 @@ from ..harmonics import aperiodic_share, harmonic_amplitudes
 
 @dataclass(frozen=True)
 class RecordHarmonics:
-    """One load case's record in harmonics (force in N, accelerations in m/s^2).
+    """One load case's record in harmonics.
 
-    force: (H,) complex; acceleration: (j, H) complex; block_force (B, H) and block_acceleration
-    (B, j, H): the same per block of whole periods; first/last: (j, H) of the first and last thirds;
-    f0 (Hz), fs (Hz), periods (whole periods in the record), sensors (names); aperiodic (j,): each accelerometer's
-    share of its rms that is not periodic at the drive frequency (``harmonics.aperiodic_share`` at the frequency the
-    force record shows: the noise alone where the response settles; None where not computed)."""
+    The harmonics c_h (h = 1..H) are complex amplitudes in the signal's unit, x ~ mean + sum_h Im(c_h e^{i h w t}),
+    with time zero where the force's fundamental has phase 0; H harmonics, j accelerometers, B blocks of whole
+    periods.
+
+    Attributes
+    ----------
+    case
+        The load case's name (e.g. ``lc1``).
+    f0
+        The excitation (test) frequency [Hz], as the record declares it.
+    fs
+        The sampling rate [Hz].
+    periods
+        Whole periods of the test frequency in the record.
+    force
+        The force's harmonics [N], complex, shape (H,).
+    acceleration
+        Each accelerometer's harmonics [m/s^2], complex, shape (j, H).
+    block_force
+        The force's harmonics per block of whole periods [N], complex, shape (B, H).
+    block_acceleration
+        The accelerations' harmonics per block [m/s^2], complex, shape (B, j, H).
+    first
+        The accelerations' harmonics over the record's first third [m/s^2], complex, shape (j, H).
+    last
+        The accelerations' harmonics over the record's last third [m/s^2], complex, shape (j, H).
+    sensors
+        The accelerometers' names, j of them.
+    sensor_positions
+        The accelerometers' distances from the clamp [m], shape (j,), from a ``sensor_position`` variable of the
+        record; shape (0,) where it has none (the raw format's coordinate is named ``position``).
+    aperiodic
+        Each accelerometer's share of its rms that is not periodic at the drive frequency [-], shape (j,)
+        (``harmonics.aperiodic_share`` at the frequency the force record shows: the noise alone where the response
+        settles); None where not computed.
+    """
 
     case: str
     f0: float
@@ -52,12 +83,33 @@ def _aligned(force_coef: np.ndarray, coefs: np.ndarray) -> tuple[np.ndarray, np.
 
 
 def _harmonics(x: np.ndarray, t: np.ndarray, w: float, H: int) -> np.ndarray:
-    """Harmonics 1..H of every row of x, one least-squares solve for all rows (one design matrix)."""
+    """Return harmonics 1..H of every row of x, one least-squares solve for all rows (one design matrix)."""
     return harmonic_amplitudes(np.atleast_2d(x).T, t, w, range(1, H + 1)).T
 
 
 def record_harmonics(raw: xr.Dataset, case: str, n_harmonics: int, n_blocks: int = 8) -> RecordHarmonics:
-    """Harmonics 1..n_harmonics of the force and every accelerometer of a dual-sine record."""
+    """Return harmonics 1..n_harmonics of the force and every accelerometer of a dual-sine record.
+
+    They are estimated over the record's whole periods, over each of ``n_blocks`` blocks of whole periods and over
+    its first and last thirds, each aligned so that the force's fundamental has phase 0.
+
+    Parameters
+    ----------
+    raw
+        The raw dual-sine record: ``force`` (time) [N] and ``acceleration`` (sensor, time) [m/s^2], the ``sensor``
+        names, attributes ``sampling_rate_hz`` and ``excitation_frequency_hz``.
+    case
+        The load case's name.
+    n_harmonics
+        How many harmonics of the test frequency, H.
+    n_blocks
+        Blocks of whole periods for the block estimates (at least 2, at most the record's periods).
+
+    Returns
+    -------
+    record : RecordHarmonics
+        The record's harmonics.
+    """
     fs = float(raw.attrs["sampling_rate_hz"])
     f0 = float(raw.attrs["excitation_frequency_hz"])
     force = raw["force"].values
@@ -105,11 +157,13 @@ def record_harmonics(raw: xr.Dataset, case: str, n_harmonics: int, n_blocks: int
 
 
 def _drive_frequency(force: np.ndarray, fs: float, declared_hz: float) -> float:
-    """The drive's frequency as the force record shows it (``raw_checks_dual_sine.recovered_frequency``), for the
-    share of the response that is not periodic: a declared frequency off by the raw checks' tolerance (0.02 cycles
-    over the record) would leave 4 % of the fundamental and more of each higher harmonic unfitted, a settled record
-    read as one that does not settle. The declared one where the record's strongest line is not one of its first three
-    harmonics."""
+    """Return the drive's frequency as the force record shows it (``raw_checks_dual_sine.recovered_frequency``).
+
+    It serves the share of the response that is not periodic: a declared frequency off by the raw checks' tolerance
+    (0.02 cycles over the record) would leave 4 % of the fundamental and more of each higher harmonic unfitted, a
+    settled record read as one that does not settle. The declared one where the record's strongest line is not one of
+    its first three harmonics.
+    """
     from ..raw_checks_dual_sine import recovered_frequency
 
     f, h = recovered_frequency(np.asarray(force, dtype=float), fs, declared_hz)

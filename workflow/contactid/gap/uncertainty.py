@@ -28,7 +28,7 @@ from __future__ import annotations
 import dataclasses
 import logging
 from dataclasses import dataclass
-from typing import Mapping
+from typing import TYPE_CHECKING, Iterable, Mapping, Sequence
 
 import numpy as np
 
@@ -38,6 +38,9 @@ from ..friction_fit import FitSettings, fit_friction_law
 from .model import NONE, IdentifiedModel
 from .records import RecordHarmonics
 from .refit import identified_forces
+
+if TYPE_CHECKING:
+    from ..parameters import StructureParameters
 
 log = logging.getLogger(__name__)
 
@@ -49,9 +52,37 @@ PRODUCTS = (("mu_a", "mu", 1, "m"), ("e0_a2", "e0", 2, "N m"))
 
 @dataclass
 class FrictionUncertainty:
-    """Per parameter (``NAMES``): the value, the profile-likelihood interval (6, 2), the model-form standard
-    deviations from the load cases and from the structure (on the parameter's scale: ln for LOG_SCALE, else
-    linear), the interval with model form (6, 2), and the refits behind them ({case: (6,)}, [(6,), ...])."""
+    """The friction law's parameters with their profile-likelihood intervals and their intervals with model form.
+
+    Per parameter of ``NAMES`` (e_f, k_c, e_t, kappa, mu and e_0 at the preload): the value, the profile-likelihood
+    interval, the model-form standard deviations from the load cases and from the structure, the interval with model
+    form, and the refits behind them; and the same for what the data bind (``PRODUCTS``).
+
+    Attributes
+    ----------
+    value
+        The fitted values [N/m, 1/m, N/m, -, -, N/m], shape (6,), in the order of ``NAMES``.
+    profile
+        The profile-likelihood intervals [N/m, 1/m, N/m, -, -, N/m], shape (6, 2): lower, upper end.
+    sd_cases
+        The model-form standard deviations over the other load cases, on each parameter's scale (ln for
+        ``LOG_SCALE``'s e_f, k_c, mu and e_0, linear for e_t and kappa) [-, -, N/m, -, -, -], shape (6,).
+    sd_structure
+        The model-form standard deviations over the structures the random test allows, on the same scales
+        [-, -, N/m, -, -, -], shape (6,).
+    interval
+        The intervals with model form [N/m, 1/m, N/m, -, -, N/m], shape (6, 2): lower, upper end.
+    confidence
+        The intervals' confidence level [-] (e.g. 0.95).
+    case_fits
+        {case: the refit on that load case's forces, a row of ``NAMES`` [N/m, 1/m, N/m, -, -, N/m] of shape (6,)}.
+    structure_fits
+        The refits on the calibration forces identified with each posterior structure, rows of ``NAMES`` of shape
+        (6,), in +- pairs along the posterior's axes.
+    products
+        {``PRODUCTS`` name: {value, profile, sd_cases, sd_structure, interval, unit}}: mu a [m] and e_0 a^2 [N m]
+        (``bound_products``).
+    """
 
     value: np.ndarray
     profile: np.ndarray
@@ -64,15 +95,39 @@ class FrictionUncertainty:
     products: dict = dataclasses.field(default_factory=dict)  # {PRODUCTS name: {value, profile, sd_*, interval}}
 
     def interval_of(self, n: str) -> tuple:
-        """(interval with model form (2,), value) of a name of NAMES or PRODUCTS."""
+        """Return the interval with model form and the value of a name of NAMES or PRODUCTS.
+
+        Parameters
+        ----------
+        n
+            A name of ``NAMES`` or of ``PRODUCTS``.
+
+        Returns
+        -------
+        interval : np.ndarray
+            The interval with model form [unit of n] (``NAMES``: [N/m, 1/m, N/m, -, -, N/m]; mu_a [m], e0_a2 [N m]),
+            shape (2,): lower, upper end.
+        value : float
+            The fitted value [unit of n].
+        """
         if n in self.products:
             return self.products[n]["interval"], self.products[n]["value"]
         i = NAMES.index(n)
         return self.interval[i], self.value[i]
 
     def covers(self, truth: Mapping) -> dict:
-        """{name: whether the interval with model form holds the true value} for the names in ``truth`` (NAMES
-        and PRODUCTS)."""
+        """Return whether each interval with model form holds the true value.
+
+        Parameters
+        ----------
+        truth
+            {name of NAMES or PRODUCTS: true value in that name's unit, or None where unknown}.
+
+        Returns
+        -------
+        covered : dict
+            {name: whether the interval holds the true value} for the names of ``truth`` with a value.
+        """
         out = {}
         for n in (*NAMES, *self.products):
             if n in truth and truth[n] is not None:
@@ -80,8 +135,19 @@ class FrictionUncertainty:
                 out[n] = bool(lo <= float(truth[n]) <= hi)
         return out
 
-    def relative_halfwidth(self, names=NAMES) -> dict:
-        """{name: half the interval with model form over the value} (a relative +- of the interval)."""
+    def relative_halfwidth(self, names: Iterable[str] = NAMES) -> dict:
+        """Return half of each interval with model form over the value (a relative +- of the interval).
+
+        Parameters
+        ----------
+        names
+            Names of ``NAMES`` or ``PRODUCTS``.
+
+        Returns
+        -------
+        halfwidth : dict
+            {name: half the interval's width over the value's magnitude, a float [-]}.
+        """
         out = {}
         for n in names:
             (lo, hi), v = self.interval_of(n)
@@ -89,7 +155,14 @@ class FrictionUncertainty:
         return out
 
     def summary(self) -> dict:
-        """JSON-ready {name: {value, profile_interval, sd_cases, sd_structure, interval, scale}}."""
+        """Return the intervals JSON-ready.
+
+        Returns
+        -------
+        summary : dict
+            {name: {value, profile_interval, sd_cases, sd_structure, interval, scale}} for ``NAMES``, the same with
+            ``unit`` for ``PRODUCTS``, and ``confidence``.
+        """
         return (
             {
                 n: {
@@ -118,8 +191,21 @@ class FrictionUncertainty:
         )
 
 
-def with_e0(params, preload: float) -> np.ndarray:
-    """The five law parameters followed by e_0 at the preload (N/m, Eq. 22)."""
+def with_e0(params: np.ndarray, preload: float) -> np.ndarray:
+    """Return the five law parameters followed by e_0 at the preload (Eq. 22).
+
+    Parameters
+    ----------
+    params
+        The law's parameters (e_f, k_c, e_t, kappa, mu) [N/m, 1/m, N/m, -, -], shape (5,).
+    preload
+        The static normal preload N0 [N].
+
+    Returns
+    -------
+    values : np.ndarray
+        (e_f, k_c, e_t, kappa, mu, e_0) [N/m, 1/m, N/m, -, -, N/m], shape (6,).
+    """
     p = np.asarray(params, float)
     return np.append(p, float(stiction_shear_stiffness(preload, p[0], p[1])))
 
@@ -129,10 +215,27 @@ def _scaled(p: np.ndarray) -> np.ndarray:
     return np.where(LOG_SCALE, np.log(np.maximum(np.abs(p), 1e-300)), p)
 
 
-def spread_sd(best: np.ndarray, alternatives, pairs: bool = False) -> np.ndarray:
-    """Model-form sd of each parameter on its scale: the rms change of ``alternatives`` (rows (6,)) from
-    ``best``, or with ``pairs`` (rows in +-pairs along axes) sqrt(sum ((plus - minus) / 2)^2). Zeros without
-    alternatives."""
+def spread_sd(best: np.ndarray, alternatives: Iterable[np.ndarray], pairs: bool = False) -> np.ndarray:
+    """Return the model-form sd of each parameter on its scale (ln for ``LOG_SCALE``, else linear).
+
+    It is the rms change of ``alternatives`` from ``best``, or with ``pairs`` (rows in +-pairs along axes)
+    sqrt(sum ((plus - minus) / 2)^2). Zeros without alternatives.
+
+    Parameters
+    ----------
+    best
+        The best fit, a row of ``NAMES`` [N/m, 1/m, N/m, -, -, N/m], shape (6,) (``bound_products`` gives mu
+        times a [m] and e_0 times a^2 [N m] in their places).
+    alternatives
+        The refits, rows in the units of ``best`` ([N/m, 1/m, N/m, -, -, N/m] for NAMES), each of shape (6,).
+    pairs
+        Whether the rows come in +- pairs along axes (minus first).
+
+    Returns
+    -------
+    sd : np.ndarray
+        The standard deviations on each parameter's scale [-, -, N/m, -, -, -], shape (6,).
+    """
     alt = [np.asarray(a, float) for a in alternatives]
     if not alt:
         return np.zeros(len(NAMES))
@@ -143,9 +246,31 @@ def spread_sd(best: np.ndarray, alternatives, pairs: bool = False) -> np.ndarray
     return np.sqrt(np.mean((z - _scaled(best)) ** 2, axis=0))
 
 
-def widened_interval(profile: np.ndarray, sd: np.ndarray, confidence: float, bounds) -> np.ndarray:
-    """The profile interval (6, 2) widened by z sd on each side (z the normal quantile of ``confidence``) on
-    each parameter's scale, clipped to the search ``bounds`` ((5, 2) of the law; e_0 unclipped)."""
+def widened_interval(
+    profile: np.ndarray, sd: np.ndarray, confidence: float, bounds: Sequence[tuple[float, float]]
+) -> np.ndarray:
+    """Return the profile interval widened by z sd on each side, on each parameter's scale.
+
+    z is the normal quantile of ``confidence``; the ends are clipped to the search ``bounds`` (e_0 unclipped).
+
+    Parameters
+    ----------
+    profile
+        The profile-likelihood intervals [N/m, 1/m, N/m, -, -, N/m], shape (6, 2): lower, upper end
+        (``bound_products``: with the products in the places of mu and e_0).
+    sd
+        The model-form standard deviations on each parameter's scale [-, -, N/m, -, -, -], shape (6,).
+    confidence
+        The confidence level [-] (e.g. 0.95).
+    bounds
+        The law's search bounds (low, high) of e_f, k_c, e_t, kappa, mu [N/m, 1/m, N/m, -, -], five pairs
+        (``FitSettings.bounds``; ``bound_products``: unbounded).
+
+    Returns
+    -------
+    interval : np.ndarray
+        The widened intervals [N/m, 1/m, N/m, -, -, N/m], shape (6, 2).
+    """
     from scipy.stats import norm  # here: scipy.stats takes 0.3 s to import
 
     z = float(norm.ppf(0.5 + confidence / 2.0))
@@ -161,14 +286,40 @@ def bound_products(
     profile: np.ndarray,
     sd_cases: np.ndarray,
     lever_arm: float,
-    structure_fits,
-    structure_arms,
+    structure_fits: Sequence[np.ndarray],
+    structure_arms: Sequence[float],
     confidence: float,
 ) -> dict:
-    """{name: {value, profile, sd_cases, sd_structure, interval, unit}} of PRODUCTS (mu a in m, e_0 a^2 in N m):
-    ``value``/``profile``/``sd_cases`` of NAMES times ``lever_arm`` (m) to the product's power (the load cases share
-    one structure), the structure spread (``spread_sd``) over ``structure_fits`` (rows (6,) in +-pairs) each times
-    its own arm (``structure_arms``, m), the interval widened by ``widened_interval`` (log scale, unbounded)."""
+    """Return what the data bind, the ``PRODUCTS`` mu a and e_0 a^2, with their spreads and intervals.
+
+    ``value``, ``profile`` and ``sd_cases`` of NAMES are taken times ``lever_arm`` to the product's power (the load
+    cases share one structure), the structure spread (``spread_sd``) over ``structure_fits`` each times its own
+    arm, and the interval widened by ``widened_interval`` (log scale, unbounded).
+
+    Parameters
+    ----------
+    value
+        The fitted values [N/m, 1/m, N/m, -, -, N/m], shape (6,).
+    profile
+        The profile-likelihood intervals [N/m, 1/m, N/m, -, -, N/m], shape (6, 2).
+    sd_cases
+        The model-form standard deviations over the load cases [-, -, N/m, -, -, -], shape (6,) (on ln for mu and
+        e_0, so the same for the products).
+    lever_arm
+        The tangential lever arm a of the structure the values were fitted with [m].
+    structure_fits
+        The refits on the posterior structures, rows of ``NAMES`` [N/m, 1/m, N/m, -, -, N/m] of shape (6,), in +- pairs.
+    structure_arms
+        Each posterior structure's lever arm [m], one per row of ``structure_fits``.
+    confidence
+        The confidence level [-] (e.g. 0.95).
+
+    Returns
+    -------
+    products : dict
+        {name: {value, profile, sd_cases, sd_structure, interval, unit}} of PRODUCTS: mu_a in m, e0_a2 in N m, the
+        standard deviations on ln.
+    """
 
     def times_arm(rows, arm):  # NAMES rows with mu times a and e_0 times a^2
         w = np.ones(len(NAMES))
@@ -214,10 +365,39 @@ def _refit(
 
 
 def friction_uncertainty(
-    model: IdentifiedModel, records: Mapping, calibration: str, settings: FitSettings, seed: int, structures=()
+    model: IdentifiedModel,
+    records: Mapping[str, RecordHarmonics],
+    calibration: str,
+    settings: FitSettings,
+    seed: int,
+    structures: Iterable[StructureParameters] = (),
 ) -> FrictionUncertainty:
-    """The friction law of ``model`` (fitted on ``records[calibration]``) with its profile intervals and the
-    model-form spreads over the other load cases in ``records`` and over ``structures`` (see the module)."""
+    """Return the friction law of ``model`` with its profile intervals and its model-form spreads (see the module).
+
+    The law is refitted (polished from ``model``'s law) on ``records[calibration]`` with profile intervals, on each
+    other load case of ``records`` and on the calibration record with each structure of ``structures``.
+
+    Parameters
+    ----------
+    model
+        The identified model whose friction law was fitted on the calibration record.
+    records
+        {case: the record's harmonics}, the calibration case's and the other load cases'.
+    calibration
+        The calibration case's name.
+    settings
+        The friction fit's settings (bounds, confidence, ...).
+    seed
+        The fits' random seed.
+    structures
+        The structures the random test allows (``UpdatingResult.posterior_structures``, in +- pairs); none: no
+        structure spread.
+
+    Returns
+    -------
+    uncertainty : FrictionUncertainty
+        The law's values, intervals and spreads.
+    """
     structures = list(structures)
     quiet = logging.getLogger("contactid.friction_fit")
     level = quiet.level
