@@ -1,7 +1,9 @@
-"""The structure model updating fits: its factors, their priors and its modal predictions. ``FACTORS`` says what each
-factor scales, its prior spread and its further starts, ``apply_factors`` applies them to the nominal structure, and
-``modal_predictions`` gives the natural frequencies and the residue magnitudes of the driving-point accelerance that
-the update compares with the random test's modal fit."""
+"""The structure model updating fits: its factors, their priors and its modal predictions.
+
+``FACTORS`` says what each factor scales, its prior spread and its further starts, ``apply_factors`` applies them to
+the nominal structure, and ``modal_predictions`` gives the natural frequencies and the residue magnitudes of the
+driving-point accelerance that the update compares with the random test's modal fit.
+"""
 
 from __future__ import annotations
 
@@ -17,8 +19,28 @@ from .parameters import StructureParameters
 
 @dataclass(frozen=True)
 class StructuralFactor:
-    """A structural parameter of the updating: its name, what it scales, the prior's relative spread s
-    (of ln theta) and how it changes the structure."""
+    """A structural parameter of the updating: a factor theta on a nominal property of the structure.
+
+    Attributes
+    ----------
+    name
+        The factor's name (its key in ``FACTORS``).
+    description
+        What it scales, in words.
+    prior_sd
+        The prior's relative spread s, the standard deviation of ln theta [-].
+    apply
+        How it changes the structure: the structure and the factor's value (a multiplier of the nominal value [-])
+        to the changed structure.
+    starts
+        Further starts of the MAP fit (values of the factor): a factor whose effect vanishes at its nominal value (a
+        rigid clamp's compliance) has no gradient there, and a fit from the nominal value alone would not move it.
+    max_prior_sd
+        The largest prior spread (of ln theta) gap.model_updating.prior_sd may give it [-].
+    needs_starts
+        Whether the nominal structure needs the further starts (None: always); a finite clamp has a gradient
+        already.
+    """
 
     name: str
     description: str
@@ -39,8 +61,11 @@ def _scale_masses(p: StructureParameters, m: float) -> StructureParameters:
 
 
 def _scale_clamp_compliance(p: StructureParameters, m: float) -> StructureParameters:
-    """The clamp's rotational compliance 1 / k_c times m; a rigid clamp (k_c infinite) is taken as CLAMP_RIGID, and
-    stays rigid at m = 1 (the nominal structure, as every other factor leaves it at 1)."""
+    """Return the structure with the clamp's rotational compliance 1 / k_c times m.
+
+    A rigid clamp (k_c infinite) is taken as CLAMP_RIGID, and stays rigid at m = 1 (the nominal structure, as every
+    other factor leaves it at 1).
+    """
     if m == 1.0:
         return p
     k_c = p.clamp_rotational_stiffness if math.isfinite(p.clamp_rotational_stiffness) else CLAMP_RIGID
@@ -102,15 +127,47 @@ PROFILE_GROUPS = {"transducer_masses": ("transducer_mass_scale", "force_transduc
 
 
 def apply_factors(params: StructureParameters, factors: dict) -> StructureParameters:
-    """The structure with each named factor (multiplier of its nominal value) applied."""
+    """Return the structure with each named factor applied.
+
+    Parameters
+    ----------
+    params
+        The nominal structure.
+    factors
+        {name in ``FACTORS``: the factor, a multiplier of the nominal value [-]}, applied in this order.
+
+    Returns
+    -------
+    structure : StructureParameters
+        The structure with the factors applied.
+    """
     for name, value in factors.items():
         params = FACTORS[name].apply(params, float(value))
     return params
 
 
 def modal_predictions(params: StructureParameters, n_modes: int) -> tuple[np.ndarray, np.ndarray]:
-    """Natural frequencies (Hz) of the first ``n_modes`` structural modes and the residue magnitudes
-    |phi_i(x_s) phi_i(x_d)| / (2 omega_i) (sensor, mode) of the driving-point force's accelerance."""
+    """Return the natural frequencies and the accelerance residue magnitudes of the first structural modes.
+
+    The residues are |phi_i(x_s) phi_i(x_d)| / (2 omega_i) of the driving-point force's accelerance, with the
+    mass-normalised modes phi_i: the magnitudes of the modal fit's LSFD residues (``modal_fit.lsfd_fit``'s
+    convention, H = sum (i w)^2 R / (i w - s) + ..., undamped). A structure with fewer structural modes raises
+    ValueError (``beam_model.structural_modes``).
+
+    Parameters
+    ----------
+    params
+        The structure.
+    n_modes
+        How many structural modes, lowest first.
+
+    Returns
+    -------
+    frequencies : np.ndarray
+        Natural frequencies [Hz], shape (n_modes,).
+    residues : np.ndarray
+        Residue magnitudes [s/kg] (m/N times rad/s), shape (n_sensors, n_modes), n_sensors the accelerometers.
+    """
     model = assemble(params)
     modes = structural_modes(model, n_modes)
     phi_s = model.sensor_vectors @ modes.shapes

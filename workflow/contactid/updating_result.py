@@ -1,6 +1,9 @@
-"""The result of model updating, ``UpdatingResult``, and its summary. The factors, k_t and k_n, the updated structure,
-the misfits and the verdict, the identifiability of each parameter, the proposal the records may accept, the structures
-the linearised posterior allows, and the summary written to model_updating.json (and read back from it)."""
+"""The result of model updating, ``UpdatingResult``, and its summary.
+
+The factors, k_t and k_n, the updated structure, the misfits and the verdict, the identifiability of each parameter,
+the proposal the records may accept, the structures the linearised posterior allows, and the summary written to
+model_updating.json (and read back from it).
+"""
 
 from __future__ import annotations
 
@@ -16,10 +19,69 @@ from .updating_model import apply_factors, modal_predictions
 
 @dataclass
 class UpdatingResult:
-    """The update: the factors (name -> multiplier of the nominal value), k_t, k_n (N/m), the updated
-    structure, the data misfit chi^2 before (nominal structure, k_t and k_n refitted) and after, whether the
-    update is accepted, and per parameter its posterior sd over prior sd, whether the data bound it, and the
-    parameter it correlates with most (with the correlation)."""
+    """The update of the structure from the random test's modal fit (``contactid.updating.update_structure``).
+
+    Attributes
+    ----------
+    factors
+        {factor name (``updating_model.FACTORS``): multiplier of its nominal value [-]}.
+    k_t
+        The tangential contact stiffness of Eq. 13 [N/m].
+    k_n
+        The normal contact stiffness of Eq. 13 [N/m].
+    structure
+        The updated structure (the nominal one with these factors, k_t and k_n).
+    chi2_nominal
+        The data misfit chi^2 of the nominal structure, k_t and k_n refitted [-].
+    chi2_updated
+        The data misfit chi^2 after the update [-].
+    accepted
+        Whether the update is accepted (see ``accepted_by``).
+    identifiability
+        Per parameter (k_t, k_n and each factor): its posterior sd and prior sd (of its ln) and their ratio, whether
+        the data bound it, the parameter it correlates with most (with the correlation); for each factor the posterior
+        misfit's rise when it is held at nominal (its profile), alone and with its ``PROFILE_GROUPS`` group.
+    model_frequencies_hz
+        The updated structure's natural frequencies [Hz], shape (n_modes,), the identified modes compared; None
+        where not kept (a result read back from its summary).
+    n_data
+        The number of data the misfit counts (frequencies and residues).
+    covariance
+        The linearised posterior covariance of (ln k_t, ln k_n, ln factors), a nested list of shape
+        (2 + n_factors, 2 + n_factors); None where not computed.
+    nominal
+        The structure the factors multiply; None where not given.
+    proposal
+        The update the chi^2 test did not accept: {"factors", "k_t", "k_n"} (None when accepted).
+    accepted_by
+        What accepted it: "random_test" (the chi^2 test), "records" (the dual-sine records' held-out gap), ""
+        (nothing).
+    records_test
+        The records' test of the proposal (when run): held-out gaps, scatter, the drift where they drift.
+    chi2_threshold
+        The drop of chi^2 the random test needed (``chi2_drop_threshold``) [-]; NaN where unknown, inf where no drop
+        is significant.
+    effective_factors
+        The sum of the drop's null weights, the number of factors the data bind [-] (``null_drop_weights``; 5 bound
+        factors: 5 and chi^2_5(0.95) = 11.07).
+    channel_gains
+        Each accelerometer channel's sensitivity factor on its residues relative to the others' (their logs sum to
+        zero), fitted with k_t and k_n as the measurement chain's; empty when update_structure's gain_sd is 0:
+        reported, the structure is not multiplied by them.
+    channel_gain_sd
+        The posterior sd of each channel gain's ln.
+    channel_gains_significant
+        Whether the gains lowered the nominal structure's chi^2 significantly (and so took part in the update's
+        fit).
+    structure_alone
+        Where the gains took part: the same update without them (its ``summary``), with ``gains_drop`` (its chi^2
+        less this update's), ``gains_threshold`` (chi^2_(j-1)(confidence)) and ``gains_needed`` (the drop above it:
+        the residues call for the gains beyond what the structure's factors give); None where the gains took no
+        part.
+    gains_versus_structure
+        Where the random test could not tell the gains from the structure: the dual-sine records' test that chose
+        (``gap.evidence.records_test_of_gains``: both held-out gaps, the records' scatter, ``gains_preferred``).
+    """
 
     factors: dict
     k_t: float
@@ -60,8 +122,20 @@ class UpdatingResult:
 
     @classmethod
     def from_summary(cls, summary: dict, params: StructureParameters) -> "UpdatingResult":
-        """The result written by ``summary`` (model_updating.json), with the structure rebuilt from ``params``
-        (the configured structure) by the same factors, k_t and k_n."""
+        """Return the result written by ``summary``, with the structure rebuilt by the same factors, k_t and k_n.
+
+        Parameters
+        ----------
+        summary
+            The result's ``summary`` (model_updating.json's content).
+        params
+            The configured (nominal) structure the factors multiply.
+
+        Returns
+        -------
+        result : UpdatingResult
+            The result, without ``model_frequencies_hz``.
+        """
         p = apply_factors(params.with_contact(float(summary["k_t"]), float(summary["k_n"])), summary["factors"])
         return cls(
             dict(summary["factors"]),
@@ -89,10 +163,22 @@ class UpdatingResult:
         )
 
     def without_gains(self) -> "UpdatingResult":
-        """The update made without the channel gains (``structure_alone``), the gains still reported (as the nominal
-        structure's residues show them) but not significant: the random test cannot tell them from the structure's
-        factors (``gains_needed`` false) and the dual-sine records did not call for them
-        (``gap.pipeline.updated_model``)."""
+        """Return the update made without the channel gains (``structure_alone``).
+
+        The gains are still reported (as the nominal structure's residues show them) but not significant: the random
+        test cannot tell them from the structure's factors (``gains_needed`` false) and the dual-sine records did not
+        call for them (``gap.pipeline.updated_model``).
+
+        Returns
+        -------
+        result : UpdatingResult
+            The update without the gains.
+
+        Raises
+        ------
+        ValueError
+            When the gains took no part in the update (no ``structure_alone``) or the nominal structure is unknown.
+        """
         if self.structure_alone is None or self.nominal is None:
             raise ValueError("model updating: no update without the channel gains (the gains took no part in it)")
         return dataclasses.replace(
@@ -104,16 +190,39 @@ class UpdatingResult:
         )
 
     def proposed_structure(self) -> StructureParameters:
-        """The structure of the ``proposal``: the nominal structure with its k_t, k_n and factors."""
+        """Return the structure of the ``proposal``: the nominal structure with its k_t, k_n and factors.
+
+        Returns
+        -------
+        structure : StructureParameters
+            The proposed structure.
+
+        Raises
+        ------
+        ValueError
+            When there is no proposal (the update was accepted or never computed) or the nominal structure is unknown.
+        """
         if self.proposal is None or self.nominal is None:
             raise ValueError("model updating: no proposal to accept (the update was accepted or never computed)")
         p = self.proposal
         return apply_factors(self.nominal.with_contact(float(p["k_t"]), float(p["k_n"])), p["factors"])
 
     def accept_proposal(self, records_test: dict) -> "UpdatingResult":
-        """This result with its ``proposal`` accepted by the dual-sine records (``records_test``: what they showed,
-        kept for the audit): the proposal's factors, k_t, k_n and structure; the identifiability (with each factor's
-        profile) is already the proposal's."""
+        """Return this result with its ``proposal`` accepted by the dual-sine records.
+
+        The result takes the proposal's factors, k_t, k_n and structure; the identifiability (with each factor's
+        profile) is already the proposal's. Without a proposal, ``proposed_structure`` raises ValueError.
+
+        Parameters
+        ----------
+        records_test
+            What the dual-sine records showed (``gap.evidence.records_test_of_update``), kept for the audit.
+
+        Returns
+        -------
+        result : UpdatingResult
+            The accepted update (``accepted_by`` "records").
+        """
         structure = self.proposed_structure()
         factors = {k: float(v) for k, v in self.proposal["factors"].items()}
         k_t, k_n = float(self.proposal["k_t"]), float(self.proposal["k_n"])
@@ -133,10 +242,18 @@ class UpdatingResult:
         )
 
     def posterior_structures(self) -> list:
-        """The structures the random test allows: the update moved by +-1 standard deviation along each principal
-        axis of the linearised posterior of (ln k_t, ln k_n, ln factors), for observability tests (one parameter
-        at a time would leave the data's valley: E alone by its marginal sd moves the frequencies far more
-        than the data allow)."""
+        """Return the structures the random test allows.
+
+        They are the update moved by +-1 standard deviation along each principal axis of the linearised posterior
+        of (ln k_t, ln k_n, ln factors), for observability tests (one parameter at a time would leave the data's
+        valley: E alone by its marginal sd moves the frequencies far more than the data allow).
+
+        Returns
+        -------
+        structures : list
+            StructureParameters in +- pairs, minus first, two per axis (2 (2 + n_factors) of them); empty without a
+            covariance or a nominal structure.
+        """
         if self.covariance is None or self.nominal is None:
             return []
         cov = np.asarray(self.covariance, float)
@@ -156,7 +273,14 @@ class UpdatingResult:
         return out
 
     def summary(self) -> dict:
-        """The update as written to model_updating.json (read back by :meth:`from_summary`)."""
+        """Return the update as written to model_updating.json (read back by :meth:`from_summary`).
+
+        Returns
+        -------
+        summary : dict
+            JSON-ready fields of the result (not the structures nor the model frequencies); ``chi2_threshold`` None
+            where it is infinite.
+        """
         return {
             "accepted": self.accepted,
             "factors": dict(self.factors),
@@ -181,5 +305,8 @@ class UpdatingResult:
 
 
 def _threshold(value) -> float:
-    """chi2_threshold as model_updating.json keeps it: null for inf (no drop significant), missing in older files."""
+    """Return chi2_threshold as model_updating.json keeps it.
+
+    Null stands for inf (no drop significant); the key is missing in older files (NaN).
+    """
     return math.inf if value is None else float(value)

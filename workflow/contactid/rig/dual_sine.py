@@ -8,7 +8,7 @@ f = k fs / n_samples with k integer, so that the record holds exactly k periods
 from __future__ import annotations
 
 import logging
-from typing import Mapping
+from typing import Mapping, Sequence
 
 import numpy as np
 import xarray as xr
@@ -45,8 +45,28 @@ CONTROL_FIELDS = (
 
 
 def dual_sine_settings(rig_cfg: Mapping, case_cfg: Mapping, sampling_rate_hz: float) -> dict:
-    """Merged settings of one load case: rig.dual_sine (at the schema's defaults where left out), overridden per
-    case."""
+    """Return the merged settings of one load case's dual-sine test.
+
+    They are rig.dual_sine (at the schema's defaults where left out), overridden per case, with the excitation
+    frequency snapped to the record's frequency grid f = k fs / record_samples (k whole periods in the record).
+
+    Parameters
+    ----------
+    rig_cfg
+        The config's ``rig`` section; its ``dual_sine`` block is read (excitation_frequency_hz, record_samples,
+        n_modes, oversampling, control_tolerance, steady_state_tolerance).
+    case_cfg
+        The load case's block (``load_cases.<case>``); its ``excitation_frequency_hz``, where given, overrides the
+        rig's.
+    sampling_rate_hz
+        The record's sampling rate [Hz].
+
+    Returns
+    -------
+    settings : dict
+        The rig.dual_sine keys with ``excitation_frequency_hz`` snapped to the grid (Hz), and ``periods`` (k, the
+        whole periods in the record) and ``sampling_rate_hz`` (Hz) added.
+    """
     from ..schema import schema_defaults
 
     s = {**schema_defaults("rig", "dual_sine"), **(rig_cfg.get("dual_sine") or {})}
@@ -61,8 +81,24 @@ def dual_sine_settings(rig_cfg: Mapping, case_cfg: Mapping, sampling_rate_hz: fl
 
 
 def contact_parameters(structure_cfg: Mapping, rig_cfg: Mapping) -> ContactParameters:
-    """The rig's true contact laws with the configured effects (keys of ``rig.truth`` left out: the schema's
-    defaults, for a config not validated by the Snakefile)."""
+    """Return the rig's true contact laws with the configured effects.
+
+    Keys of ``rig.truth`` left out take the schema's defaults, for a config not validated by the Snakefile.
+
+    Parameters
+    ----------
+    structure_cfg
+        The config's ``structure`` section (its ``preload_n``, with ``rig.true_structure`` merged in).
+    rig_cfg
+        The config's ``rig`` section: ``truth.friction`` (the law's parameters and ``regularization``),
+        ``truth.normal`` (``stiffness_at_preload_n_per_m``, ``exponent``, ``cubic_n_per_m3``), ``true_structure``
+        and ``effects`` are read.
+
+    Returns
+    -------
+    contact : ContactParameters
+        The true friction and normal laws, the preload and the contact effects' magnitudes.
+    """
     from ..schema import with_defaults
 
     truth = with_defaults({"rig": {"truth": rig_cfg["truth"]}})["rig"]["truth"]
@@ -85,9 +121,25 @@ def contact_parameters(structure_cfg: Mapping, rig_cfg: Mapping) -> ContactParam
 
 
 def normal_tangent_ratio(contact: ContactParameters, k_n: float, load: float) -> float:
-    """The normal law's tangent stiffness where the compression reaches ``load`` x N0, over k_n (>= 1): the
-    integrator's law and the harmonic balance's tangent of it (``normal_path``), at the compression found by
-    ``brentq``."""
+    """Return the normal law's tangent stiffness where the compression reaches ``load`` x N0, over k_n.
+
+    The law is the integrator's and the tangent the harmonic balance's (``normal_path``), at the compression found by
+    ``brentq``.
+
+    Parameters
+    ----------
+    contact
+        The rig's contact laws (preload N0, the normal law's static approach, exponent and cubic hardening).
+    k_n
+        The reduced model's linear normal contact stiffness [N/m].
+    load
+        The total normal force where the tangent is taken, a multiple of the preload N0 [-].
+
+    Returns
+    -------
+    ratio : float
+        The tangent stiffness over ``k_n`` [-], at least 1.
+    """
     from scipy.optimize import brentq
 
     from .harmonic_balance import normal_path
@@ -115,7 +167,31 @@ def build_simulator(
     n_modes: int | None = None,
     oversampling: int | None = None,
 ) -> DualSineSimulator:
-    """The rig's reduced model and integrator for the dual-sine tests."""
+    """Return the rig's reduced model and integrator for the dual-sine tests.
+
+    The oversampling is raised where explicit central differences need it (``stable_oversampling``: a margin on
+    omega_max dt and on the viscous friction's rate), with a hardening normal law's tangent where N reaches 3 N0.
+
+    Parameters
+    ----------
+    structure_cfg
+        The config's ``structure`` section.
+    rig_cfg
+        The config's ``rig`` section (its ``true_structure``, ``fe_elements``, ``truth``, ``true_damping`` and
+        ``effects`` are read).
+    settings
+        The test's settings (``dual_sine_settings``): ``n_modes``, ``oversampling`` and ``sampling_rate_hz`` are
+        read.
+    n_modes
+        Modes of the reduced model (None: the settings').
+    oversampling
+        Integration steps per sample before the stability margin (None: the settings').
+
+    Returns
+    -------
+    simulator : DualSineSimulator
+        The integrator, its ``oversampling`` the steps per sample it uses.
+    """
     params = rig_structure(structure_cfg, rig_cfg)
     model = assemble(params)
     red = reduced_model(model, int(n_modes or settings["n_modes"]))
@@ -134,8 +210,23 @@ def build_simulator(
 
 
 def energy_balance(out: dict, sim: DualSineSimulator) -> dict:
-    """Energies over the recorded (integer-period) window (J): input work, modal
-    damping, friction and normal-contact dissipation, and the relative residual."""
+    """Return the energies over the recorded (integer-period) window and the balance's relative residual.
+
+    Parameters
+    ----------
+    out
+        The simulated signals over the window at the integration rate (``DualSineSimulator.run``'s): the force
+        ``f`` (N), the modal velocities ``v``, the friction force ``S`` (N) and slip rate ``dxi`` (m/s), the normal
+        force ``N`` (N) and the normal rate ``deta`` (m/s).
+    sim
+        The simulator that ran them (its step, damping ratios, reduced model and preload are read).
+
+    Returns
+    -------
+    energies : dict
+        ``input_work_j``, ``damping_work_j`` (modal damping), ``friction_work_j``, ``normal_work_j`` (normal-contact
+        dissipation), all in J, and ``energy_residual``, (input - dissipated) / input.
+    """
     dt = sim.dt
     r = sim.red
     v_drive = out["v"] @ r.drive
@@ -155,14 +246,16 @@ def energy_balance(out: dict, sim: DualSineSimulator) -> dict:
 
 
 def _response_targets(case_cfg: Mapping, eff: Mapping) -> tuple[float, float]:
-    """The driving-point targets (A1, A3) of the load case (m/s^2), scaled by the contact-separation effect."""
+    """Return the driving-point targets (A1, A3) of the load case (m/s^2), scaled by the contact separation."""
     scale = eff["contact_separation"] or 1.0
     return (scale * float(case_cfg["A1_m_per_s2"]), scale * float(case_cfg["A2_m_per_s2"]))
 
 
 def _log_control_outcome(case: str, ctl: ControlResult, target: tuple, n_samples: int) -> None:
-    """Log whether the response control converged: a warning with the last force (N) and response (m/s^2) when
-    it did not."""
+    """Log whether the response control converged.
+
+    A warning with the last force (N) and response (m/s^2) where it did not.
+    """
     if not ctl.converged:
         F1, F3, A1, A3, steady = ctl.history[-1]
         log.warning(
@@ -185,9 +278,11 @@ def _log_control_outcome(case: str, ctl: ControlResult, target: tuple, n_samples
 
 
 def _recorded_response(sim: DualSineSimulator, ctl: ControlResult, w: float, n_samples: int) -> tuple[dict, int, int]:
-    """The simulated response at the controlled force (``run``'s dict at the integration rate): the record of
-    ``n_samples`` samples with a margin of 512 samples either side for the anti-alias filter; a preload drift (effect)
-    runs over the record. Returns (signals, steps of the record, steps of one margin)."""
+    """Return the simulated response at the controlled force (``run``'s dict at the integration rate).
+
+    It covers the record of ``n_samples`` samples with a margin of 512 samples either side for the anti-alias filter;
+    a preload drift (effect) runs over the record. Returns (signals, steps of the record, steps of one margin).
+    """
     q = sim.oversampling
     n_rec = n_samples * q
     margin = 64 * q * 8
@@ -208,9 +303,12 @@ def _measured_record(
     noise_fraction: float,
     rng: np.random.Generator,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """The force (N) and accelerations (m/s^2, (sensors, samples)) as the front end records them: channel delays
-    and sensitivity errors if those effects are on, anti-alias filtering and decimation to the sampling rate over
-    the record, and sensor noise (``noise_fraction`` of each channel's rms, from ``rng``)."""
+    """Return the force (N) and accelerations (m/s^2, (sensors, samples)) as the front end records them.
+
+    The front end applies channel delays and sensitivity errors if those effects are on, anti-alias filtering and
+    decimation to the sampling rate over the record, and sensor noise (``noise_fraction`` of each channel's rms, from
+    ``rng``).
+    """
     q = sim.oversampling
     acc_sim = out["a"] @ sim.red.sensors.T  # (n, sensors)
     acc_sim = acc_sim.T
@@ -228,8 +326,11 @@ def _measured_record(
 
 
 def _stationarity_changes(rec: dict, sim: DualSineSimulator, w: float, n_rec: int) -> tuple[float, float]:
-    """Stationarity of the recorded window: the relative change of the driving-point harmonics |A1| and |A3| from
-    the first to the last third of the record."""
+    """Return the stationarity of the recorded window.
+
+    It is the relative change of the driving-point harmonics |A1| and |A3| from the first to the last third of the
+    record.
+    """
     drive = rec["a"] @ sim.red.drive
     third = n_rec // 3
     h_first = np.abs(harmonic_amplitudes(drive[:third], rec["t"][:third], w, (1, 3)))
@@ -238,9 +339,12 @@ def _stationarity_changes(rec: dict, sim: DualSineSimulator, w: float, n_rec: in
 
 
 def _truth_variables(rec: dict, sim: DualSineSimulator, ctl: ControlResult, sub: slice) -> dict:
-    """The truth's data variables: the contact forces and motions, the force and accelerations without front end
-    or noise and the reduced coordinates at the sampling rate (``sub`` of the record), the reduced basis'
-    frequencies and the control and steady-state histories."""
+    """Return the truth's data variables.
+
+    They are the contact forces and motions, the force and accelerations without front end or noise and the reduced
+    coordinates at the sampling rate (``sub`` of the record), the reduced basis' frequencies and the control and
+    steady-state histories.
+    """
     red = sim.red
     hist = np.array(ctl.history, dtype=float)
     return {
@@ -289,9 +393,12 @@ def _truth_variables(rec: dict, sim: DualSineSimulator, ctl: ControlResult, sub:
 def _truth_attrs(
     ctl: ControlResult, target: tuple, s: Mapping, eff: Mapping, sim: DualSineSimulator, stationarity, energy
 ) -> dict:
-    """The truth's attributes: the controlled force amplitudes (N) and response (m/s^2) with their targets, the
-    stationarity changes (``stationarity``: A1, A3), the effects, the true contact laws, the linear contact springs
-    (N/m), the energy balance (J) and the test's settings ``s``."""
+    """Return the truth's attributes.
+
+    They are the controlled force amplitudes (N) and response (m/s^2) with their targets, the stationarity changes
+    (``stationarity``: A1, A3), the effects, the true contact laws, the linear contact springs (N/m), the energy
+    balance (J) and the test's settings ``s``.
+    """
     c = sim.contact
     return {
         "F1_n": ctl.F1,
@@ -327,14 +434,42 @@ def dual_sine_test(
     noise_fraction: float,
     seed: int,
     case: str,
-    sensor_names,
+    sensor_names: Sequence[str],
 ) -> tuple[xr.Dataset, xr.Dataset]:
     """Run the response-controlled dual-sine test of one load case.
 
-    Returns (raw, truth). The raw record holds force and accelerations only (with
-    anti-alias filtering, channel delays if that effect is on, and sensor noise);
-    the truth holds S, N, xi, eta, the reduced coordinates, the force amplitudes,
-    the control and steady-state histories and the energy balance.
+    The force amplitudes F1, F3 at w and 3 w are tuned until the driving point's harmonics reach the load case's
+    targets (``control_response``), then the record is simulated and passed through the front end.
+
+    Parameters
+    ----------
+    structure_cfg
+        The config's ``structure`` section (its ``sensors.positions_m`` name the record's sensor positions).
+    rig_cfg
+        The config's ``rig`` section (``dual_sine``, ``truth``, ``true_structure``, ``true_damping``, ``effects``,
+        ...).
+    case_cfg
+        The load case's block: ``A1_m_per_s2``, ``A2_m_per_s2`` (the targets at w and 3 w, m/s^2) and optionally
+        ``excitation_frequency_hz``.
+    sampling_rate_hz
+        The record's sampling rate [Hz].
+    noise_fraction
+        The sensor noise's rms, a fraction of each channel's rms [-].
+    seed
+        The random seed (the noise's stream is ``<case>/noise``).
+    case
+        The load case's name.
+    sensor_names
+        The accelerometers' names, one per sensor.
+
+    Returns
+    -------
+    raw : xr.Dataset
+        The raw record: force and accelerations only (with anti-alias filtering, channel delays and sensitivity
+        errors if those effects are on, and sensor noise).
+    truth : xr.Dataset
+        S, N, xi, eta, the reduced coordinates, the force amplitudes, the control and steady-state histories and
+        the energy balance.
     """
     s = dual_sine_settings(rig_cfg, case_cfg, sampling_rate_hz)
     eff = effect_magnitudes(rig_cfg.get("effects"))
