@@ -1,7 +1,7 @@
-"""Checks of the configuration that a JSON schema cannot express.
+"""Check the configuration for what a JSON schema cannot express.
 
-Each failure names the key, the value, the allowed range and the fix; the
-Snakefile calls :func:`check_config` before any rule runs.
+Each failure names the key, the value, the allowed range and the fix; the Snakefile calls :func:`check_config` before
+any rule runs.
 """
 
 from __future__ import annotations
@@ -14,8 +14,21 @@ from .schema import ConfigError, with_defaults
 
 
 def duplicate_key_errors(path: str | os.PathLike) -> list[str]:
-    """Every key a YAML mapping of the file at ``path`` gives twice (YAML readers keep the last silently: a second
-    ``lc2:`` would replace the first load case), as "file:line: key 'k' (under a.b) repeats line m"."""
+    """Return every key that a YAML mapping of the file at ``path`` gives twice.
+
+    YAML readers keep the last silently: a second ``lc2:`` would replace the first load case. Each error reads
+    "file:line: key 'k' repeats line m (YAML keeps the last silently); remove or rename one".
+
+    Parameters
+    ----------
+    path
+        The YAML file to read (a config file).
+
+    Returns
+    -------
+    errors : list[str]
+        One message per repeated key; empty when no key repeats.
+    """
     import yaml
 
     errors = []
@@ -50,8 +63,11 @@ def duplicate_key_errors(path: str | os.PathLike) -> list[str]:
 
 
 def _true_structure_errors(structure: Mapping, changes: Mapping, path: str = "rig.true_structure") -> list:
-    """rig.true_structure may hold any subset of the ``structure`` keys, each of the same kind (a number, a
-    list of as many numbers, or a block); anything else is named with its fix."""
+    """Return the errors of rig.true_structure against the ``structure`` keys.
+
+    rig.true_structure may hold any subset of the ``structure`` keys, each of the same kind (a number, a list of as many
+    numbers, or a block); anything else is named with its fix.
+    """
     errors = []
     for key, value in changes.items():
         where = f"{path}.{key}"
@@ -90,7 +106,10 @@ def _true_structure_errors(structure: Mapping, changes: Mapping, path: str = "ri
 
 
 def _sensor_errors(st: Mapping) -> list:
-    """The sensors' lists of one length, and the sensors and the excitation on the beam (0, L] (m)."""
+    """Return the errors of the sensors' lists and positions.
+
+    The sensors' lists are of one length, and the sensors and the excitation lie on the beam (0, L] (m).
+    """
     errors = []
     L = st["beam"]["length_m"]
     sens = st["sensors"]
@@ -116,7 +135,7 @@ def _sensor_errors(st: Mapping) -> list:
 
 
 def _mode_count_errors(cfg: Mapping) -> list:
-    """No more modes than sensors in modal and linear_modes (Eq. 15)."""
+    """Return an error for each of modal and linear_modes with more modes than sensors (Eq. 15)."""
     errors = []
     n_sens = len(cfg["structure"]["sensors"]["positions_m"])
     for block in ("modal", "linear_modes"):
@@ -130,8 +149,11 @@ def _mode_count_errors(cfg: Mapping) -> list:
 
 
 def _random_test_errors(cfg: Mapping) -> list:
-    """The random test: a measured record's file, its band (Hz) below the anti-alias limit, the modal band inside it,
-    and a rig record long enough for the FRF segments of every uncertainty block."""
+    """Return the errors of the random test's settings.
+
+    The random test needs: a measured record's file, its band (Hz) below the anti-alias limit, the modal band inside it,
+    and a rig record long enough for the FRF segments of every uncertainty block.
+    """
     errors = []
     rt = cfg["random_test"]
     if rt["source"] == "measured" and not rt.get("file"):
@@ -165,7 +187,7 @@ def _random_test_errors(cfg: Mapping) -> list:
 
 
 def _stiction_bound_errors(cfg: Mapping) -> list:
-    """The stiffness search bounds (N/m) of the stiction fit, where given, with low < high."""
+    """Return the errors of the stiction fit's stiffness search bounds (N/m), where given: low < high."""
     errors = []
     for name in ("k_t_bounds_n_per_m", "k_n_bounds_n_per_m"):
         b = cfg["stiction"].get(name)
@@ -175,7 +197,10 @@ def _stiction_bound_errors(cfg: Mapping) -> list:
 
 
 def _load_case_errors(cfg: Mapping) -> list:
-    """A measured load case names its file; a rig load case its target amplitudes A1, A2 (m/s^2, Table 2)."""
+    """Return the errors of the load cases' sources.
+
+    A measured load case names its file; a rig load case its target amplitudes A1, A2 (m/s^2, Table 2).
+    """
     errors = []
     for case, lc in (cfg.get("load_cases") or {}).items():
         if lc.get("source", "rig") == "measured":
@@ -192,9 +217,11 @@ def _load_case_errors(cfg: Mapping) -> list:
 
 
 def _case_reference_errors(cfg: Mapping) -> list:
-    """nonlinear.calibration_case and nonlinear.figure_case name load cases; gap.candidates name the library's
-    candidates (the built-in ones; where gap.plugins add their own, their names are checked when the rule imports
-    them)."""
+    """Return the errors of the names that refer to load cases and candidates.
+
+    nonlinear.calibration_case and nonlinear.figure_case name load cases; gap.candidates name the library's candidates
+    (the built-in ones; where gap.plugins add their own, their names are checked when the rule imports them).
+    """
     errors = []
     cases = sorted(cfg.get("load_cases") or {})
     for key in ("calibration_case", "figure_case"):
@@ -215,9 +242,12 @@ def _case_reference_errors(cfg: Mapping) -> list:
 
 
 def _record_format_errors(cfg: Mapping) -> list:
-    """A measured record in another format than netCDF has a complete channel map (``importers.record_spec``, for
-    measured FRFs ``importers.frf_uff.frf_sensor_map``); a format other than netCDF is for measured records only,
-    and FRFs (uff58_frf) are for the random test only."""
+    """Return the errors of the measured records' formats.
+
+    A measured record in another format than netCDF has a complete channel map (``importers.record_spec``, for measured
+    FRFs ``importers.frf_uff.frf_sensor_map``); a format other than netCDF is for measured records only, and FRFs
+    (uff58_frf) are for the random test only.
+    """
     errors = []
     for where, block in record_blocks(cfg):
         fmt = block.get("format", "netcdf")
@@ -239,7 +269,10 @@ def _record_format_errors(cfg: Mapping) -> list:
 
 
 def _check_channel_map(block: Mapping, where: str, fmt: str, structure: Mapping) -> None:
-    """The channel map (and a CSV's sidecar) of a measured record is complete and consistent; raises RawDataError."""
+    """Check the channel map (and a CSV's sidecar) of a measured record.
+
+    The map must be complete and consistent; raises RawDataError otherwise.
+    """
     if fmt == "uff58_frf":
         from .importers.frf_uff import frf_sensor_map
 
@@ -251,7 +284,11 @@ def _check_channel_map(block: Mapping, where: str, fmt: str, structure: Mapping)
 
 
 def _rig_errors(cfg: Mapping) -> list:
-    """The virtual rig's true structure (``_true_structure_errors``) and effects (``rig.effects.effect_magnitudes``)."""
+    """Return the errors of the virtual rig's settings.
+
+    They are those of its true structure (``_true_structure_errors``) and of its effects
+    (``rig.effects.effect_magnitudes``).
+    """
     errors = _true_structure_errors(cfg["structure"], (cfg.get("rig") or {}).get("true_structure") or {})
     try:
         from .rig.effects import effect_magnitudes
@@ -263,9 +300,31 @@ def _rig_errors(cfg: Mapping) -> list:
 
 
 def check_config(cfg: Mapping, source: str = "config/config.yaml", root: str | os.PathLike | None = ".") -> None:
-    """Raise :class:`ConfigError` on cross-field inconsistencies of ``cfg`` (its left-out keys at the schema's
-    defaults, ``with_defaults``) and, with ``root`` (the project directory relative paths are taken from; None:
-    not looked at), on measured files that do not exist or that two records share (``measured_files``)."""
+    """Raise ConfigError on cross-field inconsistencies of a configuration.
+
+    ``cfg`` is taken with its left-out keys at the schema's defaults (``with_defaults``). With ``root`` (the project
+    directory relative paths are taken from; None: not looked at), measured files that do not exist or that two records
+    share (``measured_files``) are errors too. Every error is collected before the one exception is raised.
+
+    Parameters
+    ----------
+    cfg
+        The whole configuration (config/config.yaml read as a mapping). Read: ``structure`` (sensors' names, positions
+        and masses, beam.length_m, excitation_position_m), ``modal`` (n_modes, band_hz, uncertainty_blocks),
+        ``linear_modes.n_modes``, ``random_test`` (source, file, sampling_rate_hz, band_hz, duration_s),
+        ``frf.segment_length``, ``stiction`` (k_t_bounds_n_per_m, k_n_bounds_n_per_m), ``load_cases`` (source, file,
+        A1_m_per_s2, A2_m_per_s2), the measured records' format and channel maps, ``nonlinear`` (calibration_case,
+        figure_case), ``gap`` (candidates, plugins) and ``rig`` (true_structure, effects).
+    source
+        The name the message gives the configuration (its file).
+    root
+        The project directory measured files' relative paths are taken from; None: the files are not looked at.
+
+    Raises
+    ------
+    ConfigError
+        When any check fails; the message lists every failure, each with its key, value, allowed range and fix.
+    """
     from .measured_files import missing_file_errors, shared_file_errors
 
     cfg = with_defaults(cfg)

@@ -1,7 +1,7 @@
-"""Fit of the modified Valanis law (Eqs. 21-22) to identified contact forces (Section 5, Table 4):
-a seeded DEAP genetic algorithm over (e_f, k_c, e_t, kappa, mu), a local least-squares polish,
-grid refinement until the fit no longer moves, and profile-likelihood intervals that mark
-parameters the data only bound.
+"""Fit the modified Valanis law (Eqs. 21-22) to identified contact forces (Section 5, Table 4).
+
+A seeded DEAP genetic algorithm over (e_f, k_c, e_t, kappa, mu), a local least-squares polish, grid refinement until the
+fit no longer moves, and profile-likelihood intervals that mark parameters the data only bound.
 
 The datasets of the rule scripts (the fit's and the validation's) are in ``contactid.friction_datasets``.
 """
@@ -11,6 +11,7 @@ from __future__ import annotations
 import logging
 import random
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, Mapping, Sequence
 
 import numba
 import numpy as np
@@ -20,6 +21,9 @@ from .friction import PARAMETER_NAMES, valanis_friction_force
 from .harmonics import periodic_grid
 from .random_streams import generator
 
+if TYPE_CHECKING:
+    from scipy.optimize import OptimizeResult
+
 log = logging.getLogger(__name__)
 
 LOG_SCALED = (True, True, False, False, False)  # e_f, k_c on a log scale
@@ -27,12 +31,38 @@ LOG_SCALED = (True, True, False, False, False)  # e_f, k_c on a log scale
 
 @dataclass(frozen=True)
 class FitSettings:
-    """Bounds (5 x (low, high)) in the order e_f (N/m), k_c (1/m), e_t (N/m), kappa, mu;
-    GA population, generations, crossover and mutation probabilities; the first grid size and
-    the largest; the relative parameter change that stops the refinement; the confidence level;
-    the relative rms accuracy assumed for the identified S (a floor on the misfit scale of the
-    profile likelihood, since the identification's own error is not noise); how Eq. 21 is read
-    (``regularization``: ``none`` as printed, or ``slip_limit``; see ``contactid.friction``)."""
+    """Settings of the friction fit.
+
+    The search bounds, the GA's population, generations, crossover and mutation probabilities, the first grid size and
+    the largest, the relative parameter change that stops the refinement, the confidence level, the relative rms
+    accuracy assumed for the identified S (a floor on the misfit scale of the profile likelihood, since the
+    identification's own error is not noise), and how Eq. 21 is read.
+
+    Attributes
+    ----------
+    bounds
+        Search bounds, five (low, high) pairs in the order e_f, k_c, e_t, kappa, mu [N/m, 1/m, N/m, -, -].
+    population
+        GA population (individuals per generation).
+    generations
+        GA generations.
+    crossover
+        Probability that a pair of offspring is crossed [-].
+    mutation
+        Probability that an offspring is mutated [-].
+    grid_points
+        Points per period of the first grid the law is evaluated on.
+    max_grid_points
+        Largest grid the refinement may double to.
+    refine_tolerance
+        Relative change of the parameters (e_f, k_c, kappa, mu) below which the grid refinement stops [-].
+    confidence
+        Confidence level of the profile-likelihood intervals [-].
+    misfit_floor
+        Relative rms accuracy assumed for the identified S, a floor on the profile likelihood's misfit scale [-].
+    regularization
+        How Eq. 21 is read: ``none`` as printed, or ``slip_limit`` (see ``contactid.friction``).
+    """
 
     bounds: tuple = ((1e6, 1e9), (1e4, 1e7), (0.0, 1e6), (0.0, 0.95), (0.05, 1.5))
     population: int = 64
@@ -49,11 +79,37 @@ class FitSettings:
 
 @dataclass
 class FitResult:
-    """The friction fit: params (5,) best-fit e_f (N/m), k_c (1/m), e_t (N/m), kappa, mu; misfit, the NRMSE of S;
-    e_0 at the preload (N/m); the GA logbook (generation, min, mean misfit) and the grid refinement history;
-    intervals (5, 2) profile-likelihood confidence intervals (NaN when not profiled), bounded (5, 2) whether each
-    side closes inside the search bounds, e_0's interval (N/m); correlation (5, 5) of the parameters; the final grid
-    size; the profiles per parameter and the fit's warnings."""
+    """Result of the friction fit.
+
+    Attributes
+    ----------
+    params
+        Best-fit e_f, k_c, e_t, kappa, mu [N/m, 1/m, N/m, -, -], shape (5,).
+    misfit
+        NRMSE of S: the rms residual of the mean-removed S over the rms of the identified S [-].
+    e0_at_preload
+        Shear stiffness at stiction e_0 at the preload (Eq. 22) [N/m].
+    logbook
+        The GA's logbook: (generation, min misfit, mean misfit) per generation, misfits as ``misfit`` [-].
+    grid_history
+        The grid refinement's history: (grid points, e_f, k_c, e_t, kappa, mu, misfit) per grid.
+    intervals
+        Profile-likelihood confidence intervals (low, high) of each parameter [N/m, 1/m, N/m, -, -] by row,
+        shape (5, 2); NaN when not profiled.
+    bounded
+        Whether each side of each interval closes inside the search bounds (True where the data bound it) [-],
+        shape (5, 2).
+    e0_interval
+        Range (low, high) of e_0 at the preload over the profile points inside the intervals and the optimum [N/m].
+    correlation
+        Correlation of the parameters from the polish's Jacobian [-], shape (5, 5); NaN for the insensitive ones.
+    grid_points
+        Size of the final grid (points per period).
+    profiles
+        The profiles per parameter: {name: rows of (value in the parameter's unit, SSR)}.
+    warnings
+        The fit's warnings (parameters at a search bound).
+    """
 
     params: np.ndarray
     misfit: float
@@ -73,10 +129,36 @@ N_OPEN = 1.0e-3  # N: where the identified normal force is lower, the contact is
 
 
 class FitProblem:
-    """The friction fit's least-squares problem: the identified xi, N and S, the parameters' bounds and the
-    regularization."""
+    """Least-squares problem of the friction fit.
 
-    def __init__(self, xi, normal_force, S, bounds, regularization="none"):
+    The identified xi, N and S on a grid of one period, the parameters' bounds and the regularization. The parameters
+    are searched in the unit cube: e_f and k_c on a log scale (``LOG_SCALED``), the others linearly. Where the
+    identified N falls below ``N_OPEN`` the contact opens and carries no friction: the law is evaluated there with a
+    vanishing normal force (the kernel refuses N <= 0). The identified S is taken with its mean removed, and the
+    residuals are relative to its rms (``scale``).
+
+    Parameters
+    ----------
+    xi
+        Tangential contact motion over one period [m], shape (n_samples,).
+    normal_force
+        Total normal force N, preload included, compression positive [N], shape (n_samples,).
+    S
+        Identified friction force over the same period [N], shape (n_samples,).
+    bounds
+        Search bounds, five (low, high) pairs in the order e_f, k_c, e_t, kappa, mu [N/m, 1/m, N/m, -, -].
+    regularization
+        How Eq. 21 is read: ``none`` or ``slip_limit`` (see ``contactid.friction``).
+    """
+
+    def __init__(
+        self,
+        xi: np.ndarray,
+        normal_force: np.ndarray,
+        S: np.ndarray,
+        bounds: Sequence[tuple[float, float]],
+        regularization: str = "none",
+    ):
         # where the identified N falls to zero the contact opens and carries no friction: the law is
         # evaluated there with a vanishing normal force (the kernel refuses N <= 0)
         self.xi, self.N = xi, np.maximum(normal_force, N_OPEN)
@@ -86,28 +168,71 @@ class FitProblem:
         self.lo = np.array([np.log10(b[0]) if lg else b[0] for b, lg in zip(bounds, LOG_SCALED)])
         self.hi = np.array([np.log10(b[1]) if lg else b[1] for b, lg in zip(bounds, LOG_SCALED)])
 
-    def physical(self, u):
-        """Unit-cube coordinates (n, 5) to parameters."""
+    def physical(self, u: np.ndarray) -> np.ndarray:
+        """Return the parameters at unit-cube coordinates.
+
+        Parameters
+        ----------
+        u
+            Unit-cube coordinates [-], shape (n, 5) or (5,) for one set.
+
+        Returns
+        -------
+        params : np.ndarray
+            Parameter sets e_f, k_c, e_t, kappa, mu [N/m, 1/m, N/m, -, -] by column, shape (n, 5).
+        """
         v = self.lo + np.atleast_2d(u) * (self.hi - self.lo)
         out = v.copy()
         log_cols = np.array(LOG_SCALED)
         out[:, log_cols] = 10.0 ** v[:, log_cols]
         return out
 
-    def unit(self, p):
-        """Parameters (n, 5) to unit-cube coordinates (n, 5); the inverse of :meth:`physical`."""
+    def unit(self, p: np.ndarray) -> np.ndarray:
+        """Return the unit-cube coordinates of parameter sets; the inverse of :meth:`physical`.
+
+        Parameters
+        ----------
+        p
+            Parameter sets e_f, k_c, e_t, kappa, mu [N/m, 1/m, N/m, -, -] by column, shape (n, 5) or (5,) for one set.
+
+        Returns
+        -------
+        u : np.ndarray
+            Unit-cube coordinates [-], shape (n, 5).
+        """
         v = np.where(LOG_SCALED, np.log10(np.maximum(np.atleast_2d(p), 1e-300)), np.atleast_2d(p))
         return (v - self.lo) / (self.hi - self.lo)
 
-    def residuals(self, params):
-        """(n, n_samples) residuals of the mean-removed S for each of the (n, 5) parameter sets, over the rms of the
-        identified S."""
+    def residuals(self, params: np.ndarray) -> np.ndarray:
+        """Return the residuals of the mean-removed S for each parameter set, over the rms of the identified S.
+
+        Parameters
+        ----------
+        params
+            Parameter sets e_f, k_c, e_t, kappa, mu [N/m, 1/m, N/m, -, -] by column, shape (n, 5).
+
+        Returns
+        -------
+        residuals : np.ndarray
+            Residuals of each set's S against the identified S [-], shape (n, n_samples).
+        """
         S = valanis_friction_force(self.xi, self.N, params, regularization=self.regularization)
         S = S - S.mean(axis=1, keepdims=True)
         return (S - self.S) / self.scale
 
-    def misfit(self, params):
-        """NRMSE of the mean-removed S for each parameter set."""
+    def misfit(self, params: np.ndarray) -> np.ndarray:
+        """Return the NRMSE of the mean-removed S for each parameter set.
+
+        Parameters
+        ----------
+        params
+            Parameter sets e_f, k_c, e_t, kappa, mu [N/m, 1/m, N/m, -, -] by column, shape (n, 5).
+
+        Returns
+        -------
+        misfit : np.ndarray
+            The rms of each set's residuals (``residuals``) [-], shape (n,).
+        """
         return np.sqrt(np.mean(self.residuals(params) ** 2, axis=1))
 
 
@@ -183,9 +308,38 @@ def _ga(problem: FitProblem, settings: FitSettings, seed: int, label: str = "fri
         random.setstate(state)
 
 
-def least_squares_polish(problem: FitProblem, u0, fixed: dict | None = None, xtol: float = 1e-10, ftol: float = 1e-12):
-    """Least-squares polish in the unit cube; ``fixed`` {index: unit value} holds parameters; ``xtol``, ``ftol``:
-    scipy's least_squares tolerances (the chain's fit and its intervals keep the tight defaults)."""
+def least_squares_polish(
+    problem: FitProblem, u0: np.ndarray, fixed: dict | None = None, xtol: float = 1e-10, ftol: float = 1e-12
+) -> tuple[np.ndarray, float, OptimizeResult]:
+    """Polish a parameter set by least squares in the unit cube.
+
+    The Jacobian is taken by forward differences of step 1e-4 in the unit cube (backward at the upper bound), every
+    perturbed set in one call of the law's kernel, on one numba thread (a handful of sets per call: parallel threads
+    cost more than they give).
+
+    Parameters
+    ----------
+    problem
+        The fit's problem (identified signals, bounds, regularization).
+    u0
+        Start in unit-cube coordinates [-], shape (5,).
+    fixed
+        {parameter index: unit-cube value} of the parameters held fixed; None: all free.
+    xtol
+        scipy's ``least_squares`` tolerance on the change of the parameters [-] (the chain's fit and its intervals keep
+        the tight default).
+    ftol
+        scipy's ``least_squares`` tolerance on the change of the cost [-] (the tight default, as ``xtol``).
+
+    Returns
+    -------
+    u : np.ndarray
+        The optimum in unit-cube coordinates [-], shape (5,), the fixed entries at their values.
+    ssr : float
+        Sum of the squared residuals at the optimum (relative to the rms of the identified S) [-].
+    result : OptimizeResult
+        scipy's least-squares result (its ``jac`` over the free parameters).
+    """
     fixed = fixed or {}
     free = [i for i in range(5) if i not in fixed]
 
@@ -225,9 +379,12 @@ def least_squares_polish(problem: FitProblem, u0, fixed: dict | None = None, xto
 def _refined_fit(
     coef_xi, coef_n, coef_s, f0: float, preload: float, settings: FitSettings, seed: int, label: str, start=None
 ):
-    """GA (or ``start``) and polish on the harmonics synthesised on a grid of one period, the grid doubled until
-    the parameters move by less than ``settings.refine_tolerance``. Returns (problem on the last grid, optimum in
-    the unit cube, its SSR, the polish's least-squares result, the grid's points, history, GA logbook)."""
+    """Fit the law by the GA (or from ``start``) and polish it, the grid doubled until the parameters settle.
+
+    The harmonics are synthesised on a grid of one period; the grid is doubled until the parameters move by less than
+    ``settings.refine_tolerance``. Returns (problem on the last grid, optimum in the unit cube, its SSR, the polish's
+    least-squares result, the grid's points, history, GA logbook).
+    """
     m = settings.grid_points
     history = []
     u_best = None
@@ -268,19 +425,48 @@ def _refined_fit(
 
 def profile_intervals(
     problem: FitProblem,
-    u_best,
+    u_best: np.ndarray,
     ssr_min: float,
     n_data: int,
     settings: FitSettings,
     preload: float,
     label: str = "friction fit",
-):
-    """Profile-likelihood intervals of the 5 parameters at ``settings.confidence``: each parameter stepped away from
-    the optimum ``u_best`` (unit cube) with the others repolished, until the SSR crosses the threshold
-    chi2 = (n_data / M) SSR / sigma^2 (``n_data`` = 2K independent Fourier coefficients; sigma, the relative rms
-    misfit per point, the larger of the fit's own residual and ``settings.misfit_floor``), the crossing bisected;
-    a side that reaches its search bound inside the threshold is not bounded by the data. Returns (intervals (5, 2),
-    bounded (5, 2), profiles {name: (value, SSR) rows}, e_0 at the preload of every profile point inside)."""
+) -> tuple[np.ndarray, np.ndarray, dict, list]:
+    """Return the profile-likelihood intervals of the 5 parameters at ``settings.confidence``.
+
+    Each parameter is stepped away from the optimum ``u_best`` (unit cube) with the others repolished, until the SSR
+    crosses the threshold chi2 = (n_data / M) SSR / sigma^2 (``n_data`` = 2K independent Fourier coefficients; sigma,
+    the relative rms misfit per point, the larger of the fit's own residual and ``settings.misfit_floor``); the crossing
+    is bisected. A side that reaches its search bound inside the threshold is not bounded by the data.
+
+    Parameters
+    ----------
+    problem
+        The fit's problem on the final grid (M points).
+    u_best
+        The optimum in unit-cube coordinates [-], shape (5,).
+    ssr_min
+        Sum of squared residuals at the optimum (relative to the rms of the identified S) [-].
+    n_data
+        Number of independent data: 2K for K fitted harmonics.
+    settings
+        The fit's settings (confidence, misfit_floor).
+    preload
+        Static normal force N0 at which e_0 is evaluated [N].
+    label
+        Start of the progress lines logged.
+
+    Returns
+    -------
+    intervals : np.ndarray
+        Interval (low, high) of each parameter e_f, k_c, e_t, kappa, mu [N/m, 1/m, N/m, -, -] by row, shape (5, 2).
+    bounded : np.ndarray
+        Whether the data bound each side inside the search bounds [-], shape (5, 2).
+    profiles : dict
+        {name: array of (value in the parameter's unit, SSR) rows, sorted} of every profile point.
+    e0_values : list
+        e_0 at the preload of every profile point inside the threshold [N/m].
+    """
     m_pts = problem.S.size
     sigma2 = max(ssr_min / m_pts * n_data / max(n_data - 5, 1), settings.misfit_floor**2)
     from scipy.stats import chi2 as chi2_dist  # here: scipy.stats takes 0.3 s to import
@@ -347,8 +533,20 @@ def profile_intervals(
 
 
 def parameter_correlation(jacobian: np.ndarray) -> np.ndarray:
-    """(5, 5) correlation of the parameters from the least-squares Jacobian at the optimum (unit-cube coordinates);
-    NaN for the parameters the misfit is not sensitive to."""
+    """Return the correlation of the parameters from the least-squares Jacobian at the optimum.
+
+    The Jacobian is in unit-cube coordinates; NaN for the parameters the misfit is not sensitive to.
+
+    Parameters
+    ----------
+    jacobian
+        Jacobian of the relative residuals with respect to the unit-cube coordinates [-], shape (n_samples, 5).
+
+    Returns
+    -------
+    correlation : np.ndarray
+        Correlation matrix of e_f, k_c, e_t, kappa, mu [-], shape (5, 5).
+    """
     corr = np.full((5, 5), np.nan)
     norms = np.linalg.norm(jacobian, axis=0)
     sens = norms > 1e-8 * np.max(norms)
@@ -359,9 +557,26 @@ def parameter_correlation(jacobian: np.ndarray) -> np.ndarray:
     return corr
 
 
-def bound_warnings(u_best, params, settings: FitSettings) -> list:
-    """A warning for each parameter at a search bound (within 1e-3 of the unit cube's side), where the bounds may
-    exclude the best value; e_t at a lower bound of zero is its natural value, not a warning."""
+def bound_warnings(u_best: np.ndarray, params: np.ndarray, settings: FitSettings) -> list:
+    """Return a warning for each parameter at a search bound.
+
+    A parameter within 1e-3 of the unit cube's side sits at its bound, where the bounds may exclude the best value; e_t
+    at a lower bound of zero is its natural value, not a warning.
+
+    Parameters
+    ----------
+    u_best
+        The optimum in unit-cube coordinates [-], shape (5,).
+    params
+        The optimum e_f, k_c, e_t, kappa, mu [N/m, 1/m, N/m, -, -], shape (5,).
+    settings
+        The fit's settings (its bounds).
+
+    Returns
+    -------
+    warnings : list
+        One sentence per parameter at a bound, naming the bound and the key to widen.
+    """
     warnings = []
     for i, name in enumerate(PARAMETER_NAMES):
         for edge, which in ((0.0, "lower"), (1.0, "upper")):
@@ -374,9 +589,9 @@ def bound_warnings(u_best, params, settings: FitSettings) -> list:
 
 
 def fit_friction_law(
-    coef_xi,
-    coef_n,
-    coef_s,
+    coef_xi: np.ndarray,
+    coef_n: np.ndarray,
+    coef_s: np.ndarray,
     f0: float,
     preload: float,
     settings: FitSettings,
@@ -384,13 +599,49 @@ def fit_friction_law(
     n_harmonics_data: int | None = None,
     intervals: bool = True,
     label: str = "friction fit",
-    start=None,
+    start: np.ndarray | Sequence[float] | None = None,
 ) -> FitResult:
-    """GA + polish on the calibration case's xi, N (total = preload + dynamic) and S harmonics,
-    with the grid refined until the parameters move by less than ``refine_tolerance`` (``_refined_fit``); then the
-    profile-likelihood intervals (``profile_intervals``; skipped with ``intervals`` False: NaN intervals).
-    ``label`` starts the progress lines it logs. ``start`` (the 5 parameters) skips the GA: the polish starts there
-    (a refit of a known optimum on other forces, for example the model-form spread of ``contactid.gap.uncertainty``)."""
+    """Fit the friction law to the calibration case's xi, N and S harmonics.
+
+    GA and polish, with the grid refined until the parameters move by less than ``refine_tolerance`` (``_refined_fit``);
+    then the profile-likelihood intervals (``profile_intervals``; skipped with ``intervals`` False: NaN intervals). N is
+    the total force, the preload plus the dynamic part the harmonics give.
+
+    Parameters
+    ----------
+    coef_xi
+        Complex harmonic coefficients of the tangential motion xi (harmonics 1..K of ``f0``, x ~ sum Im(c_h
+        e^{i h w t})) [m], shape (n_harmonics,) or (1, n_harmonics).
+    coef_n
+        Complex harmonic coefficients of the dynamic normal force [N], shape (n_harmonics,) or (1, n_harmonics) as
+        ``coef_xi``.
+    coef_s
+        Complex harmonic coefficients of the friction force S [N], shape (n_harmonics,) or (1, n_harmonics) as
+        ``coef_xi``.
+    f0
+        Fundamental (drive) frequency [Hz].
+    preload
+        Static normal force N0 added to the dynamic one [N].
+    settings
+        The fit's settings.
+    seed
+        Seed of the GA's random stream.
+    n_harmonics_data
+        Number K of harmonics the data hold (2K independent data for the intervals); None: the columns of ``coef_s``.
+    intervals
+        Whether to profile the intervals.
+    label
+        Start of the progress lines it logs.
+    start
+        The 5 parameters e_f, k_c, e_t, kappa, mu [N/m, 1/m, N/m, -, -], shape (5,), to start the polish from, skipping
+        the GA (a refit of a known optimum on other forces, for example the model-form spread of
+        ``contactid.gap.uncertainty``); None: the GA.
+
+    Returns
+    -------
+    result : FitResult
+        The fit, its intervals, correlation, histories and warnings.
+    """
     K = np.atleast_2d(coef_s).shape[1] if n_harmonics_data is None else n_harmonics_data
     problem, u_best, ssr_min, res, m, history, logbook = _refined_fit(
         coef_xi, coef_n, coef_s, f0, preload, settings, seed, label, start
@@ -423,9 +674,28 @@ def fit_friction_law(
     )
 
 
-def settings_from_config(cfg) -> FitSettings:
-    """FitSettings from the ``friction`` config block (keys left out: the schema's defaults; the search bounds left
-    out: Table 4's neighbourhood, ``FitSettings.bounds``); bounds that are not (low < high) are refused."""
+def settings_from_config(cfg: Mapping[str, Any] | None) -> FitSettings:
+    """Return the FitSettings of the ``friction`` config block.
+
+    Keys left out take the schema's defaults; the search bounds left out take Table 4's neighbourhood
+    (``FitSettings.bounds``).
+
+    Parameters
+    ----------
+    cfg
+        The ``friction`` config block; read: bounds (e_f_n_per_m, k_c_per_m, e_t_n_per_m, kappa, mu), population,
+        generations, grid_points, max_grid_points, confidence, misfit_floor, regularization. None: every default.
+
+    Returns
+    -------
+    settings : FitSettings
+        The settings; crossover, mutation and refine_tolerance at FitSettings' defaults.
+
+    Raises
+    ------
+    ValueError
+        When a parameter's bounds are not low < high.
+    """
     from .schema import schema_defaults
 
     d = FitSettings()

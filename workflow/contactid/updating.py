@@ -33,7 +33,7 @@ off significant, yet the update finds them (docs/gap.md, "Model updating").
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
+from typing import TYPE_CHECKING, Mapping, NamedTuple, Sequence
 
 import numpy as np
 
@@ -42,13 +42,19 @@ from .parameters import StructureParameters
 from .updating_model import DEFAULT_FACTORS, FACTORS, PROFILE_GROUPS, apply_factors, modal_predictions
 from .updating_result import UpdatingResult
 
+if TYPE_CHECKING:
+    from scipy.optimize import OptimizeResult
+
 IDENTIFIED = 0.5  # posterior sd / prior sd below this: the data bound the parameter
 DIFF_STEP = 1e-5  # finite-difference step of the MAP fit's Jacobian, absolute, on the logs of the parameters
 
 
 def _prior_sds(names: list, contact_prior_sd: float, prior_sd) -> np.ndarray:
-    """Prior sd of (ln k_t, ln k_n, ln factor for each of ``names``): ``contact_prior_sd`` for the contact, FACTORS'
-    spreads for the factors unless ``prior_sd`` ({factor: sd}) replaces them; an unknown factor is refused."""
+    """Return the prior sd of (ln k_t, ln k_n, ln factor for each of ``names``).
+
+    ``contact_prior_sd`` for the contact, FACTORS' spreads for the factors unless ``prior_sd`` ({factor: sd}) replaces
+    them; an unknown factor is refused.
+    """
     for f in names:
         if f not in FACTORS:
             raise ValueError(f"gap.model_updating.parameters: unknown {f!r}; choose from {', '.join(FACTORS)}")
@@ -57,35 +63,106 @@ def _prior_sds(names: list, contact_prior_sd: float, prior_sd) -> np.ndarray:
 
 
 def gain_basis(j: int) -> np.ndarray:
-    """(j, j - 1) orthonormal basis of the plane where j channels' log gains sum to zero: the channels relative to one
-    another. A gain common to every channel scales all residues as the transducer masses nearly do (exact modal data
-    of masses 30 % heavy: free common gains took the update's drop below significance), so it is left out."""
+    """Return an orthonormal basis of the plane where j channels' log gains sum to zero.
+
+    The plane holds the channels relative to one another. A gain common to every channel scales all residues as the
+    transducer masses nearly do (exact modal data of masses 30 % heavy: free common gains took the update's drop below
+    significance), so it is left out.
+
+    Parameters
+    ----------
+    j
+        Number of channels (accelerometers).
+
+    Returns
+    -------
+    basis : np.ndarray
+        Orthonormal columns, each summing to zero [-], shape (j, j - 1).
+    """
     return np.linalg.qr(np.vstack([np.ones(j), np.eye(j)[: j - 1]]).T)[0][:, 1:]
 
 
 class _UpdatingProblem:
-    """The misfit of the structure x = (ln k_t, ln k_n, ln factors, ln channel gains) to the modal data: frequencies
-    (Hz) over their standard errors and, unless ``R_id`` is None, residues over ``residue_accuracy`` of their value;
-    ``sd`` the prior sds of x. ``n_gains`` (0, or the sensors' number less one): the accelerometer channels' sensitivity
-    factors on their residues relative to one another (the measurement chain's, not the structure's), as coordinates
-    of their logs in the plane where those sum to zero (``gain_basis``)."""
+    """Misfit of the structure x to the modal data.
 
-    def __init__(self, params, names, f_id, f_sd, R_id, residue_accuracy, sd, n_gains: int = 0):
+    x = (ln k_t, ln k_n, ln factors, ln channel gains); the misfit is of the frequencies (Hz) over their standard errors
+    and, unless ``R_id`` is None, of the residues over ``residue_accuracy`` of their value. ``n_gains`` (0, or the
+    sensors' number less one): the accelerometer channels' sensitivity factors on their residues relative to one another
+    (the measurement chain's, not the structure's), as coordinates of their logs in the plane where those sum to zero
+    (``gain_basis``).
+
+    Parameters
+    ----------
+    params
+        The nominal structure (its k_t, k_n replaced by exp(x[0]), exp(x[1])).
+    names
+        The structural factors in x, in order (keys of ``updating_model.FACTORS``).
+    f_id
+        Identified natural frequencies [Hz], shape (n_modes,).
+    f_sd
+        Their standard errors [Hz], shape (n_modes,).
+    R_id
+        Identified residue magnitudes |R_si| [s/kg], shape (n_sensors, n_modes); None: frequencies alone.
+    residue_accuracy
+        Relative standard error of a residue [-].
+    sd
+        The prior sds of x [-], shape (2 + n_factors + n_gains,).
+    n_gains
+        Number of gain coordinates at the end of x: 0, or the sensors' number less one.
+    """
+
+    def __init__(
+        self,
+        params: StructureParameters,
+        names: Sequence[str],
+        f_id: np.ndarray,
+        f_sd: np.ndarray,
+        R_id: np.ndarray | None,
+        residue_accuracy: float,
+        sd: np.ndarray,
+        n_gains: int = 0,
+    ):
         self.params, self.names, self.sd = params, names, sd
         self.f_id, self.f_sd, self.R_id, self.residue_accuracy = f_id, f_sd, R_id, residue_accuracy
         self.n = f_id.size
         self.n_gains = int(n_gains)
 
-    def structure(self, x) -> StructureParameters:
-        """The structure at x."""
+    def structure(self, x: np.ndarray) -> StructureParameters:
+        """Return the structure at x.
+
+        Parameters
+        ----------
+        x
+            The parameters, x = (ln k_t, ln k_n, ln factors, the gains' log coordinates), k_t and k_n in [N/m], the
+            others [-], shape (2 + n_factors + n_gains,).
+
+        Returns
+        -------
+        structure : StructureParameters
+            The nominal structure with k_t, k_n and the factors applied.
+        """
         return apply_factors(
             self.params.with_contact(float(np.exp(x[0])), float(np.exp(x[1]))),
             {f: float(np.exp(v)) for f, v in zip(self.names, x[2:])},
         )
 
-    def data_residuals(self, x) -> np.ndarray:
-        """Scaled residuals of the frequencies, then of the residues (sensor by sensor); 1e3 each where the
-        structure has no modes to compare."""
+    def data_residuals(self, x: np.ndarray) -> np.ndarray:
+        """Return the scaled residuals of the frequencies, then of the residues (sensor by sensor).
+
+        Each is 1e3 where the structure has no modes to compare.
+
+        Parameters
+        ----------
+        x
+            The parameters, x = (ln k_t, ln k_n, ln factors, the gains' log coordinates), k_t and k_n in [N/m], the
+            others [-], shape (2 + n_factors + n_gains,).
+
+        Returns
+        -------
+        residuals : np.ndarray
+            Frequency residuals over their standard errors, then residue residuals over ``residue_accuracy`` of their
+            value [-], shape (n_modes,) or (n_modes + n_sensors n_modes,).
+        """
         n, R_id = self.n, self.R_id
         try:
             f, R = modal_predictions(self.structure(x), n)
@@ -98,9 +175,32 @@ class _UpdatingProblem:
             r.append(((R - R_id) / (self.residue_accuracy * R_id)).ravel())
         return np.concatenate(r)
 
-    def fit(self, x_centre, free, start=None):
-        """(x, least-squares result) of the maximum a posteriori fit of the ``free`` entries of x, the others held at
-        ``x_centre``, which is the centre of the prior and the start (or ``start``'s free entries)."""
+    def fit(
+        self, x_centre: np.ndarray, free: np.ndarray, start: np.ndarray | None = None
+    ) -> tuple[np.ndarray, OptimizeResult]:
+        """Return the maximum a posteriori fit of the ``free`` entries of x, the others held at ``x_centre``.
+
+        ``x_centre`` is the centre of the prior and the start (or ``start``'s free entries). The Jacobian is taken by
+        central differences with absolute steps ``DIFF_STEP`` of the logs.
+
+        Parameters
+        ----------
+        x_centre
+            Centre of the prior and the values of the fixed entries, x = (ln k_t, ln k_n, ln factors, the gains' log
+            coordinates), k_t and k_n in [N/m], the others [-], shape (n_x,).
+        free
+            Which entries of x are fitted, shape (n_x,), boolean.
+        start
+            Start of the fit, shape (n_x,) (its free entries are used); None: ``x_centre``.
+
+        Returns
+        -------
+        x : np.ndarray
+            The fitted parameters, x = (ln k_t, ln k_n, ln factors, the gains' log coordinates), k_t and k_n in [N/m],
+            the others [-], shape (n_x,).
+        result : OptimizeResult
+            scipy's least-squares result (residuals: the data's, then the prior's of the free entries).
+        """
         sd = self.sd
 
         def res(z):
@@ -131,17 +231,33 @@ class _UpdatingProblem:
         return x, sol
 
 
-def null_drop_weights(data_jacobian, sd, n_contact: int = 2, n_nuisance: int = 0) -> np.ndarray:
-    """The weights lambda_i of the update's chi^2 drop under the nominal structure: drop ~ sum_i lambda_i chi^2_1.
+def null_drop_weights(data_jacobian: np.ndarray, sd: np.ndarray, n_contact: int = 2, n_nuisance: int = 0) -> np.ndarray:
+    """Return the weights lambda_i of the update's chi^2 drop under the nominal structure.
 
-    data_jacobian: (n_data, p) Jacobian of the scaled data residuals (unit variance) in x = (ln k_t, ln k_n, ln
-    factors); sd: (p,) prior sds of x; the first ``n_contact`` entries, and the last ``n_nuisance`` (the channel gains),
-    are fitted in the nominal fit too. Linearised,
-    a fit with the Gaussian prior P = diag(1 / sd^2) leaves the residual (I - H) e with the hat matrix
-    H = J (J^T J + P)^-1 J^T, so the drop from the nominal fit (H0, the contact columns) to the update (H1) is
-    e^T [(I - H0)^2 - (I - H1)^2] e, whose null distribution is sum_i lambda_i chi^2_1 over that matrix's eigenvalues.
-    A factor the data bind adds a weight near 1 (k bound factors: chi^2_k), one the data leave at its prior a
-    weight near 0 (posterior sd / prior sd r: 1 - r^4 for a factor uncorrelated with the others)."""
+    The drop ~ sum_i lambda_i chi^2_1. The first ``n_contact`` entries of x, and the last ``n_nuisance`` (the channel
+    gains), are fitted in the nominal fit too. Linearised, a fit with the Gaussian prior P = diag(1 / sd^2) leaves the
+    residual (I - H) e with the hat matrix H = J (J^T J + P)^-1 J^T, so the drop from the nominal fit (H0, the contact
+    columns) to the update (H1) is e^T [(I - H0)^2 - (I - H1)^2] e, whose null distribution is sum_i lambda_i chi^2_1
+    over that matrix's eigenvalues. A factor the data bind adds a weight near 1 (k bound factors: chi^2_k), one the data
+    leave at its prior a weight near 0 (posterior sd / prior sd r: 1 - r^4 for a factor uncorrelated with the others).
+
+    Parameters
+    ----------
+    data_jacobian
+        Jacobian of the scaled data residuals (unit variance) in x = (ln k_t, ln k_n, ln factors) [-],
+        shape (n_data, p).
+    sd
+        Prior sds of x [-], shape (p,).
+    n_contact
+        Number of leading entries of x (the contact's) fitted in the nominal fit.
+    n_nuisance
+        Number of trailing entries of x (the channel gains) fitted in the nominal fit.
+
+    Returns
+    -------
+    weights : np.ndarray
+        The eigenvalues lambda_i, clipped at zero [-], shape (n_data,).
+    """
     J = np.asarray(data_jacobian, float)
     P = np.diag(1.0 / np.asarray(sd, float) ** 2)
     eye = np.eye(J.shape[0])
@@ -156,11 +272,25 @@ def null_drop_weights(data_jacobian, sd, n_contact: int = 2, n_nuisance: int = 0
     return np.clip(np.linalg.eigvalsh(0.5 * (A + A.T)), 0.0, None)
 
 
-def chi2_drop_threshold(weights, confidence: float) -> float:
-    """The drop of chi^2 that sum_i w_i chi^2_1 (``null_drop_weights``) exceeds with probability 1 - confidence, by
-    Satterthwaite's match of mean and variance, c chi^2_nu with c = sum w^2 / sum w, nu = (sum w)^2 / sum w^2 (exact
-    where every weight is 0 or 1: k weights of 1 give chi^2_k(confidence)); inf where no weight is left (the data
-    bind no factor, and no drop is significant)."""
+def chi2_drop_threshold(weights: np.ndarray | Sequence[float], confidence: float) -> float:
+    """Return the drop of chi^2 that sum_i w_i chi^2_1 (``null_drop_weights``) exceeds with probability 1 - confidence.
+
+    By Satterthwaite's match of mean and variance, c chi^2_nu with c = sum w^2 / sum w, nu = (sum w)^2 / sum w^2 (exact
+    where every weight is 0 or 1: k weights of 1 give chi^2_k(confidence)); inf where no weight is left (the data bind
+    no factor, and no drop is significant).
+
+    Parameters
+    ----------
+    weights
+        The null distribution's weights (``null_drop_weights``) [-], shape (n_data,).
+    confidence
+        The test's confidence level [-].
+
+    Returns
+    -------
+    threshold : float
+        The drop of chi^2 [-]; inf where the weights sum to (nearly) zero.
+    """
     from scipy.stats import chi2  # here: scipy.stats takes 0.3 s to import
 
     w = np.asarray(weights, float)
@@ -171,9 +301,12 @@ def chi2_drop_threshold(weights, confidence: float) -> float:
 
 
 def _posterior_identifiability(jacobian, sd, labels: list) -> tuple[np.ndarray, dict]:
-    """(covariance of x from the Jacobian of the residuals (data + prior) at the optimum, the linearised posterior;
-    {label: posterior sd, prior sd, their ratio, whether the data bound it (ratio < IDENTIFIED), the parameter it
-    correlates with most and the correlation})."""
+    """Return the linearised posterior's covariance of x and each parameter's identifiability.
+
+    (covariance of x from the Jacobian of the residuals (data + prior) at the optimum, the linearised posterior; {label:
+    posterior sd, prior sd, their ratio, whether the data bound it (ratio < IDENTIFIED), the parameter it correlates
+    with most and the correlation}).
+    """
     J = jacobian
     try:
         cov = np.linalg.inv(J.T @ J)
@@ -198,8 +331,23 @@ def _posterior_identifiability(jacobian, sd, labels: list) -> tuple[np.ndarray, 
 
 
 class ChannelGainTest(NamedTuple):
-    """``channel_gains_significant``'s answer, with the two nominal fits (x of k_t, k_n, the factors at nominal and,
-    in ``x_with``, the gains) that ``update_structure`` starts from."""
+    """Answer of ``channel_gains_significant``, with the two nominal fits that ``update_structure`` starts from.
+
+    Attributes
+    ----------
+    significant
+        Whether the gains lower the nominal fit's chi^2 by more than chi^2_(j-1)(confidence).
+    gains
+        Each channel's gain relative to the others (their logs sum to zero) [-], one per accelerometer.
+    sd
+        Posterior sd of each gain's ln [-], one per accelerometer.
+    x_with
+        The nominal fit with the gains: x = (ln k_t, ln k_n, the factors at nominal (0), the gains' log coordinates),
+        k_t and k_n in [N/m], shape (2 + n_factors + n_sensors - 1,).
+    x_without
+        The nominal fit without them: x = (ln k_t, ln k_n, the factors at nominal (0)), k_t and k_n in [N/m],
+        shape (2 + n_factors,).
+    """
 
     significant: bool
     gains: tuple
@@ -209,14 +357,51 @@ class ChannelGainTest(NamedTuple):
 
 
 def channel_gains_significant(
-    params, names, f_id, f_sd, R_id, residue_accuracy, sd, gain_sd, confidence
+    params: StructureParameters,
+    names: Sequence[str],
+    f_id: np.ndarray,
+    f_sd: np.ndarray,
+    R_id: np.ndarray,
+    residue_accuracy: float,
+    sd: np.ndarray,
+    gain_sd: float,
+    confidence: float,
 ) -> ChannelGainTest:
-    """The channels' gains relative to one another (``gain_basis``, prior sd ``gain_sd`` of their logs) fitted with k_t
-    and k_n on the nominal structure, the posterior sd of each one's log, and whether they lower its chi^2 by more
-    than chi^2_(j-1)(confidence): the residues call the channels miscalibrated. Where they
-    do not, the update is made without them: fitted always, they took part of a structure's own misfit at the sensors
-    (the compound benchmark's update of compound-14-s1 went from 16.2 % to 13.6 % instead of 15.0 %, and its normal
-    dashpot was no longer named)."""
+    """Return whether the channels' relative gains are significant, with their fit.
+
+    The channels' gains relative to one another (``gain_basis``, prior sd ``gain_sd`` of their logs) are fitted with k_t
+    and k_n on the nominal structure, with the posterior sd of each one's log; they are significant where they lower its
+    chi^2 by more than chi^2_(j-1)(confidence): the residues call the channels miscalibrated. Where they do not, the
+    update is made without them: fitted always, they took part of a structure's own misfit at the sensors (the compound
+    benchmark's update of compound-14-s1 went from 16.2 % to 13.6 % instead of 15.0 %, and its normal dashpot was no
+    longer named).
+
+    Parameters
+    ----------
+    params
+        The nominal structure, with the chain's k_t, k_n as the start.
+    names
+        The structural factors of the update (held at nominal here).
+    f_id
+        Identified natural frequencies [Hz], shape (n_modes,).
+    f_sd
+        Their standard errors [Hz], shape (n_modes,).
+    R_id
+        Identified residue magnitudes |R_si| [s/kg], shape (n_sensors, n_modes).
+    residue_accuracy
+        Relative standard error of a residue [-].
+    sd
+        Prior sds of (ln k_t, ln k_n, ln factors) [-], shape (2 + n_factors,).
+    gain_sd
+        Prior sd of the ln of a channel's relative gain [-].
+    confidence
+        The test's confidence level [-].
+
+    Returns
+    -------
+    test : ChannelGainTest
+        Whether the gains are significant, the gains, their sds and the two nominal fits.
+    """
     from scipy.stats import chi2  # here: scipy.stats takes 0.3 s to import
 
     j = R_id.shape[0]
@@ -241,30 +426,55 @@ def channel_gains_significant(
 
 def update_structure(
     params: StructureParameters,
-    f_id_hz,
-    f_sigma_hz,
-    residues,
+    f_id_hz: np.ndarray | Sequence[float],
+    f_sigma_hz: np.ndarray | Sequence[float],
+    residues: np.ndarray | None,
     residue_accuracy: float = 0.01,
-    factors=DEFAULT_FACTORS,
+    factors: Sequence[str] = DEFAULT_FACTORS,
     contact_prior_sd: float = 3.0,
     confidence: float = 0.95,
-    prior_sd=None,
+    prior_sd: Mapping[str, float] | None = None,
     gain_sd: float = 0.0,
 ) -> UpdatingResult:
     """Update the structure ``params`` (with its k_t, k_n as the start) to the random test's modal data.
 
-    f_id_hz, f_sigma_hz: (n,) identified natural frequencies and their standard errors (Hz); residues:
-    (n_sensors, n) |R_si| of the modal fit (or None: frequencies alone); residue_accuracy: relative standard
-    error of a residue; factors: names of FACTORS to update; contact_prior_sd: prior sd of ln k_t and
-    ln k_n (wide); confidence: the update is accepted when chi^2 drops by more than ``chi2_drop_threshold``
-    (chi^2_k(confidence) for k factors the data bind); prior_sd: {factor: sd of its ln} replacing FACTORS' prior
-    spreads (a lever arm measured to 1 %: 0.01); gain_sd: prior sd of the ln of the accelerometer channels' sensitivity
-    factors relative to one another (their logs summing to zero, ``gain_basis``) on the residues (0: none); where they
-    lower the nominal fit's chi^2 significantly (``channel_gains_significant``) they are fitted with k_t and k_n in the
-    nominal fit and in the update alike
-    (the measurement chain's, not counted among the factors the update adds; ``UpdatingResult.channel_gains``): a
-    channel 2 % off otherwise made the random test's residues call for a clamp compliance 900 times the nominal's.
-    See the module's docstring."""
+    The update is accepted when chi^2 drops by more than ``chi2_drop_threshold`` (chi^2_k(confidence) for k factors the
+    data bind). The accelerometer channels' relative gains (``gain_sd`` > 0), where they lower the nominal fit's chi^2
+    significantly (``channel_gains_significant``), are fitted with k_t and k_n in the nominal fit and in the update
+    alike (the measurement chain's, not counted among the factors the update adds; ``UpdatingResult.channel_gains``): a
+    channel 2 % off otherwise made the random test's residues call for a clamp compliance 900 times the nominal's. See
+    the module's docstring.
+
+    Parameters
+    ----------
+    params
+        The nominal structure, with the chain's k_t, k_n as the start.
+    f_id_hz
+        Identified natural frequencies [Hz], shape (n_modes,).
+    f_sigma_hz
+        Their standard errors [Hz], shape (n_modes,).
+    residues
+        The modal fit's residue magnitudes |R_si| [s/kg], shape (n_sensors, n_modes); None: frequencies alone.
+    residue_accuracy
+        Relative standard error of a residue [-].
+    factors
+        Names of FACTORS to update.
+    contact_prior_sd
+        Prior sd of ln k_t and ln k_n (wide) [-].
+    confidence
+        Confidence level of the acceptance test [-].
+    prior_sd
+        {factor: sd of its ln} [-] replacing FACTORS' prior spreads (a lever arm measured to 1 %: 0.01); None: FACTORS'.
+    gain_sd
+        Prior sd of the ln of the accelerometer channels' sensitivity factors relative to one another (their logs
+        summing to zero, ``gain_basis``) on the residues [-]; 0: none.
+
+    Returns
+    -------
+    result : UpdatingResult
+        The update: factors, k_t, k_n, structure, chi^2 before and after, acceptance or proposal, identifiability with
+        each factor's profile, channel gains and, where the gains took part, the same update without them.
+    """
     f_id = np.asarray(f_id_hz, float)
     f_sd = np.asarray(f_sigma_hz, float)
     n = f_id.size
