@@ -1,11 +1,13 @@
-"""The blind benchmark's items (config ``gap_benchmark``): the effects' benchmark ranges and where the localisation
-should point when an effect is missing from the library, the blind, effect-free, leave-out and ladder items, the
-compound items (a perturbed rig with 0, 1 or 2 effects) and their rigs' configs, what an item hides and its expected
-run time."""
+"""Items of the blind benchmark (config ``gap_benchmark``).
+
+The effects' benchmark ranges and where the localisation should point when an effect is missing from the library, the
+blind, effect-free, leave-out and ladder items, the compound items (a perturbed rig with 0, 1 or 2 effects) and their
+rigs' configs, what an item hides and its expected run time.
+"""
 
 from __future__ import annotations
 
-from typing import Mapping
+from typing import Mapping, Sequence
 
 import numpy as np
 
@@ -42,8 +44,31 @@ EXPECTED_PLACE = {
 
 
 def benchmark_items(cfg: Mapping, seed: int) -> dict:
-    """{name: spec} with spec = {effect, magnitude, seed, library (None = all), kind}; ``cfg`` the gap_benchmark
-    block (keys left out: the schema's defaults)."""
+    """Return the blind benchmark's items: blind, effect-free, leave-out and compound ones.
+
+    Each blind item puts one effect at a magnitude drawn uniformly from its benchmark range (``RANGES``, or
+    ``gap_benchmark.ranges``) on one seed; an effect-free item has no effect; a leave-out item puts the effect at its
+    range's middle with the effect left out of the library; the compound items are ``compound_items``'s.
+
+    Parameters
+    ----------
+    cfg
+        The ``gap_benchmark`` config block (keys left out: the schema's defaults); read: effects, ranges, magnitudes,
+        seeds, effect_free, leave_out, compound.
+    seed
+        The config's seed, from which every magnitude is drawn.
+
+    Returns
+    -------
+    items : dict
+        {name: spec} with spec = {effect, magnitude (in the effect's own unit, ``rig.effects``), seed, library (None =
+        all), kind}.
+
+    Raises
+    ------
+    ValueError
+        When ``gap_benchmark.effects`` names an unknown effect.
+    """
     cfg = {**schema_defaults("gap_benchmark"), **dict(cfg or {})}
     effects = cfg.get("effects") or list(EFFECTS)
     unknown = [e for e in effects if e not in EFFECTS]
@@ -77,11 +102,24 @@ def benchmark_items(cfg: Mapping, seed: int) -> dict:
 
 
 def expected_seconds(spec: Mapping) -> int:
-    """A benchmark item's expected run time (s, on one core of the 2-core reference machine, as the blind benchmark
-    measured it), for the workflow's scheduler to start the long items first so that no core idles at the end
-    waiting for one of them (``gap_benchmark_item``'s priority). The rig's truth sets it: a preload drift in a
-    compound item (its later passes march whole records: 30-75 s) and a contact that opens (every simulation
-    marched from the linear state: 31-38 s) are the long ones; most items take 10-20 s."""
+    """Return a benchmark item's expected run time.
+
+    The time is on one core of the 2-core reference machine, as the blind benchmark measured it, for the workflow's
+    scheduler to start the long items first so that no core idles at the end waiting for one of them
+    (``gap_benchmark_item``'s priority). The rig's truth sets it: a preload drift in a compound item (its later passes
+    march whole records: 30-75 s) and a contact that opens (every simulation marched from the linear state: 31-38 s) are
+    the long ones; most items take 10-20 s.
+
+    Parameters
+    ----------
+    spec
+        The item's spec (``benchmark_items``, ``ladder_items``); read: effect, magnitude, effects, kind, fraction.
+
+    Returns
+    -------
+    seconds : int
+        Expected run time [s].
+    """
     effects = dict(spec.get("effects") or {})
     if spec.get("effect"):
         effects[spec["effect"]] = spec.get("magnitude", 0.0)
@@ -93,14 +131,44 @@ def expected_seconds(spec: Mapping) -> int:
 
 
 def ladder_typical(effect: str, ranges: Mapping = RANGES) -> float:
-    """An effect's typical magnitude (``rig.effects``' typical value), kept inside its benchmark range's upper
-    end (contact separation's typical 7.2 makes lc3's impacts keep the motion from settling)."""
+    """Return an effect's typical magnitude, kept inside its benchmark range's upper end.
+
+    The typical magnitude is ``rig.effects``' typical value; contact separation's typical 7.2 makes lc3's impacts keep
+    the motion from settling, so the range's upper end caps it.
+
+    Parameters
+    ----------
+    effect
+        The effect's name (a key of ``rig.effects.EFFECTS``).
+    ranges
+        {effect: (low, high)} benchmark ranges, each in its effect's own unit.
+
+    Returns
+    -------
+    magnitude : float
+        The typical magnitude in the effect's own unit (``EffectSpec.unit``), one of [-], [s], [s/m], [N s/m].
+    """
     return float(min(EFFECTS[effect].typical, ranges[effect][1]))
 
 
 def ladder_items(cfg: Mapping, seed: int) -> dict:
-    """{name: spec} of the detection ladder (config gap_benchmark.ladder: fractions of each effect's typical
-    magnitude, for every seed): single-effect items named ``ladder_<effect>-<k>-s<seed>``."""
+    """Return the detection ladder's items.
+
+    The ladder (config gap_benchmark.ladder) puts each effect at fractions of its typical magnitude, for every seed:
+    single-effect items named ``ladder_<effect>-<k>-s<seed>``.
+
+    Parameters
+    ----------
+    cfg
+        The ``gap_benchmark`` config block (keys left out: the schema's defaults); read: ladder, effects, ranges, seeds.
+    seed
+        The config's seed (the ladder's magnitudes are not drawn: unused).
+
+    Returns
+    -------
+    items : dict
+        {name: spec} with spec = {effect, magnitude, seed, library (None = all), kind "ladder", fraction}.
+    """
     cfg = {**schema_defaults("gap_benchmark"), **dict(cfg or {})}
     fractions = [float(f) for f in cfg["ladder"]]
     effects = cfg.get("effects") or list(EFFECTS)
@@ -121,8 +189,25 @@ def ladder_items(cfg: Mapping, seed: int) -> dict:
 
 
 def item_config(cfg: Mapping, spec: Mapping) -> tuple[dict, dict]:
-    """The config of an item's rig (a compound item's perturbed as ``compound_config`` says) and the effects it hides
-    {effect: magnitude (rig units)}; ``cfg``: the base config with the schema's defaults."""
+    """Return the config of an item's rig and the effects it hides.
+
+    A compound item's rig is perturbed as ``compound_config`` says.
+
+    Parameters
+    ----------
+    cfg
+        The base config, with the schema's defaults.
+    spec
+        The item's spec (``benchmark_items``, ``ladder_items``); read: effect, magnitude, kind, and a compound item's
+        effects and perturbation.
+
+    Returns
+    -------
+    config : dict
+        The config of the item's rig.
+    effects : dict
+        {effect: magnitude (in the effect's own unit, ``rig.effects``)} the item hides.
+    """
     effects = {spec["effect"]: spec["magnitude"]} if spec["effect"] else {}
     if spec["kind"] == "compound":
         cfg = compound_config(cfg, spec)
@@ -131,7 +216,20 @@ def item_config(cfg: Mapping, spec: Mapping) -> tuple[dict, dict]:
 
 
 def hidden_text(spec: Mapping, effects: Mapping) -> str:
-    """What an item hides, in words (for the log)."""
+    """Return what an item hides, in words (for the log).
+
+    Parameters
+    ----------
+    spec
+        The item's spec; read: effect, magnitude, kind.
+    effects
+        {effect: magnitude} the item hides (``item_config``), for a compound item.
+
+    Returns
+    -------
+    text : str
+        "<effect> at <magnitude>", "no effect", or a compound item's perturbed rig with its effects.
+    """
     hidden = f"{spec['effect']} at {spec['magnitude']:.4g}" if spec["effect"] else "no effect"
     if spec["kind"] == "compound":
         hidden = "perturbed rig with " + (", ".join(f"{e} at {m:.4g}" for e, m in effects.items()) or "no effect")
@@ -164,13 +262,33 @@ FRICTION_LAW_RANGES = {"mu": (0.28, 0.48), "kappa": (0.15, 0.42), "e_f_factor": 
 DUAL_SINE_DAMPING = (0.85, 1.15)
 
 
-def compound_items(n_per_seed: int, seeds, seed: int, ranges: Mapping) -> dict:
-    """{name: spec} of the compound items: item k of each seed perturbs the rig's structure at random (E
-    +-3 %, transducer masses +-40 %, lever arm +-8 %; polynomial hardening on or off; a damping form; on half of them a
-    clamp that gives, CLAMP_STIFFNESS; on half a friction law away from Table 4's, FRICTION_LAW_RANGES; on a third
-    Eq. 21 read with the slip limit; on a third the damping in the dual-sine tests other than in the random test,
-    DUAL_SINE_DAMPING) and adds
-    k mod 3 effects (two in different places), each at a random magnitude in its benchmark range."""
+def compound_items(n_per_seed: int, seeds: Sequence[int], seed: int, ranges: Mapping) -> dict:
+    """Return the compound items: a perturbed rig with 0, 1 or 2 effects.
+
+    Item k of each seed perturbs the rig's structure at random (E +-3 %, transducer masses +-40 %, lever arm +-8 %;
+    polynomial hardening on or off; a damping form; on half of them a clamp that gives, CLAMP_STIFFNESS; on half a
+    friction law away from Table 4's, FRICTION_LAW_RANGES; on a third Eq. 21 read with the slip limit; on a third the
+    damping in the dual-sine tests other than in the random test, DUAL_SINE_DAMPING) and adds k mod 3 effects (two in
+    different places), each at a random magnitude in its benchmark range.
+
+    Parameters
+    ----------
+    n_per_seed
+        Compound items per seed.
+    seeds
+        The rigs' seeds.
+    seed
+        The config's seed, from which every draw is made.
+    ranges
+        {effect: (low, high)} benchmark ranges, each in its effect's own unit.
+
+    Returns
+    -------
+    items : dict
+        {name: spec} with spec = {kind "compound", seed, effect None, magnitude 0, library None, effects, perturbation,
+        normal_cubic_n_per_m3, damping_form, clamp_rotational_stiffness_nm_per_rad, friction_law,
+        friction_regularization, dual_sine_damping_factor}.
+    """
     items = {}
     places = list(COMPOUND_EFFECTS)
     for s in seeds:
@@ -219,9 +337,24 @@ def compound_items(n_per_seed: int, seeds, seed: int, ranges: Mapping) -> dict:
 
 
 def compound_config(cfg: Mapping, spec: Mapping) -> dict:
-    """The config of a compound item's rig: rig.true_structure (with its clamp), the normal law, the damping form, the
-    friction law's values and its reading of Eq. 21 perturbed as ``spec`` says (the identification keeps
-    ``structure`` and ``friction``)."""
+    """Return the config of a compound item's rig.
+
+    rig.true_structure (with its clamp), the normal law, the damping form, the friction law's values and its reading of
+    Eq. 21 are perturbed as ``spec`` says; the identification keeps ``structure`` and ``friction``.
+
+    Parameters
+    ----------
+    cfg
+        The base config, with the schema's defaults; read: structure (beam.youngs_modulus_pa, sensors.masses_kg,
+        force_transducer_mass_kg, contact_geometry.tangential_lever_arm_m) and rig.truth (normal, friction).
+    spec
+        The compound item's spec (``compound_items``).
+
+    Returns
+    -------
+    config : dict
+        A deep copy of ``cfg`` with rig.true_structure, rig.truth.normal, rig.true_damping and rig.truth.friction set.
+    """
     import copy
 
     out = copy.deepcopy(dict(cfg))

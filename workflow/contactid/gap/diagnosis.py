@@ -1,19 +1,17 @@
-"""The diagnosis: the gap measured at every level of the chain, localised, explained by the
-candidate library, and its shrinkage with uncertainty.
+"""Run the diagnosis: the gap measured at every level of the chain, localised, explained by the candidate library.
 
-Settings (config ``gap``): the harmonics compared, the candidates, the thresholds of the verdict
-and the bootstrap. The verdict names the best candidate only when (1) the held-out gap before is
-above ``min_gap`` and the records' own scatter, (2) the candidate shrinks the held-out gap by at least
-``min_reduction`` with the bootstrap's lower bound above zero, and (3) it beats the runner-up's
-held-out gap by the factor ``separation``; otherwise the verdict is "none" and the localisation
-says where the gap lies.
+Its shrinkage is given with its uncertainty. Settings (config ``gap``): the harmonics compared, the candidates, the
+thresholds of the verdict and the bootstrap. The verdict names the best candidate only when (1) the held-out gap before
+is above ``min_gap`` and the records' own scatter, (2) the candidate shrinks the held-out gap by at least
+``min_reduction`` with the bootstrap's lower bound above zero, and (3) it beats the runner-up's held-out gap by the
+factor ``separation``; otherwise the verdict is "none" and the localisation says where the gap lies.
 """
 
 from __future__ import annotations
 
 import logging
 from dataclasses import dataclass, field
-from typing import Mapping
+from typing import TYPE_CHECKING, Any, Callable, Mapping, Sequence
 
 import numpy as np
 
@@ -40,6 +38,11 @@ from .story import resolution, tell
 from .verdict import at_floor, gap_shares, retried
 from .workers import start_candidates
 
+if TYPE_CHECKING:
+    from ..updating_result import UpdatingResult
+    from .calibration import Calibration
+    from .simulation import SimResult
+
 log = logging.getLogger(__name__)
 
 
@@ -50,9 +53,44 @@ log = logging.getLogger(__name__)
 
 @dataclass
 class Diagnosis:
-    """The diagnosis's outcome: the verdict and its reason sentence, the candidates' ranking, where the gap lies, the
-    calibration and held-out cases, the explanation's steps with the gap they leave, the decisions' trace, the
-    resolution, the shrinkage, the updated model, and the arrays and simulations the report plots."""
+    """Outcome of the gap diagnosis.
+
+    The verdict and its reason sentence, the candidates' ranking, where the gap lies, the calibration and held-out
+    cases, the explanation's steps with the gap they leave, the decisions' trace, the resolution, the shrinkage, the
+    updated model, and the arrays and simulations the report plots.
+
+    Attributes
+    ----------
+    verdict
+        The verdict: the effect named, or "none".
+    reason
+        The verdict's reason, a sentence.
+    ranking
+        The candidates' ranking rows (``ranking.rank_candidates``), best score first.
+    where
+        Where the gap lies (``localise.localise``'s summary: place, place_reason, stage gaps, ...), with the held-out
+        gap before, its bootstrap interval and the records' scatter (held-out gaps, relative to the records' harmonics).
+    calibration_case
+        The load case the candidates are refitted on.
+    heldout_cases
+        The load cases held out (scored).
+    arrays
+        The localisation's arrays for gap.nc (gap by sensor, harmonic, part of the cycle, ...).
+    sims
+        {"base" or candidate: {case: simulation}} of the base model and of each candidate.
+    shrink
+        The held-out gap before and after the winner and the runner-up by case, harmonic and sensor (``shrink_views``).
+    explanation
+        The explanation's steps, each with the held-out gap before and after it and its share.
+    remaining_gap
+        What the explanation leaves: held-out gap, share, whether at the floor, and where it lies.
+    trace
+        The decisions' trace (``story.tell``).
+    resolution
+        What the records can attribute (``story.resolution``), with the candidates' isolability.
+    updated_model
+        The model with the explained effects (``explain.updated_model_summary``).
+    """
 
     verdict: str
     reason: str
@@ -70,8 +108,13 @@ class Diagnosis:
     updated_model: dict = field(default_factory=dict)
 
     def summary(self) -> dict:
-        """The diagnosis as diagnosis.json holds it: every field but the arrays, the simulations and the updated
-        model."""
+        """Return the diagnosis as diagnosis.json holds it.
+
+        Returns
+        -------
+        summary : dict
+            Every field but the arrays, the simulations and the updated model.
+        """
         return {
             "verdict": self.verdict,
             "reason": self.reason,
@@ -89,8 +132,35 @@ class Diagnosis:
 
 @dataclass
 class _DiagnosisRun:
-    """What every pass of one diagnosis shares: the records, the calibration and scored cases, the settings,
-    the baseline simulations and (once drawn) the bootstrap resamples of the scored cases' records."""
+    """State that every pass of one diagnosis shares.
+
+    The records, the calibration and scored cases, the settings, the baseline simulations and (once drawn) the bootstrap
+    resamples of the scored cases' records.
+
+    Attributes
+    ----------
+    records
+        {load case: its record's harmonics}.
+    calibration_case
+        The load case the candidates are refitted on.
+    score_cases
+        The load cases scored: the held-out ones (the calibration case where none is held out).
+    settings
+        The diagnosis's settings.
+    fit_settings
+        The friction fit's settings.
+    workers
+        Processes the candidates run in.
+    base_sims
+        {load case: the base model's simulation}.
+    boot
+        {scored case: bootstrap resamples of its acceleration harmonics [m/s^2],
+        shape (n_bootstrap, n_sensors, n_harmonics)}, empty until drawn.
+    channel_delays
+        The random test's per-channel delays [s], shape (n_sensors,), where known.
+    channel_gains
+        The random test's channel gains relative to one another [-], shape (n_sensors,), where known.
+    """
 
     records: Mapping[str, RecordHarmonics]
     calibration_case: str
@@ -107,9 +177,29 @@ class _DiagnosisRun:
     def H(self) -> int:
         return self.settings.n_harmonics
 
-    def candidates(self, names, model: IdentifiedModel, base_sims: dict, **extra):
-        """The candidates ``names`` calibrated on the calibration case and predicting the scored cases, in
-        ``workers`` processes (``start_candidates``; call the result to collect them)."""
+    def candidates(
+        self, names: Sequence[str], model: IdentifiedModel, base_sims: dict, **extra: Any
+    ) -> Callable[[], dict]:
+        """Start the candidates ``names``, calibrated on the calibration case and predicting the scored cases.
+
+        They run in ``workers`` processes (``start_candidates``; call the result to collect them).
+
+        Parameters
+        ----------
+        names
+            The candidates' names (keys of the library).
+        model
+            The model the candidates are added to.
+        base_sims
+            {load case: simulation} each candidate's simulations start from.
+        **extra
+            Further keywords of ``start_candidates`` (base_steps, joint, alone, held_theta).
+
+        Returns
+        -------
+        collect : Callable[[], dict]
+            The function that returns {name: (calibration, simulations by case, residuals by case)}, in library order.
+        """
         return start_candidates(
             names,
             self.workers,
@@ -128,11 +218,24 @@ class _DiagnosisRun:
         )
 
     def draw_bootstrap(self) -> None:
-        """Bootstrap over record blocks: the simulations stay fixed, the records are resampled."""
+        """Draw the bootstrap over record blocks: the simulations stay fixed, the records are resampled."""
         self.boot = bootstrap_draws(self.records, self.score_cases, self.settings)
 
-    def heldout_gap(self, sims_by_case, boot_index=None) -> float:
-        """The held-out gap of these simulations (``heldout_gap_of``), on the records or on one bootstrap draw."""
+    def heldout_gap(self, sims_by_case: Mapping[str, SimResult], boot_index: int | None = None) -> float:
+        """Return the held-out gap of these simulations (``heldout_gap_of``), on the records or on one bootstrap draw.
+
+        Parameters
+        ----------
+        sims_by_case
+            {scored case: simulation}.
+        boot_index
+            Index of the bootstrap draw to score on; None: the records themselves.
+
+        Returns
+        -------
+        gap : float
+            The held-out gap, relative to the records' harmonics [-].
+        """
         return heldout_gap_of(
             self.records,
             self.score_cases,
@@ -141,14 +244,40 @@ class _DiagnosisRun:
             None if boot_index is None else {c: self.boot[c][boot_index] for c in self.score_cases},
         )
 
-    def heldout_gaps(self, sims_by_case) -> tuple[float, np.ndarray]:
-        """The held-out gap and its bootstrap draws."""
+    def heldout_gaps(self, sims_by_case: Mapping[str, SimResult]) -> tuple[float, np.ndarray]:
+        """Return the held-out gap and its bootstrap draws.
+
+        Parameters
+        ----------
+        sims_by_case
+            {scored case: simulation}.
+
+        Returns
+        -------
+        gap : float
+            The held-out gap on the records [-].
+        draws : np.ndarray
+            The held-out gap on each bootstrap draw [-], shape (n_bootstrap,).
+        """
         draws = heldout_gap_draws(self.records, self.score_cases, self.H, sims_by_case, self.boot)
         return self.heldout_gap(sims_by_case), draws
 
-    def next_pass(self, results: dict):
-        """The explanation's next pass: the remaining candidates refitted jointly with the steps so far, started
-        from the last step's simulations (``explain``)."""
+    def next_pass(self, results: dict) -> Callable[[Sequence[str], Calibration], dict]:
+        """Return the explanation's next pass.
+
+        The remaining candidates are refitted jointly with the steps so far, started from the last step's simulations
+        (``explain``).
+
+        Parameters
+        ----------
+        results
+            {candidate: (calibration, simulations by case, residuals by case)} of the first pass.
+
+        Returns
+        -------
+        run : Callable[[Sequence[str], Calibration], dict]
+            The pass: given the remaining candidates and the last step's calibration, their results as ``results``.
+        """
 
         def run(remaining, cal):
             starts = {
@@ -170,8 +299,11 @@ class _DiagnosisRun:
 
 
 def _remaining_gap(left, left_share, where, last, run: _DiagnosisRun, linear, structures) -> dict:
-    """diagnosis.json's ``remaining``: the held-out gap the explanation leaves, its share, whether it is at the
-    floor, and where it lies (localised again with the explanation's effects in, where it is above the floor)."""
+    """Return diagnosis.json's ``remaining``: the held-out gap the explanation leaves.
+
+    With its share, whether it is at the floor, and where it lies (localised again with the explanation's effects in,
+    where it is above the floor).
+    """
     settings = run.settings
     remaining = {
         "heldout_gap": left,
@@ -199,17 +331,53 @@ def diagnose(
     linear: dict | None = None,
     workers: int = 1,
     identified: IdentifiedModel | None = None,
-    updating=None,
-    channel_delays=None,
+    updating: UpdatingResult | None = None,
+    channel_delays: np.ndarray | Sequence[float] | None = None,
 ) -> Diagnosis:
-    """Run the whole diagnosis on the load cases' records (``calibration_case`` for the refits,
-    the others held out); the candidates in ``workers`` processes (see ``start_candidates``). ``identified``: the
-    chain's own model when ``model`` is its update (``gap.pipeline.updated_model``; ``updating`` its
-    UpdatingResult): the explanation then starts with the update's step. ``channel_delays``: each accelerometer
-    channel's delay on the force (s) as the random test shows it (``random_test_delays``), held in common by the
-    channel-delay candidate's refit; None: that refit searches every channel's delay from zero. The channels' gains
-    relative to one another, as the random test's residues show them (``updating.channel_gains``), are what the
-    channel-gain candidate applies; without them it adds nothing."""
+    """Run the whole diagnosis on the load cases' records.
+
+    ``calibration_case`` is used for the refits, the others are held out; the candidates run in ``workers`` processes
+    (see ``start_candidates``). With ``identified`` (the chain's own model when ``model`` is its update) the explanation
+    starts with the update's step. The channels' gains relative to one another, as the random test's residues show them
+    (``updating.channel_gains``), are what the channel-gain candidate applies; without them it adds nothing.
+
+    Parameters
+    ----------
+    model
+        The model to diagnose: the chain's identified model, or its update (``gap.pipeline.updated_model``).
+    records
+        {load case: its dual-sine record's harmonics}.
+    calibration_case
+        The load case the candidates are refitted on.
+    settings
+        The diagnosis's settings (config ``gap``).
+    fit_settings
+        The friction fit's settings, for the candidates' refits of the law.
+    linear
+        The linear stage's gaps (``localise.linear_stage``: the random test's FRF against the model), added to the stage
+        gaps; None: left out.
+    workers
+        Processes the candidates run in.
+    identified
+        The chain's own model when ``model`` is its update; None otherwise.
+    updating
+        The model updating's result (``updating.update_structure``) when ``model`` is its update: its step, its
+        posterior structures for the localisation and its channel gains; None: no updating.
+    channel_delays
+        Each accelerometer channel's delay on the force as the random test shows it (``random_test_delays``) [s],
+        shape (n_sensors,), held in common by the channel-delay candidate's refit; None: that refit searches every
+        channel's delay from zero.
+
+    Returns
+    -------
+    diagnosis : Diagnosis
+        The verdict, ranking, localisation, explanation and what the report plots.
+
+    Raises
+    ------
+    ValueError
+        When ``calibration_case`` is not among the records' load cases.
+    """
     H = settings.n_harmonics
     if calibration_case not in records:
         raise ValueError(f"gap: the calibration case {calibration_case!r} is not among the load cases {list(records)}")
@@ -284,10 +452,22 @@ def diagnose(
         where["random_test_channel_delays_s"] = {str(k): float(t) for k, t in zip(sensors, run.channel_delays)}
     later = retried({n: r[0].theta for n, r in results.items()}, LIBRARY, settings)
 
-    def delay_seeds(remaining) -> dict:
-        """{candidate: (its result, the next pass on top of it)} for each per-channel delay candidate among
-        ``remaining``, held at the random test's channel delays where those are resolved (``DELAY_SEED_MIN``):
-        ``explain``'s further first halves of a pair."""
+    def delay_seeds(remaining: Sequence[str]) -> dict:
+        """Return the per-channel delay candidates among ``remaining`` held at the random test's channel delays.
+
+        For each per-channel delay candidate among ``remaining``, held at the random test's channel delays where those
+        are resolved (``DELAY_SEED_MIN``): ``explain``'s further first halves of a pair.
+
+        Parameters
+        ----------
+        remaining
+            The candidates the explanation has not added yet.
+
+        Returns
+        -------
+        seeds : dict
+            {candidate: (its result, the next pass on top of it)}; empty where the delays are not resolved.
+        """
         d = run.channel_delays
         if d is None or not np.all(np.isfinite(d)) or np.max(np.abs(d)) < DELAY_SEED_MIN:
             return {}

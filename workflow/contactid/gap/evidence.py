@@ -1,12 +1,15 @@
-"""The records' statistics and tests: the held-out gap of a model's simulations and its bootstrap over record
-blocks, the held-out gap before and after by case, harmonic and sensor, whether the records drift, and what the
-dual-sine records say of a model update (accepted, with or without the channels' gains, which factor carries it)."""
+"""Compute the records' statistics and tests of the gap diagnosis.
+
+The held-out gap of a model's simulations and its bootstrap over record blocks, the held-out gap before and after by
+case, harmonic and sensor, whether the records drift, and what the dual-sine records say of a model update (accepted,
+with or without the channels' gains, which factor carries it).
+"""
 
 from __future__ import annotations
 
 import dataclasses
 import logging
-from typing import TYPE_CHECKING, Mapping
+from typing import TYPE_CHECKING, Callable, Mapping, Sequence
 
 import numpy as np
 
@@ -22,14 +25,48 @@ from .refit import baseline, evaluate
 from .verdict import DEFAULT_PLACE, UPDATING_EFFECTS, PlaceThresholds, records_carry_factor
 
 if TYPE_CHECKING:
+    from ..parameters import StructureParameters
     from .settings import GapSettings
+    from .simulation import SimResult
 
 log = logging.getLogger(__name__)
 
 
-def shrink_views(records, cases, before_sims, after_sims, boot, H) -> dict:
-    """Held-out gap before and after, per load case (with bootstrap 95 % intervals over record blocks),
-    per harmonic and per sensor."""
+def shrink_views(
+    records: Mapping[str, RecordHarmonics],
+    cases: Sequence[str],
+    before_sims: Mapping[str, SimResult],
+    after_sims: Mapping[str, SimResult],
+    boot: Mapping[str, np.ndarray],
+    H: int,
+) -> dict:
+    """Return the held-out gap before and after, per load case, per harmonic and per sensor.
+
+    Per load case with bootstrap 95 % intervals over record blocks; per harmonic relative to the records' whole
+    harmonics, per sensor relative to that sensor's.
+
+    Parameters
+    ----------
+    records
+        {load case: its record's harmonics}.
+    cases
+        The held-out load cases to compare on.
+    before_sims
+        {load case: simulation} of the model before.
+    after_sims
+        {load case: simulation} of the model after (a candidate's).
+    boot
+        {load case: bootstrap resamples of its acceleration harmonics [m/s^2], shape (n_bootstrap, n_sensors, H)}
+        (``bootstrap_draws``).
+    H
+        Harmonics compared (1..H).
+
+    Returns
+    -------
+    views : dict
+        {"by_case": {case: {"before", "after", "before_interval", "after_interval"}}, "by_harmonic": {"before", "after":
+        one value per harmonic}, "by_sensor": {"before", "after": {sensor: value}}}: relative gaps [-].
+    """
     out = {"by_case": {}, "by_harmonic": {}, "by_sensor": {}}
     num_h = {"before": 0.0, "after": 0.0}
     sensors = records[cases[0]].sensors
@@ -59,18 +96,43 @@ def shrink_views(records, cases, before_sims, after_sims, boot, H) -> dict:
 
 
 def _bootstrap_records(rec: RecordHarmonics, rng, n: int, H: int) -> np.ndarray:
-    """(n, j, H) resampled record harmonics: means of blocks drawn with replacement."""
+    """Return (n, j, H) resampled record harmonics: means of blocks drawn with replacement."""
     B = rec.block_acceleration.shape[0]
     idx = rng.integers(0, B, size=(n, B))
     return rec.block_acceleration[idx][:, :, :, :H].mean(axis=1)
 
 
 def heldout_gap_of(
-    records: Mapping[str, RecordHarmonics], cases, H: int, sims_by_case: Mapping, resampled=None
+    records: Mapping[str, RecordHarmonics],
+    cases: Sequence[str],
+    H: int,
+    sims_by_case: Mapping[str, SimResult],
+    resampled: Mapping[str, np.ndarray] | None = None,
 ) -> float:
-    """The held-out gap of simulations ``sims_by_case`` on ``cases``: the rms over the cases of each case's residual
-    norm (the sensors' harmonics 1..H and the change from the first to the last third, relative to the record's
-    harmonics); ``resampled``: {case: (j, H) bootstrap harmonics} in place of the records' own."""
+    """Return the held-out gap of simulations ``sims_by_case`` on ``cases``.
+
+    The gap is the rms over the cases of each case's residual norm: the sensors' harmonics 1..H and the change from the
+    first to the last third, relative to the record's harmonics.
+
+    Parameters
+    ----------
+    records
+        {load case: its record's harmonics}.
+    cases
+        The load cases scored.
+    H
+        Harmonics compared (1..H).
+    sims_by_case
+        {load case: simulation}.
+    resampled
+        {case: bootstrap acceleration harmonics in place of the records' own [m/s^2], shape (n_sensors, H)}; None: the
+        records' own.
+
+    Returns
+    -------
+    gap : float
+        The held-out gap, relative to the records' harmonics [-].
+    """
     vals = []
     for c in cases:
         rec = records[c]
@@ -84,16 +146,56 @@ def heldout_gap_of(
     return float(np.sqrt(np.mean(vals)))
 
 
-def bootstrap_draws(records: Mapping[str, RecordHarmonics], cases, settings: GapSettings) -> dict:
-    """{case: (n_bootstrap, j, H) record harmonics resampled over record blocks} for ``cases``, from the
-    diagnosis's own random stream (``settings.seed``, "gap/bootstrap")."""
+def bootstrap_draws(records: Mapping[str, RecordHarmonics], cases: Sequence[str], settings: GapSettings) -> dict:
+    """Return the records' harmonics resampled over record blocks for ``cases``.
+
+    The draws come from the diagnosis's own random stream (``settings.seed``, "gap/bootstrap").
+
+    Parameters
+    ----------
+    records
+        {load case: its record's harmonics}.
+    cases
+        The load cases to resample.
+    settings
+        The diagnosis's settings (seed, n_bootstrap, n_harmonics).
+
+    Returns
+    -------
+    draws : dict
+        {case: resampled acceleration harmonics [m/s^2], shape (n_bootstrap, n_sensors, H)}.
+    """
     rng = generator(settings.seed, "gap/bootstrap")
     return {c: _bootstrap_records(records[c], rng, settings.n_bootstrap, settings.n_harmonics) for c in cases}
 
 
-def heldout_gap_draws(records: Mapping[str, RecordHarmonics], cases, H: int, sims_by_case, boot: Mapping) -> np.ndarray:
-    """The held-out gap (``heldout_gap_of``) of ``sims_by_case`` on each bootstrap draw of ``boot``
-    (``bootstrap_draws``)."""
+def heldout_gap_draws(
+    records: Mapping[str, RecordHarmonics],
+    cases: Sequence[str],
+    H: int,
+    sims_by_case: Mapping[str, SimResult],
+    boot: Mapping[str, np.ndarray],
+) -> np.ndarray:
+    """Return the held-out gap (``heldout_gap_of``) of ``sims_by_case`` on each bootstrap draw of ``boot``.
+
+    Parameters
+    ----------
+    records
+        {load case: its record's harmonics}.
+    cases
+        The load cases scored.
+    H
+        Harmonics compared (1..H).
+    sims_by_case
+        {load case: simulation}.
+    boot
+        {case: resampled acceleration harmonics [m/s^2], shape (n_bootstrap, n_sensors, H)} (``bootstrap_draws``).
+
+    Returns
+    -------
+    gaps : np.ndarray
+        The held-out gap on each draw [-], shape (n_bootstrap,).
+    """
     n = len(next(iter(boot.values())))
     return np.array([heldout_gap_of(records, cases, H, sims_by_case, {c: boot[c][b] for c in cases}) for b in range(n)])
 
@@ -101,9 +203,12 @@ def heldout_gap_draws(records: Mapping[str, RecordHarmonics], cases, H: int, sim
 def _gaps_and_scatter(
     held_out: Mapping[str, RecordHarmonics], settings: GapSettings, sims: Mapping, scatter_of: str
 ) -> dict:
-    """The held-out gap (``heldout_gap_of``) of each model's simulations ``sims`` {label: {case: SimResult}} as
+    """Return the held-out gap of each model's simulations and the records' scatter.
+
+    The held-out gap (``heldout_gap_of``) of each model's simulations ``sims`` {label: {case: SimResult}} as
     ``heldout_gap_<label>``, and the records' scatter: the sd of model ``scatter_of``'s gap over the bootstrap of record
-    blocks (``bootstrap_draws``, the diagnosis's own stream). The two records' tests below weigh two models by it."""
+    blocks (``bootstrap_draws``, the diagnosis's own stream). The two records' tests below weigh two models by it.
+    """
     H = settings.n_harmonics
     cases = list(held_out)
     draws = heldout_gap_draws(held_out, cases, H, sims[scatter_of], bootstrap_draws(held_out, cases, settings))
@@ -119,17 +224,41 @@ def records_test_of_update(
     calibration: RecordHarmonics | None = None,
     fit_settings: FitSettings | None = None,
 ) -> dict:
-    """What the dual-sine records say of a model update: the held-out gap (``heldout_gap_of``) of the chain's model
-    and of the updated one (each with its own friction law) on the ``held_out`` records, and the records' scatter
-    (sd of the chain's gap over the bootstrap of record blocks, as the diagnosis draws it); ``accepted`` by
-    ``verdict.records_accept_update``.
+    """Return what the dual-sine records say of a model update.
+
+    The held-out gap (``heldout_gap_of``) of the chain's model and of the updated one (each with its own friction law)
+    on the ``held_out`` records, and the records' scatter (sd of the chain's gap over the bootstrap of record blocks, as
+    the diagnosis draws it); ``accepted`` by ``verdict.records_accept_update``.
 
     Where the held-out records drift (``records_drift``) and the library holds preload_drift, each model is given the
     drift refitted on the ``calibration`` record (``fit_settings``' bounds) before its held-out gap is taken, and the
-    test weighs what the drift leaves: a drift common to both models otherwise sat in both gaps and hid the update
-    (the compound benchmark's rigs with a drift and a perturbed structure: 0.0490 -> 0.0409 with the update, short of
-    half, so a transducer mass stood in for it and the contact effect of the pair was never reached). The gaps without
-    the drift stay in ``heldout_gap_chain_alone`` and ``heldout_gap_updated_alone``."""
+    test weighs what the drift leaves: a drift common to both models otherwise sat in both gaps and hid the update (the
+    compound benchmark's rigs with a drift and a perturbed structure: 0.0490 -> 0.0409 with the update, short of half,
+    so a transducer mass stood in for it and the contact effect of the pair was never reached). The gaps without the
+    drift stay in ``heldout_gap_chain_alone`` and ``heldout_gap_updated_alone``.
+
+    Parameters
+    ----------
+    chain
+        The chain's identified model.
+    updated
+        The updated model.
+    held_out
+        {held-out load case: its record's harmonics}.
+    settings
+        The diagnosis's settings.
+    calibration
+        The calibration case's record, on which a drift is refitted; None: no drift is refitted.
+    fit_settings
+        The friction fit's settings (its bounds) for the drift's refit; None: no drift is refitted.
+
+    Returns
+    -------
+    test : dict
+        {"heldout_gap_chain", "heldout_gap_updated", "record_scatter", "cases", "accepted"}, with the drift refitted
+        also "heldout_gap_chain_alone", "heldout_gap_updated_alone" and "preload_drift" {label: refitted drift}; gaps
+        and drifts relative [-].
+    """
     from .verdict import records_accept_update
 
     H = settings.n_harmonics
@@ -191,7 +320,7 @@ def records_test_of_update(
 
 def records_test_of_gains(
     with_gains: IdentifiedModel,
-    gains,
+    gains: Sequence[float],
     structure_alone: IdentifiedModel,
     held_out: Mapping[str, RecordHarmonics],
     calibration: RecordHarmonics,
@@ -199,12 +328,39 @@ def records_test_of_gains(
     settings: GapSettings,
     chain: IdentifiedModel | None = None,
 ) -> dict:
-    """What the dual-sine records say where the random test cannot tell the accelerometer channels' gains from the
-    structure's factors (``UpdatingResult.structure_alone``): the held-out gap of the model updated with the gains,
-    read through them (``gains``, each channel's relative factor; the friction law refitted on the ``calibration``
-    record as the channels read it), against the model updated without them, and the records' scatter (the bootstrap's
-    sd of the latter's gap); with ``chain`` (the model not updated) its gap too, ``heldout_gap_chain``;
-    ``gains_preferred`` by ``verdict.records_prefer_gains``."""
+    """Return what the dual-sine records say of the accelerometer channels' gains against the structure's factors.
+
+    Where the random test cannot tell the gains from the structure's factors (``UpdatingResult.structure_alone``): the
+    held-out gap of the model updated with the gains, read through them (the friction law refitted on the
+    ``calibration`` record as the channels read it), against the model updated without them, and the records' scatter
+    (the bootstrap's sd of the latter's gap); with ``chain`` (the model not updated) its gap too, ``heldout_gap_chain``;
+    ``gains_preferred`` by ``verdict.records_prefer_gains``.
+
+    Parameters
+    ----------
+    with_gains
+        The model updated with the channels' gains.
+    gains
+        Each accelerometer channel's relative gain factor [-], shape (n_sensors,).
+    structure_alone
+        The model updated without the gains.
+    held_out
+        {held-out load case: its record's harmonics}.
+    calibration
+        The calibration case's record, on which the gains' model refits its friction law.
+    fit_settings
+        The friction fit's settings (its bounds).
+    settings
+        The diagnosis's settings.
+    chain
+        The model not updated; None: its gap is not taken.
+
+    Returns
+    -------
+    test : dict
+        {"heldout_gap_gains", "heldout_gap_structure", ("heldout_gap_chain",) "record_scatter", "cases",
+        "gains_preferred"}; gaps relative [-].
+    """
     from .verdict import records_prefer_gains
 
     H = settings.n_harmonics
@@ -231,8 +387,25 @@ def records_test_of_gains(
 
 
 def records_drift(records: Mapping[str, RecordHarmonics], H: int, thresholds: PlaceThresholds = DEFAULT_PLACE) -> bool:
-    """Whether the records drift as the localisation's place tells it (``verdict.place``): the median over the
-    records of the trend's size in standard errors (``record_drift``) above ``thresholds.drift_z``."""
+    """Return whether the records drift as the localisation's place tells it (``verdict.place``).
+
+    The median over the records of the trend's size in standard errors (``record_drift``) is compared with
+    ``thresholds.drift_z``.
+
+    Parameters
+    ----------
+    records
+        {load case: its record's harmonics}.
+    H
+        Harmonics compared (1..H).
+    thresholds
+        The place's thresholds (``drift_z``).
+
+    Returns
+    -------
+    drifts : bool
+        True where the median trend exceeds ``thresholds.drift_z`` standard errors.
+    """
     return bool(np.median([record_drift(r, H)[1] for r in records.values()]) > thresholds.drift_z)
 
 
@@ -243,25 +416,53 @@ UPDATING_THETA = {"transducer_mass_scale": lambda factor: np.array([factor - 1.0
 def records_attribution(
     chain: IdentifiedModel,
     factors: Mapping[str, float],
-    structure_without,
+    structure_without: Callable[[str], StructureParameters],
     calibration: RecordHarmonics,
     held_out: Mapping[str, RecordHarmonics],
-    bounds,
+    bounds: Sequence[tuple[float, float]],
     record_scatter: float,
     gap_chain: float,
     settings: GapSettings,
 ) -> dict:
-    """Which factor carries an update the dual-sine records accepted, told by the records themselves: for each factor
-    that amounts to a library effect (``verdict.UPDATING_EFFECTS``), that effect alone at the factor's value (the
-    candidate, ``candidates.LIBRARY``: its stiffness refit and friction polish on the calibration record) and the
-    update without that factor (``structure_without(factor)``: the other factors, k_t and k_n refitted to the
-    frequencies), each predicting the held-out records. The factor is named (``effect``) when its effect alone
-    explains the chain's held-out gap materially (``verdict.records_accept_update``) and the update without it leaves
+    """Return which factor carries an update the dual-sine records accepted, told by the records themselves.
+
+    For each factor that amounts to a library effect (``verdict.UPDATING_EFFECTS``): that effect alone at the factor's
+    value (the candidate, ``candidates.LIBRARY``: its stiffness refit and friction polish on the calibration record) and
+    the update without that factor (``structure_without(factor)``: the other factors, k_t and k_n refitted to the
+    frequencies), each predicting the held-out records. The factor is named (``effect``) when its effect alone explains
+    the chain's held-out gap materially (``verdict.records_accept_update``) and the update without it leaves
     ``settings.separation`` times as much, as a verdict's runner-up must. The random test's profiles cannot tell such
-    factors apart where the update is small (the detection ladder's transducer masses +3 %: profiles 0.081 against
-    the mass scale's 0.045; the records: the masses alone leave 0.0026 of the chain's 0.0246, the update without
-    them 0.0074, its k_t and k_n refitted taking up part of it). Returns {"factors": {factor: {"alone": gap,
-    "without": gap}}, "effect": name or None}."""
+    factors apart where the update is small (the detection ladder's transducer masses +3 %: profiles 0.081 against the
+    mass scale's 0.045; the records: the masses alone leave 0.0026 of the chain's 0.0246, the update without them
+    0.0074, its k_t and k_n refitted taking up part of it).
+
+    Parameters
+    ----------
+    chain
+        The chain's identified model.
+    factors
+        {factor: value} of the accepted update, multipliers of the nominal values [-].
+    structure_without
+        The update's structure without the named factor (the others, k_t and k_n refitted).
+    calibration
+        The calibration case's record.
+    held_out
+        {held-out load case: its record's harmonics}.
+    bounds
+        The friction law's search bounds, five (low, high) pairs of e_f, k_c, e_t, kappa, mu [N/m, 1/m, N/m, -, -].
+    record_scatter
+        The records' scatter: sd of the chain's held-out gap over the bootstrap [-].
+    gap_chain
+        The chain's held-out gap [-].
+    settings
+        The diagnosis's settings.
+
+    Returns
+    -------
+    attribution : dict
+        {"factors": {factor: {"alone": gap, "without": gap}}, "effect": name or None}; gaps relative [-] (None where the
+        law or the simulation failed).
+    """
     H = settings.n_harmonics
     num = settings.numerics
     cases = list(held_out)
