@@ -1,10 +1,13 @@
-"""The candidates' ranking: each candidate's row (its held-out gap and bootstrap interval against the model's,
-the score, its refitted parameters and friction law, whether it acts where the localisation puts the gap and
-settles where the records do), sorted by score."""
+"""Rank the gap diagnosis's candidates.
+
+Each candidate's row: its held-out gap and bootstrap interval against the model's, the score, its refitted parameters
+and friction law, whether it acts where the localisation puts the gap and settles where the records do; the rows sorted
+by score.
+"""
 
 from __future__ import annotations
 
-from typing import Mapping
+from typing import Callable, Mapping
 
 import numpy as np
 
@@ -29,11 +32,13 @@ def _ranking_row(
     where: Mapping,
     memo: bool = True,
 ) -> dict:
-    """A candidate's row of the ranking: its held-out gap (``after``, its bootstrap ``after_b``) against the
-    model's (``before``, ``before_b``), the score (n ln(gap^2 ratio) + 2 k over ``n_data`` residual entries), its
-    refitted parameters and friction law, the structure/sensor misfit it leaves on the calibration record, and
-    whether it acts where the localisation puts the gap (``memo``: the inverse identification memoised,
-    ``Numerics.memo``)."""
+    """Return a candidate's row of the ranking.
+
+    Its held-out gap (``after``, its bootstrap ``after_b``) against the model's (``before``, ``before_b``), the score (n
+    ln(gap^2 ratio) + 2 k over ``n_data`` residual entries), its refitted parameters and friction law, the
+    structure/sensor misfit it leaves on the calibration record, and whether it acts where the localisation puts the gap
+    (``memo``: the inverse identification memoised, ``Numerics.memo``).
+    """
     k = LIBRARY[name].n_parameters(len(records[calibration_case].sensors))
     # does the candidate make the structure and sensor model consistent with the calibration record?
     res_after = float(
@@ -71,21 +76,59 @@ def _ranking_row(
 
 
 def rank_candidates(
-    results,
-    heldout_gap,
-    n_bootstrap,
-    before,
-    before_b,
-    n_data,
-    records,
-    calibration_case,
-    where,
-    aperiodic_limit=0.1,
+    results: Mapping[str, tuple],
+    heldout_gap: Callable[..., float],
+    n_bootstrap: int,
+    before: float,
+    before_b: np.ndarray,
+    n_data: int,
+    records: Mapping[str, RecordHarmonics],
+    calibration_case: str,
+    where: Mapping,
+    aperiodic_limit: float = 0.1,
     memo: bool = True,
-):
-    """The candidates' ranking rows, sorted by score (scores equal to 3 decimals are a tie, the same model solved
-    from other starts: library order), and each candidate's bootstrap held-out gaps. Each row also says where the
-    candidate's model settles unlike the records (``model_periodicity`` with ``aperiodic_limit``)."""
+) -> tuple[list, dict]:
+    """Return the candidates' ranking rows, sorted by score, and each candidate's bootstrap held-out gaps.
+
+    Scores equal to 3 decimals are a tie (the same model solved from other starts): library order. Each row also says
+    where the candidate's model settles unlike the records (``model_periodicity`` with ``aperiodic_limit``). A candidate
+    whose held-out prediction diverged explains nothing: its gaps are infinite.
+
+    Parameters
+    ----------
+    results
+        {candidate: (calibration, simulations by case, residuals by case)} (``start_candidates``' results).
+    heldout_gap
+        The held-out gap of simulations by case, called as heldout_gap(sims) on the records and heldout_gap(sims, b) on
+        bootstrap draw b (``_DiagnosisRun.heldout_gap``), returning the relative gap [-].
+    n_bootstrap
+        Number of bootstrap draws.
+    before
+        The model's held-out gap before any candidate [-].
+    before_b
+        The model's held-out gap on each bootstrap draw [-], shape (n_bootstrap,).
+    n_data
+        Number of residual entries the score counts (real and imaginary parts of the scored harmonics).
+    records
+        {load case: its record's harmonics}.
+    calibration_case
+        The load case the candidates are refitted on.
+    where
+        The localisation's summary (``localise.localise``); read: place, identification_noise.
+    aperiodic_limit
+        Share of a response not periodic at the drive above which it does not settle (``gap.place.aperiodic_limit``)
+        [-].
+    memo
+        Whether the inverse identifications are memoised (``Numerics.memo``).
+
+    Returns
+    -------
+    rows : list
+        The ranking rows (dicts: effect, held-out gaps before and after with intervals, score, reduction, parameters,
+        friction, consistent, periodicity, ...), best score first.
+    boots : dict
+        {candidate: its held-out gap on each bootstrap draw [-], shape (n_bootstrap,)}.
+    """
     rows, boots = [], {}
     for name, (cal, sims, res) in results.items():
         after = heldout_gap(sims)

@@ -1,9 +1,12 @@
-"""The report's section on the sim-to-real gap: the diagnosis of the configured data and, when built,
-the blind benchmark (text generated from diagnosis.json and benchmark.json, no number typed by hand).
+"""The report's section on the sim-to-real gap.
+
+The diagnosis of the configured data and, when built, the blind benchmark (text generated from diagnosis.json and
+benchmark.json, no number typed by hand).
 
 The section's assembly: ``gap_section``, the candidates' table, the figures it includes and the friction law's notes and
 intervals; the diagnosis in words is ``report_diagnosis``'s (the base model's paragraph ``report_base_model``'s), the
-benchmarks' paragraphs ``report_benchmark``'s, the shared number formatting ``report_format``'s."""
+benchmarks' paragraphs ``report_benchmark``'s, the shared number formatting ``report_format``'s.
+"""
 
 from __future__ import annotations
 
@@ -18,11 +21,23 @@ from .report_format import num
 
 
 def updated_law_note(intervals: dict | None) -> str:
-    """A sentence for Table 4's caption where the random test's model updating changed the structure
-    (friction_intervals.json's model "updated"): Table 4's law rests on the nominal structure, and the updated model's
-    law, with its model-form intervals (``intervals_text``'s table), is the one to read; "" otherwise. (A structure 12 %
+    """Return a sentence for Table 4's caption where the random test's model updating changed the structure.
+
+    Where friction_intervals.json's model is "updated", Table 4's law rests on the nominal structure, and the updated
+    model's law, with its model-form intervals (``intervals_text``'s table), is the one to read. (A structure 12 %
     softer with accelerometers 60 % heavy: Table 4 gave mu 0.277 with an interval 0.224-0.324 that excludes the rig's
-    0.397; the updated model 0.388, 0.312-0.482.)"""
+    0.397; the updated model 0.388, 0.312-0.482.)
+
+    Parameters
+    ----------
+    intervals
+        friction_intervals.json's content (model, parameters with value and interval); None: not built.
+
+    Returns
+    -------
+    note : str
+        The sentence (LaTeX), with a leading space; "" where the model is not the updated one.
+    """
     if not intervals or intervals.get("model") != "updated":
         return ""
     par = intervals.get("parameters") or {}
@@ -40,9 +55,21 @@ def updated_law_note(intervals: dict | None) -> str:
 
 
 def explained_law_note(updated: dict | None) -> str:
-    """A sentence for Table 4's caption where the gap diagnosis explained effects, or applied the damping at test level
-    the records confirm (results/gap/updated_model.json): the friction law refitted with them beside the chain's,
-    which they bias; "" where the model is the chain's."""
+    """Return a sentence for Table 4's caption where the gap diagnosis explained effects or applied test-level damping.
+
+    Where the diagnosis explained effects, or applied the damping at test level the records confirm
+    (results/gap/updated_model.json): the friction law refitted with them beside the chain's, which they bias.
+
+    Parameters
+    ----------
+    updated
+        results/gap/updated_model.json's content (effects, damping_at_test_level, friction); None: not built.
+
+    Returns
+    -------
+    note : str
+        The sentence (LaTeX), with a leading space; "" where the model is the chain's.
+    """
     if not updated:
         return ""
     td = updated.get("damping_at_test_level") or {}
@@ -72,7 +99,19 @@ def explained_law_note(updated: dict | None) -> str:
 
 
 def intervals_text(intervals: dict | None) -> str:
-    """The friction law's intervals with the model-form term (friction_intervals.json) as a paragraph and table."""
+    """Return the friction law's intervals with the model-form term as a paragraph and table.
+
+    Parameters
+    ----------
+    intervals
+        friction_intervals.json's content (model, n_structures, parameters with value, profile_interval, sd_cases,
+        sd_structure, interval); None: left out.
+
+    Returns
+    -------
+    text : str
+        The paragraph and table (LaTeX); "" without intervals.
+    """
     if not intervals:
         return ""
     par = intervals["parameters"]
@@ -137,8 +176,20 @@ def intervals_text(intervals: dict | None) -> str:
 
 
 def candidates_table(diag: dict) -> str:
-    """The table of the candidates (held-out gap before and after, its bootstrap interval and the shrink in %, the
-    score); empty without candidates."""
+    """Return the table of the candidates.
+
+    The held-out gap before and after, its bootstrap interval and the shrink in %, the score.
+
+    Parameters
+    ----------
+    diag
+        diagnosis.json's content; its ``ranking`` is read.
+
+    Returns
+    -------
+    table : str
+        The table (LaTeX); empty without candidates.
+    """
     rows = pd.DataFrame(
         [
             {
@@ -181,7 +232,7 @@ def candidates_table(diag: dict) -> str:
 
 
 def _figure(name: str, caption: str) -> str:
-    """A gap figure at the report's text width, the width it is drawn at (print_style): text >= 8 pt on paper."""
+    """Return a gap figure at the report's text width, the width it is drawn at (print_style): text >= 8 pt on paper."""
     return (
         "\\begin{figure}[H]\\centering\\includegraphics[width=\\textwidth]{" + name + ".pdf}"
         "\\caption{" + caption + "}\\label{fig:" + name + "}\\end{figure}\n"
@@ -219,8 +270,22 @@ GAP_FIGURES = (
 
 
 def gap_section(diag: dict, bench: dict | None, intervals: dict | None = None) -> str:
-    """The report's section on the gap (LaTeX) from diagnosis.json, benchmark.json (None: not built) and
-    friction_intervals.json (None: left out)."""
+    """Return the report's section on the gap (LaTeX).
+
+    Parameters
+    ----------
+    diag
+        diagnosis.json's content.
+    bench
+        benchmark.json's content; None: not built.
+    intervals
+        friction_intervals.json's content; None: left out.
+
+    Returns
+    -------
+    section : str
+        The diagnosis's paragraphs, the candidates' table, the figures, the intervals and the benchmark's text.
+    """
     return (
         diagnosis_paragraphs(diag)
         + candidates_table(diag)

@@ -9,20 +9,58 @@ the same tolerance (measured on the default data and three one-effect data sets,
 
 from __future__ import annotations
 
-from typing import Callable
+from typing import Callable, Sequence
 
 import numpy as np
 
 
 def stacked(r: np.ndarray) -> np.ndarray:
-    """A residual vector as real numbers: complex entries as their real parts, then their imaginary parts."""
+    """Return a residual vector as real numbers: complex entries as their real parts, then their imaginary parts.
+
+    Parameters
+    ----------
+    r
+        The residual vector, real or complex (relative [-] as ``refit.gap_residual``'s), shape (n_residual,) or any
+        other (raveled).
+
+    Returns
+    -------
+    stacked : np.ndarray
+        The real parts then the imaginary parts of the raveled ``r`` (``r`` itself, as floats, where real) [unit of r],
+        shape (2 r.size,) or (r.size,).
+    """
     r = np.asarray(r).ravel()
     return np.concatenate([r.real, r.imag]) if np.iscomplexobj(r) else r.astype(float)
 
 
-def quadratic_model_minimum(thetas, residuals, low: float, high: float) -> float:
-    """theta in [low, high] minimising ||q(theta)||, q the vector quadratic through three points (theta_i, r_i)
-    (Lagrange form, per residual entry; complex entries as real and imaginary parts)."""
+def quadratic_model_minimum(thetas: Sequence[float], residuals: Sequence[np.ndarray], low: float, high: float) -> float:
+    """Return the theta in [low, high] minimising ||q(theta)||, q the vector quadratic through three points.
+
+    q passes through the three points (theta_i, r_i) (Lagrange form, per residual entry; complex entries as real and
+    imaginary parts); ||q||^2 is a quartic in theta, minimised over the interval's ends and its derivative's real roots
+    inside it.
+
+    Parameters
+    ----------
+    thetas
+        Three distinct values of the candidate's parameter theta [unit of thetas].
+    residuals
+        The residual vector at each of ``thetas`` [-], each of shape (n_residual,), real or complex.
+    low
+        Lower end of the interval searched [unit of thetas].
+    high
+        Upper end of the interval searched [unit of thetas].
+
+    Returns
+    -------
+    theta : float
+        The model's minimiser in [low, high] [unit of thetas].
+
+    Raises
+    ------
+    ValueError
+        When ``thetas`` are not three distinct values.
+    """
     t = np.asarray(thetas, dtype=float)
     if t.size != 3 or len(set(t.tolist())) != 3:
         raise ValueError("quadratic_model_minimum: give three distinct thetas")
@@ -46,8 +84,10 @@ def quadratic_model_minimum(thetas, residuals, low: float, high: float) -> float
 
 
 def _separated(points: dict, thetas, spacing: float, norm) -> list:
-    """``thetas`` (sorted) thinned so that no two lie within ``spacing``: of a close pair the one with the smaller
-    norm stays."""
+    """Return ``thetas`` (sorted) thinned so that no two lie within ``spacing``.
+
+    Of a close pair the one with the smaller norm stays.
+    """
     kept: list = []
     for th in thetas:
         if kept and th - kept[-1] <= spacing:
@@ -71,24 +111,43 @@ def residual_line_search(
     xatol: float,
     max_evaluations: int,
 ) -> float:
-    """The theta in [low, high] with the smallest ||residual(theta)||, by successive vector-quadratic models.
+    """Return the theta in [low, high] with the smallest ||residual(theta)||, by successive vector-quadratic models.
 
-    points: {theta: residual vector} already evaluated (at least three in [low, high]; residual None where the
-    model could not be simulated). Each step fits the quadratic through the best point and its nearest evaluated
-    neighbours on either side (or the two nearest), moves to its minimum within the neighbours' bracket, and stops
-    when that minimum lies within ``xatol`` of the best point or after ``max_evaluations`` new evaluations.
+    Each step fits the quadratic through the best point and its nearest evaluated neighbours on either side (or the two
+    nearest), moves to its minimum within the neighbours' bracket, and stops when that minimum lies within ``xatol`` of
+    the best point or after ``max_evaluations`` new evaluations.
 
-    Points closer than 2 ``xatol`` count once in the models (the better of them), and where a model's minimum falls
-    on an evaluated point worse than the best (the data contradict the model at this scale), that point is set aside
-    and the bracket refined: the midpoints between the best point and its neighbours (each side wider than 8
-    ``xatol``) are evaluated and the models go on from the narrower trio. Without this, a state that differed between
-    neighbouring thetas (the transducer-mass candidate at +41.2 %: gap 0.036 beside 0.0165 at +41.7 %, 0.0153 when
-    reached from elsewhere: another periodic state) stopped the search at +41.7 % on data 30 % heavy. A minimum the
-    model puts on the best point while both of the best point's evaluated neighbours lie farther than
-    ``VERIFY_BRACKET`` xatol is accepted only after that bracket has been refined once the same way (a quadratic
-    through points far apart confirms its own minimum: residuals far from quadratic stopped on the scan's middle
-    point). Returns the best
-    evaluated theta (of ``points`` and the new ones; ``points`` is updated)."""
+    Points closer than 2 ``xatol`` count once in the models (the better of them), and where a model's minimum falls on
+    an evaluated point worse than the best (the data contradict the model at this scale), that point is set aside and
+    the bracket refined: the midpoints between the best point and its neighbours (each side wider than 8 ``xatol``) are
+    evaluated and the models go on from the narrower trio. Without this, a state that differed between neighbouring
+    thetas (the transducer-mass candidate at +41.2 %: gap 0.036 beside 0.0165 at +41.7 %, 0.0153 when reached from
+    elsewhere: another periodic state) stopped the search at +41.7 % on data 30 % heavy. A minimum the model puts on the
+    best point while both of the best point's evaluated neighbours lie farther than ``VERIFY_BRACKET`` xatol is accepted
+    only after that bracket has been refined once the same way (a quadratic through points far apart confirms its own
+    minimum: residuals far from quadratic stopped on the scan's middle point).
+
+    Parameters
+    ----------
+    residual
+        The residual vector at a theta, the candidate's parameter (``refit.gap_residual``: relative [-],
+        shape (n_residual,)); None where the model could not be simulated.
+    points
+        {theta: residual vector or None} already evaluated (at least three in [low, high]); updated with the new ones.
+    low
+        Lower end of the interval searched [unit of theta].
+    high
+        Upper end of the interval searched [unit of theta].
+    xatol
+        Tolerance on theta [unit of theta].
+    max_evaluations
+        Most new evaluations of ``residual``.
+
+    Returns
+    -------
+    theta : float
+        The best evaluated theta (of ``points`` and the new ones) [unit of theta].
+    """
 
     def norm(th):
         r = points[th]

@@ -1,29 +1,43 @@
-"""The decisions of the gap diagnosis as pure functions of plain numbers, testable without the rig:
-where the gap lies (``place``) and whether a step explains the held-out gap (``explains_materially``,
+"""The decisions of the gap diagnosis as pure functions of plain numbers, testable without the rig.
+
+Where the gap lies (``place``) and whether a step explains the held-out gap (``explains_materially``,
 ``indistinguishable``, ...); the verdict itself is told from the explanation (``story``).
 
-``localise.localise`` and ``diagnosis.diagnose`` compute the numbers (stage gaps, drift, sensor
-misfits, ranked candidates with their held-out gaps and bootstrap intervals) and call these.
+``localise.localise`` and ``diagnosis.diagnose`` compute the numbers (stage gaps, drift, sensor misfits, ranked
+candidates with their held-out gaps and bootstrap intervals) and call these.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Mapping, Sequence
+from typing import Any, Mapping, Sequence
 
 import numpy as np
 
 
 @dataclass(frozen=True)
 class PlaceThresholds:
-    """The place's thresholds (config ``gap.place``; measured on rig data with each effect, docs/gap.md; the
-    schema holds the same defaults, which tests/test_config.py checks): the records drift when their trend exceeds
-    ``drift_z`` standard errors; the structure and sensor model disagrees with the records when the inverse
-    identification's sensor misfit exceeds ``residual_factor`` times its scatter; the normal contact is not
-    elastic when the best elastic normal law leaves more than ``normal_limit`` of N; the contact is open where
-    the identified N is at or below ``open_limit`` times the preload N0. A record whose response is more than
-    ``aperiodic_limit`` not periodic at the drive (``harmonics.aperiodic_share``, the worst accelerometer) does not
-    settle: the localisation reports it (``where.periodicity``), the place does not use it."""
+    """Thresholds of the place where the gap lies (config ``gap.place``).
+
+    Measured on rig data with each effect (docs/gap.md); the schema holds the same defaults, which tests/test_config.py
+    checks. A record whose response is more than ``aperiodic_limit`` not periodic at the drive
+    (``harmonics.aperiodic_share``, the worst accelerometer) does not settle: the localisation reports it
+    (``where.periodicity``), the place does not use it.
+
+    Attributes
+    ----------
+    drift_z
+        The records drift when their trend exceeds this many standard errors [-].
+    residual_factor
+        The structure and sensor model disagrees with the records when the inverse identification's sensor misfit
+        exceeds this many times its scatter [-].
+    normal_limit
+        The normal contact is not elastic when the best elastic normal law leaves more than this share of N [-].
+    open_limit
+        The contact is open where the identified N is at or below this fraction of the preload N0 [-].
+    aperiodic_limit
+        Share of a record's response not periodic at the drive above which it does not settle [-].
+    """
 
     drift_z: float = 8.0
     residual_factor: float = 20.0
@@ -33,51 +47,128 @@ class PlaceThresholds:
 
     @classmethod
     def from_config(cls, block: Mapping | None) -> "PlaceThresholds":
-        """From the ``gap.place`` block (keys left out: the defaults)."""
+        """Return the thresholds of the ``gap.place`` block.
+
+        Parameters
+        ----------
+        block
+            The ``gap.place`` config block (drift_z, residual_factor, normal_limit, open_limit, aperiodic_limit; keys
+            left out: the defaults); None: every default.
+
+        Returns
+        -------
+        thresholds : PlaceThresholds
+            The thresholds.
+        """
         return cls(**{k: float(v) for k, v in (block or {}).items()})
 
 
 DEFAULT_PLACE = PlaceThresholds()
 
 
-def open_fraction(normal_force, preload: float, open_limit: float = DEFAULT_PLACE.open_limit) -> float:
-    """Share of the cycle's samples where the contact is open: N at or below ``open_limit`` x the preload N0."""
+def open_fraction(normal_force: np.ndarray, preload: float, open_limit: float = DEFAULT_PLACE.open_limit) -> float:
+    """Return the share of the cycle's samples where the contact is open: N at or below ``open_limit`` x the preload N0.
+
+    Parameters
+    ----------
+    normal_force
+        Total normal force N over one cycle [N], shape (n_samples,).
+    preload
+        The static preload N0 [N].
+    open_limit
+        Fraction of the preload at or below which the contact is open [-].
+
+    Returns
+    -------
+    fraction : float
+        Share of the samples where the contact is open [-].
+    """
     return float(np.mean(np.asarray(normal_force) <= open_limit * preload))
 
 
 def never_opens(step: Mapping) -> bool:
-    """Whether an explanation step is a contact-separation law that never opened the contact in its simulations
-    (``explanation[k].contact_opens`` false): it stands for a stiffer or harder normal law, model form."""
+    """Return whether an explanation step is a contact-separation law that never opened the contact.
+
+    Such a step (``explanation[k].contact_opens`` false in its simulations) stands for a stiffer or harder normal law,
+    model form.
+
+    Parameters
+    ----------
+    step
+        An explanation step; read: effect, contact_opens.
+
+    Returns
+    -------
+    never : bool
+        True for a contact-separation step whose simulations never opened the contact.
+    """
     return step.get("effect") == "contact_separation" and step.get("contact_opens") is False
 
 
 def acts_where(acts_on: str, place: str) -> bool:
-    """Whether a candidate acting on ``acts_on`` acts where the gap lies: the same place, "any", or either
-    contact direction when the place is "contact" (the normal motion not observable)."""
+    """Return whether a candidate acting on ``acts_on`` acts where the gap lies.
+
+    The same place, "any", or either contact direction when the place is "contact" (the normal motion not observable).
+
+    Parameters
+    ----------
+    acts_on
+        Where the candidate acts (``Candidate.acts_on``).
+    place
+        Where the gap lies (``place``).
+
+    Returns
+    -------
+    acts : bool
+        True where the candidate acts at the place.
+    """
     return acts_on in ("any", place) or (place == "contact" and acts_on in ("normal_contact", "tangential_contact"))
 
 
 def place(
     drift: Mapping[str, Mapping],
     stage: Mapping[str, float],
-    id_res,
-    scatter,
+    id_res: np.ndarray | Sequence[float],
+    scatter: np.ndarray | Sequence[float],
     eta_observable: bool = True,
     eta_spread: float = 0.0,
     thresholds: PlaceThresholds = DEFAULT_PLACE,
 ) -> tuple[str, str]:
-    """Where the gap lies, with the reason: (place, reason).
+    """Return where the gap lies, with the reason: (place, reason).
 
-    drift: per load case {"change": relative change over the record, "z": its size in standard errors};
-    stage: at least "open_fraction", "contact_force_N" and "contact_force_S" (relative gaps);
-    id_res, scatter: per load case, the inverse identification's sensor misfit and its standard error.
-    The first that holds of: the records drift (median z > thresholds.drift_z) -> "non_stationary"; the
-    structure and sensor model misfits the records (median id_res / scatter > thresholds.residual_factor) ->
-    "structure_or_measurement"; the contact opens (the identified N, observable, reaches zero) ->
-    "normal_contact"; the normal motion eta is not observable (``eta_observable`` False: the identified eta
-    moves by ``eta_spread`` over the structures the data allow), so the normal law cannot be tested and the
-    directions cannot be told apart -> "contact"; no elastic normal law fits N(eta) (contact_force_N >
-    thresholds.normal_limit) -> "normal_contact"; otherwise "tangential_contact"."""
+    The first that holds of: the records drift (median z > thresholds.drift_z) -> "non_stationary"; the structure and
+    sensor model misfits the records (median id_res / scatter > thresholds.residual_factor) ->
+    "structure_or_measurement"; the contact opens (the identified N, observable, reaches zero) -> "normal_contact"; the
+    normal motion eta is not observable (``eta_observable`` False: the identified eta moves by ``eta_spread`` over the
+    structures the data allow), so the normal law cannot be tested and the directions cannot be told apart -> "contact";
+    no elastic normal law fits N(eta) (contact_force_N > thresholds.normal_limit) -> "normal_contact"; otherwise
+    "tangential_contact".
+
+    Parameters
+    ----------
+    drift
+        Per load case {"change": relative change over the record, "z": its size in standard errors}.
+    stage
+        The stage gaps, at least "open_fraction", "contact_force_N" and "contact_force_S" (relative gaps and the share
+        of the cycle the contact is open) [-].
+    id_res
+        Per load case, the inverse identification's relative sensor misfit [-], shape (n_cases,).
+    scatter
+        Per load case, the standard error of ``id_res`` [-], shape (n_cases,).
+    eta_observable
+        Whether the identified normal motion eta is observable.
+    eta_spread
+        Largest relative change of the identified eta over the structures the data allow [-].
+    thresholds
+        The place's thresholds.
+
+    Returns
+    -------
+    place : str
+        "non_stationary", "structure_or_measurement", "normal_contact", "contact" or "tangential_contact".
+    reason : str
+        The reason, a sentence with its numbers.
+    """
     id_res, scatter = np.asarray(id_res, float), np.asarray(scatter, float)
     z = np.array([v["z"] for v in drift.values()])
     if np.median(z) > thresholds.drift_z:
@@ -113,46 +204,125 @@ def place(
     )
 
 
-def setting(settings, name: str) -> float:
-    """The gap setting ``name`` (min_gap, min_reduction, ...) from GapSettings or a mapping of them."""
+def setting(settings: Any, name: str) -> float:
+    """Return the gap setting ``name`` (min_gap, min_reduction, ...) from GapSettings or a mapping of them.
+
+    Parameters
+    ----------
+    settings
+        GapSettings, or a mapping of the gap settings.
+    name
+        The setting's name.
+
+    Returns
+    -------
+    value : float
+        The setting's value; the settings read through it (min_gap, min_reduction, separation, noise_factor) are
+        dimensionless [-].
+    """
     return float(settings[name] if isinstance(settings, Mapping) else getattr(settings, name))
 
 
 def percent(gap: float, digits: int = 3) -> str:
-    """A held-out gap (a fraction) for people: in per cent, as the report prints every gap ("0.298 %")."""
+    """Return a held-out gap (a fraction) for people: in per cent, as the report prints every gap ("0.298 %").
+
+    Parameters
+    ----------
+    gap
+        The gap, a fraction [-].
+    digits
+        Significant digits.
+
+    Returns
+    -------
+    text : str
+        The gap in per cent to ``digits`` significant digits, followed by " %".
+    """
     return f"{100 * float(gap):.{digits}g} %"
 
 
-def explains_most(gap: float, after: float, scatter: float, settings) -> bool:
-    """Whether a change of the model explains most of a held-out gap: it shrinks the whole gap by at least
-    min_reduction and by more than noise_factor x the records' scatter. The test of a model update (by the records, and
-    as a verdict), as a candidate's verdict asks min_reduction of the whole gap; an explanation's steps ask
-    ``explains_materially`` instead."""
+def explains_most(gap: float, after: float, scatter: float, settings: Any) -> bool:
+    """Return whether a change of the model explains most of a held-out gap.
+
+    It shrinks the whole gap by at least min_reduction and by more than noise_factor x the records' scatter. The test of
+    a model update (by the records, and as a verdict), as a candidate's verdict asks min_reduction of the whole gap; an
+    explanation's steps ask ``explains_materially`` instead.
+
+    Parameters
+    ----------
+    gap
+        The held-out gap before the change [-].
+    after
+        The held-out gap after it [-].
+    scatter
+        The records' scatter: sd of the gap over the bootstrap [-].
+    settings
+        GapSettings, or a mapping of them; read: min_reduction, noise_factor.
+
+    Returns
+    -------
+    explains : bool
+        False where either gap is not finite.
+    """
     if not (np.isfinite(gap) and np.isfinite(after)):
         return False
     drop = gap - after
     return bool(drop >= setting(settings, "min_reduction") * gap and drop > setting(settings, "noise_factor") * scatter)
 
 
-def explainable(gap: float, settings) -> float:
-    """The part of a held-out gap an effect can explain: what lies above the identification's own floor (min_gap),
-    taken in quadrature as an rms is, sqrt(gap^2 - min_gap^2) (0 at or below the floor)."""
+def explainable(gap: float, settings: Any) -> float:
+    """Return the part of a held-out gap an effect can explain: what lies above the identification's floor.
+
+    The floor is min_gap, the identification's own; the part above it is taken in quadrature as an rms is, sqrt(gap^2 -
+    min_gap^2) (0 at or below the floor).
+
+    Parameters
+    ----------
+    gap
+        The held-out gap [-].
+    settings
+        GapSettings, or a mapping of them; read: min_gap.
+
+    Returns
+    -------
+    above : float
+        The part above the floor [-].
+    """
     return float(np.sqrt(max(gap**2 - setting(settings, "min_gap") ** 2, 0.0)))
 
 
-def explains_materially(gap: float, after: float, scatter: float, settings) -> bool:
-    """Whether an added effect shrinks what is left of the held-out gap materially (the additive explanation's
-    stopping rule; gap and after are the held-out gaps before and after the step):
+def explains_materially(gap: float, after: float, scatter: float, settings: Any) -> bool:
+    """Return whether an added effect shrinks what is left of the held-out gap materially.
+
+    The additive explanation's stopping rule; gap and after are the held-out gaps before and after the step. All of:
+
     - what is left above the identification's floor (``explainable``) shrinks by at least min_reduction. Measured
       against the floor because no effect takes a gap below it: with min_reduction of the whole gap, a step could never
-      be added once the gap was below twice the floor, and two-effect items whose first step left 1.3-1.8 x the floor
-      (a damping ratio beside a normal dashpot) stopped there;
+      be added once the gap was below twice the floor, and two-effect items whose first step left 1.3-1.8 x the floor (a
+      damping ratio beside a normal dashpot) stopped there;
     - the records tell the step from leaving the model as it is, as a verdict's winner from its runner-up: the gap
       before is at least separation x the gap after. Far above the floor the first rule asks more; near it every
-      candidate with a free parameter takes up some of the identification's own misfit (a rig whose accelerometers
-      were 30 % light and nothing else off: the update left 0.755 %, a normal-law shape took it to 0.640 %, every
-      other candidate, off included, within separation);
-    - the gap shrinks by more than noise_factor x the records' scatter."""
+      candidate with a free parameter takes up some of the identification's own misfit (a rig whose accelerometers were
+      30 % light and nothing else off: the update left 0.755 %, a normal-law shape took it to 0.640 %, every other
+      candidate, off included, within separation);
+    - the gap shrinks by more than noise_factor x the records' scatter.
+
+    Parameters
+    ----------
+    gap
+        The held-out gap before the step [-].
+    after
+        The held-out gap after it [-].
+    scatter
+        The records' scatter: sd of the gap over the bootstrap [-].
+    settings
+        GapSettings, or a mapping of them; read: min_gap, min_reduction, separation, noise_factor.
+
+    Returns
+    -------
+    explains : bool
+        False where either gap is not finite.
+    """
     if not (np.isfinite(gap) and np.isfinite(after)):
         return False
     above = explainable(gap, settings)
@@ -165,46 +335,98 @@ def explains_materially(gap: float, after: float, scatter: float, settings) -> b
     )
 
 
-def indistinguishable(gaps: Mapping[str, float], best: str, settings) -> list:
-    """The candidates of one explanation pass the records cannot tell from the one added (``best``): those whose
-    held-out gap after is below ``separation`` times its own (the rule by which the verdict calls a winner), closest
-    first. gaps: {candidate: held-out gap after it} of the pass. A step with such alternatives says which effect
-    explains the gap only up to them (a compliant clamp's 1.13 % was taken to 0.553 % by a channel skew and to
-    0.554 % by a normal dashpot)."""
+def indistinguishable(gaps: Mapping[str, float], best: str, settings: Any) -> list:
+    """Return the candidates of one explanation pass the records cannot tell from the one added (``best``).
+
+    Those whose held-out gap after is below ``separation`` times its own (the rule by which the verdict calls a winner),
+    closest first. A step with such alternatives says which effect explains the gap only up to them (a compliant clamp's
+    1.13 % was taken to 0.553 % by a channel skew and to 0.554 % by a normal dashpot).
+
+    Parameters
+    ----------
+    gaps
+        {candidate: held-out gap after it} of the pass [-].
+    best
+        The candidate added.
+    settings
+        GapSettings, or a mapping of them; read: separation.
+
+    Returns
+    -------
+    others : list
+        The other candidates' names, closest gap first.
+    """
     limit = setting(settings, "separation") * gaps[best]
     others = [n for n, g in gaps.items() if n != best and np.isfinite(g) and g < limit]
     return sorted(others, key=lambda n: gaps[n])
 
 
-def records_accept_update(gap_chain: float, gap_updated: float, scatter: float, settings) -> bool:
-    """Whether the dual-sine records accept a model update the random test's chi^2 test did not: the chain's
-    held-out gap is above the identification's floor (there is something to explain) and the update explains it
-    by min_reduction of it and beyond noise_factor x the records' scatter (``explains_most``: measured against the whole
-    gap, not only what lies above the floor as an explanation's step is; with the latter, the detection ladder's channel
-    skew at a third, seed 1, had an update accepted, 1.57 -> 0.79 %, that stood in for half the skew, and the verdict
-    went to none). gap_chain, gap_updated: held-out gaps of the chain's model and of the
-    updated one (each with its friction law refitted); scatter: the sd of the chain's gap over the records'
-    bootstrap. Beyond the scatter alone is not enough: on rigs whose structure is the model's, updates fitted to the
-    random test's noise took a share of a contact effect's gap (multi-asperity friction) and hid the effect
-    (docs/measurements.md)."""
+def records_accept_update(gap_chain: float, gap_updated: float, scatter: float, settings: Any) -> bool:
+    """Return whether the dual-sine records accept a model update the random test's chi^2 test did not.
+
+    The chain's held-out gap is above the identification's floor (there is something to explain) and the update explains
+    it by min_reduction of it and beyond noise_factor x the records' scatter (``explains_most``: measured against the
+    whole gap, not only what lies above the floor as an explanation's step is; with the latter, the detection ladder's
+    channel skew at a third, seed 1, had an update accepted, 1.57 -> 0.79 %, that stood in for half the skew, and the
+    verdict went to none). Beyond the scatter alone is not enough: on rigs whose structure is the model's, updates
+    fitted to the random test's noise took a share of a contact effect's gap (multi-asperity friction) and hid the
+    effect (docs/measurements.md).
+
+    Parameters
+    ----------
+    gap_chain
+        Held-out gap of the chain's model (its friction law refitted) [-].
+    gap_updated
+        Held-out gap of the updated model (its friction law refitted) [-].
+    scatter
+        The sd of the chain's gap over the records' bootstrap [-].
+    settings
+        GapSettings, or a mapping of them; read: min_gap, min_reduction, noise_factor.
+
+    Returns
+    -------
+    accepted : bool
+        False where either gap is not finite or the chain's gap is at the floor.
+    """
     if not (np.isfinite(gap_chain) and np.isfinite(gap_updated)) or at_floor(gap_chain, settings):
         return False
     return explains_most(gap_chain, gap_updated, scatter, settings)
 
 
 def records_prefer_gains(
-    gap_structure: float, gap_gains: float, scatter: float, settings, gap_chain: float | None = None
+    gap_structure: float, gap_gains: float, scatter: float, settings: Any, gap_chain: float | None = None
 ) -> bool:
-    """Whether the dual-sine records call for the accelerometer channels' gains where the random test cannot tell
-    them from the structure's factors (``evidence.records_test_of_gains``): the model updated with the gains and read
-    through them leaves a held-out gap (``gap_gains``) below the structure-alone update's (``gap_structure``) by a
-    factor of ``separation`` and by more than noise_factor x the records' ``scatter``. Otherwise the structure is kept:
-    a rig's structure is off a few per cent everywhere, and the candidate ``channel_gain_error`` still applies the
-    gains on it. Unless the records contradict the structure alone: it leaves more than the chain's own model
-    (``gap_chain``, not updated) and more than the gains' model, each by more than noise_factor x the scatter. Channels
-    3 % off apart beside a normal dashpot on a rig a few per cent off (E +1.7 %, accelerometers +29 %): the structure
-    alone took a clamp 1600 x compliant for the gains and widened the gap, 11.87 -> 13.09 % (the gains' model 11.94 %),
-    and the explanation left 3.9 % naming neither effect; with the gains, both were named and 1.3 % left."""
+    """Return whether the dual-sine records call for the accelerometer channels' gains.
+
+    Where the random test cannot tell them from the structure's factors (``evidence.records_test_of_gains``): the model
+    updated with the gains and read through them leaves a held-out gap (``gap_gains``) below the structure-alone
+    update's (``gap_structure``) by a factor of ``separation`` and by more than noise_factor x the records' ``scatter``.
+    Otherwise the structure is kept: a rig's structure is off a few per cent everywhere, and the candidate
+    ``channel_gain_error`` still applies the gains on it. Unless the records contradict the structure alone: it leaves
+    more than the chain's own model (``gap_chain``, not updated) and more than the gains' model, each by more than
+    noise_factor x the scatter. Channels 3 % off apart beside a normal dashpot on a rig a few per cent off (E +1.7 %,
+    accelerometers +29 %): the structure alone took a clamp 1600 x compliant for the gains and widened the gap, 11.87 ->
+    13.09 % (the gains' model 11.94 %), and the explanation left 3.9 % naming neither effect; with the gains, both were
+    named and 1.3 % left.
+
+    Parameters
+    ----------
+    gap_structure
+        Held-out gap of the structure-alone update [-].
+    gap_gains
+        Held-out gap of the update with the gains, read through them [-].
+    scatter
+        The records' scatter: sd of the structure-alone gap over the bootstrap [-].
+    settings
+        GapSettings, or a mapping of them; read: separation, noise_factor.
+    gap_chain
+        Held-out gap of the chain's model, not updated [-]; None: not taken.
+
+    Returns
+    -------
+    preferred : bool
+        True where the records call for the gains.
+    """
     if not (np.isfinite(gap_structure) and np.isfinite(gap_gains)):
         return False
     beyond = setting(settings, "noise_factor") * scatter
@@ -214,23 +436,59 @@ def records_prefer_gains(
     return bool(contradicted or gap_structure >= setting(settings, "separation") * gap_gains)
 
 
-def records_carry_factor(gap_chain: float, alone: float, without: float, scatter: float, settings) -> bool:
-    """Whether the dual-sine records put an accepted update on one factor: that factor's effect alone (held-out gap
-    ``alone``) explains the chain's gap materially (``records_accept_update``) and the update without the factor
-    (``without``) leaves ``settings.separation`` times as much, as a verdict's runner-up must
-    (``evidence.records_attribution``)."""
+def records_carry_factor(gap_chain: float, alone: float, without: float, scatter: float, settings: Any) -> bool:
+    """Return whether the dual-sine records put an accepted update on one factor.
+
+    That factor's effect alone (held-out gap ``alone``) explains the chain's gap materially (``records_accept_update``)
+    and the update without the factor (``without``) leaves ``settings.separation`` times as much, as a verdict's
+    runner-up must (``evidence.records_attribution``).
+
+    Parameters
+    ----------
+    gap_chain
+        The chain's held-out gap [-].
+    alone
+        Held-out gap with the factor's effect alone [-].
+    without
+        Held-out gap of the update without the factor [-].
+    scatter
+        The records' scatter: sd of the chain's gap over the bootstrap [-].
+    settings
+        GapSettings, or a mapping of them; read: min_gap, min_reduction, noise_factor, separation.
+
+    Returns
+    -------
+    carries : bool
+        True where the factor carries the update.
+    """
     return (
         records_accept_update(gap_chain, alone, scatter, settings)
         and without >= setting(settings, "separation") * alone
     )
 
 
-def retried(first_thetas: Mapping[str, Sequence], library: Mapping, settings) -> list:
-    """The candidates the explanation tries again after its first step: those whose refit alone moved them off
-    (a candidate the calibration case sets off on its own is not tried on what later steps leave), or all of them
-    with ``settings.retry_unmoved``. Measured on the compound benchmark's logs (40 items): every effect named at a
-    later step had moved alone; of the unmoved, one was later named, falsely, on a perturbation-only set; they took
-    a sixth of the later passes' time."""
+def retried(first_thetas: Mapping[str, Sequence], library: Mapping, settings: Any) -> list:
+    """Return the candidates the explanation tries again after its first step.
+
+    Those whose refit alone moved them off (a candidate the calibration case sets off on its own is not tried on what
+    later steps leave), or all of them with ``settings.retry_unmoved``. Measured on the compound benchmark's logs (40
+    items): every effect named at a later step had moved alone; of the unmoved, one was later named, falsely, on a
+    perturbation-only set; they took a sixth of the later passes' time.
+
+    Parameters
+    ----------
+    first_thetas
+        {candidate: its parameters refitted alone, in their own units}.
+    library
+        The candidate library {name: Candidate} (its parameters' ``is_off``).
+    settings
+        GapSettings; read: retry_unmoved.
+
+    Returns
+    -------
+    names : list
+        The candidates to try again, in the order of ``first_thetas``.
+    """
     if settings.retry_unmoved:
         return list(first_thetas)
     out = []
@@ -242,14 +500,43 @@ def retried(first_thetas: Mapping[str, Sequence], library: Mapping, settings) ->
     return out
 
 
-def at_floor(gap: float, settings) -> bool:
-    """Whether a held-out gap is at the identification's own floor (below min_gap): nothing left to explain."""
+def at_floor(gap: float, settings: Any) -> bool:
+    """Return whether a held-out gap is at the identification's own floor (below min_gap): nothing left to explain.
+
+    Parameters
+    ----------
+    gap
+        The held-out gap [-].
+    settings
+        GapSettings, or a mapping of them; read: min_gap.
+
+    Returns
+    -------
+    at_floor : bool
+        True below min_gap.
+    """
     return bool(gap < setting(settings, "min_gap"))
 
 
 def gap_shares(before: float, steps_after: Sequence[float]) -> tuple[list, float]:
-    """Shares of the held-out gap's power (its square) removed by each step of the additive explanation, and the
-    share left: they sum to 1. before: the identified model's held-out gap; steps_after: the gap after each step."""
+    """Return the shares of the held-out gap's power (its square) removed by each step of the additive explanation.
+
+    And the share left: they sum to 1.
+
+    Parameters
+    ----------
+    before
+        The identified model's held-out gap [-].
+    steps_after
+        The held-out gap after each step [-].
+
+    Returns
+    -------
+    shares : list
+        Share of the power removed by each step [-].
+    left : float
+        Share of the power left after the last step [-].
+    """
     shares, prev = [], before
     for after in steps_after:
         shares.append(float((prev**2 - after**2) / before**2))
@@ -270,15 +557,33 @@ UPDATING_Z = 2.0  # a factor moved when |ln factor| exceeds this many posterior 
 
 
 def _profile(ident: Mapping) -> float | None:
-    """A factor's profile as the verdict reads it: its group's (held at nominal with the group's other factors,
-    ``updating_model.PROFILE_GROUPS``) where it has one, else its own (None in an older model_updating.json)."""
+    """Return a factor's profile as the verdict reads it.
+
+    Its group's (held at nominal with the group's other factors, ``updating_model.PROFILE_GROUPS``) where it has one,
+    else its own (None in an older model_updating.json).
+    """
     return ident.get("group_profile_chi2_increase", ident.get("profile_chi2_increase"))
 
 
 def moved_factors(factors: Mapping[str, float], identifiability: Mapping[str, Mapping]) -> list:
-    """The factors of an update that moved on their own: holding the factor (with its group) at its nominal value
-    raises the posterior misfit by more than UPDATING_Z^2, or, without a profile (an older model_updating.json),
-    |ln factor| > UPDATING_Z posterior sd."""
+    """Return the factors of an update that moved on their own.
+
+    Holding the factor (with its group) at its nominal value raises the posterior misfit by more than UPDATING_Z^2, or,
+    without a profile (an older model_updating.json), |ln factor| > UPDATING_Z posterior sd.
+
+    Parameters
+    ----------
+    factors
+        {factor: value} of the update, multipliers of the nominal values [-].
+    identifiability
+        {factor: its identifiability} (model_updating.json's: profile_chi2_increase, group_profile_chi2_increase,
+        posterior_sd).
+
+    Returns
+    -------
+    moved : list
+        The factors that moved, in the order of ``factors``.
+    """
 
     def has_moved(f, v):
         d = identifiability[f]
@@ -295,23 +600,42 @@ def updating_effect(
     by_records: bool = False,
     attribution: Mapping | None = None,
 ) -> str | None:
-    """The library effect an accepted model update amounts to: when the structural factors that moved all map to one
-    effect (UPDATING_EFFECTS; the two transducer-mass factors map to the same one), that effect; else None. A factor
-    moved when holding it at its nominal value raises the posterior misfit by more than UPDATING_Z^2 (its profile,
-    ``profile_chi2_increase``), or, where the update has no profile (an older model_updating.json), when |ln factor|
-    > UPDATING_Z posterior sd. The profile
-    does not depend on where the poorly bound parameters (k_n, the lever arm) came to rest, which the linearised sd
-    does: the blind benchmark's transducer masses +20 % were found at 1.194-1.197 in two runs, at 2.7 and 1.8
-    linearised sd (k_n 2.34e7 and 2.23e7 N/m), and called "none" the second time.
+    """Return the library effect an accepted model update amounts to.
+
+    When the structural factors that moved all map to one effect (UPDATING_EFFECTS; the two transducer-mass factors map
+    to the same one), that effect; else None. A factor moved when holding it at its nominal value raises the posterior
+    misfit by more than UPDATING_Z^2 (its profile, ``profile_chi2_increase``), or, where the update has no profile (an
+    older model_updating.json), when |ln factor| > UPDATING_Z posterior sd. The profile does not depend on where the
+    poorly bound parameters (k_n, the lever arm) came to rest, which the linearised sd does: the blind benchmark's
+    transducer masses +20 % were found at 1.194-1.197 in two runs, at 2.7 and 1.8 linearised sd (k_n 2.34e7 and 2.23e7
+    N/m), and called "none" the second time.
 
     ``by_records``: the update was accepted by the dual-sine records, not by the random test's chi^2 test, whose
-    profiles then stay below UPDATING_Z^2 (the detection ladder's transducer masses +10 %: 1.1-1.2). The records
-    have shown the update is real; the random test's profiles still say which factor carries it: the one whose
-    profile is at least UPDATING_Z^2 times every other factor's (1.24 against 0.03 there). The same rule serves an
-    update the chi^2 test accepted with no factor moved on its own (a drop just above its bar). Where the profiles
-    do not tell (the ladder's transducer masses +3 %: 0.081 against the mass scale's 0.045), the records' own
-    ``attribution`` (``evidence.records_attribution``: the factor whose effect alone explains the gap and without
-    which the update does not) names it."""
+    profiles then stay below UPDATING_Z^2 (the detection ladder's transducer masses +10 %: 1.1-1.2). The records have
+    shown the update is real; the random test's profiles still say which factor carries it: the one whose profile is at
+    least UPDATING_Z^2 times every other factor's (1.24 against 0.03 there). The same rule serves an update the chi^2
+    test accepted with no factor moved on its own (a drop just above its bar). Where the profiles do not tell (the
+    ladder's transducer masses +3 %: 0.081 against the mass scale's 0.045), the records' own ``attribution``
+    (``evidence.records_attribution``: the factor whose effect alone explains the gap and without which the update does
+    not) names it.
+
+    Parameters
+    ----------
+    factors
+        {factor: value} of the update, multipliers of the nominal values [-].
+    identifiability
+        {factor: its identifiability} (model_updating.json's: group, profile_chi2_increase, group_profile_chi2_increase,
+        posterior_sd).
+    by_records
+        Whether the dual-sine records accepted the update (not the random test's chi^2 test).
+    attribution
+        The records' attribution (``evidence.records_attribution``); None: not made.
+
+    Returns
+    -------
+    effect : str | None
+        The library effect's name, or None where the update amounts to none or to several.
+    """
     if by_records and attribution and attribution.get("effect"):
         return str(attribution["effect"])
     # the units a profile is taken of: a factor, or the factors of a group held at nominal together (the two
