@@ -1,5 +1,6 @@
-"""Sim-to-real gap diagnosis: the identified model (the "sim") against the records (the "real"): where they
-disagree, which unmodelled effect explains it, how far the gap shrinks, and what the records cannot tell.
+"""Sim-to-real gap diagnosis: the identified model (the "sim") against the records (the "real").
+
+Where they disagree, which unmodelled effect explains it, how far the gap shrinks, and what the records cannot tell.
 
 Modules, by role:
 - settings and the run: ``settings`` (GapSettings, read once from the config), ``diagnosis`` (the Diagnosis and

@@ -1,16 +1,21 @@
-"""The blind benchmark's scores, from the items' result rows: top-1 accuracy, confusion matrix, false alarms and the
-leave-out results (``score``, ``confusion_figure``), the compound items' (``compound_score``; the friction law's errors
-against the rig's truth, the effects an explanation names), the detection ladder's (``ladder_score``) and the records'
-check's false alarms (``records_check_score``)."""
+"""The blind benchmark's scores, from the items' result rows.
+
+Top-1 accuracy, confusion matrix, false alarms and the leave-out results (``score``, ``confusion_figure``), the compound
+items' (``compound_score``; the friction law's errors against the rig's truth, the effects an explanation names), the
+detection ladder's (``ladder_score``) and the records' check's false alarms (``records_check_score``).
+"""
 
 from __future__ import annotations
 
-from typing import Mapping
+from typing import TYPE_CHECKING, Mapping, Sequence
 
 import numpy as np
 
 from .bench_items import EXPECTED_PLACE
 from .story import effect_steps
+
+if TYPE_CHECKING:
+    from .model import IdentifiedModel
 
 # candidates that explain a contact effect (a perturbation-only set must name none of them); contact_separation
 # changes the normal law's shape, which the perturbation's hardening also does, so it counts as model form
@@ -20,8 +25,22 @@ SCORED_INTERVALS = ("mu", "kappa", "e0", "mu_a", "e0_a2")
 
 
 def records_check_score(rows: list) -> dict:
-    """How often the records' check called the benchmark's (right) records wrong: findings with a signature (false
-    alarms, which would make the verdict records_disagree) and gross warnings, over the items it ran on."""
+    """Return how often the records' check called the benchmark's (right) records wrong.
+
+    Its findings with a signature (false alarms, which would make the verdict records_disagree) and its gross warnings,
+    over the items it ran on.
+
+    Parameters
+    ----------
+    rows
+        The items' result rows (``benchmark``'s dicts); those with a ``records_check`` mapping count.
+
+    Returns
+    -------
+    scores : dict
+        {"items": items the check ran on, "false_alarms": items it did not pass, "gross_warnings": items with a
+        gross finding}.
+    """
     ran = [r["records_check"] for r in rows if isinstance(r.get("records_check"), Mapping)]
     return {
         "items": len(ran),
@@ -31,7 +50,22 @@ def records_check_score(rows: list) -> dict:
 
 
 def score(rows: list) -> dict:
-    """Top-1 accuracy, confusion matrix, false alarms, shrink and the leave-out results."""
+    """Return top-1 accuracy, confusion matrix, false alarms, shrink and the leave-out results.
+
+    Parameters
+    ----------
+    rows
+        The items' result rows (``benchmark``'s dicts, kinds blind, effect_free, leave_out and compound; failed
+        items listed apart).
+
+    Returns
+    -------
+    scores : dict
+        The scores: n_blind, top1_accuracy [-], n_effect_free, false_alarms, shrink_of_correct (min and median [-],
+        and whether all are at least a half), leave_out (counts and items), confusion (true effect -> verdict ->
+        count), per_effect_accuracy [-], diagnosis_seconds (median and max [s]), compound (``compound_score``, where
+        there are compound items), failed and two_stories.
+    """
     failed = [r for r in rows if r.get("failed")]
     rows = [r for r in rows if not r.get("failed")]
     comp = [r for r in rows if r["kind"] == "compound"]
@@ -96,10 +130,28 @@ def score(rows: list) -> dict:
 
 
 def ladder_score(rows: list, floor: float, tolerance: float = 0.25) -> dict:
-    """The detection ladder: an item is detectable when the identified model's held-out gap (before model updating,
-    which may take up a transducer-mass effect) exceeds twice the floor (``gap.min_gap``); there the effect must
-    be the verdict and its refitted magnitude within ``tolerance`` of the truth (where the two are comparable,
-    ``refitted_magnitude``). Per item and overall."""
+    """Return the detection ladder's scores, per item and overall.
+
+    An item is detectable when the identified model's held-out gap (before model updating, which may take up a
+    transducer-mass effect) exceeds twice the floor (``gap.min_gap``); there the effect must be the verdict and its
+    refitted magnitude within ``tolerance`` of the truth (where the two are comparable, ``refitted_magnitude``).
+
+    Parameters
+    ----------
+    rows
+        The ladder items' result rows (``benchmark``'s dicts).
+    floor
+        The floor, ``gap.min_gap``: the relative held-out gap the chain's own identification leaves [-].
+    tolerance
+        Largest relative error of a refitted magnitude against the truth [-].
+
+    Returns
+    -------
+    scores : dict
+        Counts (n, n_failed, n_detectable, false_names_below_detectable, two_stories), ``floor`` and ``tolerance``,
+        the shares named_where_detectable and magnitude_within_where_detectable [-], all_named_and_within, and per
+        item its row (magnitude_error relative [-]).
+    """
     items = []
     for r in rows:
         if r.get("failed"):
@@ -149,7 +201,16 @@ def ladder_score(rows: list, floor: float, tolerance: float = 0.25) -> dict:
 
 
 def confusion_figure(result: dict, path: str) -> None:
-    """Heat map of the confusion matrix (rows: true effect, columns: verdict)."""
+    """Draw the heat map of the confusion matrix (rows: true effect, columns: verdict).
+
+    Parameters
+    ----------
+    result
+        The scores of ``score`` (its ``confusion``, ``top1_accuracy``, ``n_blind``, ``false_alarms`` and
+        ``n_effect_free``).
+    path
+        The figure's file (PNG).
+    """
     import matplotlib
 
     matplotlib.use("Agg")
@@ -178,8 +239,24 @@ def confusion_figure(result: dict, path: str) -> None:
 
 
 def friction_truth(truth_friction: Mapping, preload: float, lever_arm: float | None = None) -> dict:
-    """The rig's true mu, kappa and e_0 at the preload (N/m, Eq. 22), and with its true tangential ``lever_arm`` (m)
-    what the data bind: mu a (m) and e_0 a^2 (N m)."""
+    """Return the rig's true mu, kappa and e_0 at the preload (Eq. 22), and with its lever arm what the data bind.
+
+    Given the rig's true tangential ``lever_arm`` a, also what the data bind: mu a and e_0 a^2.
+
+    Parameters
+    ----------
+    truth_friction
+        The rig's true friction law (config ``rig.truth.friction``: mu, kappa, e_f_n_per_m, k_c_per_m).
+    preload
+        The static normal preload [N].
+    lever_arm
+        The rig's true tangential lever arm a [m], or None.
+
+    Returns
+    -------
+    truth : dict
+        {"mu": [-], "kappa": [-], "e0": [N/m]}, and with ``lever_arm`` also {"mu_a": [m], "e0_a2": [N m]}.
+    """
     from ..contact_laws import stiction_shear_stiffness
 
     t = truth_friction
@@ -193,8 +270,23 @@ def friction_truth(truth_friction: Mapping, preload: float, lever_arm: float | N
     return out
 
 
-def friction_errors(model, truth_friction: Mapping, preload: float) -> dict:
-    """Relative errors of the model's mu, kappa and e_0 at the preload against the rig's truth."""
+def friction_errors(model: IdentifiedModel, truth_friction: Mapping, preload: float) -> dict:
+    """Return the relative errors of the model's mu, kappa and e_0 at the preload against the rig's truth.
+
+    Parameters
+    ----------
+    model
+        The model whose friction law is scored (its ``friction``: e_f, k_c, e_t, kappa, mu).
+    truth_friction
+        The rig's true friction law (config ``rig.truth.friction``, as ``friction_truth`` reads it).
+    preload
+        The static normal preload [N].
+
+    Returns
+    -------
+    errors : dict
+        {"mu", "kappa", "e0"}: each the model's value over the truth's, less one [-].
+    """
     from ..contact_laws import stiction_shear_stiffness
 
     e_f, k_c, _, kappa, mu = model.friction
@@ -203,21 +295,65 @@ def friction_errors(model, truth_friction: Mapping, preload: float) -> dict:
     return {"mu": float(mu / t["mu"] - 1), "kappa": float(kappa / t["kappa"] - 1), "e0": float(e0 / t["e0"] - 1)}
 
 
-def bound_errors(model, truth_friction: Mapping, preload: float, true_lever_arm: float) -> dict:
-    """Relative errors of what the data bind when the tangential lever arm a is unknown (``contactid.gap.uncertainty``):
-    mu a and e_0 a^2, the model's a against the rig's true a."""
+def bound_errors(model: IdentifiedModel, truth_friction: Mapping, preload: float, true_lever_arm: float) -> dict:
+    """Return the relative errors of what the data bind when the tangential lever arm a is unknown.
+
+    The products mu a and e_0 a^2 (``contactid.gap.uncertainty``), the model's a against the rig's true a.
+
+    Parameters
+    ----------
+    model
+        The model whose friction law and lever arm are scored (its ``friction`` and
+        ``structure.tangential_lever_arm``).
+    truth_friction
+        The rig's true friction law (config ``rig.truth.friction``, as ``friction_truth`` reads it).
+    preload
+        The static normal preload [N].
+    true_lever_arm
+        The rig's true tangential lever arm a [m].
+
+    Returns
+    -------
+    errors : dict
+        {"mu_a", "e0_a2"}: each the model's product over the truth's, less one [-].
+    """
     err = friction_errors(model, truth_friction, preload)
     r = model.structure.tangential_lever_arm / float(true_lever_arm)
     return {"mu_a": float((1 + err["mu"]) * r - 1), "e0_a2": float((1 + err["e0"]) * r**2 - 1)}
 
 
-def named_effects(explanation) -> list:
-    """The effects an explanation names (``story.effect_steps``), an update by the effect it names."""
+def named_effects(explanation: Sequence[Mapping]) -> list:
+    """Return the effects an explanation names (``story.effect_steps``), an update by the effect it names.
+
+    Parameters
+    ----------
+    explanation
+        The diagnosis's explanation steps (diagnosis.json ``explanation``).
+
+    Returns
+    -------
+    effects : list
+        The named effects, in the explanation's order.
+    """
     return [s.get("names", s["effect"]) for s in effect_steps(explanation)]
 
 
 def compound_score(rows: list) -> dict:
-    """Scores of the compound items (see config/README.md, gap_benchmark.compound)."""
+    """Return the scores of the compound items (see config/README.md, gap_benchmark.compound).
+
+    Parameters
+    ----------
+    rows
+        The compound items' result rows (``benchmark.compound_row``'s dicts).
+
+    Returns
+    -------
+    scores : dict
+        Counts, the shares of items whose named effects are right [-], per effect its recall and precision [-], the
+        median remaining gap [-], the share with an accepted update [-], and for the perturbation-only items the
+        friction law's median absolute relative errors [-], its intervals' coverage [-] and median relative
+        half-widths [-].
+    """
 
     def named(r):
         return set(named_effects(r["explanation"]))

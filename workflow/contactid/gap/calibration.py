@@ -1,13 +1,14 @@
-"""A candidate's calibration: the search for the theta that minimises the calibration case's gap, the chain
-redone (``refit.evaluate``) at every theta it tries.
+"""A candidate's calibration: the search for the theta that minimises the calibration case's gap.
 
-theta minimises the calibration gap, with the friction law refitted at each theta. The held-out load cases are
-then predicted with theta and the refitted friction law, never fitted.
+The chain is redone (``refit.evaluate``) at every theta the search tries: theta minimises the calibration gap, with the
+friction law refitted at each theta. The held-out load cases are then predicted with theta and the refitted friction
+law, never fitted.
 """
 
 from __future__ import annotations
 
 import logging
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -27,8 +28,37 @@ log = logging.getLogger(__name__)
 
 @dataclass
 class Calibration:
-    """A candidate calibrated on the calibration case: theta, the refitted friction law, the
-    calibration gap, the model and augmentation to predict with, and the number of simulations."""
+    """A candidate calibrated on the calibration case.
+
+    Theta, the refitted friction law, the calibration gap, the model and augmentation to predict with, and the number of
+    simulations.
+
+    Attributes
+    ----------
+    candidate
+        The candidate's name.
+    theta
+        The candidate's parameters, each in its own unit (``Parameter.unit``) [units of Candidate.parameters],
+        shape (n_parameters,) (one per accelerometer channel for a per-channel candidate).
+    friction
+        The refitted friction law (e_f, k_c, e_t, kappa, mu) [N/m, 1/m, N/m, -, -], shape (5,).
+    gap
+        The calibration gap: the calibration case's relative misfit of the sensors' harmonics [-].
+    model
+        The identified model with the refitted friction law, to predict with.
+    augmentation
+        The effects added to the model (the earlier steps' and the candidate's at theta), to predict with.
+    evaluations
+        The number of distinct simulations the calibration ran.
+    friction_misfit
+        The refitted law's NRMSE on the identified tangential force S [-] (NaN where the law or the simulation
+        failed).
+    simulation
+        The calibration case's simulation at theta (polished by the integrator), or None where it could not be
+        simulated.
+    steps
+        ((name, theta), ...) of every effect in the augmentation, in the explanation's order.
+    """
 
     candidate: str
     theta: np.ndarray
@@ -43,17 +73,48 @@ class Calibration:
 
 
 class _CandidateRuns:
-    """The chain redone (``evaluate``) at the thetas a calibration tries, each once: called with theta, it returns
-    (gap, model with refitted friction, simulation, friction misfit, augmentation), every simulation starting from
-    the previous one's steady state; a theta the law or the simulation fails at gets an infinite gap (and is logged).
-    Every theta is run polished by the integrator where ``numerics.polish_searches`` (True: every state of the search,
-    so that it sees the reference's gaps to its settling tolerance: held-out gaps within 0.01-0.08 % of the
-    time-marching diagnosis's on benchmarks/gap_diagnosis.py's four data sets, against 2.4-8.6 % with the periodic
-    states alone, same verdicts and, but for near ties, rankings; for 25-90 % more diagnosis time, a contact that may
-    open marching from the linear state then, as the reference does), otherwise only where called with ``polish``.
-    ``evaluations`` counts the distinct runs."""
+    """The chain redone (``evaluate``) at the thetas a calibration tries, each once.
 
-    def __init__(self, model, cand, rec, bounds, n_harmonics: int, start, base, numerics: Numerics = DEFAULT):
+    Called with theta, it returns (gap, model with refitted friction, simulation, friction misfit, augmentation), every
+    simulation starting from the previous one's steady state; a theta the law or the simulation fails at gets an
+    infinite gap (and is logged). Every theta is run polished by the integrator where ``numerics.polish_searches``
+    (True: every state of the search, so that it sees the reference's gaps to its settling tolerance: held-out gaps
+    within 0.01-0.08 % of the time-marching diagnosis's on benchmarks/gap_diagnosis.py's four data sets, against 2.4-8.6
+    % with the periodic states alone, same verdicts and, but for near ties, rankings; for 25-90 % more diagnosis time, a
+    contact that may open marching from the linear state then, as the reference does), otherwise only where called with
+    ``polish``. ``evaluations`` counts the distinct runs.
+
+    Parameters
+    ----------
+    model
+        The identified model the candidate is added to.
+    cand
+        The candidate.
+    rec
+        The calibration case's record harmonics.
+    bounds
+        The friction law's search bounds (``FitSettings.bounds``: 5 x (low, high) of e_f, k_c, e_t, kappa, mu).
+    n_harmonics
+        Harmonics compared in the gap.
+    start
+        The simulation the first run starts from (its steady state), or None.
+    base
+        The effects already added (the explanation's earlier steps); the candidate's are added to them.
+    numerics
+        How the steady states are found and the searches run.
+    """
+
+    def __init__(
+        self,
+        model: IdentifiedModel,
+        cand: Candidate,
+        rec: RecordHarmonics,
+        bounds: tuple,
+        n_harmonics: int,
+        start: SimResult | None,
+        base: Augmentation,
+        numerics: Numerics = DEFAULT,
+    ):
         self.model, self.cand, self.rec, self.base = model, cand, rec, base
         self.bounds, self.n_harmonics, self.numerics = bounds, n_harmonics, numerics
         self.last_sim = start
@@ -86,8 +147,21 @@ class _CandidateRuns:
                 self.cache[key] = (np.inf, self.model, None, np.nan, aug)
         return self.cache[key]
 
-    def residual(self, theta) -> np.ndarray | None:
-        """The calibration gap's residual vector at ``theta`` (``gap_residual``), None where it cannot be simulated."""
+    def residual(self, theta: np.ndarray | float) -> np.ndarray | None:
+        """Return the calibration gap's residual vector at ``theta`` (``gap_residual``), None where not simulated.
+
+        Parameters
+        ----------
+        theta
+            The candidate's parameters [units of Candidate.parameters], shape (n_parameters,) (a scalar for one
+            parameter).
+
+        Returns
+        -------
+        residual : np.ndarray | None
+            The residual vector (complex, relative to the record's acceleration harmonics) [-], shape (n_residual,),
+            or None.
+        """
         g, _, sim, _, _ = self(np.atleast_1d(theta))
         return gap_residual(sim, self.rec, self.n_harmonics) if sim is not None and np.isfinite(g) else None
 
@@ -95,20 +169,21 @@ class _CandidateRuns:
 def _per_channel_theta(
     run: _CandidateRuns, cand: Candidate, rec: RecordHarmonics, max_evaluations: int, common=None
 ) -> np.ndarray:
-    """theta of a per-channel candidate (one parameter per accelerometer channel); zero where that is no worse.
+    """Return theta of a per-channel candidate (a parameter per accelerometer channel); zero where that is no worse.
 
     ``common`` (j,): per-channel values measured elsewhere (channel delays: the random test's residue phases,
-    ``modal_fit.residue_phase_delays``). Their mean is held and Nelder-Mead searches the channels' differences from
-    them (j - 1 parameters; simplex steps of 2.5 % of the range, at most 3 x max_evaluations simulations). The
-    calibration gap does not bind a delay common to every channel: the forces identified from the record and the
-    refitted friction law take it up. From zero, the search put the ladder's skews of 20 us at 12.5-15.6 us and of
-    6.7 us at 12 us (a common shift of about -5 us); from the random test's delays, at 19.8-20.0 us and 6.4 us, with
-    the same calibration gap and 30 simulations instead of 50 (docs/measurements.md).
+    ``modal_fit.residue_phase_delays``). Their mean is held and Nelder-Mead searches the channels' differences from them
+    (j - 1 parameters; simplex steps of 2.5 % of the range, at most 3 x max_evaluations simulations). The calibration
+    gap does not bind a delay common to every channel: the forces identified from the record and the refitted friction
+    law take it up. From zero, the search put the ladder's skews of 20 us at 12.5-15.6 us and of 6.7 us at 12 us (a
+    common shift of about -5 us); from the random test's delays, at 19.8-20.0 us and 6.4 us, with the same calibration
+    gap and 30 simulations instead of 50 (docs/measurements.md).
 
     Without ``common``: Nelder-Mead on the gap from zero, simplex steps of 10 % of the range. (Least squares on the
-    residual vector found a skew's delays more exactly, but also a common delay on every channel, -28 us, that stood
-    in for a normal dashpot's dissipation: a compound benchmark item named the channel skew instead of the dashpot;
-    docs/measurements.md.)"""
+    residual vector found a skew's delays more exactly, but also a common delay on every channel, -28 us, that stood in
+    for a normal dashpot's dissipation: a compound benchmark item named the channel skew instead of the dashpot;
+    docs/measurements.md.)
+    """
     from scipy.optimize import minimize
 
     j = rec.acceleration.shape[0]
@@ -147,8 +222,10 @@ def _per_channel_theta(
 
 
 def _held_gains(channel_gains, j: int) -> np.ndarray:
-    """The channel-gain candidate's theta (gain errors g - 1) from the random test's relative gains, or zeros where
-    they are not known for these j channels."""
+    """Return the channel-gain candidate's theta (gain errors g - 1) from the random test's relative gains.
+
+    Zeros where they are not known for these j channels.
+    """
     g = None if channel_gains is None else np.asarray(channel_gains, dtype=float)
     if g is None or g.size != j or not np.all(np.isfinite(g)) or np.any(g <= 0):
         return np.zeros(j)
@@ -158,10 +235,12 @@ def _held_gains(channel_gains, j: int) -> np.ndarray:
 def _least_squares_unit(
     run: _CandidateRuns, lo: np.ndarray, hi: np.ndarray, x0: np.ndarray, max_evaluations: int
 ) -> np.ndarray:
-    """x in the unit cube of [lo, hi] minimising the residual vector's norm, by trust-region reflective least squares
-    from x0 (finite-difference steps of 1e-3 of each range; at most max(3, max_evaluations // 2) steps, each one
-    simulation plus one per parameter for the Jacobian; a point that cannot be simulated counts as a large
-    residual)."""
+    """Return x in the unit cube of [lo, hi] minimising the residual vector's norm.
+
+    By trust-region reflective least squares from x0 (finite-difference steps of 1e-3 of each range; at most max(3,
+    max_evaluations // 2) steps, each one simulation plus one per parameter for the Jacobian; a point that cannot be
+    simulated counts as a large residual).
+    """
     from scipy.optimize import least_squares
 
     from ..finite_differences import forward_difference_jacobian
@@ -189,20 +268,25 @@ def _least_squares_unit(
 
 
 def _unresolved_from_off(value: float, p, xatol: float) -> bool:
-    """Whether a search's optimum ``value`` of parameter ``p`` lies within the search's tolerance ``xatol`` of the
-    value that leaves the model as it is (and is not that value): the search does not resolve it from "off", which
-    it then is. On the effect-free default data the transducer-mass search ended at -1.07e-5 (tolerance 3.9e-3) in
-    one diagnosis and at "off" in the other: a mass change however small refits k_t and k_n to the frequencies
-    (``model._refit_contact``), whose k_n is flat there and moved k_t by 1e-5, and the held-out gaps of the two
-    diagnoses stood 0.88 % apart (docs/measurements.md, "The searches stop where time marching stops")."""
+    """Return whether a search's optimum ``value`` of parameter ``p`` is not resolved from "off".
+
+    It is not where it lies within the search's tolerance ``xatol`` of the value that leaves the model as it is (and is
+    not that value), and is then taken as "off". On the effect-free default data the transducer-mass search ended at
+    -1.07e-5 (tolerance 3.9e-3) in one diagnosis and at "off" in the other: a mass change however small refits k_t and
+    k_n to the frequencies (``model._refit_contact``), whose k_n is flat there and moved k_t by 1e-5, and the held-out
+    gaps of the two diagnoses stood 0.88 % apart (docs/measurements.md, "The searches stop where time marching stops").
+    """
     return not p.is_off(value) and abs(float(value) - p.off) <= xatol
 
 
 def _scalar_theta(
     run: _CandidateRuns, cand: Candidate, max_evaluations: int, numerics: Numerics = DEFAULT
 ) -> np.ndarray:
-    """theta (1,) of a one-parameter candidate: a scan of the range, the search between the best point's neighbours
-    (``numerics.search``: on the residual vector, or on the gap alone), and "off" where that is better."""
+    """Return theta (1,) of a one-parameter candidate.
+
+    A scan of the range, the search between the best point's neighbours (``numerics.search``: on the residual vector, or
+    on the gap alone), and "off" where that is better.
+    """
     # a scan of the range (1/32, 1/8, 1/4, 1/2, 3/4), then the bounded search between the best point's neighbours:
     # a search over the whole range from its middle can settle in a side basin (the blind benchmark's
     # transducer-mass items: theta 0.35 instead of 0.22, a held-out gap four times larger)
@@ -250,10 +334,12 @@ def _scalar_theta(
 def _simplex_theta(
     run: _CandidateRuns, cand: Candidate, max_evaluations: int, starts, numerics: Numerics = DEFAULT
 ) -> np.ndarray:
-    """theta of a candidate with several parameters, from the best of a scan of the first parameter (and of the earlier
-    optimum and ``starts``): a joint refit by least squares on the residual vector (``numerics.search`` "residual";
-    smooth near the earlier optimum), otherwise Nelder-Mead on the gap in the unit cube of their ranges (a contact that
-    opens makes the gap kinked)."""
+    """Return theta of a candidate with several parameters.
+
+    From the best of a scan of the first parameter (and of the earlier optimum and ``starts``): a joint refit by least
+    squares on the residual vector (``numerics.search`` "residual"; smooth near the earlier optimum), otherwise
+    Nelder-Mead on the gap in the unit cube of their ranges (a contact that opens makes the gap kinked).
+    """
     from scipy.optimize import minimize
 
     lo = np.array([p.low for p in cand.parameters])
@@ -292,24 +378,55 @@ def calibrate(
     max_evaluations: int = 12,
     start: SimResult | None = None,
     base: Augmentation = NONE,
-    starts=(),
-    channel_delays=None,
-    channel_gains=None,
+    starts: Sequence[np.ndarray] = (),
+    channel_delays: np.ndarray | None = None,
+    channel_gains: np.ndarray | None = None,
     numerics: Numerics = DEFAULT,
 ) -> Calibration:
-    """theta of ``cand`` minimising the calibration case's gap (friction law refitted at each theta);
-    each simulation starts from the previous one's steady state (``start``: the model's own). ``base``:
-    effects already added (the additive explanation's earlier steps); the candidate's are added to them. ``starts``:
-    more points (theta) a search over several parameters starts from if they are better than its scan's best.
-    ``channel_delays``: the random test's per-channel delays (s), where known; a per-channel candidate that sets
-    delays holds their common part (``_per_channel_theta``).
-    ``channel_gains``: the channels' gains relative to one another as the random test's residues show them
-    (``UpdatingResult.channel_gains``); the channel-gain candidate applies them as they are (``_held_gains``).
-    ``numerics``: how the steady states are found and the search runs (``numerics.Numerics``). With
+    """Return the calibration of ``cand``: the theta minimising the calibration case's gap.
+
+    The friction law is refitted at each theta; each simulation starts from the previous one's steady state (``start``:
+    the model's own). A per-channel candidate that sets delays holds the common part of ``channel_delays``
+    (``_per_channel_theta``); the channel-gain candidate applies ``channel_gains`` as they are (``_held_gains``). With
     ``numerics.polish_searches`` (the default, the diagnosis's) every state the search compares is polished by the
-    integrator; False: the search compares harmonic-balance states (within 5e-4 of the integrator's orbit) and only
-    the optimum is evaluated again with the integrator's polish, so its gap and simulation are the reference's (same
-    optimum within 1 %, a quarter to a third less diagnosis time, measured on 10 benchmark items).
+    integrator; False: the search compares harmonic-balance states (within 5e-4 of the integrator's orbit) and only the
+    optimum is evaluated again with the integrator's polish, so its gap and simulation are the reference's (same optimum
+    within 1 %, a quarter to a third less diagnosis time, measured on 10 benchmark items). Where nothing in the range
+    can be simulated, the effect is off.
+
+    Parameters
+    ----------
+    model
+        The identified model the candidate is added to.
+    cand
+        The candidate.
+    rec
+        The calibration case's record harmonics.
+    settings
+        The friction fit's settings (its ``bounds`` bound the refitted law).
+    n_harmonics
+        Harmonics compared in the gap.
+    max_evaluations
+        The search's budget of simulations (how each search uses it: config/README.md, ``gap.max_evaluations``).
+    start
+        The simulation the first run starts from (the model's own steady state), or None.
+    base
+        Effects already added (the additive explanation's earlier steps); the candidate's are added to them.
+    starts
+        More points (theta) a search over several parameters starts from if they are better than its scan's best
+        [units of Candidate.parameters], each of shape (n_parameters,).
+    channel_delays
+        The random test's per-channel delays [s], shape (n_sensors,), where known (else None).
+    channel_gains
+        The channels' gains relative to one another as the random test's residues show them
+        (``UpdatingResult.channel_gains``) [-], shape (n_sensors,), or None.
+    numerics
+        How the steady states are found and the search runs (``numerics.Numerics``).
+
+    Returns
+    -------
+    calibration : Calibration
+        The candidate at its optimum, its simulation polished by the integrator.
     """
     run = _CandidateRuns(model, cand, rec, settings.bounds, n_harmonics, start, base, numerics)
     if cand.per_channel:
@@ -337,7 +454,7 @@ def calibrate(
 
 
 def _calibration_at(run: _CandidateRuns, theta) -> Calibration:
-    """The Calibration of ``run``'s candidate at ``theta``: its simulation polished by the integrator."""
+    """Return the Calibration of ``run``'s candidate at ``theta``: its simulation polished by the integrator."""
     theta = np.atleast_1d(theta)
     g, m2, sim, misfit, aug = run(theta, polish=True)
     name = run.cand.name
@@ -350,12 +467,41 @@ def held(
     rec: RecordHarmonics,
     settings: FitSettings,
     n_harmonics: int,
-    theta,
+    theta: np.ndarray,
     start: SimResult | None = None,
     base: Augmentation = NONE,
     numerics: Numerics = DEFAULT,
 ) -> Calibration:
-    """``cand`` at ``theta`` measured elsewhere (channel delays: the random test's residue phases), not searched: the
-    friction law refitted to the calibration case's forces with it, the simulation polished by the integrator."""
+    """Return ``cand`` at a ``theta`` measured elsewhere, not searched.
+
+    The theta comes from elsewhere (channel delays: the random test's residue phases). The friction law is refitted to
+    the calibration case's forces with it, the simulation polished by the integrator.
+
+    Parameters
+    ----------
+    model
+        The identified model the candidate is added to.
+    cand
+        The candidate.
+    rec
+        The calibration case's record harmonics.
+    settings
+        The friction fit's settings (its ``bounds`` bound the refitted law).
+    n_harmonics
+        Harmonics compared in the gap.
+    theta
+        The candidate's parameters as measured [units of Candidate.parameters], shape (n_parameters,).
+    start
+        The simulation the run starts from (the model's own steady state), or None.
+    base
+        Effects already added (the additive explanation's earlier steps); the candidate's are added to them.
+    numerics
+        How the steady states are found (``numerics.Numerics``).
+
+    Returns
+    -------
+    calibration : Calibration
+        The candidate at ``theta``.
+    """
     run = _CandidateRuns(model, cand, rec, settings.bounds, n_harmonics, start, base, numerics)
     return _calibration_at(run, np.asarray(theta, dtype=float))

@@ -1,7 +1,9 @@
-"""Figures of the diagnosis (results/gap/): one per question, drawn at the report's text width with text of at
-least 8 pt (:mod:`contactid.print_style`). The report includes the gap by stage, the candidates ranked, before and
-after per held-out case and the step-by-step explanation (PDF at ``\\textwidth``); the diagnostic views (by
-harmonic and sensor, by part of the cycle, the force-state maps) are figures of their own in results/gap/."""
+r"""Figures of the diagnosis (results/gap/): one per question, drawn at the report's text width.
+
+Text of at least 8 pt (:mod:`contactid.print_style`). The report includes the gap by stage, the candidates ranked,
+before and after per held-out case and the step-by-step explanation (PDF at ``\textwidth``); the diagnostic views (by
+harmonic and sensor, by part of the cycle, the force-state maps) are figures of their own in results/gap/.
+"""
 
 from __future__ import annotations
 
@@ -33,23 +35,53 @@ HELDOUT = "heldout"
 
 
 def _num(x) -> float:
-    """A diagnosis.json number as a float (null, written for a non-finite value, as NaN)."""
+    """Return a diagnosis.json number as a float (null, written for a non-finite value, as NaN)."""
     return float("nan") if x is None else float(x)
 
 
 def _name(effect: str) -> str:
-    """A candidate's name as words: contact_separation -> contact separation."""
+    """Return a candidate's name as words: contact_separation -> contact separation."""
     return str(effect).replace("_", " ")
 
 
 def min_gap(diag: dict, default: float = 0.006) -> float:
-    """gap.min_gap of the diagnosis (its remaining gap's floor)."""
+    """Return gap.min_gap of the diagnosis (its remaining gap's floor).
+
+    Parameters
+    ----------
+    diag
+        The diagnosis (diagnosis.json; its ``remaining_gap.floor``).
+    default
+        The floor where the diagnosis states none [-].
+
+    Returns
+    -------
+    floor : float
+        The relative held-out gap below which nothing is explained [-].
+    """
     return float((diag.get("remaining_gap") or {}).get("floor", default))
 
 
 def stage_rows(diag: dict, thresholds: PlaceThresholds = DEFAULT_PLACE) -> list[tuple[str, str, float, tuple]]:
-    """The stage figure's rows: (key, label, value, (threshold, its name) or ()). The held-out gap first (compared
-    with gap.min_gap), then each stage; the localisation's thresholds where a stage is compared with one."""
+    """Return the stage figure's rows: (key, label, value, (threshold, its name) or ()).
+
+    The held-out gap first (compared with gap.min_gap), then each stage; the localisation's thresholds where a stage is
+    compared with one.
+
+    Parameters
+    ----------
+    diag
+        The diagnosis (diagnosis.json: ``where``'s held-out gap, stages and identification noise,
+        ``remaining_gap``).
+    thresholds
+        The localisation's thresholds (gap.place).
+
+    Returns
+    -------
+    rows : list[tuple[str, str, float, tuple]]
+        Per row the stage's key, its label, its relative value [-] (NaN where not finite) and (its threshold [-],
+        the threshold's name), or () where it is compared with none.
+    """
     w = diag["where"]
     rows = [(HELDOUT, "held-out gap (accelerations)", _num(w["heldout_gap_before"]), (min_gap(diag), "gap.min_gap"))]
     noise = list((w.get("identification_noise") or {}).values())
@@ -65,8 +97,10 @@ def stage_rows(diag: dict, thresholds: PlaceThresholds = DEFAULT_PLACE) -> list[
 
 
 def _two_digits(v: float) -> str:
-    """A number to two significant digits as people write it: 280, 17, 0.64, 0.0007 (not 2.8e+02 or 7e-04); below
-    1e-4 in powers of ten (1.2e-05)."""
+    """Return a number to two significant digits as people write it: 280, 17, 0.64, 0.0007 (not 2.8e+02 or 7e-04).
+
+    Below 1e-4 in powers of ten (1.2e-05).
+    """
     if not np.isfinite(v):
         return "n/a"
     if v == 0:
@@ -77,16 +111,29 @@ def _two_digits(v: float) -> str:
 
 
 def _stage_value_text(v: float, limit: tuple) -> str:
-    """The stage figure's right-hand column: the value (%), and the threshold it is compared with."""
+    """Return the stage figure's right-hand column: the value (%), and the threshold it is compared with."""
     text = "0" if v == 0 else ("n/a" if not np.isfinite(v) else f"{_two_digits(v)} %")
     return text + (f"  ({limit[1]}: {_two_digits(100 * limit[0])} %)" if limit else "")
 
 
 @ps.print_figure
-def stages(diag: dict, png: str, pdf: str | None = None, thresholds: PlaceThresholds = DEFAULT_PLACE):
-    """The gap at each stage of the chain (%, log axis; a zero value written as 0, its bar absent), with the
-    threshold each is compared with (black mark, and in the right-hand column): gap.min_gap for the held-out gap,
-    the localisation's (gap.place) for the stages it tests."""
+def stages(diag: dict, png: str, pdf: str | None = None, thresholds: PlaceThresholds = DEFAULT_PLACE) -> None:
+    """Draw the gap at each stage of the chain (%, log axis; a zero value written as 0, its bar absent).
+
+    With the threshold each is compared with (black mark, and in the right-hand column): gap.min_gap for the held-out
+    gap, the localisation's (gap.place) for the stages it tests.
+
+    Parameters
+    ----------
+    diag
+        The diagnosis (diagnosis.json).
+    png
+        The figure's PNG file.
+    pdf
+        Its PDF file, or None.
+    thresholds
+        The localisation's thresholds (gap.place).
+    """
     plt = ps.pyplot()
     rows = stage_rows(diag, thresholds)
     values = np.array([100 * v for _, _, v, _ in rows])
@@ -118,8 +165,19 @@ def stages(diag: dict, png: str, pdf: str | None = None, thresholds: PlaceThresh
 
 
 @ps.print_figure
-def harmonics(ds: xr.Dataset, png: str, pdf: str | None = None):
-    """The gap by harmonic (log) and by sensor, per load case."""
+def harmonics(ds: xr.Dataset, png: str, pdf: str | None = None) -> None:
+    """Draw the gap by harmonic (log) and by sensor, per load case.
+
+    Parameters
+    ----------
+    ds
+        The diagnosis's gap.nc (``gap_by_harmonic`` and ``gap_by_sensor``, relative, over case, harmonic and
+        sensor).
+    png
+        The figure's PNG file.
+    pdf
+        Its PDF file, or None.
+    """
     plt = ps.pyplot()
     fig, axes = plt.subplots(1, 2, figsize=(W, 2.9))
     for c in ds["case"].values:
@@ -145,8 +203,19 @@ def harmonics(ds: xr.Dataset, png: str, pdf: str | None = None):
 
 
 @ps.print_figure
-def cycle(ds: xr.Dataset, png: str, pdf: str | None = None):
-    """The gap by part of the cycle and the energy dissipated per cycle in each direction, per load case."""
+def cycle(ds: xr.Dataset, png: str, pdf: str | None = None) -> None:
+    """Draw the gap by part of the cycle and the energy dissipated per cycle in each direction, per load case.
+
+    Parameters
+    ----------
+    ds
+        The diagnosis's gap.nc (``gap_by_cycle_part``, relative, over case and cycle_part; ``energy_tangential`` and
+        ``energy_normal`` in J over case and source: identified, model).
+    png
+        The figure's PNG file.
+    pdf
+        Its PDF file, or None.
+    """
     plt = ps.pyplot()
     fig, axes = plt.subplots(1, 2, figsize=(W, 3.0))
     x = np.arange(ds.sizes["cycle_part"])
@@ -173,9 +242,21 @@ def cycle(ds: xr.Dataset, png: str, pdf: str | None = None):
 
 
 @ps.print_figure
-def force_state(ds: xr.Dataset, png: str, pdf: str | None = None):
-    """The residual force-state maps over one period: S identified - friction law over (xi, dxi/dt), N identified
-    - the best elastic normal law over (eta, deta/dt); one colour scale per row, centred on zero."""
+def force_state(ds: xr.Dataset, png: str, pdf: str | None = None) -> None:
+    """Draw the residual force-state maps over one period, one colour scale per row, centred on zero.
+
+    S identified - friction law over (xi, dxi/dt), N identified - the best elastic normal law over (eta, deta/dt).
+
+    Parameters
+    ----------
+    ds
+        The diagnosis's gap.nc (the ``map_*`` variables over case and phase: xi and eta in m, their rates in m/s,
+        the residual forces in N).
+    png
+        The figure's PNG file.
+    pdf
+        Its PDF file, or None.
+    """
     plt = ps.pyplot()
     n = ds.sizes["case"]
     fig, axes = plt.subplots(2, n, figsize=(W, 5.0), squeeze=False, layout="constrained")
@@ -196,8 +277,21 @@ def force_state(ds: xr.Dataset, png: str, pdf: str | None = None):
 
 
 def ranking_bars(diag: dict) -> list[dict]:
-    """The ranking figure's bars: per candidate its held-out gap after (%) and bootstrap interval; a candidate
-    that does not lower the held-out gap (after >= before) is clipped at before and marked no effect."""
+    """Return the ranking figure's bars: per candidate its held-out gap after (%) and bootstrap interval.
+
+    A candidate that does not lower the held-out gap (after >= before) is clipped at before and marked no effect.
+
+    Parameters
+    ----------
+    diag
+        The diagnosis (diagnosis.json; its ``ranking``).
+
+    Returns
+    -------
+    bars : list[dict]
+        Per candidate: "effect", "end" (where the bar ends) [%], "low" and "high" (the interval's ends) [%],
+        "no_effect", "diverged" and "reduction" (the held-out gap's, relative to before) [-].
+    """
     out = []
     for r in diag["ranking"]:
         before, after = 100 * _num(r["heldout_gap_before"]), 100 * _num(r["heldout_gap_after"])
@@ -218,10 +312,21 @@ def ranking_bars(diag: dict) -> list[dict]:
 
 
 @ps.print_figure
-def ranking(diag: dict, png: str, pdf: str | None = None):
-    """The candidates ranked: each one's held-out gap after (bar, 95 % bootstrap interval), the gap before, the
-    identification's floor gap.min_gap (below it the verdict is none) and the records' scatter as lines; a
-    candidate with no effect ends at before, marked."""
+def ranking(diag: dict, png: str, pdf: str | None = None) -> None:
+    """Draw the candidates ranked: each one's held-out gap after (bar, 95 % bootstrap interval).
+
+    The gap before, the identification's floor gap.min_gap (below it the verdict is none) and the records' scatter as
+    lines; a candidate with no effect ends at before, marked.
+
+    Parameters
+    ----------
+    diag
+        The diagnosis (diagnosis.json).
+    png
+        The figure's PNG file.
+    pdf
+        Its PDF file, or None.
+    """
     plt = ps.pyplot()
     bars, w = ranking_bars(diag), diag["where"]
     before, floor, scatter = 100 * _num(w["heldout_gap_before"]), 100 * min_gap(diag), 100 * _num(w["record_scatter"])
@@ -267,7 +372,7 @@ def ranking(diag: dict, png: str, pdf: str | None = None):
 
 
 def _shrink_by_case(ax, sh: dict, floor: float) -> None:
-    """Before (grey) and after each of the winner and the runner-up, per held-out case, 95 % bootstrap."""
+    """Draw before (grey) and after each of the winner and the runner-up, per held-out case, 95 % bootstrap."""
     cases = list(next(iter(sh.values()))["by_case"])
     x = np.arange(len(cases))
     width = 0.8 / (len(sh) + 1)
@@ -293,8 +398,18 @@ def _shrink_by_case(ax, sh: dict, floor: float) -> None:
 
 
 @ps.print_figure
-def shrink(diag: dict, png: str, pdf: str | None = None):
-    """Held-out gap before and after for the winner and the runner-up, per held-out case and per harmonic."""
+def shrink(diag: dict, png: str, pdf: str | None = None) -> None:
+    """Draw the held-out gap before and after for the winner and the runner-up, per held-out case and per harmonic.
+
+    Parameters
+    ----------
+    diag
+        The diagnosis (diagnosis.json; its ``shrink``).
+    png
+        The figure's PNG file.
+    pdf
+        Its PDF file, or None.
+    """
     plt = ps.pyplot()
     fig, axes = plt.subplots(1, 2, figsize=(W, 3.3))
     sh = diag.get("shrink") or {}
@@ -328,10 +443,28 @@ WATERFALL_LABEL_WIDTH = 14  # characters per line of a waterfall bar's label (fi
 
 
 def waterfall_bars(diag: dict) -> tuple[list, list, list, list]:
-    """The waterfall's bars (labels, bottoms, heights in %, colours): the held-out gap the explanation starts from
-    (the chain's identified model, before a model update that is its first step), what each step removes (labelled
-    with its share of the gap's power; orange where a step widens it: an effect held where the random test measured it
-    exposes one it masked, which the next step takes) and what remains."""
+    """Return the waterfall's bars (labels, bottoms, heights in %, colours).
+
+    The held-out gap the explanation starts from (the chain's identified model, before a model update that is its first
+    step), what each step removes (labelled with its share of the gap's power; orange where a step widens it: an effect
+    held where the random test measured it exposes one it masked, which the next step takes) and what remains.
+
+    Parameters
+    ----------
+    diag
+        The diagnosis (diagnosis.json: its ``explanation``, ``remaining_gap`` and ``where``).
+
+    Returns
+    -------
+    labels : list
+        The bars' labels.
+    bottoms : list
+        Where each bar starts, a held-out gap in per cent [%].
+    heights : list
+        Each bar's height in per cent [%] (negative where a step widens the gap).
+    colors : list
+        The bars' colours.
+    """
     import textwrap
 
     steps = diag.get("explanation") or []
@@ -360,10 +493,21 @@ def waterfall_bars(diag: dict) -> tuple[list, list, list, list]:
 
 
 @ps.print_figure
-def explanation(diag: dict, png: str, pdf: str | None = None):
-    """The additive explanation as a waterfall (``waterfall_bars``): the identified model's held-out gap, what each
-    added effect removes (its share of the gap's power), what remains; the identification's floor (gap.min_gap)
-    drawn."""
+def explanation(diag: dict, png: str, pdf: str | None = None) -> None:
+    """Draw the additive explanation as a waterfall (``waterfall_bars``).
+
+    The identified model's held-out gap, what each added effect removes (its share of the gap's power), what remains;
+    the identification's floor (gap.min_gap) drawn.
+
+    Parameters
+    ----------
+    diag
+        The diagnosis (diagnosis.json).
+    png
+        The figure's PNG file.
+    pdf
+        Its PDF file, or None.
+    """
     plt = ps.pyplot()
     steps = diag.get("explanation") or []
     left = diag.get("remaining_gap") or {}
@@ -400,8 +544,21 @@ IN_REPORT = ("stages", "ranking", "shrink", "explanation")
 DIAGNOSTIC = ("harmonics", "cycle", "force_state")
 
 
-def all_figures(diagnosis_path: str, gap_path: str, out: dict, thresholds: PlaceThresholds = DEFAULT_PLACE):
-    """Every figure: ``out`` maps a view to its PNG path, and ``<view>_pdf`` to its PDF where there is one."""
+def all_figures(diagnosis_path: str, gap_path: str, out: dict, thresholds: PlaceThresholds = DEFAULT_PLACE) -> None:
+    """Draw every figure of the diagnosis.
+
+    Parameters
+    ----------
+    diagnosis_path
+        The diagnosis's diagnosis.json.
+    gap_path
+        The diagnosis's gap.nc.
+    out
+        Maps a view (``IN_REPORT``, ``DIAGNOSTIC``) to its PNG path, and ``<view>_pdf`` to its PDF where there is
+        one.
+    thresholds
+        The localisation's thresholds (gap.place).
+    """
     with open(diagnosis_path) as f:
         diag = json.load(f)
     stages(diag, out["stages"], out.get("stages_pdf"), thresholds)
@@ -413,8 +570,17 @@ def all_figures(diagnosis_path: str, gap_path: str, out: dict, thresholds: Place
 
 
 def failed_item_figures(reason: str, out: dict) -> None:
-    """A benchmark item the rig could not simulate has no diagnosis: each of its figures (``out``: view -> PNG) says
-    why instead."""
+    """Draw, for a benchmark item the rig could not simulate, each of its figures saying why.
+
+    Such an item has no diagnosis.
+
+    Parameters
+    ----------
+    reason
+        Why the item was not diagnosed.
+    out
+        Maps a view to its PNG path.
+    """
     plt = ps.pyplot()
     for view, png in out.items():
         fig, ax = plt.subplots(figsize=(W, 1.2))

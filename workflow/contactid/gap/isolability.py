@@ -25,8 +25,27 @@ def _real(v: np.ndarray) -> np.ndarray:
 
 
 def signature(before: Mapping[str, np.ndarray], after: Mapping[str, np.ndarray], cases: Sequence[str]) -> np.ndarray:
-    """A candidate's signature: its held-out residuals ``after`` less the model's ``before`` ({case: residual}), over
-    ``cases``, as one real vector."""
+    """Return a candidate's signature: its held-out residuals less the model's, as one real vector.
+
+    The changes ``after - before`` of the residuals over ``cases``, concatenated.
+
+    Parameters
+    ----------
+    before
+        The model's held-out residuals by case ({case: residual}, ``refit.gap_residual``: complex, scaled by the
+        record's acceleration harmonics' norm) [-], each of shape (n_residual,) with n_residual = 2 n_sensors
+        n_harmonics.
+    after
+        The candidate's refitted held-out residuals by case, as ``before`` [-], each of shape (n_residual,).
+    cases
+        The held-out cases, in the order their changes are concatenated.
+
+    Returns
+    -------
+    signature : np.ndarray
+        The residual changes ``after - before`` of every case, real parts then imaginary parts of each case's change
+        (real residuals as they are) [-], shape (2 n_residual n_cases,).
+    """
     return np.concatenate([_real(np.asarray(after[c]) - np.asarray(before[c])) for c in cases])
 
 
@@ -35,9 +54,28 @@ def _without(v: np.ndarray, basis: np.ndarray | None) -> np.ndarray:
 
 
 def isolability(signatures: Mapping[str, np.ndarray], form: Sequence[str], limit: float = ISOLABLE_COSINE) -> dict:
-    """{"pairs": [{candidates: [a, b], cosine}], "limit", "form_removed"}: the pairs of non-form candidates whose
-    signatures, with the form candidates' directions projected out, have a cosine above ``limit`` (most alike first).
-    Candidates whose signature is zero (refitted to off) or not finite have no direction and are left out."""
+    """Return the pairs of non-form candidates that the records cannot tell apart.
+
+    These are the pairs whose signatures, with the form candidates' directions projected out, have a cosine above
+    ``limit`` (most alike first). Candidates whose signature is zero (refitted to off) or not finite have no direction
+    and are left out.
+
+    Parameters
+    ----------
+    signatures
+        Each candidate's signature by name ({candidate: ``signature``}) [-], each of shape (n_signature,), the same
+        for every candidate.
+    form
+        The form candidates (the base model's damping): their directions are projected out of the others'.
+    limit
+        Cosine above which a pair is not isolable [-].
+
+    Returns
+    -------
+    table : dict
+        {"pairs": [{"candidates": [a, b], "cosine": cosine}, ...], "limit": ``limit``, "form_removed": the form
+        candidates whose directions were projected out}; the cosines [-].
+    """
     finite = {k: np.asarray(v, float) for k, v in signatures.items() if np.all(np.isfinite(v)) and np.any(v)}
     forms = [finite[k] for k in form if k in finite]
     basis = np.linalg.qr(np.column_stack(forms))[0] if forms else None

@@ -1,6 +1,9 @@
-"""The gap diagnosis's settings (config ``gap``): what is compared, the candidates, the thresholds of every decision,
-the bootstrap, model updating's priors and the numerical choices (``numerics.Numerics``), read once from the config
-(``GapSettings.from_config``, the schema's defaults where keys are left out)."""
+"""The gap diagnosis's settings (config ``gap``), read once from the config.
+
+What is compared, the candidates, the thresholds of every decision, the bootstrap, model updating's priors and the
+numerical choices (``numerics.Numerics``), read once from the config (``GapSettings.from_config``, the schema's defaults
+where keys are left out).
+"""
 
 from __future__ import annotations
 
@@ -14,23 +17,65 @@ from .verdict import DEFAULT_PLACE, PlaceThresholds
 
 @dataclass(frozen=True)
 class GapSettings:
-    """n_harmonics: harmonics compared (gap); identification_harmonics: K of the inverse
-    identification; candidates: names (None = the whole library); min_gap: a held-out gap below this
-    (relative) is what the chain's own identification leaves and is not explained; min_reduction: the held-out gap
-    must shrink at least this much (relative) for a verdict; separation: the winner's held-out gap
-    must be at least this factor below the runner-up's; noise_factor: the gap before must exceed this
-    many bootstrap standard deviations of the records' scatter; n_bootstrap: resamples of the
-    record blocks; seed; eta_observability_limit: the normal motion eta counts as observable when it moves by at
-    most this (relative) over the structures the random test allows (``eta_model_spread``), else the place cannot be
-    the normal or the tangential contact alone; model_updating: update the base structure from the random test before
-    the candidates
-    (``contactid.updating``; updating_parameters the structural factors, residue_accuracy the residues' relative
-    standard error, frequency_floor the relative model-form uncertainty added to each frequency,
-    updating_confidence the significance an update needs to be accepted, updating_records_test: an update the
-    chi^2 test did not accept is accepted when the dual-sine records' held-out gap shrinks with it,
-    ``verdict.records_accept_update``); numerics: how the steady states are found and the candidates' searches run
-    (``numerics.Numerics``; the config sets its polish_searches, gap.polish_searches, and leaves the rest at their
-    defaults)."""
+    """Settings of the gap diagnosis (config ``gap``).
+
+    Attributes
+    ----------
+    n_harmonics
+        Harmonics of the test frequency compared between the model's simulation and the records (the gap).
+    identification_harmonics
+        K, the harmonics of the inverse identification (``nonlinear.n_harmonics``).
+    candidates
+        The candidates' names (None: the whole library).
+    min_gap
+        A held-out gap below this (relative) is what the chain's own identification leaves and is not explained [-].
+    min_reduction
+        The held-out gap must shrink at least this much (relative) for a verdict [-].
+    separation
+        The winner's held-out gap must be at least this factor below the runner-up's [-].
+    noise_factor
+        The gap before must exceed this many bootstrap standard deviations of the records' scatter [-].
+    n_bootstrap
+        Resamples of the record blocks.
+    seed
+        Seed of the run (the bootstrap's random stream, "gap/bootstrap").
+    max_evaluations
+        The calibration refit's budget of simulations (config ``gap.max_evaluations``; how each search uses it:
+        ``calibration.calibrate``).
+    model_updating
+        Update the base structure from the random test before the candidates (``contactid.updating``).
+    eta_observability_limit
+        The normal motion eta counts as observable when it moves by at most this (relative) over the structures the
+        random test allows (``eta_model_spread``), else the place cannot be the normal or the tangential contact
+        alone [-].
+    updating_parameters
+        The structural factors model updating fits (``contactid.updating_model.FACTORS``' names).
+    residue_accuracy
+        The residues' relative standard error [-].
+    frequency_floor
+        The relative model-form uncertainty added to each frequency's standard error [-].
+    updating_confidence
+        The significance an update needs to be accepted [-].
+    updating_prior_sd
+        ((factor, prior sd of its ln), ...) replacing ``contactid.updating_model.FACTORS``' priors (ln of a factor:
+        [-]).
+    updating_records_test
+        An update the chi^2 test did not accept is accepted when the dual-sine records' held-out gap shrinks with it
+        (``verdict.records_accept_update``).
+    updating_gain_sd
+        Prior sd of ln of each channel's sensitivity on the residues (0: the channels calibrated) [-].
+    joint_refit
+        The explanation's later steps refit the earlier steps' parameters with theirs.
+    numerics
+        How the steady states are found and the candidates' searches run (``numerics.Numerics``; the config sets its
+        polish_searches, gap.polish_searches, and leaves the rest at their defaults).
+    pair_lookahead
+        Where no candidate shrinks a gap above this many ``min_gap`` materially, a pair is tried [-].
+    retry_unmoved
+        Later passes also try the candidates whose refit alone left them off.
+    place
+        The localisation's thresholds (gap.place).
+    """
 
     n_harmonics: int = 9
     identification_harmonics: int = 25
@@ -67,8 +112,34 @@ class GapSettings:
 
     @classmethod
     def from_config(cls, gap_cfg: Mapping | None, seed: int, n_harmonics_id: int) -> "GapSettings":
-        """The settings from config ``gap`` (keys left out take the schema's defaults), the run's seed and the number of
-        harmonics the identification used; raises ValueError for a candidate the library does not have."""
+        """Return the settings from config ``gap``, the run's seed and the identification's number of harmonics.
+
+        Keys left out take the schema's defaults.
+
+        Parameters
+        ----------
+        gap_cfg
+            The config's ``gap`` section (None: every key at its default): n_harmonics, candidates, min_gap,
+            min_reduction, separation, noise_factor, n_bootstrap, max_evaluations, eta_observability_limit,
+            joint_refit, polish_searches, pair_lookahead, retry_unmoved, place and model_updating (enabled,
+            parameters, residue_accuracy, confidence, frequency_floor, channel_gain_sd, prior_sd, records_test).
+        seed
+            The run's seed (config ``seed``).
+        n_harmonics_id
+            The number of harmonics the identification used (``nonlinear.n_harmonics``).
+
+        Returns
+        -------
+        settings : GapSettings
+            The settings.
+
+        Raises
+        ------
+        ValueError
+            For a candidate the library does not have, a min_reduction outside (0, 1), a separation below 1, or
+            n_harmonics outside 3 .. ``n_harmonics_id`` (and, through the model_updating block, for an unknown
+            factor or a prior sd out of range).
+        """
         from ..schema import schema_defaults
 
         defaults = schema_defaults("gap")  # keys left out take the schema's defaults
@@ -109,7 +180,7 @@ class GapSettings:
 
 
 def _updating_settings(b: Mapping) -> dict:
-    """GapSettings fields of the config block gap.model_updating (its defaults filled in)."""
+    """Return the GapSettings fields of the config block gap.model_updating (its defaults filled in)."""
     from ..updating_model import FACTORS
 
     params = tuple(b["parameters"])
@@ -129,7 +200,7 @@ def _updating_settings(b: Mapping) -> dict:
 
 
 def _prior_sd(block, factors) -> tuple:
-    """((factor, prior sd of its ln), ...) of gap.model_updating.prior_sd, checked."""
+    """Return ((factor, prior sd of its ln), ...) of gap.model_updating.prior_sd, checked."""
     out = []
     for name, v in dict(block or {}).items():
         if name not in factors:
