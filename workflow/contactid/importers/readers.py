@@ -1,12 +1,15 @@
-"""Readers of the files test rigs write: universal file format dataset 58 (pyuff), LabVIEW
-TDMS (nptdms) and CSV (pandas). Each returns, for every mapped channel, its samples (float64,
-as stored) and the sampling interval the file states (or None), after checking the file's own
-unit labels against the channel map. Every failure names the file and the channel."""
+"""Readers of the files test rigs write: universal file format dataset 58, LabVIEW TDMS and CSV.
+
+The readers use pyuff, nptdms and pandas. Each returns, for every mapped channel, its samples (float64, as stored) and
+the sampling interval the file states (or None), after checking the file's own unit labels against the channel map.
+Every failure names the file and the channel.
+"""
 
 from __future__ import annotations
 
 import os
 import re
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
@@ -17,7 +20,16 @@ from .channels import ImportSpec, check_file_unit
 
 @dataclass
 class Samples:
-    """One channel as read: samples (file units) and the sampling interval stated by the file (s)."""
+    """One channel as read: samples (file units) and the sampling interval stated by the file.
+
+    Attributes
+    ----------
+    values
+        The samples as stored, in the file's units (the channel map's ``units``) [units of ChannelSpec.units],
+        shape (n_samples,).
+    dt
+        The sampling interval the file states [s], or None where it states none.
+    """
 
     values: np.ndarray
     dt: float | None
@@ -39,8 +51,27 @@ def _missing(path, what, channel, available):
 
 
 def datasets58(path: str, fix: str) -> list:
-    """Every dataset 58 of a universal file (pyuff's dicts); a file pyuff cannot read is refused with an error that
-    names it and ends with ``fix`` (what to write instead)."""
+    """Return every dataset 58 of a universal file (pyuff's dicts).
+
+    A file pyuff cannot read is refused with an error that names it and ends with ``fix`` (what to write instead).
+
+    Parameters
+    ----------
+    path
+        The universal file.
+    fix
+        What to write instead, the error message's end.
+
+    Returns
+    -------
+    sets : list
+        The file's datasets 58, as pyuff's dicts.
+
+    Raises
+    ------
+    RawDataError
+        Where pyuff cannot read the file.
+    """
     import pyuff
 
     try:
@@ -52,8 +83,26 @@ def datasets58(path: str, fix: str) -> list:
 
 
 def read_uff58(spec: ImportSpec) -> dict:
-    """Time histories from a universal file (datasets 58, function type 1 = time response,
-    even abscissa), each channel selected by its ID line 1 (``id1``)."""
+    """Return the time histories of a universal file (datasets 58), each channel selected by its ID line 1 (``id1``).
+
+    Each dataset must be of function type 1 (time response) with an even abscissa.
+
+    Parameters
+    ----------
+    spec
+        What to import: the file and its channel map.
+
+    Returns
+    -------
+    samples : dict
+        {role: Samples} of every mapped channel, its sampling interval from the dataset's abscissa increment.
+
+    Raises
+    ------
+    RawDataError
+        For a channel not in the file, a dataset that is not an evenly sampled real time response or holds no data,
+        a unit label that contradicts the map, or samples that are not a 1-D array of numbers.
+    """
     path = spec.file
     by_id = {}
     for s in datasets58(path, "write the time histories as datasets 58"):
@@ -83,8 +132,27 @@ def read_uff58(spec: ImportSpec) -> dict:
 
 
 def read_tdms(spec: ImportSpec) -> dict:
-    """Channels of a TDMS file, each selected as "group/channel"; the sampling interval from the
-    channel's ``wf_increment`` property, the unit from ``unit_string``."""
+    """Return the channels of a TDMS file, each selected as "group/channel".
+
+    The sampling interval comes from the channel's ``wf_increment`` property, the unit from ``unit_string``.
+
+    Parameters
+    ----------
+    spec
+        What to import: the file and its channel map.
+
+    Returns
+    -------
+    samples : dict
+        {role: Samples} of every mapped channel.
+
+    Raises
+    ------
+    RawDataError
+        For a file that cannot be read as TDMS, a channel not in the file or that cannot be read, a unit label that
+        contradicts the map, or samples that are not a 1-D array of numbers (a missing channel raised through
+        ``_missing``).
+    """  # noqa: DOC503
     from nptdms import TdmsFile
 
     path = spec.file
@@ -112,11 +180,26 @@ CSV_SEPARATORS = {",": ",", ";": ";", "\t": "\t", " ": r"\s+"}
 _DECIMAL_COMMA = re.compile(r"^[-+]?\d*,\d+([eE][-+]?\d+)?$")
 
 
-def csv_layout(path: str, names) -> dict:
-    """How a CSV file is laid out, as the data loggers and spreadsheets that write them differ: the header row (the
-    first line that names every column in ``names``, after any lines of metadata or comments), the separator (comma,
-    semicolon, tab or blanks) and the decimal mark (a comma where the separator is not one). Read from the first
-    256 kB; {} (comma, header on the first line) where no line names them all, so that the missing column is named."""
+def csv_layout(path: str, names: Iterable[str]) -> dict:
+    """Return how a CSV file is laid out, as the data loggers and spreadsheets that write them differ.
+
+    The header row (the first line that names every column in ``names``, after any lines of metadata or comments), the
+    separator (comma, semicolon, tab or blanks) and the decimal mark (a comma where the separator is not one). Read from
+    the first 256 kB.
+
+    Parameters
+    ----------
+    path
+        The CSV file.
+    names
+        The columns the header row must name.
+
+    Returns
+    -------
+    layout : dict
+        pandas.read_csv's keywords {"sep", "decimal", "skiprows"}; {} (comma, header on the first line) where no
+        line names them all, so that the missing column is named.
+    """
     with open(path, encoding="utf-8-sig", errors="replace") as fh:
         lines = fh.read(262144).splitlines()
     wanted = {str(n).strip() for n in names}
@@ -134,9 +217,27 @@ def csv_layout(path: str, names) -> dict:
 
 
 def read_csv(spec: ImportSpec) -> dict:
-    """Columns of a CSV file with a header row, each selected by its header; the sampling interval
-    from the time column when the sidecar names one. Lines of metadata above the header, semicolon, tab or blank
-    separated columns and decimal commas are recognised (``csv_layout``)."""
+    """Return the columns of a CSV file with a header row, each selected by its header.
+
+    The sampling interval comes from the time column when the sidecar names one. Lines of metadata above the header,
+    semicolon, tab or blank separated columns and decimal commas are recognised (``csv_layout``).
+
+    Parameters
+    ----------
+    spec
+        What to import: the file, its channel map and its time column (and that column's units).
+
+    Returns
+    -------
+    samples : dict
+        {role: Samples} of every mapped channel.
+
+    Raises
+    ------
+    RawDataError
+        For a file that cannot be read as CSV with a header row, or a time column that is not evenly spaced and
+        increasing (and, reading a column, for one missing or holding a cell that is not a number).
+    """
     import pandas as pd
 
     path = spec.file
@@ -185,7 +286,23 @@ READERS = {"uff58": read_uff58, "tdms": read_tdms, "csv": read_csv}
 
 
 def read_channels(spec: ImportSpec) -> dict:
-    """{role: Samples} of the file, by the reader of ``spec.format``."""
+    """Return {role: Samples} of the file, by the reader of ``spec.format``.
+
+    Parameters
+    ----------
+    spec
+        What to import: the format, the file and its channel map.
+
+    Returns
+    -------
+    samples : dict
+        {role: Samples} of every mapped channel.
+
+    Raises
+    ------
+    RawDataError
+        Where the file does not exist or is empty (and, from the reader, where it cannot be read as its format).
+    """
     if not os.path.exists(spec.file):
         raise RawDataError(f"{spec.where}: file {spec.file!r} not found; correct 'file:'")
     if os.path.getsize(spec.file) == 0:

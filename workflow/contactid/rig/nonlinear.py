@@ -44,12 +44,35 @@ progress = logging.getLogger(__name__)  # the response control's iterations (rig
 class ReducedModel:
     """Reduced model in mass-normalised coordinates z (q = basis @ z).
 
-    omega: (n_r,) rad/s of the reduced stuck system; basis: (n_dof, n_r);
-    xi, eta: (n_r,) linear contact coordinates; shortening: (n_r, n_r) G;
-    force: (n_r,) generalized force of a unit force at d_p; drive: (n_r,) w at d_p;
-    sensors: (n_sensors, n_r) w at the sensors; beam_mode: (n_r,) True where
-    the block carries less than half of the kinetic energy; k_t, k_n: the
-    linear springs built into omega (N/m).
+    The coordinates z are mass-normalised (basis^T M basis = I): z is in kg^0.5 m, and a row vector that maps z to a
+    displacement (xi, eta, the drive point's and the sensors' w) is in kg^-0.5. n_r is the number of reduced coordinates
+    (the modes kept plus the static responses), n_dof the FE model's degrees of freedom.
+
+    Attributes
+    ----------
+    omega
+        Natural angular frequencies of the reduced stuck system [rad/s], shape (n_r,).
+    basis
+        The basis, q = basis @ z (mass-normalised) [kg^-0.5] on the translations ([rad/(kg^0.5 m)] on the
+        rotations), shape (n_dof, n_r).
+    xi
+        The linear tangential contact coordinate, xi_lin = xi @ z [kg^-0.5], shape (n_r,).
+    eta
+        The linear normal contact coordinate, eta = eta @ z [kg^-0.5], shape (n_r,).
+    shortening
+        G, the beam shortening's matrix on z (xi = xi_lin - z^T G z / 2) [kg^-1 m^-1], shape (n_r, n_r).
+    force
+        The generalized force of a unit force at d_p [kg^-0.5] (per N of the force), shape (n_r,).
+    drive
+        w at d_p, the drive point's displacement w = drive @ z [kg^-0.5], shape (n_r,).
+    sensors
+        w at the sensors, each sensor's displacement = sensors @ z [kg^-0.5], shape (n_sensors, n_r).
+    beam_mode
+        True where the block carries less than half of the coordinate's kinetic energy [-] (boolean), shape (n_r,).
+    k_t
+        The linear tangential contact spring built into omega [N/m].
+    k_n
+        The linear normal contact spring built into omega [N/m].
     """
 
     omega: np.ndarray
@@ -90,20 +113,53 @@ it integrates on the project's rig (174 periods of 754 steps) 44 MB; a record at
 steps per period) 0.2-0.3 GiB. Past it a ``WorkLimitError``."""
 
 
-def work_limit_error(message: str):
-    """A WorkLimitError with ``message`` (imported when raised)."""
+def work_limit_error(message: str) -> Exception:
+    """Return a WorkLimitError with ``message`` (imported when raised).
+
+    Parameters
+    ----------
+    message
+        The error's message.
+
+    Returns
+    -------
+    error : Exception
+        The ``io.WorkLimitError``, for the caller to raise.
+    """
     from ..io import WorkLimitError  # here: this module is imported where xarray is not needed
 
     return WorkLimitError(message)
 
 
 def gib(n_bytes: float) -> str:
-    """A memory size for a message ("30.6 GiB", "12 MiB")."""
+    """Return a memory size written for a message ("30.6 GiB", "12 MiB").
+
+    Parameters
+    ----------
+    n_bytes
+        The memory size, a count of bytes [-].
+
+    Returns
+    -------
+    text : str
+        The size in GiB from 1 GiB up, else in MiB.
+    """
     return f"{n_bytes / 2**30:.3g} GiB" if n_bytes >= 2**30 else f"{n_bytes / 2**20:.3g} MiB"
 
 
 def frequency_text(f_hz: float) -> str:
-    """A frequency for a message, in Hz, kHz, MHz or GHz."""
+    """Return a frequency written for a message, in Hz, kHz, MHz or GHz.
+
+    Parameters
+    ----------
+    f_hz
+        The frequency [Hz].
+
+    Returns
+    -------
+    text : str
+        The frequency to three or four significant digits with its unit.
+    """
     for unit, scale in (("GHz", 1e9), ("MHz", 1e6), ("kHz", 1e3)):
         if abs(f_hz) >= scale:
             return f"{f_hz / scale:.3g} {unit}"
@@ -111,15 +167,45 @@ def frequency_text(f_hz: float) -> str:
 
 
 def record_bytes(n_steps: int, n_r: int, state: bool = True) -> int:
-    """Memory (bytes) of ``DualSineSimulator.run``'s stored signals over ``n_steps`` steps of a reduced model of
-    ``n_r`` coordinates, with the coordinates and velocities (``state``) or without: measured 313 (336 with them)
-    bytes per step at n_r = 11, 16 (10 + n_r (1 + 2 state)) bytes bound it (the stored arrays and the temporaries)."""
+    """Return the memory (bytes) of ``DualSineSimulator.run``'s stored signals.
+
+    Over ``n_steps`` steps of a reduced model of ``n_r`` coordinates, with the coordinates and velocities (``state``) or
+    without: measured 313 (336 with them) bytes per step at n_r = 11, 16 (10 + n_r (1 + 2 state)) bytes bound it (the
+    stored arrays and the temporaries).
+
+    Parameters
+    ----------
+    n_steps
+        The steps stored.
+    n_r
+        The reduced model's number of coordinates.
+    state
+        Whether the coordinates and velocities are stored too.
+
+    Returns
+    -------
+    n_bytes : int
+        The bound on the memory, in bytes.
+    """
     return int(n_steps) * 16 * (10 + int(n_r) * (3 if state else 1))
 
 
 def stiffest_mode(red: ReducedModel) -> str:
-    """The reduced model's stiffest mode in words: its frequency and, where a contact spring carries most of its
-    strain energy (k eta_i^2 / omega_i^2 of the mass-normalised mode), which spring and its stiffness."""
+    """Return the reduced model's stiffest mode in words.
+
+    Its frequency and, where a contact spring carries most of its strain energy (k eta_i^2 / omega_i^2 of the
+    mass-normalised mode), which spring and its stiffness.
+
+    Parameters
+    ----------
+    red
+        The reduced model.
+
+    Returns
+    -------
+    text : str
+        The mode's frequency (in Hz, kHz, MHz or GHz) and the contact springs' stiffnesses (N/m), for a message.
+    """
     i = int(np.argmax(red.omega))
     w2 = max(float(red.omega[i]) ** 2, 1e-300)
     shares = {
@@ -142,14 +228,37 @@ def stiffest_mode(red: ReducedModel) -> str:
 
 
 def stable_oversampling(red: ReducedModel, fs: float, q_min: int, stiffening: float = 1.0, viscous: float = 0.0) -> int:
-    """Integration steps per sample at ``fs`` (Hz), at least ``q_min``, at which the explicit central differences keep
-    a margin: omega_max dt <= 1.6 (omega_max (rad/s) times ``stiffening``, a hardening normal law's tangent ratio;
-    2 is the edge) and the viscous friction's rate sigma_2 |dxi/dq|^2 (1/s; ``viscous`` sigma_2 in N s/m), which a step
-    takes explicitly, times dt at most 1 (2 is the edge: the rig's records blew up at sigma_2 = 2e4 N s/m, rate x dt
-    1.96, with the default eight steps per sample).
+    """Return the integration steps per sample at which the explicit central differences keep a margin.
 
-    Raises ``io.WorkLimitError`` past ``MAX_STEPS_PER_SAMPLE``, naming the stiffest mode (and the contact spring
-    that makes it) or the viscous rate."""
+    The steps per sample at ``fs``, at least ``q_min``, keep omega_max dt <= 1.6 (omega_max (rad/s) times
+    ``stiffening``, a hardening normal law's tangent ratio; 2 is the edge) and the viscous friction's rate sigma_2
+    |dxi/dq|^2 (1/s), which a step takes explicitly, times dt at most 1 (2 is the edge: the rig's records blew up at
+    sigma_2 = 2e4 N s/m, rate x dt 1.96, with the default eight steps per sample).
+
+    Parameters
+    ----------
+    red
+        The reduced model (its stiffest mode, omega_max = max ``red.omega``, and ``red.xi``).
+    fs
+        The record's sampling rate [Hz].
+    q_min
+        The fewest steps per sample.
+    stiffening
+        The factor on the stiffest mode's angular frequency, a hardening normal law's tangent ratio [-].
+    viscous
+        The viscous friction's sigma_2 [N s/m].
+
+    Returns
+    -------
+    q : int
+        The integration steps per sample.
+
+    Raises
+    ------
+    WorkLimitError
+        Past ``MAX_STEPS_PER_SAMPLE`` (raised through ``work_limit_error``), naming the stiffest mode (and the
+        contact spring that makes it) or the viscous rate.
+    """  # noqa: DOC503
     q_mode = int(np.ceil(stiffening * red.omega.max() / (1.6 * fs)))
     rate = float(viscous) * float(red.xi @ red.xi)
     q_rate = int(np.ceil(rate / fs))
@@ -175,9 +284,26 @@ def stable_oversampling(red: ReducedModel, fs: float, q_min: int, stiffening: fl
 
 
 def reduced_model(model: FEModel, n_modes: int, static_correction: bool = True) -> ReducedModel:
-    """Basis of the lowest ``n_modes`` stuck modes plus the static responses to a unit tangential
-    and a unit normal contact force and to the excitation (residual flexibility of the truncated
-    modes for every load the model carries)."""
+    """Return the reduced model on a basis of the lowest stuck modes plus static responses.
+
+    The basis holds the lowest ``n_modes`` stuck modes plus the static responses to a unit tangential and a unit normal
+    contact force and to the excitation (residual flexibility of the truncated modes for every load the model carries),
+    re-orthogonalised.
+
+    Parameters
+    ----------
+    model
+        The assembled FE model of the structure, the contact springs included.
+    n_modes
+        The number of stuck modes kept.
+    static_correction
+        Whether the static responses are added to the basis.
+
+    Returns
+    -------
+    red : ReducedModel
+        The reduced model (n_r = n_modes + 3 coordinates with the static responses, else n_modes).
+    """
     modes = all_modes(model)
     phi = modes.shapes[:, :n_modes]
     if static_correction:
@@ -213,11 +339,34 @@ def reduced_model(model: FEModel, n_modes: int, static_correction: bool = True) 
 class ContactParameters:
     """Contact laws of the rig (SI units).
 
-    friction: (e_f, k_c, e_t, kappa, mu) of Eqs. 21-22; regularization: how the law is read
-    (``none``: as printed, ``slip_limit``; see ``contactid.friction``); preload N0 (N);
-    static_approach delta0 (m), exponent p and cubic hardening k_3 (N/m^3) of the normal law; hunt_crossley
-    alpha (s/m); viscous sigma_2 (N s/m); iwan_share (0..1) and the Iwan
-    sliders' slip-limit weights (sum 1); preload_drift (relative, over the record).
+    Attributes
+    ----------
+    friction
+        (e_f, k_c, e_t, kappa, mu) of Eqs. 21-22 [N/m, 1/m, N/m, -, -].
+    preload
+        N0, the static normal preload [N].
+    static_approach
+        delta0, the normal law's static approach [m].
+    exponent
+        p, the normal law's exponent [-].
+    hunt_crossley
+        alpha of the normal law's damping N (1 - alpha deta/dt) [s/m].
+    viscous
+        sigma_2 of the viscous friction S + sigma_2 dxi/dt [N s/m].
+    iwan_share
+        The share of the tangential contact carried by the Iwan (Maxwell-slip) sliders, 0..1 [-].
+    iwan_weights
+        The Iwan sliders' slip-limit weights (sum 1) [-], shape (n_sliders,).
+    preload_drift
+        The preload's relative change over the record [-].
+    n_min
+        The normal force at or below which the contact carries no friction (it is open) [N].
+    unilateral
+        Whether the normal contact may open (the power law); False: a bilateral spring that may pull.
+    regularization
+        How the friction law is read (``none``: as printed, ``slip_limit``; see ``contactid.friction``).
+    cubic
+        k_3, the normal law's cubic hardening [N/m^3].
     """
 
     friction: tuple
@@ -236,40 +385,103 @@ class ContactParameters:
 
 
 def friction_record(contact: ContactParameters) -> np.ndarray:
-    """The kernels' friction record: (e_f, k_c, e_t, kappa, mu, slip_limit) with slip_limit 1.0 for the
-    ``slip_limit`` reading of Eq. 21 and 0.0 for the law as printed."""
+    """Return the kernels' friction record (e_f, k_c, e_t, kappa, mu, slip_limit).
+
+    slip_limit is 1.0 for the ``slip_limit`` reading of Eq. 21 and 0.0 for the law as printed.
+
+    Parameters
+    ----------
+    contact
+        The contact laws.
+
+    Returns
+    -------
+    record : np.ndarray
+        (e_f, k_c, e_t, kappa, mu, slip_limit) [N/m, 1/m, N/m, -, -, -], shape (6,).
+    """
     return np.array([*(float(x) for x in contact.friction), float(slip_limit_flag(contact.regularization))])
 
 
 def iwan_slip_weights(n: int, spread: float = 0.8) -> np.ndarray:
-    """Slip limits of n Maxwell-slip sliders as fractions of mu N: thresholds spread
-    uniformly over [1 - spread, 1 + spread] (relative), each slider with stiffness
-    e_0 / n, normalised so that they sum to 1."""
+    """Return the slip limits of n Maxwell-slip sliders as fractions of mu N.
+
+    The thresholds are spread uniformly over [1 - spread, 1 + spread] (relative), each slider with stiffness e_0 / n,
+    normalised so that they sum to 1.
+
+    Parameters
+    ----------
+    n
+        The number of sliders.
+    spread
+        The thresholds' half-range about 1 (relative) [-].
+
+    Returns
+    -------
+    weights : np.ndarray
+        The sliders' slip limits, summing to 1 [-], shape (n,).
+    """
     w = np.linspace(1 - spread, 1 + spread, n)
     return w / w.sum()
 
 
 @dataclass
 class SteadyStateLog:
-    """How steady state was reached: the driving-point harmonic amplitudes
-    A1 (at w) and A3 (at 3w) of each chunk, and the relative change between chunks."""
+    """How steady state was reached, chunk by chunk.
+
+    Attributes
+    ----------
+    a1
+        The driving-point acceleration's harmonic amplitude |A1| at w of each chunk [m/s^2].
+    a3
+        Its amplitude |A3| at 3w of each chunk [m/s^2].
+    change
+        The largest relative change of the two harmonics between chunks, from the second chunk on [-].
+    """
 
     a1: list = field(default_factory=list)
     a3: list = field(default_factory=list)
     change: list = field(default_factory=list)
 
 
-def force_coefficients(F1, F3) -> np.ndarray:
-    """Complex harmonics c_h (h = 1..H) of the excitation, f = sum_h Im(c_h e^{i h w t}) (N):
-    [F1, 0, F3] for two amplitudes, or F1 itself (an array) when F3 is None."""
+def force_coefficients(F1: float | np.ndarray, F3: float | None) -> np.ndarray:
+    """Return the complex harmonics c_h (h = 1..H) of the excitation, f = sum_h Im(c_h e^{i h w t}).
+
+    [F1, 0, F3] for two amplitudes, or F1 itself (an array) when F3 is None.
+
+    Parameters
+    ----------
+    F1
+        The fundamental's force amplitude [N], or, with ``F3`` None, the complex harmonics c_h themselves [N],
+        shape (H,).
+    F3
+        The third harmonic's force amplitude [N], or None.
+
+    Returns
+    -------
+    coef : np.ndarray
+        The complex harmonics c_1..c_H [N], shape (3,) for two amplitudes, else (H,).
+    """
     if F3 is None:
         return np.atleast_1d(np.asarray(F1, dtype=complex))
     return np.array([F1, 0.0, F3], dtype=complex)
 
 
 class DualSineSimulator:
-    """Time integration of the reduced rig model under f = F1 sin(wt) + F3 sin(3wt)
-    (or any periodic force given by its harmonics)."""
+    """Time integration of the reduced rig model under f = F1 sin(wt) + F3 sin(3wt).
+
+    Or under any periodic force given by its harmonics.
+
+    Parameters
+    ----------
+    red
+        The reduced model.
+    contact
+        The contact laws.
+    zeta
+        The modal damping ratio of each reduced coordinate [-], shape (n_r,).
+    dt
+        The integration time step [s].
+    """
 
     def __init__(self, red: ReducedModel, contact: ContactParameters, zeta: np.ndarray, dt: float):
         self.red = red
@@ -281,8 +493,10 @@ class DualSineSimulator:
         self.reset()
 
     def reset(self):
-        """Return to rest: zero coordinates, velocities, friction state and Iwan sliders at t = 0, no preload drift and
-        no last chunk."""
+        """Return to rest: zero coordinates, velocities, friction state and Iwan sliders at t = 0.
+
+        No preload drift and no last chunk.
+        """
         n = self.red.omega.size
         self.z = np.zeros(n)
         self.v = np.zeros(n)
@@ -294,13 +508,37 @@ class DualSineSimulator:
         self.drift_t0 = 0.0
 
     def linear_frf(self, w: float) -> complex:
-        """Driving-point accelerance of the stuck linear reduced system at w (m/s^2/N)."""
+        """Return the driving-point accelerance of the stuck linear reduced system at w.
+
+        Parameters
+        ----------
+        w
+            The angular frequency [rad/s].
+
+        Returns
+        -------
+        accelerance : complex
+            The driving-point acceleration per force [m/s^2/N].
+        """
         r = self.red
         x = r.force / (r.omega**2 - w**2 + 2j * self.zeta * r.omega * w)
         return complex(-(w**2) * (r.drive @ x))
 
-    def start_from_linear(self, F1, F3, w: float):
-        """Initial state: the stuck linear system's steady state at t = 0 (force as in ``run``)."""
+    def start_from_linear(self, F1: float | np.ndarray, F3: float | None, w: float):
+        """Start from the stuck linear system's steady state at t = 0 (force as in ``run``).
+
+        The friction state starts at the stuck spring force.
+
+        Parameters
+        ----------
+        F1
+            The fundamental's force amplitude [N] (a float), or, with ``F3`` None, the excitation's complex
+            harmonics c_h (h = 1..H) of f = sum_h Im(c_h e^{i h w t}) [N], shape (H,).
+        F3
+            The third harmonic's force amplitude [N], or None (``F1`` then holds every harmonic).
+        w
+            The fundamental angular frequency [rad/s].
+        """
         r = self.red
         self.reset()
         for k, F in enumerate(force_coefficients(F1, F3)):
@@ -314,11 +552,51 @@ class DualSineSimulator:
         # the friction state starts at the stuck spring force
         self.state[0] = r.k_t * (r.xi @ self.z)
 
-    def run(self, F1, F3, w: float, n_steps: int, store_from: int | None = None, state: bool = True) -> dict:
-        """Advance n_steps under f = F1 sin(wt) + F3 sin(3wt) (N), or, with F3 None, under
-        f = sum_h Im(F1[h-1] e^{i h w t}) for a complex coefficient array F1; returns the stored
-        signals (from ``store_from``) at the step rate, the coordinates "z" and velocities "v" only with ``state``
-        (a third of the stored numbers: the gap's simulations of a whole record do not read them)."""
+    def run(
+        self,
+        F1: float | np.ndarray,
+        F3: float | None,
+        w: float,
+        n_steps: int,
+        store_from: int | None = None,
+        state: bool = True,
+    ) -> dict:
+        """Advance ``n_steps`` under the force and return the stored signals.
+
+        The force is f = F1 sin(wt) + F3 sin(3wt), or, with F3 None, f = sum_h Im(F1[h-1] e^{i h w t}) for a complex
+        coefficient array F1. The signals are stored from ``store_from`` at the step rate, the coordinates "z" and
+        velocities "v" only with ``state`` (a third of the stored numbers: the gap's simulations of a whole record do
+        not read them).
+
+        Parameters
+        ----------
+        F1
+            The fundamental's force amplitude [N] (a float), or, with ``F3`` None, the excitation's complex
+            harmonics c_h (h = 1..H) of f = sum_h Im(c_h e^{i h w t}) [N], shape (H,).
+        F3
+            The third harmonic's force amplitude [N], or None (``F1`` then holds every harmonic).
+        w
+            The fundamental angular frequency [rad/s].
+        n_steps
+            The number of steps.
+        store_from
+            The first step stored (None: none is stored).
+        state
+            Whether the coordinates and velocities are stored too.
+
+        Returns
+        -------
+        signals : dict
+            Over n_store = n_steps - store_from steps: "t" [s], "f" the force [N], "S" and "N" the contact forces
+            [N], "xi" and "eta" [m], "dxi" and "deta" their rates [m/s], each of shape (n_store,); "a" the
+            generalized accelerations [kg^0.5 m/s^2], shape (n_store, n_r); with ``state`` "z" [kg^0.5 m] and "v"
+            [kg^0.5 m/s], shape (n_store, n_r).
+
+        Raises
+        ------
+        WorkLimitError
+            Where the stored signals would pass ``WORK_LIMIT_BYTES`` (raised through ``work_limit_error``).
+        """  # noqa: DOC503
         coef = force_coefficients(F1, F3)
         n_store = 0 if store_from is None else n_steps - store_from
         n_r = self.red.omega.size
@@ -381,7 +659,13 @@ class DualSineSimulator:
         return out
 
     def snapshot(self) -> tuple:
-        """The integrator's state (to return to with ``restore``)."""
+        """Return the integrator's state (to return to with ``restore``).
+
+        Returns
+        -------
+        snapshot : tuple
+            (z, v, friction state, Iwan sliders, t, drift rate, drift start), copies.
+        """
         return (
             self.z.copy(),
             self.v.copy(),
@@ -393,19 +677,61 @@ class DualSineSimulator:
         )
 
     def restore(self, snap: tuple) -> None:
-        """Return the integrator to a state ``snapshot`` took."""
+        """Return the integrator to a state ``snapshot`` took.
+
+        Parameters
+        ----------
+        snap
+            The state, as ``snapshot`` returned it.
+        """
         z, v, state, x_sl, t, rate, t0 = snap
         self.z[:], self.v[:], self.state[:], self.x_sl[:] = z, v, state, x_sl
         self.t, self.drift_rate, self.drift_t0 = t, rate, t0
 
     def settle(
-        self, F1, F3, w: float, chunk_periods: int = 8, tol: float = 1e-4, min_chunks: int = 3, max_chunks: int = 200
+        self,
+        F1: float | np.ndarray,
+        F3: float | None,
+        w: float,
+        chunk_periods: int = 8,
+        tol: float = 1e-4,
+        min_chunks: int = 3,
+        max_chunks: int = 200,
     ) -> tuple[np.ndarray, SteadyStateLog, bool]:
-        """Run chunks of ``chunk_periods`` periods until the driving-point harmonics
-        at w and 3w change by less than ``tol`` (relative) from one chunk to the next.
-        Returns ([A1, A3] complex of the last chunk, log, converged); the last chunk's signals (``run``'s dict)
-        stay in ``last_chunk`` (without the coordinates and velocities), so that a settled response can be recorded
-        from them."""
+        """Run chunks of ``chunk_periods`` periods until the driving-point harmonics at w and 3w settle.
+
+        They settle when they change by less than ``tol`` (relative) from one chunk to the next. The last chunk's
+        signals (``run``'s dict) stay in ``last_chunk`` (without the coordinates and velocities), so that a settled
+        response can be recorded from them.
+
+        Parameters
+        ----------
+        F1
+            The fundamental's force amplitude [N] (a float), or, with ``F3`` None, the excitation's complex
+            harmonics c_h (h = 1..H) of f = sum_h Im(c_h e^{i h w t}) [N], shape (H,).
+        F3
+            The third harmonic's force amplitude [N], or None (``F1`` then holds every harmonic).
+        w
+            The fundamental angular frequency [rad/s].
+        chunk_periods
+            The periods per chunk.
+        tol
+            The largest relative change of the harmonics between chunks that counts as settled [-].
+        min_chunks
+            The fewest chunks run.
+        max_chunks
+            The most chunks run.
+
+        Returns
+        -------
+        harmonics : np.ndarray
+            [A1, A3], the driving-point acceleration's complex harmonics at w and 3w of the last chunk [m/s^2],
+            shape (2,).
+        log : SteadyStateLog
+            How steady state was reached.
+        converged : bool
+            Whether the harmonics settled within ``max_chunks``.
+        """
         n = int(round(chunk_periods * 2 * np.pi / w / self.dt))
         # whole steps per period (the gap's model; the rig's step does not divide the period): the harmonics of
         # whole periods by FFT, equal to the least squares to rounding at a fifth of its cost
