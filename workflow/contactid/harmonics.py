@@ -1,10 +1,14 @@
-"""Harmonics of periodic signals, in one convention: x(t) ~ mean + sum_h Im(c_h e^{i h w t}), h = 1, 2, ...
-(w = 2 pi f0 rad/s, c_h complex, in the signal's units). Analysis by least squares on any window
+"""Harmonics of periodic signals in one convention: x(t) ~ mean + sum_h Im(c_h e^{i h w t}), h = 1, 2, ...
+
+Here w = 2 pi f0 rad/s and c_h is complex, in the signal's units. Analysis by least squares on any window
 (``harmonic_amplitudes``, ``harmonic_content``, ``fourier_series``, Eq. 16) or by FFT of whole periods
-(``periodic_harmonics``); synthesis at any times, with analytic derivatives and integrals (``synthesize``, Eq. 17),
-or on a grid over one period (``periodic_grid``). Every module that analyses or synthesises harmonics uses these."""
+(``periodic_harmonics``); synthesis at any times, with analytic derivatives and integrals (``synthesize``, Eq. 17), or
+on a grid over one period (``periodic_grid``). Every module that analyses or synthesises harmonics uses these.
+"""
 
 from __future__ import annotations
+
+from collections.abc import Iterable
 
 import numpy as np
 
@@ -20,12 +24,12 @@ with ``io.WorkLimitError``."""
 
 
 def _design_row_bytes(n_columns: int) -> int:
-    """Memory (bytes) per sample of ``harmonic_amplitudes``' design matrix and its complex powers."""
+    """Return the memory (bytes) per sample of ``harmonic_amplitudes``' design matrix and its complex powers."""
     return 8 * int(n_columns) + 32
 
 
 def _design(t: np.ndarray, w: float, harmonics: list) -> np.ndarray:
-    """The least-squares design matrix [1, sin(h w t), cos(h w t)...] (t.size, 1 + 2 len(harmonics))."""
+    """Return the least-squares design matrix [1, sin(h w t), cos(h w t)...] (t.size, 1 + 2 len(harmonics))."""
     # e^{i h w t} by powers of e^{i w t} (about h machine epsilons of error, a tenth of the cost of sin and cos)
     X = np.empty((t.size, 1 + 2 * len(harmonics)))
     X[:, 0] = 1.0
@@ -38,10 +42,37 @@ def _design(t: np.ndarray, w: float, harmonics: list) -> np.ndarray:
     return X
 
 
-def harmonic_amplitudes(signal: np.ndarray, t: np.ndarray, w: float, harmonics) -> np.ndarray:
-    """Complex amplitudes c_h of signal ~ mean + sum_h Im(c_h exp(i h w t)) by least squares
-    (t in s, w in rad/s; valid on any window, whole number of periods or not). ``signal`` (n,) or (n, k): k
-    signals sampled at the same times, solved together (c of shape (H, k)). Memory within ``ARRAY_LIMIT_BYTES``."""
+def harmonic_amplitudes(signal: np.ndarray, t: np.ndarray, w: float, harmonics: Iterable[int]) -> np.ndarray:
+    """Return the complex amplitudes c_h of signal ~ mean + sum_h Im(c_h exp(i h w t)) by least squares.
+
+    Valid on any window, a whole number of periods or not. Several signals sampled at the same times are solved
+    together. The memory stays within ``ARRAY_LIMIT_BYTES``: past it the normal equations are summed over blocks of
+    samples.
+
+    Parameters
+    ----------
+    signal
+        The samples, in any unit (e.g. [N], [m/s^2]), shape (n_t,), or (n_t, k) for k signals sampled at the same
+        times.
+    t
+        The sampling times [s], shape (n_t,).
+    w
+        The fundamental angular frequency [rad/s].
+    harmonics
+        The harmonic numbers h (1 the fundamental).
+
+    Returns
+    -------
+    coef : np.ndarray
+        The complex amplitudes c_h, in the order of ``harmonics`` [unit of signal], shape (n_harmonics,), or
+        (n_harmonics, k) for k signals.
+
+    Raises
+    ------
+    WorkLimitError
+        Where the design matrix passes ``ARRAY_LIMIT_BYTES`` and the least squares cannot be done in blocks (fewer
+        than two periods, or harmonics repeated or above the Nyquist frequency).
+    """
     harmonics = [int(h) for h in harmonics]
     t = np.asarray(t, dtype=float)
     n_columns = 1 + 2 * len(harmonics)
@@ -87,23 +118,79 @@ def harmonic_amplitudes(signal: np.ndarray, t: np.ndarray, w: float, harmonics) 
     return coef[1::2] + 1j * coef[2::2]
 
 
-def harmonic_content(signal: np.ndarray, sampling_rate_hz: float, frequency_hz: float, harmonics) -> np.ndarray:
-    """Complex harmonic amplitudes of a record sampled from t = 0 (see :func:`harmonic_amplitudes`);
-    |c_h| is the amplitude of harmonic h of ``frequency_hz``."""
+def harmonic_content(
+    signal: np.ndarray, sampling_rate_hz: float, frequency_hz: float, harmonics: Iterable[int]
+) -> np.ndarray:
+    """Return the complex harmonic amplitudes of a record sampled from t = 0 (see :func:`harmonic_amplitudes`).
+
+    |c_h| is the amplitude of harmonic h of ``frequency_hz``.
+
+    Parameters
+    ----------
+    signal
+        The record's samples, in any unit (e.g. [N], [m/s^2]), shape (n_t,), or (n_t, k) for k signals sampled at
+        the same times.
+    sampling_rate_hz
+        The sampling rate [Hz].
+    frequency_hz
+        The fundamental frequency [Hz].
+    harmonics
+        The harmonic numbers h (1 the fundamental).
+
+    Returns
+    -------
+    coef : np.ndarray
+        The complex amplitudes c_h, in the order of ``harmonics`` [unit of signal], shape (n_harmonics,), or
+        (n_harmonics, k) for k signals.
+    """
     t = np.arange(len(signal)) / sampling_rate_hz
     return harmonic_amplitudes(signal, t, 2 * np.pi * frequency_hz, harmonics)
 
 
 def fourier_series(signals: np.ndarray, fs: float, f0: float, n_harmonics: int) -> np.ndarray:
-    """Complex harmonic amplitudes c_h (h = 1..K) of each row, signal ~ mean + sum Im(c_h e^{i h w t}) (Eq. 16)."""
+    """Return the complex harmonic amplitudes c_h (h = 1..K) of each row, signal ~ mean + sum Im(c_h e^{i h w t}).
+
+    Eq. 16, by least squares on each row sampled from t = 0 (``harmonic_content``).
+
+    Parameters
+    ----------
+    signals
+        The records, one a row, in any unit (e.g. [N], [m/s^2]), shape (n_signals, n_t), or (n_t,) for one.
+    fs
+        The sampling rate [Hz].
+    f0
+        The fundamental frequency [Hz].
+    n_harmonics
+        K, the number of harmonics.
+
+    Returns
+    -------
+    coef : np.ndarray
+        The complex amplitudes c_1..c_K of each row [unit of signals], shape (n_signals, n_harmonics).
+    """
     h = np.arange(1, n_harmonics + 1)
     return np.array([harmonic_content(x, fs, f0, h) for x in np.atleast_2d(signals)])
 
 
 def positive_spectrum(x: np.ndarray, H: int) -> np.ndarray:
-    """DFT bins 1..H of each row of ``x`` (along its last axis): by the real FFT where x is real and H lies below the
-    Nyquist bin (the same values to rounding, a fifth to a half of the complex FFT's time: 0.2 against 0.9 ms for the
-    inverse identification's 99 x 200 grids), else by the complex FFT."""
+    """Return the DFT bins 1..H of each row of ``x`` (along its last axis).
+
+    By the real FFT where x is real and H lies below the Nyquist bin (the same values to rounding, a fifth to a half of
+    the complex FFT's time: 0.2 against 0.9 ms for the inverse identification's 99 x 200 grids), else by the complex
+    FFT.
+
+    Parameters
+    ----------
+    x
+        The samples along the last axis, in any unit (e.g. [N], [m/s^2]), shape (..., n_samples).
+    H
+        The highest bin returned.
+
+    Returns
+    -------
+    bins : np.ndarray
+        The (unnormalised) DFT bins 1..H [unit of x], shape (..., H).
+    """
     n = x.shape[-1]
     if np.isrealobj(x) and H <= n // 2:
         return np.fft.rfft(x, axis=-1)[..., 1 : H + 1]
@@ -111,8 +198,30 @@ def positive_spectrum(x: np.ndarray, H: int) -> np.ndarray:
 
 
 def periodic_harmonics(x: np.ndarray, t_first: float, w: float, n_per: int, H: int) -> np.ndarray:
-    """Harmonics 1..H (x ~ mean + sum Im(c_h e^{i h w t})) of rows sampled uniformly over a whole
-    number of periods of n_per samples each, the first at t_first (exact, by FFT of the period mean)."""
+    """Return the harmonics 1..H (x ~ mean + sum Im(c_h e^{i h w t})) of rows sampled over whole periods.
+
+    The rows are sampled uniformly over a whole number of periods of n_per samples each, the first at t_first (exact, by
+    FFT of the period mean; samples past the last whole period are left out).
+
+    Parameters
+    ----------
+    x
+        The samples, one signal a row, in any unit (e.g. [N], [m/s^2]), shape (n_rows, n_samples), or (n_samples,)
+        for one.
+    t_first
+        The time of the first sample [s].
+    w
+        The fundamental angular frequency [rad/s].
+    n_per
+        The samples per period.
+    H
+        The number of harmonics.
+
+    Returns
+    -------
+    coef : np.ndarray
+        The complex amplitudes c_1..c_H of each row [unit of x], shape (n_rows, H).
+    """
     x = np.atleast_2d(x)
     periods = x.shape[1] // n_per
     mean_period = x[:, : periods * n_per].reshape(x.shape[0], periods, n_per).mean(axis=1)
@@ -122,10 +231,29 @@ def periodic_harmonics(x: np.ndarray, t_first: float, w: float, n_per: int, H: i
 
 
 def aperiodic_share(x: np.ndarray, fs: float, f0: float, band: float = 0.45) -> np.ndarray:
-    """Share of each row's rms (about its mean) that is not periodic at f0: what is left once the mean and every
-    harmonic of f0 below ``band`` x fs are fitted (least squares over the whole periods of the record, x sampled at
-    fs from t = 0). A periodic response leaves the sensors' noise alone (the noise fraction, 0.005 on the rig); a
-    motion that does not settle (impacts, chaos) leaves far more (0.2-0.5 on a separating contact's record)."""
+    """Return the share of each row's rms (about its mean) that is not periodic at f0.
+
+    What is left once the mean and every harmonic of f0 below ``band`` x fs are fitted (least squares over the whole
+    periods of the record, x sampled at fs from t = 0). A periodic response leaves the sensors' noise alone (the noise
+    fraction, 0.005 on the rig); a motion that does not settle (impacts, chaos) leaves far more (0.2-0.5 on a separating
+    contact's record).
+
+    Parameters
+    ----------
+    x
+        The records, one a row, in any unit (e.g. [N], [m/s^2]), shape (n_rows, n_samples), or (n_samples,) for one.
+    fs
+        The sampling rate [Hz].
+    f0
+        The fundamental frequency [Hz].
+    band
+        The highest harmonic fitted, as a fraction of ``fs`` [-].
+
+    Returns
+    -------
+    share : np.ndarray
+        The aperiodic rms over the rms about the mean, per row [-], shape (n_rows,).
+    """
     x = np.atleast_2d(np.asarray(x, dtype=float))
     periods = int(np.floor(x.shape[1] * f0 / fs + 1e-9))
     n = min(x.shape[1], int(round(periods * fs / f0))) if periods >= 2 else x.shape[1]
@@ -142,8 +270,28 @@ def aperiodic_share(x: np.ndarray, fs: float, f0: float, band: float = 0.45) -> 
 
 
 def synthesize(coef: np.ndarray, f0: float, t: np.ndarray, derivative: int = 0) -> np.ndarray:
-    """Time signals sum_h Im(c_h (i h w)^d e^{i h w t}) of coefficients (rows, K); d = -2 integrates
-    twice analytically (Eq. 17)."""
+    """Return the time signals sum_h Im(c_h (i h w)^d e^{i h w t}) of harmonic coefficients (Eq. 17).
+
+    With d the ``derivative``: d = -2 integrates twice analytically. Past ``ARRAY_LIMIT_BYTES`` the synthesis is done
+    block by block.
+
+    Parameters
+    ----------
+    coef
+        The complex amplitudes c_1..c_K of each row, in any unit (e.g. [N], [m/s^2]), shape (n_rows, K), or (K,) for
+        one.
+    f0
+        The fundamental frequency [Hz].
+    t
+        The times [s], shape (n_t,).
+    derivative
+        d, the order of the time derivative (negative: integrals).
+
+    Returns
+    -------
+    signals : np.ndarray
+        The signals [unit of coef] times s^-d (d = -2: [unit of coef] s^2), shape (n_rows, n_t).
+    """
     coef = np.atleast_2d(coef)
     h = np.arange(1, coef.shape[1] + 1)
     w = 2 * np.pi * f0
@@ -159,10 +307,29 @@ def synthesize(coef: np.ndarray, f0: float, t: np.ndarray, derivative: int = 0) 
 
 
 def periodic_grid(coef: np.ndarray, f0: float, m: int, derivative: int = 0) -> np.ndarray:
-    """Synthesize K-harmonic periodic signals (rows of complex coefficients, x ~ sum Im(c (i h w)^d e^{ihwt}))
-    on ``m`` points of one period, t = n / (m f0) (Fourier interpolation): ``synthesize`` on that grid, by one
-    inverse real FFT per row where m > 2 K (the same values to rounding, about 1e-15 of the signal, 4-30 times
-    faster than the matrix product)."""
+    """Return K-harmonic periodic signals synthesised on ``m`` points of one period, t = n / (m f0).
+
+    The signals x ~ sum Im(c (i h w)^d e^{ihwt}) of rows of complex coefficients, by Fourier interpolation:
+    ``synthesize`` on that grid, by one inverse real FFT per row where m > 2 K (the same values to rounding, about 1e-15
+    of the signal, 4-30 times faster than the matrix product).
+
+    Parameters
+    ----------
+    coef
+        The complex amplitudes c_1..c_K of each row, in any unit (e.g. [N], [m/s^2]), shape (n_rows, K), or (K,) for
+        one.
+    f0
+        The fundamental frequency [Hz].
+    m
+        The number of points over the period.
+    derivative
+        d, the order of the time derivative (negative: integrals).
+
+    Returns
+    -------
+    signals : np.ndarray
+        The signals at t = n / (m f0), n = 0..m-1 [unit of coef] times s^-d, shape (n_rows, m).
+    """
     coef = np.atleast_2d(coef)
     K = coef.shape[1]
     if m <= 2 * K:

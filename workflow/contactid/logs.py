@@ -1,5 +1,8 @@
-"""Logging set-up for rule scripts: everything to the rule's log file, and the package's progress
-(INFO and above) to stderr as well, which Snakemake shows on the console."""
+"""Logging set-up for rule scripts: everything to the rule's log file, the package's progress to stderr as well.
+
+The package's progress (INFO and above) goes to stderr as well as to the log file, and Snakemake shows it on the
+console.
+"""
 
 from __future__ import annotations
 
@@ -11,9 +14,25 @@ from pathlib import Path
 import numpy as np
 
 
-def fmt(value, digits: int = 4) -> str:
-    """A value for a log line, written for people: numbers to ``digits`` significant digits, arrays
-    and lists as comma-separated numbers, mappings as ``key = value`` pairs (no numpy reprs)."""
+def fmt(value: object, digits: int = 4) -> str:
+    """Return a value written for people, for a log line.
+
+    Numbers to ``digits`` significant digits, arrays and lists as comma-separated numbers, mappings as ``key = value``
+    pairs (no numpy reprs).
+
+    Parameters
+    ----------
+    value
+        What to write: a string, a bool, a number, a mapping, a list, a tuple or an array (numpy scalars included);
+        anything else by ``str``.
+    digits
+        Significant digits of a floating-point number (and of those in mappings, lists and arrays).
+
+    Returns
+    -------
+    text : str
+        The value as text.
+    """
     if isinstance(value, (str, bytes, np.str_)):
         return str(value)
     if isinstance(value, (bool, np.bool_)):
@@ -33,8 +52,15 @@ def fmt(value, digits: int = 4) -> str:
 
 
 class _ConsoleFormatter(logging.Formatter):
-    """``HH:MM:SS job: message``, with the level named from WARNING up; no traceback (the file has
-    it, and Python prints the uncaught one on stderr itself)."""
+    """Console format ``HH:MM:SS job: message``, with the level named from WARNING up.
+
+    No traceback (the file has it, and Python prints the uncaught one on stderr itself).
+
+    Parameters
+    ----------
+    label
+        The job's name shown before each message (the log file's name without its suffix).
+    """
 
     def __init__(self, label: str):
         super().__init__("%(asctime)s %(message)s", datefmt="%H:%M:%S")
@@ -48,16 +74,29 @@ class _ConsoleFormatter(logging.Formatter):
 
 
 class _ProgressFilter(logging.Filter):
-    """The package's and the scripts' records (logger ``contactid...``), and warnings from anywhere."""
+    """Pass the package's and the scripts' records (logger ``contactid...``), and warnings from anywhere."""
 
     def filter(self, record: logging.LogRecord) -> bool:
         return record.name.split(".")[0] == "contactid" or record.levelno >= logging.WARNING
 
 
 def setup_logging(path: str | None) -> logging.Logger:
-    """Send the package's and the script's log records to ``path`` (or stderr alone), and the
-    package's INFO records and every warning to stderr with a short format (``HH:MM:SS <log file's
-    name>: message``); an uncaught error is logged there as well before it ends the script."""
+    """Send the package's and the script's log records to a file, and its progress to stderr.
+
+    The records go to ``path`` (or to stderr alone); the package's INFO records and every warning go to stderr as well,
+    with a short format (``HH:MM:SS <log file's name>: message``). An uncaught error is logged there as well before it
+    ends the script.
+
+    Parameters
+    ----------
+    path
+        The rule's log file, or None to log to stderr alone.
+
+    Returns
+    -------
+    log : logging.Logger
+        The package's logger (``contactid``).
+    """
     handler = logging.FileHandler(path, mode="w") if path else logging.StreamHandler(sys.stderr)
     handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
     root = logging.getLogger()

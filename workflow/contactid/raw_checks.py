@@ -1,12 +1,14 @@
-"""Checks of raw records before identification that the dual-sine records and the random test share. The config's
-raw_checks with the schema's defaults, the checks' thresholds (the constants below, from the physics and statistics of
-the records) and the checks of every channel (magnitude, dead channels, clipping, offsets).
+"""Checks of raw records before identification that the dual-sine records and the random test share.
 
-The dual-sine records' own checks are in ``raw_checks_dual_sine``, the random test's in ``raw_checks_random``."""
+The config's raw_checks with the schema's defaults, the checks' thresholds (the constants below, from the physics and
+statistics of the records) and the checks of every channel (magnitude, dead channels, clipping, offsets).
+
+The dual-sine records' own checks are in ``raw_checks_dual_sine``, the random test's in ``raw_checks_random``.
+"""
 
 from __future__ import annotations
 
-from typing import Mapping
+from typing import Iterator, Mapping, Sequence
 
 import numpy as np
 import xarray as xr
@@ -21,7 +23,20 @@ from .io import RawDataError
 
 
 def check_settings(checks: Mapping | None) -> dict:
-    """raw_checks with the schema's defaults filled in (max_harmonic and min_periods, the record reader's, apart)."""
+    """Return raw_checks with the schema's defaults filled in (max_harmonic and min_periods, the reader's, apart).
+
+    Parameters
+    ----------
+    checks
+        The config's ``raw_checks`` section (None or keys left out or null: the schema's defaults): clip_samples,
+        frequency_tolerance_cycles, stationarity_tolerance, drift_tolerance, min_coherence, coherence_fraction and
+        max_frf_resolution_hz.
+
+    Returns
+    -------
+    settings : dict
+        The schema's raw_checks defaults (but max_harmonic and min_periods) with the keys ``checks`` sets over them.
+    """
     from .schema import schema_defaults
 
     defaults = {k: v for k, v in schema_defaults("raw_checks").items() if k not in ("max_harmonic", "min_periods")}
@@ -61,8 +76,28 @@ CLIP_SPIKE = 4.0
 OFFSET_SHARE = 0.01
 
 
-def channels_of(raw: xr.Dataset, path: str = "record"):
-    """(name, samples) of the force and every accelerometer, after the magnitude check."""
+def channels_of(raw: xr.Dataset, path: str = "record") -> Iterator[tuple]:
+    """Yield (name, samples) of the force and every accelerometer, after the magnitude check.
+
+    Parameters
+    ----------
+    raw
+        The raw record (``force`` over time [N], ``acceleration`` over sensor and time [m/s^2], the ``sensor``
+        coordinate).
+    path
+        The record's file, for messages.
+
+    Yields
+    ------
+    channel : tuple[str, np.ndarray]
+        The channel's name ("force" first, then the sensors' names) and its samples [N] (the force) or [m/s^2] (an
+        accelerometer), shape (n_samples,).
+
+    Raises
+    ------
+    RawDataError
+        Where a channel's magnitude passes ``PHYSICAL_LIMIT`` (a scaling error).
+    """
     chans = [("force", np.asarray(raw["force"].values, float))]
     chans += [(str(s), a) for s, a in zip(raw["sensor"].values, np.asarray(raw["acceleration"].values, float))]
     for name, x in chans:
@@ -76,12 +111,34 @@ def channels_of(raw: xr.Dataset, path: str = "record"):
 
 
 def unit_of(k: int) -> str:
-    """The unit of channel ``k`` of ``channels_of`` (the force first)."""
+    """Return the unit of channel ``k`` of ``channels_of`` (the force first).
+
+    Parameters
+    ----------
+    k
+        The channel's index in ``channels_of`` (0: the force).
+
+    Returns
+    -------
+    unit : str
+        "N" for the force, "m/s^2" for an accelerometer.
+    """
     return "N" if k == 0 else "m/s^2"
 
 
 def dead_fix(k: int) -> str:
-    """What a dead channel ``k`` of ``channels_of`` is and what to do."""
+    """Return what a dead channel ``k`` of ``channels_of`` is and what to do.
+
+    Parameters
+    ----------
+    k
+        The channel's index in ``channels_of`` (0: the force).
+
+    Returns
+    -------
+    text : str
+        The likely cause and the fix, for a message.
+    """
     if k == 0:
         return (
             "a dead force transducer, its cable or a channel not recorded; check the transducer and its cable "
@@ -93,9 +150,24 @@ def dead_fix(k: int) -> str:
     )
 
 
-def flat_channel_check(channels, path: str) -> None:
-    """Refuse a channel of ``channels`` ([(name, samples)], from ``channels_of``: the force first) whose samples are all
-    equal: nothing was recorded on it (no clipping, frequency or harmonic means anything there)."""
+def flat_channel_check(channels: Sequence[tuple[str, np.ndarray]], path: str) -> None:
+    """Refuse a channel whose samples are all equal: nothing was recorded on it.
+
+    No clipping, frequency or harmonic means anything there.
+
+    Parameters
+    ----------
+    channels
+        [(name, samples)] from ``channels_of``, the force first: samples [N] (the force) or [m/s^2] (an
+        accelerometer), each of shape (n_samples,).
+    path
+        The record's file, for messages.
+
+    Raises
+    ------
+    RawDataError
+        For the first channel whose samples are all equal.
+    """
     for k, (name, x) in enumerate(channels):
         if x.size and float(np.ptp(x)) == 0.0:
             raise RawDataError(
@@ -105,8 +177,20 @@ def flat_channel_check(channels, path: str) -> None:
 
 
 def samples_at_limit(x: np.ndarray) -> int:
-    """How many samples sit at the channel's largest or smallest value (not all of them clipped: a clean periodic
-    record repeats its peak sample every period; ``flat_tops`` tells)."""
+    """Return how many samples sit at the channel's largest or smallest value.
+
+    Not all of them are clipped: a clean periodic record repeats its peak sample every period; ``flat_tops`` tells.
+
+    Parameters
+    ----------
+    x
+        The channel's samples [N] (the force) or [m/s^2] (an accelerometer), shape (n_samples,).
+
+    Returns
+    -------
+    count : int
+        The larger of the counts at the largest and at the smallest value (every sample for a flat channel).
+    """
     span = float(np.ptp(x))
     if span == 0.0:
         return x.size
@@ -118,9 +202,12 @@ _SIDE = 3  # samples either side of a flat top through which its continuation is
 
 
 def _continuation_scatter(x: np.ndarray, tol: float) -> float:
-    """The channel's sample-to-sample scatter: the robust rms (1.4826 median absolute value) of each sample less the
-    quadratic through the ``_SIDE`` samples either side of it, over the samples off its extreme values (within
-    ``tol``: a clipped channel's flat tops, which the quadratic meets exactly, left out)."""
+    """Return the channel's sample-to-sample scatter.
+
+    The robust rms (1.4826 median absolute value) of each sample less the quadratic through the ``_SIDE`` samples either
+    side of it, over the samples off its extreme values (within ``tol``: a clipped channel's flat tops, which the
+    quadratic meets exactly, left out).
+    """
     if x.size < 2 * _SIDE + 1:
         return 0.0
     u = np.r_[-_SIDE:0, 1 : _SIDE + 1].astype(float)
@@ -133,10 +220,10 @@ def _continuation_scatter(x: np.ndarray, tol: float) -> float:
 
 
 def flat_tops(x: np.ndarray, unit: str = "") -> tuple[int, str]:
-    """Clipping of one channel: (how many samples are held at its largest or smallest value, the evidence, in
-    ``unit``).
+    """Return the clipping of one channel: how many samples are held at its largest or smallest value, and the evidence.
 
     A clipped channel holds samples at the range limit where the signal went on beyond it, seen two ways:
+
     - the limit's value collects every sample beyond it: it occurs more than ``CLIP_SPIKE`` times as often as each of
       the three values just below it (plus one). A record with noise repeats no value, a clean periodic record repeats
       each of its values once a period, the peak as often as its neighbours, and a quantised sine's top step holds at
@@ -144,7 +231,22 @@ def flat_tops(x: np.ndarray, unit: str = "") -> tuple[int, str]:
     - a run at the limit (gaps of up to two samples below it bridged) that the signal's continuation, the quadratic
       through the ``_SIDE`` samples either side of it, exceeds by ``CLIP_EXCESS`` times the channel's
       sample-to-sample scatter: a flat top. A clean periodic record's peak, repeated at the same phase every period
-      (one or two samples, the neighbours below), is met by that continuation within the scatter."""
+      (one or two samples, the neighbours below), is met by that continuation within the scatter.
+
+    Parameters
+    ----------
+    x
+        The channel's samples [N] (the force) or [m/s^2] (an accelerometer), shape (n_samples,).
+    unit
+        The channel's unit, for the evidence's text ("" for none).
+
+    Returns
+    -------
+    held : int
+        How many samples are held at the limits in flat tops (0 for none).
+    evidence : str
+        What shows it, with values in ``unit`` ("" for none).
+    """
     span = float(np.ptp(x))
     if span == 0.0 or x.size < 2 * _SIDE + 2:
         return 0, ""
@@ -192,9 +294,36 @@ def flat_tops(x: np.ndarray, unit: str = "") -> tuple[int, str]:
     return held, evidence
 
 
-def clipping_warnings(channels, path: str, clip_samples: int, drive: str) -> list[str]:
-    """Refuse a clipped channel of ``channels`` ([(name, samples)], from ``channels_of``) when ``clip_samples``
-    samples are held at its range limit in flat tops (``flat_tops``); warn from half that many."""
+def clipping_warnings(
+    channels: Sequence[tuple[str, np.ndarray]], path: str, clip_samples: int, drive: str
+) -> list[str]:
+    """Refuse a clipped channel; warn of one clipped half as much.
+
+    A channel is refused when ``clip_samples`` samples are held at its range limit in flat tops (``flat_tops``), and
+    warned of from half that many.
+
+    Parameters
+    ----------
+    channels
+        [(name, samples)] from ``channels_of``, the force first: samples [N] (the force) or [m/s^2] (an
+        accelerometer), each of shape (n_samples,).
+    path
+        The record's file, for messages.
+    clip_samples
+        Samples held at the range limit that make a channel clipped (config ``raw_checks.clip_samples``).
+    drive
+        What to lower besides the input range's gain, for the message ("excitation", "force level").
+
+    Returns
+    -------
+    warnings : list[str]
+        One warning per channel with at least half of ``clip_samples`` (and two) samples held.
+
+    Raises
+    ------
+    RawDataError
+        For the first channel with ``clip_samples`` or more samples held.
+    """
     warnings = []
     for k, (name, x) in enumerate(channels):
         held, evidence = flat_tops(x, unit_of(k))
@@ -210,15 +339,40 @@ def clipping_warnings(channels, path: str, clip_samples: int, drive: str) -> lis
 
 
 def _offset_text(k: int) -> str:
-    """What an offset on channel ``k`` of ``channels_of`` (the force first) is and what to check."""
+    """Return what an offset on channel ``k`` of ``channels_of`` (the force first) is and what to check."""
     what = "a transducer" if k == 0 else "an accelerometer"
     zero = "the charge amplifier's" if k == 0 else "the charge amplifier's or signal conditioner's"
     return f"{what} offset or drift (harmless to the identification, which uses the harmonics; check {zero} zero)"
 
 
-def offset_warnings(names, mean: np.ndarray, reference: np.ndarray, noise: np.ndarray, n: int, what) -> list[str]:
-    """Warnings for channels whose ``mean`` stands ``LINE_SNR`` standard errors (``noise`` rms over ``n`` samples) out
-    of zero and exceeds ``OFFSET_SHARE`` of ``reference`` (its drive line, or its rms), named ``what[k]``."""
+def offset_warnings(
+    names: Sequence[str], mean: np.ndarray, reference: np.ndarray, noise: np.ndarray, n: int, what: Sequence[str]
+) -> list[str]:
+    """Return warnings for channels whose mean is an offset worth a warning.
+
+    A channel's ``mean`` is one where it stands ``LINE_SNR`` standard errors (``noise`` rms over ``n`` samples) out of
+    zero and exceeds ``OFFSET_SHARE`` of ``reference`` (its drive line, or its rms).
+
+    Parameters
+    ----------
+    names
+        The channels' names, the force first (``channels_of``'s order).
+    mean
+        Each channel's mean [N] (the force) or [m/s^2] (an accelerometer), shape (n_channels,).
+    reference
+        What each mean is compared with, its drive line's amplitude or its rms [unit of mean], shape (n_channels,).
+    noise
+        Each channel's noise rms [unit of mean], shape (n_channels,).
+    n
+        The number of samples the means are taken over.
+    what
+        The name of each channel's reference, for the message ("amplitude at w", "rms").
+
+    Returns
+    -------
+    warnings : list[str]
+        One warning per channel with an offset.
+    """
     out = []
     for k, name in enumerate(names):
         m = float(mean[k])

@@ -2,9 +2,9 @@
 
 The rig's and the reduced model's drive is a sum of harmonics, each with a sine and a cosine of the same angle,
 evaluated every time step: about a third of a step's time. GNU libm's ``sincos`` shares its argument reduction and
-polynomials with ``sin`` and ``cos`` and returns the same digits (checked in ``tests/test_sincos.py``) in about the
-time of one of them. Where the C library has no ``sincos`` (macOS, Windows), ``sin_cos`` calls sine and cosine
-separately: the same results, only slower.
+polynomials with ``sin`` and ``cos`` and returns the same digits (checked in ``tests/test_sincos.py``) in about the time
+of one of them. Where the C library has no ``sincos`` (macOS, Windows), ``sin_cos`` calls sine and cosine separately:
+the same results, only slower.
 """
 
 from __future__ import annotations
@@ -17,7 +17,10 @@ from numba import njit
 
 
 def _libm_sincos_address() -> int | None:
-    """The address of the C library's ``sincos`` (void sincos(double, double *, double *)), or None."""
+    """Return the address of the C library's ``sincos``, or None where it has none.
+
+    The function is ``void sincos(double, double *, double *)``.
+    """
     for name in (ctypes.util.find_library("m"), "libm.so.6"):
         if not name:
             continue
@@ -42,7 +45,7 @@ if HAS_LIBM_SINCOS:
 
     @intrinsic
     def _sincos(typingctx, x):
-        """(sin x, cos x) from libm's sincos (x in rad)."""
+        """Return (sin x, cos x) from libm's ``sincos`` (x in rad)."""
         sig = types.UniTuple(types.float64, 2)(types.float64)
 
         def codegen(context, builder, signature, args):
@@ -57,13 +60,41 @@ if HAS_LIBM_SINCOS:
         return sig, codegen
 
     @njit(cache=True)
-    def sin_cos(x):
-        """(sin x, cos x) of the angle x (rad), both from one libm ``sincos`` call."""
+    def sin_cos(x: float) -> tuple[float, float]:
+        """Return (sin x, cos x) of the angle x, both from one libm ``sincos`` call.
+
+        Parameters
+        ----------
+        x
+            Angle [rad].
+
+        Returns
+        -------
+        sin_x : float
+            Sine of ``x`` [-].
+        cos_x : float
+            Cosine of ``x`` [-].
+        """
         return _sincos(x)
 
 else:  # pragma: no cover - platforms without GNU sincos
 
     @njit(cache=True)
-    def sin_cos(x):
-        """(sin x, cos x) of the angle x (rad)."""
+    def sin_cos(x: float) -> tuple[float, float]:
+        """Return (sin x, cos x) of the angle x.
+
+        Sine and cosine called separately (no ``sincos`` in this C library): the same results, only slower.
+
+        Parameters
+        ----------
+        x
+            Angle [rad].
+
+        Returns
+        -------
+        sin_x : float
+            Sine of ``x`` [-].
+        cos_x : float
+            Cosine of ``x`` [-].
+        """
         return np.sin(x), np.cos(x)
