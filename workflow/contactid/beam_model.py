@@ -23,6 +23,7 @@ from __future__ import annotations
 import math
 import weakref
 from dataclasses import dataclass
+from typing import Iterable
 
 import numpy as np
 import scipy.linalg
@@ -32,19 +33,47 @@ from .parameters import StructureParameters
 
 @dataclass(frozen=True)
 class FEModel:
-    """Assembled linear model.
+    """Assembled linear finite-element model of the structure.
 
-    Attributes:
-        nodes: beam node positions (m), node 0 at the clamp.
-        mass, stiffness: (n_dof, n_dof) matrices (kg, N/m in mixed units).
-        w_dof, theta_dof: dof index of w and w' at each node (-1 where clamped).
-        u_dof, ys_dof, thetas_dof: indices of u, y_s, theta_s.
-        xi_vector, eta_vector: row vectors with xi = xi_vector @ q, eta = eta_vector @ q.
-        force_vector: generalized force of a unit force at d_p.
-        sensor_vectors: (n_sensors, n_dof), w(x_s) = sensor_vectors @ q.
-        block_lateral_vector, block_axial_vector: the block's absolute lateral
-            (eta - y_s) and axial (hanging point + l_s theta_s) displacements.
-        params: the parameters it was built from.
+    Degrees of freedom q: the beam's deflections w [m] and slopes w' [rad] at the nodes (those the clamp fixes left
+    out), then u, y_s [m] and theta_s [rad]. The matrices and vectors below are in the mixed units these dofs give.
+
+    Attributes
+    ----------
+    nodes
+        Beam node positions [m], node 0 at the clamp, shape (n_nodes,).
+    mass
+        Mass matrix [kg] (kg m and kg m^2 where slopes and theta_s enter), shape (n_dof, n_dof).
+    stiffness
+        Stiffness matrix [N/m] (N and N m/rad where slopes and theta_s enter), with the linear contact springs of
+        Eq. (13), shape (n_dof, n_dof).
+    w_dof
+        Dof index of w at each node [-] (-1 where clamped), shape (n_nodes,).
+    theta_dof
+        Dof index of w' at each node [-] (-1 where clamped), shape (n_nodes,).
+    u_dof
+        Dof index of the axial tip motion u.
+    ys_dof
+        Dof index of the string's stretch y_s.
+    thetas_dof
+        Dof index of the block's pendulum angle theta_s.
+    xi_vector
+        Row vector with xi = xi_vector @ q (Eq. 9, linear part) [-] (its entry on the tip slope is the lever arm a
+        [m]), shape (n_dof,).
+    eta_vector
+        Row vector with eta = eta_vector @ q (Eq. 8) [-] (its entry on the tip slope is the lever arm r [m]),
+        shape (n_dof,).
+    force_vector
+        Generalized force of a unit force at d_p [-], shape (n_dof,).
+    sensor_vectors
+        Rows with w(x_s) = sensor_vectors @ q at the sensors [-], shape (n_sensors, n_dof).
+    block_lateral_vector
+        Row vector of the block's absolute lateral displacement (eta - y_s) [-], shape (n_dof,).
+    block_axial_vector
+        Row vector of the block's absolute axial displacement (hanging point + l_s theta_s) [-] (lever arms [m] on
+        the tip slope and theta_s), shape (n_dof,).
+    params
+        The parameters it was built from.
     """
 
     nodes: np.ndarray
@@ -70,20 +99,47 @@ class FEModel:
 
     @property
     def contact_stiffness_matrix(self) -> np.ndarray:
-        """k_t xi xi^T + k_n eta eta^T (N/m)."""
+        """Stiffness matrix of the linear contact springs, k_t xi xi^T + k_n eta eta^T.
+
+        Returns
+        -------
+        contact_stiffness_matrix : np.ndarray
+            Contact springs' stiffness matrix [N/m] (mixed units as ``stiffness``), shape (n_dof, n_dof).
+        """
         p = self.params
         return p.k_t * np.outer(self.xi_vector, self.xi_vector) + p.k_n * np.outer(self.eta_vector, self.eta_vector)
 
     @property
     def stiffness_without_contact(self) -> np.ndarray:
-        """Stiffness matrix with the contact springs removed (Eq. 12's K when
-        S and N are the whole contact forces)."""
+        """Stiffness matrix with the contact springs removed.
+
+        Eq. (12)'s K when S and N are the whole contact forces.
+
+        Returns
+        -------
+        stiffness_without_contact : np.ndarray
+            Stiffness matrix without the contact springs [N/m] (mixed units as ``stiffness``), shape (n_dof, n_dof).
+        """
         return self.stiffness - self.contact_stiffness_matrix
 
 
-def mesh_nodes(length: float, key_points, n_elements: int) -> np.ndarray:
-    """Node positions (m) with a node at every key point and about
-    ``n_elements`` elements of near-equal size."""
+def mesh_nodes(length: float, key_points: Iterable[float], n_elements: int) -> np.ndarray:
+    """Return node positions with a node at every key point and about ``n_elements`` elements of near-equal size.
+
+    Parameters
+    ----------
+    length
+        Beam length [m].
+    key_points
+        Positions that must be nodes (sensors, excitation) [m], measured from the clamp.
+    n_elements
+        Target number of elements over the whole length.
+
+    Returns
+    -------
+    nodes : np.ndarray
+        Node positions [m], ascending from 0 to ``length``, shape (n_nodes,).
+    """
     pts = sorted({0.0, float(length), *(float(x) for x in key_points)})
     h_target = length / max(int(n_elements), 1)
     nodes = [0.0]
@@ -96,8 +152,10 @@ def mesh_nodes(length: float, key_points, n_elements: int) -> np.ndarray:
 
 
 def _element_matrices(EI: float, rhoA: float, le):
-    """Hermite beam element stiffness and consistent mass matrices (N/m and kg, mixed units) of elements of length
-    ``le`` (m; a scalar: (4, 4) each, an array of n: (n, 4, 4))."""
+    """Return Hermite beam element stiffness and consistent mass matrices.
+
+    In N/m and kg (mixed units), of elements of length ``le`` (m; a scalar: (4, 4) each, an array of n: (n, 4, 4)).
+    """
     le = np.asarray(le, dtype=float)
     one, z = np.ones_like(le), le
     k = (EI / le**3)[..., None, None] * np.stack(
@@ -122,8 +180,11 @@ def _element_matrices(EI: float, rhoA: float, le):
 
 
 def _element_scatter(w_dof: np.ndarray, theta_dof: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(rows, cols, sel): where the entries of the elements' (n_el, 4, 4) matrices, flattened and taken at ``sel``,
-    add into the global matrix, element by element and row by row (clamped dofs, index -1, left out)."""
+    """Return where the elements' matrix entries add into the global matrix.
+
+    (rows, cols, sel): where the entries of the elements' (n_el, 4, 4) matrices, flattened and taken at ``sel``, add
+    into the global matrix, element by element and row by row (clamped dofs, index -1, left out).
+    """
     d = np.stack([w_dof[:-1], theta_dof[:-1], w_dof[1:], theta_dof[1:]], axis=1)  # (n_el, 4)
     rows = np.broadcast_to(d[:, :, None], d.shape + (4,)).reshape(-1)
     cols = np.broadcast_to(d[:, None, :], d.shape + (4,)).reshape(-1)
@@ -132,8 +193,10 @@ def _element_scatter(w_dof: np.ndarray, theta_dof: np.ndarray) -> tuple[np.ndarr
 
 
 def _element_shortening(le):
-    """int N'^T N' dx of a Hermite element (the geometric stiffness of a unit axial tension), 1/m; of elements of
-    length ``le`` (m; a scalar: (4, 4), an array of n: (n, 4, 4))."""
+    """Return int N'^T N' dx of Hermite elements (the geometric stiffness of a unit axial tension).
+
+    In 1/m; of elements of length ``le`` (m; a scalar: (4, 4), an array of n: (n, 4, 4)).
+    """
     z = np.asarray(le, dtype=float)
     one = np.ones_like(z)
     return (1.0 / (30.0 * z))[..., None, None] * np.stack(
@@ -148,9 +211,23 @@ def _element_shortening(le):
 
 
 def shortening_matrix(model: "FEModel") -> np.ndarray:
-    """G with int_0^L w'^2 dx = q^T G q, so the beam shortening of Eq. (9) is -q^T G q / 2 (1/m), times the
-    structure's ``shortening_scale`` (1: Eq. 9 as printed; 0: linear kinematics, G = 0). The elements' matrices
-    are scattered as ``assemble`` scatters its own (the sums of an element-by-element loop, bit for bit)."""
+    """Return G with int_0^L w'^2 dx = q^T G q, times the structure's ``shortening_scale``.
+
+    The beam shortening of Eq. (9) is -q^T G q / 2, times the structure's ``shortening_scale`` (1: Eq. 9 as printed;
+    0: linear kinematics, G = 0). The elements' matrices are scattered as ``assemble`` scatters its own (the sums of an
+    element-by-element loop, bit for bit).
+
+    Parameters
+    ----------
+    model
+        The assembled model.
+
+    Returns
+    -------
+    G : np.ndarray
+        Shortening matrix [1/m] between deflection dofs (mixed units: [-] between a deflection and a slope, [m]
+        between slopes), shape (n_dof, n_dof).
+    """
     G = np.zeros((model.n_dof, model.n_dof))
     rows, cols, sel = _element_scatter(model.w_dof, model.theta_dof)
     np.add.at(G, (rows, cols), _element_shortening(np.diff(model.nodes)).reshape(-1)[sel])
@@ -165,7 +242,23 @@ def _node_index(nodes: np.ndarray, x: float) -> int:
 
 
 def assemble(params: StructureParameters) -> FEModel:
-    """Assemble mass and stiffness matrices from the energies (A2)-(A3)."""
+    """Assemble the mass and stiffness matrices from the energies (A2)-(A3).
+
+    Parameters
+    ----------
+    params
+        The structure.
+
+    Returns
+    -------
+    model : FEModel
+        The assembled model, with the linear contact springs of Eq. (13) in its stiffness.
+
+    Raises
+    ------
+    ValueError
+        When a sensor or the excitation position lies outside the beam (0, L].
+    """
     p = params
     key = [*p.sensor_positions, p.excitation_position]
     for x in key:
@@ -243,9 +336,15 @@ def assemble(params: StructureParameters) -> FEModel:
 class Modes:
     """Undamped modes of an :class:`FEModel`.
 
-    frequencies_hz: natural frequencies (Hz); shapes: (n_dof, n_modes),
-    mass-normalised (shapes.T @ M @ shapes = I); block_energy_fraction: share of
-    each mode's kinetic energy carried by the hanging block's own coordinates.
+    Attributes
+    ----------
+    frequencies_hz
+        Natural frequencies [Hz], shape (n_modes,).
+    shapes
+        Mode shapes, mass-normalised (shapes.T @ M @ shapes = I) [kg^-0.5] on the translational dofs (rad/(kg^0.5 m)
+        on the slopes), shape (n_dof, n_modes).
+    block_energy_fraction
+        Share of each mode's kinetic energy carried by the hanging block's own coordinates [-], shape (n_modes,).
     """
 
     frequencies_hz: np.ndarray
@@ -254,8 +353,21 @@ class Modes:
 
 
 def fix_signs(vectors: np.ndarray) -> np.ndarray:
-    """Columns with their largest-magnitude entry made positive, so that eigenvectors (whose sign
-    the solver leaves free, and may flip between processes) are reproducible."""
+    """Return the columns with their largest-magnitude entry made positive.
+
+    So that eigenvectors (whose sign the solver leaves free, and may flip between processes) are reproducible.
+
+    Parameters
+    ----------
+    vectors
+        Vectors as columns, shape (n, n_vectors); in the package mass-normalised mode shapes [kg^-0.5] (any unit
+        works).
+
+    Returns
+    -------
+    vectors : np.ndarray
+        The same columns, each possibly negated [unit of vectors], shape (n, n_vectors).
+    """
     idx = np.argmax(np.abs(vectors), axis=0)
     return vectors * np.sign(vectors[idx, np.arange(vectors.shape[1])])
 
@@ -264,8 +376,21 @@ _MODES: dict = {}
 
 
 def all_modes(model: FEModel) -> Modes:
-    """All undamped modes, sorted by frequency, mass-normalised (computed once per model object:
-    the identification and the gap diagnosis ask for the same model's modes many times)."""
+    """Return all undamped modes, sorted by frequency, mass-normalised.
+
+    Computed once per model object: the identification and the gap diagnosis ask for the same model's modes many
+    times.
+
+    Parameters
+    ----------
+    model
+        The assembled model.
+
+    Returns
+    -------
+    modes : Modes
+        Every mode of the model (n_modes = n_dof), suspension modes of the block included.
+    """
     key = id(model)
     hit = _MODES.get(key)
     if hit is not None and hit[0]() is model:
@@ -291,12 +416,31 @@ def _all_modes(model: FEModel) -> Modes:
 
 
 def structural_modes(model: FEModel, n_modes: int | None = None, max_block_fraction: float = 0.5) -> Modes:
-    """Modes of the beam (the paper's modes 1, 2, 3, ...), sorted by frequency.
+    """Return the modes of the beam (the paper's modes 1, 2, 3, ...), sorted by frequency.
 
     Suspension modes of the hanging block (pendulum swing, bounce on the string),
     whose kinetic energy lies mostly in y_s and theta_s, are left out: they sit
     near 1 Hz and 10 Hz, far below the band of interest, and no beam sensor
     sees them.
+
+    Parameters
+    ----------
+    model
+        The assembled model.
+    n_modes
+        How many modes, lowest first; None: every structural mode.
+    max_block_fraction
+        A mode whose kinetic energy share on the block's own coordinates reaches this is a suspension mode [-].
+
+    Returns
+    -------
+    modes : Modes
+        The structural modes.
+
+    Raises
+    ------
+    ValueError
+        When the model has fewer than ``n_modes`` structural modes.
     """
     m = all_modes(model)
     keep = np.flatnonzero(m.block_energy_fraction < max_block_fraction)
@@ -308,8 +452,20 @@ def structural_modes(model: FEModel, n_modes: int | None = None, max_block_fract
 
 
 def natural_frequencies(params: StructureParameters, n_modes: int = 3) -> np.ndarray:
-    """First ``n_modes`` structural natural frequencies (Hz) of the linear system
-    with the contact springs of Eq. (13)."""
+    """Return the first structural natural frequencies of the linear system with the contact springs of Eq. (13).
+
+    Parameters
+    ----------
+    params
+        The structure.
+    n_modes
+        How many frequencies, lowest first.
+
+    Returns
+    -------
+    frequencies : np.ndarray
+        Natural frequencies [Hz], ascending, shape (n_modes,).
+    """
     return structural_modes(assemble(params), n_modes).frequencies_hz
 
 
@@ -318,13 +474,22 @@ RITZ_MODES = 20  # modes of K_0 in ContactFrequencyMap's basis (with the two sta
 
 
 class ContactFrequencyMap:
-    """Natural frequencies (Hz) as a function of (k_t, k_n) for one structure,
-    reusing the assembly: K = K_0 + k_t xi xi^T + k_n eta eta^T.
+    """Natural frequencies as a function of the contact stiffnesses (k_t, k_n) for one structure.
 
-    Used in the stiffness fit, where the structure is evaluated many times. The contact springs are a rank-2
-    change of K_0, so the eigenproblem is solved in a Ritz basis: the lowest RITZ_MODES modes of (K_0, M) and the
-    static shapes K_0^-1 xi, K_0^-1 eta (the contact's constraint modes), M-orthonormal. Where K_0 is singular or
-    the model too small, the full eigenproblem is solved.
+    Reuses the assembly: K = K_0 + k_t xi xi^T + k_n eta eta^T. Used in the stiffness fit, where the structure is
+    evaluated many times. The contact springs are a rank-2 change of K_0, so the eigenproblem is solved in a Ritz basis:
+    the lowest RITZ_MODES modes of (K_0, M) and the static shapes K_0^-1 xi, K_0^-1 eta (the contact's constraint
+    modes), M-orthonormal. Where K_0 is singular or the model too small, the full eigenproblem is solved.
+
+    Parameters
+    ----------
+    params
+        The structure (its own k_t, k_n are replaced at each call).
+    n_modes
+        How many structural frequencies a call returns, lowest first.
+    max_block_fraction
+        A mode whose kinetic energy share on the block's own coordinates reaches this is a suspension mode, left out
+        (as in ``structural_modes``) [-].
     """
 
     def __init__(self, params: StructureParameters, n_modes: int = 3, max_block_fraction: float = 0.5):
@@ -347,9 +512,30 @@ class ContactFrequencyMap:
                 self._basis = None
 
     def __call__(self, k_t: float, k_n: float, stiffness_scale: float = 1.0) -> np.ndarray:
-        """The structural natural frequencies (Hz) with contact springs k_t, k_n (N/m) and Young's modulus
-        ``stiffness_scale`` times the structure's (in the Ritz basis of the structure's own: within 1e-8 of the
-        full eigenproblem for scales of 0.9-1.1, tests/test_beam_model.py)."""
+        """Return the structural natural frequencies with contact springs k_t, k_n and a scaled Young's modulus.
+
+        Solved in the Ritz basis of the structure's own modes: within 1e-8 of the full eigenproblem for scales of
+        0.9-1.1 (tests/test_beam_model.py).
+
+        Parameters
+        ----------
+        k_t
+            Linear tangential contact stiffness [N/m].
+        k_n
+            Linear normal contact stiffness [N/m].
+        stiffness_scale
+            Young's modulus as a multiple of the structure's [-].
+
+        Returns
+        -------
+        frequencies : np.ndarray
+            Structural natural frequencies [Hz], ascending, shape (n_modes,).
+
+        Raises
+        ------
+        ValueError
+            When fewer than ``n_modes`` of the lowest ``n_modes`` + 6 modes are structural.
+        """
         m = self.model
         n_check = min(m.n_dof, self.n_modes + 6)
         ds = float(stiffness_scale) - 1.0
@@ -372,9 +558,12 @@ class ContactFrequencyMap:
         return np.sqrt(np.clip(lam[keep], 0, None)) / (2 * np.pi)
 
     def _stiffness_part(self) -> tuple:
-        """(K_E, its Ritz projection or None): the part of K_0 proportional to Young's modulus (bending and axial
-        stiffness; not the clamp, the string or gravity), so that a structure with E x s has K_0 + (s - 1) K_E. Made
-        once, when a scale is first asked for (the gap model's contact refits never ask)."""
+        """Return K_E and its Ritz projection (or None), made once.
+
+        K_E is the part of K_0 proportional to Young's modulus (bending and axial stiffness; not the clamp, the string
+        or gravity), so that a structure with E x s has K_0 + (s - 1) K_E. Made once, when a scale is first asked for
+        (the gap model's contact refits never ask).
+        """
         if self._ke is None:
             p = self.model.params
             ke = assemble(p.replace(youngs_modulus=2.0 * p.youngs_modulus)).stiffness_without_contact - self._k0
@@ -383,12 +572,14 @@ class ContactFrequencyMap:
 
 
 def _m_orthonormal_complement(phi: np.ndarray, shapes: np.ndarray, mass: np.ndarray, rtol: float = 1e-12) -> np.ndarray:
-    """The part of ``shapes`` (columns) outside the span of the M-orthonormal columns ``phi``, M-orthonormal
-    (Gram-Schmidt in the mass metric, each projection done twice); a shape within ``rtol`` of that span (in M-norm)
-    adds nothing and is left out. (The contact's static shapes lie within 4e-8 (eta) and 1e-5 (xi) of the lowest 20
-    modes' span on the paper's structure: made M-orthonormal by a Cholesky factor of V^T M V, the eta shape's column
-    made that matrix numerically singular on some structures (transducer masses 7 % heavy), and the map fell back to
-    the full eigenproblem at every call, eight times the cost.)"""
+    """Return the part of ``shapes`` (columns) outside the span of the M-orthonormal columns ``phi``, M-orthonormal.
+
+    Gram-Schmidt in the mass metric, each projection done twice; a shape within ``rtol`` of that span (in M-norm) adds
+    nothing and is left out. (The contact's static shapes lie within 4e-8 (eta) and 1e-5 (xi) of the lowest 20 modes'
+    span on the paper's structure: made M-orthonormal by a Cholesky factor of V^T M V, the eta shape's column made that
+    matrix numerically singular on some structures (transducer masses 7 % heavy), and the map fell back to the full
+    eigenproblem at every call, eight times the cost.)
+    """
     basis = phi
     out = []
     for v in shapes.T:
@@ -405,8 +596,27 @@ def _m_orthonormal_complement(phi: np.ndarray, shapes: np.ndarray, mass: np.ndar
 
 
 def shape_on_grid(model: FEModel, q: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Lateral deflection w(x) (m) and slope w'(x) (rad) of dof vector(s) ``q``
-    (n_dof,) or (n_dof, k), evaluated with the Hermite shape functions."""
+    """Return the lateral deflection w(x) and slope w'(x) of dof vector(s) ``q``.
+
+    Evaluated with the Hermite shape functions of the element holding each x.
+
+    Parameters
+    ----------
+    model
+        The assembled model.
+    q
+        Dof vector(s): displacements [m] (slopes in rad), or mass-normalised mode shapes [kg^-0.5]; shape (n_dof,)
+        or (n_dof, n_vectors).
+    x
+        Positions along the beam, measured from the clamp [m], shape (n_x,).
+
+    Returns
+    -------
+    w : np.ndarray
+        Deflection at ``x`` [unit of q] (m for displacements), shape (n_x,) or (n_x, n_vectors) as ``q``.
+    slope : np.ndarray
+        Slope w' at ``x`` [rad] for displacements ([unit of q] per m in general), shape (n_x,) or (n_x, n_vectors).
+    """
     q = np.asarray(q)
     squeeze = q.ndim == 1
     if squeeze:

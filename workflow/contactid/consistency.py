@@ -1,7 +1,6 @@
-"""The paper's own inconsistency: Table 1's frequencies against Table 3's
-stiffnesses and Table 4's e_0, under candidate modelling assumptions.
+"""The paper's own inconsistency: Table 1's frequencies against Table 3's stiffnesses and Table 4's e_0.
 
-Each scenario fixes some quantities, fits others to Table 1 by least squares
+Each scenario (a candidate modelling assumption) fixes some quantities, fits others to Table 1 by least squares
 on the relative frequency errors, and reports the model frequencies and their
 errors. The finding this supports: the frequencies constrain the rotational
 restraint a^2 k_t k_b / (k_t + k_b) at the tip, not k_t alone, so k_t follows
@@ -11,7 +10,7 @@ only once the tangential lever arm a (not given by the paper) is fixed.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Mapping
+from typing import Any, Mapping
 
 import numpy as np
 import pandas as pd
@@ -27,8 +26,19 @@ TABLE4 = {"e_f": 3.857e7, "k_c": 2.547e5, "e_t": 0.0, "kappa": 0.284, "mu": 0.39
 
 @dataclass(frozen=True)
 class Scenario:
-    """A modelling assumption to test against Table 1: its label, a description, the ``StructureParameters`` fields
-    it fixes (name -> value) and the names of those it fits."""
+    """A modelling assumption to test against Table 1.
+
+    Attributes
+    ----------
+    name
+        Its label (a letter in the table).
+    description
+        What it assumes, in words.
+    fixed
+        The ``StructureParameters`` fields it fixes: name -> value, in the field's unit.
+    free
+        The names of the ``StructureParameters`` fields it fits (log-scaled where positive and wide).
+    """
 
     name: str
     description: str
@@ -39,8 +49,31 @@ class Scenario:
 LOG_FIELDS = {"k_t", "k_n", "youngs_modulus", "clamp_rotational_stiffness"}
 
 
-def fit_scenario(base: StructureParameters, scenario: Scenario, target_hz=TABLE1_HZ):
-    """Fit the scenario's free quantities to ``target_hz``; returns (values, frequencies)."""
+def fit_scenario(
+    base: StructureParameters, scenario: Scenario, target_hz: np.ndarray = TABLE1_HZ
+) -> tuple[dict[str, float], np.ndarray]:
+    """Fit the scenario's free quantities to the target frequencies.
+
+    Least squares on the relative frequency errors, the fields of ``LOG_FIELDS`` in log10, the others bounded below
+    by zero (masses and lengths stay non-negative).
+
+    Parameters
+    ----------
+    base
+        The structure the scenario's fixed values are put into.
+    scenario
+        The assumption: which fields it fixes and which it fits.
+    target_hz
+        Natural frequencies to fit [Hz], lowest first, shape (n_freq,); by default the paper's Table 1.
+
+    Returns
+    -------
+    values : dict[str, float]
+        The fitted fields, name -> value in the field's own unit [units of StructureParameters] (N/m for k_t, Pa for
+        youngs_modulus, m for a length, ...); empty where the scenario fits nothing.
+    frequencies : np.ndarray
+        The model's natural frequencies with those values [Hz], shape (n_freq,).
+    """
     p0 = base.replace(**scenario.fixed)
     names = scenario.free
     if not names:
@@ -66,11 +99,30 @@ def fit_scenario(base: StructureParameters, scenario: Scenario, target_hz=TABLE1
     return ch, natural_frequencies(p, len(target_hz))
 
 
-def paper_consistency_table(structure_cfg: Mapping, friction_truth: Mapping | None = None) -> pd.DataFrame:
-    """Table 1 against Table 3 / Table 4 under candidate assumptions.
+def paper_consistency_table(
+    structure_cfg: Mapping[str, Any], friction_truth: Mapping[str, Any] | None = None
+) -> pd.DataFrame:
+    """Return Table 1 against Table 3 / Table 4 under candidate assumptions.
 
     The base model is the configured structure with the paper's nominal
-    assumptions: tangential lever arm a = r and E = 210 GPa.
+    assumptions: tangential lever arm a = r and E = 210 GPa. With ``friction_truth``, a last row gives the configured
+    structure itself with the rig's k_t = e_0(N0) (the rig's default truth).
+
+    Parameters
+    ----------
+    structure_cfg
+        The config's ``structure`` mapping (as for ``parameters.structure_from_config``), with ``preload_n``.
+    friction_truth
+        The rig truth's friction law (``rig.truth.friction``: ``e_f_n_per_m``, ``k_c_per_m``, ``e_t_n_per_m``,
+        ``kappa``, ``mu``), or None for no ``config`` row.
+
+    Returns
+    -------
+    table : pd.DataFrame
+        One row per scenario: ``scenario``, ``assumption``, ``fitted`` (the fitted values in words), ``k_t_n_per_m``,
+        ``k_n_n_per_m``, ``tangential_lever_arm_m``, ``youngs_modulus_pa``, ``rotational_restraint_nm_per_rad``,
+        the model frequencies ``f1_hz``..``f3_hz``, their errors against Table 1 ``err1_pct``..``err3_pct`` and
+        ``max_abs_err_pct`` (in %).
     """
     cfg_params = structure_from_config(structure_cfg, TABLE3["k_t"], TABLE3["k_n"])
     base = cfg_params.replace(tangential_lever_arm=cfg_params.pin_radius, youngs_modulus=2.1e11)
