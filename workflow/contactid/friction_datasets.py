@@ -6,6 +6,8 @@ chain's forces fitted beside it; a load case's S is predicted by the fitted law 
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from .friction import PARAMETER_NAMES, REGULARIZATIONS, valanis_friction_force
@@ -15,12 +17,18 @@ from .friction_fit import N_OPEN, FitResult, FitSettings, fit_friction_law, log
 from .friction_parameters import ESTIMATES, GRID_FIELDS, fitted_parameters, parameter_variables
 from .harmonics import periodic_grid
 
+if TYPE_CHECKING:
+    import xarray as xr
+
 
 def _fit_on_forces(
     S, xi, N, fs: float, f0: float, preload: float, settings: FitSettings, seed: int, n_harmonics: int, label: str
 ) -> FitResult:
-    """The law fitted (``fit_friction_law``) to one method's S (N), xi (m) and N_dyn (N) records, sampled at ``fs``
-    (Hz), through their first ``n_harmonics`` harmonics of ``f0`` (Hz)."""
+    """Return the law fitted (``fit_friction_law``) to one method's S, xi and N_dyn records.
+
+    S (N), xi (m) and N_dyn (N) records sampled at ``fs`` (Hz), fitted through their first ``n_harmonics`` harmonics of
+    ``f0`` (Hz).
+    """
     from .harmonics import fourier_series
 
     c = [fourier_series(x, fs, f0, n_harmonics)[0] for x in (xi, N, S)]
@@ -28,9 +36,11 @@ def _fit_on_forces(
 
 
 def _fit_variables(res: FitResult) -> dict:
-    """The dataset's variables of the working method's fit: one variable per parameter (e_f, k_c, e_t in N/m, 1/m,
-    N/m; kappa, mu dimensionless) with its interval, the bounds, correlation, the GA's misfits per generation and
-    the grid refinements."""
+    """Return the dataset's variables of the working method's fit.
+
+    One variable per parameter (e_f, k_c, e_t in N/m, 1/m, N/m; kappa, mu dimensionless) with its interval, the bounds,
+    correlation, the GA's misfits per generation and the grid refinements.
+    """
     return {
         **parameter_variables(res.params, res.intervals),
         "bounded_below": (
@@ -76,8 +86,11 @@ def _fit_variables(res: FitResult) -> dict:
 def _fit_attrs(
     res: FitResult, forces, preload: float, f0: float, settings: FitSettings, seed: int, n_harmonics: int
 ) -> dict:
-    """The dataset's attributes of the working method's fit: e_0 at the preload and its interval (N/m), misfit,
-    settings, and the share of the record with the contact open (identified N total <= ``N_OPEN``)."""
+    """Return the dataset's attributes of the working method's fit.
+
+    e_0 at the preload and its interval (N/m), misfit, settings, and the share of the record with the contact open
+    (identified N total <= ``N_OPEN``).
+    """
     attrs = {
         "e0_at_preload_n_per_m": res.e0_at_preload,
         "e0_interval_low": res.e0_interval[0],
@@ -101,9 +114,11 @@ def _fit_attrs(
 
 
 def _paper_fit_outputs(paper_forces, preload: float, fit) -> tuple[dict, dict]:
-    """(variables, attributes) of the law fitted to the paper's chain's forces by ``fit`` (``_fit_on_forces`` with
-    the record's settings bound); when they cannot be fitted (its total N reaches 0 N, or the fit fails), no variable
-    and the reason as ``paper_fit_error``."""
+    """Return (variables, attributes) of the law fitted to the paper's chain's forces by ``fit``.
+
+    ``fit`` is ``_fit_on_forces`` with the record's settings bound; when the forces cannot be fitted (their total N
+    reaches 0 N, or the fit fails), no variable and the reason as ``paper_fit_error``.
+    """
     try:
         n_paper = preload + paper_forces["N_dyn_paper"].values
         if np.min(n_paper) <= 0:  # not a separation the working method sees: the paper's N is wrong
@@ -124,9 +139,46 @@ def _paper_fit_outputs(paper_forces, preload: float, fit) -> tuple[dict, dict]:
     return data, {"paper_e0_at_preload_n_per_m": rp.e0_at_preload, "paper_misfit_nrmse": rp.misfit}
 
 
-def friction_fit_dataset(forces, preload: float, settings: FitSettings, seed: int, n_harmonics: int, paper_forces=None):
-    """Dataset of the fit on the calibration case's identified forces (working method), with the
-    paper's chain's forces fitted beside it when given (reproduction)."""
+def friction_fit_dataset(
+    forces: xr.Dataset,
+    preload: float,
+    settings: FitSettings,
+    seed: int,
+    n_harmonics: int,
+    paper_forces: xr.Dataset | None = None,
+) -> xr.Dataset:
+    """Fit the friction law to the calibration case's identified forces and return the fit's dataset.
+
+    The working method's forces are fitted; the paper's chain's forces are fitted beside them when given
+    (reproduction).
+
+    Parameters
+    ----------
+    forces
+        The calibration case's identified contact forces (rule contact_forces): ``S`` [N], ``xi`` [m] and ``N_dyn``
+        (the dynamic part of the normal force) [N] over a uniformly sampled ``time`` [s], with the attribute
+        ``excitation_frequency_hz``.
+    preload
+        Static normal preload N0 [N].
+    settings
+        The fit's settings (bounds, GA, grid, confidence, regularization).
+    seed
+        Seed of the genetic algorithm.
+    n_harmonics
+        Harmonics of the excitation frequency the records are fitted through.
+    paper_forces
+        The paper's chain's forces (variables ``S_paper``, ``xi_paper``, ``N_dyn_paper`` in N, m, N, on the same
+        ``time``), or None for no reproduction fit.
+
+    Returns
+    -------
+    fit : xr.Dataset
+        One variable per law parameter (e_f, k_c, e_t, kappa, mu, over ``estimate``: value and profile-likelihood
+        interval), ``bounded_below``, ``bounded_above``, ``correlation`` (``parameter`` x ``parameter_``), the GA's
+        ``ga_best`` and ``ga_mean`` per ``generation``, the grid refinements; the attributes of the fit (e_0 at the
+        preload and its interval in N/m, misfit, settings, open fraction); with ``paper_forces``, the paper's
+        chain's fit under the prefix ``paper_`` or its ``paper_fit_error``.
+    """
     import xarray as xr
 
     fs = 1.0 / float(forces["time"].values[1] - forces["time"].values[0])
@@ -154,9 +206,38 @@ def friction_fit_dataset(forces, preload: float, settings: FitSettings, seed: in
     )
 
 
-def validation_dataset(forces, fit, preload: float, n_harmonics: int, truth=None):
-    """Prediction of S(t) for a load case from its own identified xi(t), N(t) with the fitted law,
-    on a fine periodic grid; NRMSE against the identified S and against the truth."""
+def validation_dataset(
+    forces: xr.Dataset, fit: xr.Dataset, preload: float, n_harmonics: int, truth: xr.Dataset | None = None
+) -> xr.Dataset:
+    """Predict S(t) of a load case from its own identified xi(t), N(t) with the fitted law.
+
+    On a fine periodic grid (the fit's ``grid_points`` per period), with the NRMSE against the identified S and,
+    given the truth, against the true S; the law is also evaluated under the other reading of Eq. 21
+    (``regularization``) to show how much that choice matters.
+
+    Parameters
+    ----------
+    forces
+        The load case's identified contact forces (rule contact_forces): ``xi`` [m], ``xi_dot`` [m/s], ``N_dyn`` [N]
+        and ``S`` [N] over a uniformly sampled ``time`` [s], with the attribute ``excitation_frequency_hz``.
+    fit
+        The friction fit's dataset (``friction_fit_dataset``): the law's parameters and the attributes
+        ``grid_points`` and ``regularization``.
+    preload
+        Static normal preload N0 [N].
+    n_harmonics
+        Harmonics of the excitation frequency the records are synthesised from.
+    truth
+        The rig's truth for the load case (variable ``S`` [N] on the same ``time``), or None (measured records).
+
+    Returns
+    -------
+    validation : xr.Dataset
+        ``xi``, ``xi_dot``, ``N`` (total), ``S_identified``, ``S_predicted`` (and ``S_truth``) over one period
+        (``phase``, fraction of the period), the S means removed; attributes ``nrmse_vs_identified`` (and
+        ``nrmse_vs_truth``) and ``nrmse_other_regularization`` (the other reading's prediction against this one's), as
+        fractions, with ``excitation_frequency_hz``, ``regularization`` and ``other_regularization``.
+    """
     import xarray as xr
 
     from .harmonics import fourier_series

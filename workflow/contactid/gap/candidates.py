@@ -14,7 +14,7 @@ candidate maps its parameter vector theta onto any combination of the Augmentati
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from typing import Callable
+from typing import Callable, Iterable, Sequence
 
 import numpy as np
 
@@ -23,11 +23,29 @@ from .model import Augmentation
 
 @dataclass(frozen=True)
 class Parameter:
-    """One parameter of a candidate: name, unit, search range [low, high], and where a search over
-    several parameters starts (``start``; the middle of the range by default), for example the value
-    that leaves the identified model as it is. ``domain``: the widest range a one-parameter search widens [low, high]
-    to where its optimum ends at an end of the range (``extended``; None: the range is the parameter's whole domain),
-    so that an effect larger than its typical range is refitted, not cut at the range's end."""
+    """One parameter of a candidate: its name, unit, search range and start.
+
+    A search over several parameters starts at ``start`` (the middle of the range by default), for example the value
+    that leaves the identified model as it is. ``domain`` is the widest range a one-parameter search widens [low, high]
+    to where its optimum ends at an end of the range (``extended``), so that an effect larger than its typical range is
+    refitted, not cut at the range's end.
+
+    Attributes
+    ----------
+    name
+        The parameter's name.
+    unit
+        Its unit, as text ("1" for a dimensionless number, "s", "s/m", "N s/m").
+    low
+        Low end of the search range [unit of unit].
+    high
+        High end of the search range [unit of unit].
+    start
+        Where a search over several parameters starts [unit of unit]; None: the middle of the range.
+    domain
+        The widest range (low, high) a search may widen to [unit of unit]; None: the range is the parameter's whole
+        domain.
+    """
 
     name: str
     unit: str
@@ -37,8 +55,20 @@ class Parameter:
     domain: tuple[float, float] | None = None
 
     def extended(self, at_low: bool, at_high: bool) -> "Parameter | None":
-        """The range widened past the ends an optimum reached (``at_low``, ``at_high``) by three times its span, within
-        ``domain``; None where the domain allows no wider range there."""
+        """Return the range widened past the ends an optimum reached, by three times its span, within ``domain``.
+
+        Parameters
+        ----------
+        at_low
+            Whether the optimum ended at the range's low end (widen it downwards).
+        at_high
+            Whether the optimum ended at the range's high end (widen it upwards).
+
+        Returns
+        -------
+        parameter : Parameter | None
+            The parameter with the wider range; None where the domain allows no wider range there.
+        """
         lo_d, hi_d = self.domain or (self.low, self.high)
         span = self.high - self.low
         low = max(lo_d, self.low - 3.0 * span) if at_low else self.low
@@ -46,8 +76,22 @@ class Parameter:
         return replace(self, low=low, high=high) if (low, high) != (self.low, self.high) else None
 
     def covering(self, value: float) -> "Parameter":
-        """This parameter starting at ``value``, its range widened as ``extended`` widens it until it holds ``value``
-        (a refit that ended beyond the library's range, searched again in a joint refit)."""
+        """Return this parameter starting at ``value``, its range widened until it holds ``value``.
+
+        The range is widened as ``extended`` widens it. For a refit that ended beyond the library's range, searched
+        again in a joint refit. Where the domain stops the widening short of ``value``, the start is the range's nearest
+        end.
+
+        Parameters
+        ----------
+        value
+            The value the range must hold and the search start from [unit of unit].
+
+        Returns
+        -------
+        parameter : Parameter
+            The parameter with the (possibly wider) range and its start at ``value``.
+        """
         p = self
         while value < p.low or value > p.high:
             wider = p.extended(value < p.low, value > p.high)
@@ -58,22 +102,56 @@ class Parameter:
 
     @property
     def off(self) -> float:
-        """The value that leaves the model as it is: zero, or the range's low end where zero is outside it."""
+        """The value that leaves the model as it is: zero, or the range's low end where zero is outside it.
+
+        Returns
+        -------
+        off : float
+            The neutral value [unit of unit].
+        """
         return 0.0 if self.low <= 0.0 <= self.high else self.low
 
     def is_off(self, value: float) -> bool:
-        """Whether ``value`` leaves the model as it is (within 1e-9 of the range)."""
+        """Return whether ``value`` leaves the model as it is (within 1e-9 of the range of ``off``).
+
+        Parameters
+        ----------
+        value
+            A value of the parameter [unit of unit].
+
+        Returns
+        -------
+        bool
+            True where ``value`` is the neutral value ``off``.
+        """
         return abs(float(value) - self.off) <= 1e-9 * (self.high - self.low)
 
 
 @dataclass(frozen=True)
 class Candidate:
-    """A candidate effect: name, what it models, its parameters and theta -> Augmentation.
-    ``per_channel``: the one parameter is repeated for every accelerometer channel. ``acts_on``: the
-    place of the gap it can explain (one of PLACES, or "any"): a winner must act where the
-    localisation puts the gap. ``form``: the candidate changes the base model's form (its damping) rather than adding
-    an effect at the contact or in the measurement: what it explains is the reference of what model-form differences
-    leave on the records (``story.beyond_model_form``), and it is tried even where the library in use leaves it out."""
+    """A candidate effect: its name, what it models, its parameters and theta -> Augmentation.
+
+    Attributes
+    ----------
+    name
+        The candidate's name, unique in the library.
+    meaning
+        What it models, in words.
+    parameters
+        Its ``Parameter`` objects, in the order of theta.
+    augmentation
+        theta -> the ``Augmentation`` of the identified model that the effect makes (theta: the parameters' values
+        [units of Parameter.unit], shape (n_parameters,)).
+    per_channel
+        The one parameter is repeated for every accelerometer channel.
+    acts_on
+        The place of the gap it can explain (one of PLACES, or "any"): a winner must act where the localisation puts
+        the gap.
+    form
+        The candidate changes the base model's form (its damping) rather than adding an effect at the contact or in
+        the measurement: what it explains is the reference of what model-form differences leave on the records
+        (``story.beyond_model_form``), and it is tried even where the library in use leaves it out.
+    """
 
     name: str
     meaning: str
@@ -84,8 +162,18 @@ class Candidate:
     form: bool = False
 
     def n_parameters(self, n_channels: int) -> int:
-        """The number of parameters the candidate fits: one per accelerometer channel where ``per_channel``, otherwise
-        its parameters' count."""
+        """Return the number of parameters the candidate fits.
+
+        Parameters
+        ----------
+        n_channels
+            Number of accelerometer channels.
+
+        Returns
+        -------
+        int
+            One per accelerometer channel where ``per_channel``, otherwise its parameters' count.
+        """
         return n_channels if self.per_channel else len(self.parameters)
 
 
@@ -94,7 +182,24 @@ LIBRARY: dict[str, Candidate] = {}
 
 
 def register(candidate: Candidate) -> Candidate:
-    """Add a candidate to the library (a user's plugin calls this); names must be unique."""
+    """Add a candidate to the library (a user's plugin calls this); names must be unique.
+
+    Parameters
+    ----------
+    candidate
+        The candidate to add.
+
+    Returns
+    -------
+    candidate : Candidate
+        The same candidate.
+
+    Raises
+    ------
+    ValueError
+        When the name is taken (or is "none"), the candidate has no parameter, ``acts_on`` is not one of PLACES or
+        "any", or a parameter's low end is not below its high end.
+    """
     if candidate.name in LIBRARY or candidate.name == "none":
         raise ValueError(f"gap candidate {candidate.name!r}: the name is taken; choose another")
     if not candidate.parameters:
@@ -218,22 +323,54 @@ register(
 BUILTIN = tuple(LIBRARY)
 
 
-def merged_augmentation(steps) -> Augmentation:
-    """The augmentation of several effects together, ``steps`` [(Candidate, theta), ...] (later ones win a field)."""
+def merged_augmentation(steps: Iterable[tuple[Candidate, np.ndarray]]) -> Augmentation:
+    """Return the augmentation of several effects together (later ones win a field).
+
+    Parameters
+    ----------
+    steps
+        (Candidate, theta) pairs, theta the candidate's parameter values [units of Parameter.unit],
+        shape (n_parameters,).
+
+    Returns
+    -------
+    augmentation : Augmentation
+        The effects merged, in the order given.
+    """
     aug = Augmentation()
     for c, th in steps:
         aug = aug.merge(c.augmentation(th))
     return aug
 
 
-def joint_candidate(new: Candidate, earlier, n_channels: int) -> tuple[Candidate, Callable]:
-    """``new`` refitted together with the explanation's earlier steps ``earlier`` [(Candidate, theta), ...]: a
-    candidate whose parameters are new's (searched from their starts) followed by each earlier one's (starting at
-    its refitted theta, per-channel ones repeated per channel), so that an earlier step that absorbed part of a
-    second effect (viscous friction taking on a normal dashpot's dissipation) can give it back. Returns (the
-    candidate, split), split(theta) -> [theta of new, theta of each earlier step]. Every parameter has a start
-    (new's: off, zero or its range's low end, unless it gives one), so the search also starts from the earlier
-    step's optimum itself (``calibration.calibrate``)."""
+def joint_candidate(
+    new: Candidate, earlier: Sequence[tuple[Candidate, np.ndarray]], n_channels: int
+) -> tuple[Candidate, Callable]:
+    """Return ``new`` refitted together with the explanation's earlier steps ``earlier``.
+
+    A candidate whose parameters are new's (searched from their starts) followed by each earlier one's (starting at its
+    refitted theta, per-channel ones repeated per channel), so that an earlier step that absorbed part of a second
+    effect (viscous friction taking on a normal dashpot's dissipation) can give it back. Every parameter has a start
+    (new's: off, zero or its range's low end, unless it gives one), so the search also starts from the earlier step's
+    optimum itself (``calibration.calibrate``).
+
+    Parameters
+    ----------
+    new
+        The candidate added.
+    earlier
+        The explanation's earlier steps, (Candidate, theta) pairs, theta their refitted parameter values
+        [units of Parameter.unit], shape (n_parameters,) (per-channel ones: (n_channels,)).
+    n_channels
+        Number of accelerometer channels (the per-channel parameters' count).
+
+    Returns
+    -------
+    candidate : Candidate
+        The joint candidate (new's name, meaning, place and form).
+    split : Callable
+        split(theta) -> [theta of new, theta of each earlier step]: the joint theta split into the steps' own.
+    """
 
     def expand(c: Candidate, theta=None):
         params = c.parameters * (n_channels if c.per_channel else 1)
@@ -258,8 +395,19 @@ def joint_candidate(new: Candidate, earlier, n_channels: int) -> tuple[Candidate
     return joint, split
 
 
-def load_plugins(modules) -> None:
-    """Import the users' candidate modules (``gap.plugins``); each calls ``register``."""
+def load_plugins(modules: Iterable[str] | None) -> None:
+    """Import the users' candidate modules (``gap.plugins``); each calls ``register``.
+
+    Parameters
+    ----------
+    modules
+        Importable module names; None or empty: none.
+
+    Raises
+    ------
+    ValueError
+        When a module cannot be imported (the message says to put it on PYTHONPATH or under workflow/).
+    """
     import importlib
 
     for name in modules or ():

@@ -1,11 +1,14 @@
-"""The candidates' refits: each candidate calibrated on the calibration case (on top of the explanation's
-earlier steps) and predicting the scored cases, and the pool of forked worker processes that runs them at once."""
+"""The candidates' refits and the pool of forked worker processes that runs them at once.
+
+Each candidate is calibrated on the calibration case (on top of the explanation's earlier steps) and predicts the
+scored cases.
+"""
 
 from __future__ import annotations
 
 import dataclasses
 import logging
-from typing import Mapping
+from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
@@ -39,17 +42,19 @@ def _candidate(
     held_theta=None,
     numerics: Numerics = DEFAULT,
 ):
-    """One candidate added to the explanation's earlier steps ``base_steps`` ((name, theta), ...): calibrated on
-    the calibration case (with ``joint``, together with the earlier steps' parameters, ``joint_candidate``;
-    otherwise with them held), predicted on the scored cases (each simulation warm-started from the baseline's).
-    ``alone``: {name: theta} of the first pass (each candidate alone); a joint refit also starts between the
-    earlier steps' optimum and this candidate's own (two effects that can stand in for each other, viscous friction
+    """Refit one candidate added to the explanation's earlier steps ``base_steps`` ((name, theta), ...).
+
+    Calibrated on the calibration case (with ``joint``, together with the earlier steps' parameters,
+    ``joint_candidate``; otherwise with them held), predicted on the scored cases (each simulation warm-started from the
+    baseline's). ``alone``: {name: theta} of the first pass (each candidate alone); a joint refit also starts between
+    the earlier steps' optimum and this candidate's own (two effects that can stand in for each other, viscous friction
     and a normal dashpot, leave a ridge between the one-effect optimum and the truth). ``channel_delays``: the random
     test's per-channel delays and ``channel_gains`` its channels' relative gains (``calibration.calibrate``).
     ``held_theta``: the candidate at this theta, not searched (``calibration.held``; the earlier steps held).
     ``numerics``: how the steady states are found and the searches run (``numerics.Numerics``, the diagnosis's
     ``GapSettings.numerics``; an argument of the task, so that a worker process sees it too). Returns (calibration,
-    sims, residuals) by case."""
+    sims, residuals) by case.
+    """
     rec = records[calibration_case]
     # per-channel effects (channel delays) trade off with no contact effect and would add a dimension per channel:
     # they are held, and a per-channel candidate is refitted on the earlier steps held
@@ -133,19 +138,30 @@ def _candidate(
 
 
 def _candidate_task(task):
-    """(name, common): ``_candidate(name, **common)`` (``common["numerics"]``: the diagnosis's numerical settings,
-    handed to the process that runs the candidate with the task). Each candidate starts without Newton history
-    (``HarmonicBalance.forget``): which worker runs which candidate after which depends on timing, and a candidate
-    that started from another's last Jacobian ended elsewhere where its calibration gap is flat (the default data's
-    transducer-mass refit, mass error 0.0075 in one run and 0.0104 in the next)."""
+    """Run ``_candidate(name, **common)`` for a task (name, common).
+
+    ``common["numerics"]``: the diagnosis's numerical settings, handed to the process that runs the candidate with the
+    task. Each candidate starts without Newton history (``HarmonicBalance.forget``): which worker runs which candidate
+    after which depends on timing, and a candidate that started from another's last Jacobian ended elsewhere where its
+    calibration gap is flat (the default data's transducer-mass refit, mass error 0.0075 in one run and 0.0104 in the
+    next).
+    """
     name, common = task
     HarmonicBalance.forget()
     return _candidate(name, **common)
 
 
 def fork_safe() -> bool:
-    """Whether worker processes may be forked here: not after numba's parallel threads have started
-    (its default threading layer, workqueue, is not fork-safe; TBB is)."""
+    """Return whether worker processes may be forked here.
+
+    Not after numba's parallel threads have started (its default threading layer, workqueue, is not fork-safe; TBB
+    is).
+
+    Returns
+    -------
+    bool
+        True where forking is safe: numba's parallel threads have not started, or they run on TBB.
+    """
     import numba
     from numba.np.ufunc import parallel as _parallel
 
@@ -156,8 +172,10 @@ _POOLS: dict = {}  # workers -> a pool forked while that was safe, kept for the 
 
 
 def _pool(workers: int):
-    """A pool of ``workers`` forked processes: made while forking is safe (``fork_safe``) and then reused, or
-    None if it cannot be made safely."""
+    """Return a pool of ``workers`` forked processes, or None if it cannot be made safely.
+
+    Made while forking is safe (``fork_safe``) and then reused.
+    """
     if workers not in _POOLS:
         if not fork_safe():
             return None
@@ -171,18 +189,47 @@ def _pool(workers: int):
 
 
 def prepare_workers(workers: int) -> bool:
-    """Fork the candidates' worker processes now, while forking is safe (before anything in this process runs
-    numba's parallel friction kernel, e.g. the friction fit after model updating); True if they exist."""
+    """Fork the candidates' worker processes now, while forking is safe.
+
+    Before anything in this process runs numba's parallel friction kernel, e.g. the friction fit after model updating.
+
+    Parameters
+    ----------
+    workers
+        Number of worker processes (1 or fewer: none).
+
+    Returns
+    -------
+    bool
+        True if the worker processes exist.
+    """
     return workers > 1 and _pool(workers) is not None
 
 
-def start_candidates(names, workers: int, **common):
-    """Start the candidates (see ``_candidate``) and return a function that gives {name: (calibration, sims,
-    residuals)} in library order. With ``workers`` > 1 they run at once in forked worker processes while this
-    process goes on (the results equal the serial ones to the last digit: each candidate starts without Newton
-    history, ``_candidate_task``); serially, when the function is called. A pool can only be forked before numba's
-    parallel threads start in this process (in a rule script: before the localisation runs the friction kernel);
-    later calls reuse it."""
+def start_candidates(names: Sequence[str], workers: int, **common: Any) -> Callable[[], dict[str, tuple]]:
+    """Start the candidates' refits and return a function that collects them.
+
+    With ``workers`` > 1 they run at once in forked worker processes while this process goes on (the results equal the
+    serial ones to the last digit: each candidate starts without Newton history, ``_candidate_task``); serially, when
+    the function is called. A pool can only be forked before numba's parallel threads start in this process (in a rule
+    script: before the localisation runs the friction kernel); later calls reuse it.
+
+    Parameters
+    ----------
+    names
+        The library's names of the candidates to refit, in library order.
+    workers
+        Number of worker processes (at most one per candidate; 1: serially).
+    **common
+        The keyword arguments of ``_candidate`` every candidate shares (model, records, calibration_case,
+        score_cases, base_sims, fit_settings, H, max_evaluations, base_steps, ...).
+
+    Returns
+    -------
+    collect : Callable[[], dict[str, tuple]]
+        Called without arguments, gives {name: (calibration, sims, residuals)} in library order (waiting for the
+        workers).
+    """
     workers = max(1, min(int(workers), len(names)))
     pool = _pool(workers) if workers > 1 else None
     if workers > 1 and pool is None:
