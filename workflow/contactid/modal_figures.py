@@ -1,5 +1,8 @@
-"""The modal fit as an engineer checks it: Fig. 3 (every sensor's FRF, measured and LSFD-synthesised, phase and
-coherence, the identified frequencies and damping) and the stability diagram of the LSCF poles over model order."""
+"""The modal fit as an engineer checks it: Fig. 3 and the stability diagram of the LSCF poles.
+
+Fig. 3 shows every sensor's FRF, measured and LSFD-synthesised, phase and coherence, the identified frequencies and
+damping; the stability diagram shows the LSCF poles over model order.
+"""
 
 from __future__ import annotations
 
@@ -17,7 +20,7 @@ def _band(modal: xr.Dataset) -> tuple[float, float]:
 
 
 def _mark_band(axes, band, f_max: float) -> None:
-    """Grey outside the fitted band on every axis."""
+    """Grey out the frequencies outside the fitted band on every axis."""
     for ax in axes:
         ax.axvspan(0.0, band[0], color="0.88", lw=0, zorder=0)
         ax.axvspan(
@@ -27,14 +30,14 @@ def _mark_band(axes, band, f_max: float) -> None:
 
 
 def _phase_deg(h: np.ndarray) -> np.ndarray:
-    """Phase (deg) in [-180, 180] with NaN where it wraps, so that no line is drawn across the axis."""
+    """Return the phase (deg) in [-180, 180] with NaN where it wraps, so that no line is drawn across the axis."""
     p = np.degrees(np.angle(h))
     p[1:][np.abs(np.diff(p)) > 180.0] = np.nan
     return p
 
 
 def _mode_labels(ax, modal: xr.Dataset) -> None:
-    """The identified natural frequencies and damping ratios written at the top of the magnitude axis."""
+    """Write the identified natural frequencies and damping ratios at the top of the magnitude axis."""
     for fn, z in zip(modal["natural_frequency"].values, modal["damping_ratio"].values):
         ax.axvline(fn, color="0.45", lw=0.5, ls="--", zorder=1)
         ax.text(
@@ -51,8 +54,27 @@ def _mode_labels(ax, modal: xr.Dataset) -> None:
 
 @ps.print_figure
 def plot_fig03(frf: xr.Dataset, modal: xr.Dataset, png: str, pdf: str, f_max_hz: float = 500.0) -> None:
-    """Fig. 3: accelerance magnitude and phase of every sensor, measured (H1) and synthesised from the identified
-    modes (LSFD in the fitted band), the identified frequencies and damping ratios, the band, coherence below."""
+    """Draw Fig. 3: accelerance magnitude and phase of every sensor, measured and synthesised, with coherence below.
+
+    Measured (H1) and synthesised from the identified modes (LSFD in the fitted band), with the identified frequencies
+    and damping ratios written over their peaks, the frequencies outside the fitted band greyed out, and the coherence
+    below.
+
+    Parameters
+    ----------
+    frf
+        The random test's FRF dataset (results/linear/frf.nc): ``h1_real``, ``h1_imag`` (accelerance [m/s^2/N]) and
+        ``coherence`` over (``sensor``, ``frequency`` [Hz]).
+    modal
+        The modal fit (rule modal): ``natural_frequency`` [Hz] and ``damping_ratio`` [-] per ``mode``, the
+        attributes ``band_low_hz`` and ``band_high_hz``.
+    png
+        Path of the PNG written.
+    pdf
+        Path of the PDF written.
+    f_max_hz
+        Upper end of the frequency axis [Hz].
+    """
     plt = ps.pyplot()
     f = frf["frequency"].values
     sel = (f > 0) & (f <= f_max_hz)
@@ -107,8 +129,27 @@ def _categories(sp: StabilityPoles):
 
 
 def consecutive_stable_orders(sp: StabilityPoles, frequency_hz: float, order: int, tol: float = 0.01) -> int:
-    """How many consecutive orders up to ``order`` have a pole within ``tol`` (relative) of ``frequency_hz`` that
-    is stable in frequency, damping and vector."""
+    """Return how many consecutive orders up to ``order`` have a fully stable pole near ``frequency_hz``.
+
+    A pole within ``tol`` (relative) of ``frequency_hz`` that is stable in frequency, damping and vector; counted down
+    from ``order`` until an order has none.
+
+    Parameters
+    ----------
+    sp
+        The stability diagram's poles.
+    frequency_hz
+        The mode's frequency [Hz].
+    order
+        The highest model order counted.
+    tol
+        Relative frequency tolerance [-].
+
+    Returns
+    -------
+    int
+        The number of consecutive orders, 0 where ``order`` itself has no such pole.
+    """
     n = 0
     for o in range(order, int(sp.order.min()) - 1, -1):
         here = (sp.order == o) & sp.stable & (np.abs(sp.frequency_hz / frequency_hz - 1) <= tol)
@@ -120,9 +161,31 @@ def consecutive_stable_orders(sp: StabilityPoles, frequency_hz: float, order: in
 
 @ps.print_figure
 def plot_stability(frf: xr.Dataset, modal: xr.Dataset, png: str, pdf: str, min_order: int = 2) -> StabilityPoles:
-    """The stability diagram: the LSCF poles in the fitted band at orders ``min_order``..modal order (marked by
-    how they compare with the previous order), the chosen poles (the identified modes) ringed, over the summed
-    accelerance magnitude of all sensors (right axis). Returns the poles."""
+    """Draw the stability diagram of the LSCF poles in the fitted band and return the poles.
+
+    The poles at orders ``min_order``..modal order (marked by how they compare with the previous order), the chosen
+    poles (the identified modes) ringed, over the summed accelerance magnitude of all sensors (right axis).
+
+    Parameters
+    ----------
+    frf
+        The random test's FRF dataset (results/linear/frf.nc): ``h1_real``, ``h1_imag`` (accelerance [m/s^2/N]) over
+        (``sensor``, ``frequency`` [Hz]).
+    modal
+        The modal fit (rule modal): ``natural_frequency`` [Hz] per ``mode``, the attributes ``band_low_hz``,
+        ``band_high_hz`` and ``order`` (the model order of the chosen poles).
+    png
+        Path of the PNG written.
+    pdf
+        Path of the PDF written.
+    min_order
+        The lowest model order drawn.
+
+    Returns
+    -------
+    poles : StabilityPoles
+        The poles of every order drawn.
+    """
     plt = ps.pyplot()
     band, order = _band(modal), int(modal.attrs["order"])
     f, H = frf["frequency"].values, complex_frf(frf)

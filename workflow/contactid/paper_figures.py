@@ -1,9 +1,11 @@
-"""Figs. 4-9 of the paper and the GA convergence, drawn at the width paper/report.tex prints them at
-(:mod:`contactid.print_style`): text at least 8 pt on paper."""
+"""Figs. 4-9 of the paper and the GA convergence.
+
+Drawn at the width paper/report.tex prints them at (:mod:`contactid.print_style`): text at least 8 pt on paper.
+"""
 
 from __future__ import annotations
 
-from typing import Mapping
+from typing import Any, Mapping
 
 import numpy as np
 import xarray as xr
@@ -15,13 +17,26 @@ from .friction_parameters import fitted_parameters
 
 
 def _periods(t: np.ndarray, f0: float, periods: int = 3, last: bool = False):
-    """The samples (a mask of ``t``, s) of the record's first ``periods`` periods of ``f0`` (Hz), or its last."""
+    """Return the samples (a mask of ``t``, s) of the record's first ``periods`` periods of ``f0`` (Hz), or its last."""
     return t >= t[-1] - periods / f0 if last else t <= periods / f0
 
 
 @ps.print_figure
 def plot_fig04(gc: xr.Dataset, case: str, png: str, pdf: str) -> None:
-    """Fig. 4: generalized coordinates p_i(t) of the linear modes (Eq. 17), three periods."""
+    """Draw Fig. 4: generalized coordinates p_i(t) of the linear modes (Eq. 17), three periods.
+
+    Parameters
+    ----------
+    gc
+        The load case's generalized coordinates (rule generalized_coordinates): ``p`` [kg^0.5 m] over (``mode``,
+        ``time`` [s]), the attribute ``excitation_frequency_hz``.
+    case
+        The load case's name (in the title).
+    png
+        Path of the PNG written.
+    pdf
+        Path of the PDF written.
+    """
     plt = ps.pyplot()
     t = gc["time"].values
     sel = _periods(t, gc.attrs["excitation_frequency_hz"])
@@ -41,7 +56,22 @@ def plot_fig04(gc: xr.Dataset, case: str, png: str, pdf: str) -> None:
 
 @ps.print_figure
 def plot_fig05(nnm: xr.Dataset, case: str, png: str, pdf: str) -> None:
-    """Fig. 5: driving-point acceleration, measured (line) and reconstructed from the NNMs (circles)."""
+    """Draw Fig. 5: driving-point acceleration, measured (line) and reconstructed from the NNMs (circles).
+
+    Over the record's first three periods.
+
+    Parameters
+    ----------
+    nnm
+        The load case's nonlinear normal modes (rule nonlinear_modes): ``drive_measured`` and ``drive_reconstructed``
+        [m/s^2] over ``time`` [s], the attributes ``excitation_frequency_hz`` and ``reconstruction_nrmse`` (a fraction).
+    case
+        The load case's name (in the title).
+    png
+        Path of the PNG written.
+    pdf
+        Path of the PDF written.
+    """
     plt = ps.pyplot()
     t = nnm["time"].values
     sel = slice(0, int(np.searchsorted(t, 3.0 / nnm.attrs["excitation_frequency_hz"])))
@@ -73,7 +103,7 @@ _LOOPS = (("S", "xi", r"$\xi$ ($\mu$m)", "S (N)"), ("N_dyn", "eta", r"$\eta$ ($\
 
 
 def _limits(values: np.ndarray, pad: float = 0.08) -> tuple[float, float]:
-    """Axis limits around ``values`` with ``pad`` of their span on each side (never a zero span)."""
+    """Return axis limits around ``values`` with ``pad`` of their span on each side (never a zero span)."""
     lo, hi = float(np.nanmin(values)), float(np.nanmax(values))
     span = hi - lo if hi > lo else max(abs(hi), 1e-12)
     return lo - pad * span, hi + pad * span
@@ -83,9 +113,12 @@ LOOP_PERIODS = 4  # Fig. 6 draws each loop over the record's last periods
 
 
 def _last_periods(ds: xr.Dataset, periods: int = LOOP_PERIODS):
-    """The samples of the record's last ``periods`` periods (of its ``excitation_frequency_hz``; every sample where
-    the dataset does not say). The identified loops repeat every period (harmonic series) and the rig's settle:
-    drawn over a whole record, 170 periods on top of each other gave the same picture as a 2 MB PDF that took 10 s."""
+    """Return the samples of the record's last ``periods`` periods.
+
+    Periods of its ``excitation_frequency_hz``; every sample where the dataset does not say. The identified loops
+    repeat every period (harmonic series) and the rig's settle: drawn over a whole record, 170 periods on top of each
+    other gave the same picture as a 2 MB PDF that took 10 s.
+    """
     f0 = ds.attrs.get("excitation_frequency_hz")
     if not f0 or "time" not in ds.coords:
         return slice(None)
@@ -93,8 +126,10 @@ def _last_periods(ds: xr.Dataset, periods: int = LOOP_PERIODS):
 
 
 def _loop_panel(ax, ds: xr.Dataset, force: str, motion: str, suffix: str, colour: str, label: str) -> None:
-    """One hysteresis loop (``force`` + ``suffix`` against ``motion`` + ``suffix``, over the record's last
-    ``LOOP_PERIODS`` periods) over the truth where there is one; the axis limits are the loop's own."""
+    """Draw one hysteresis loop over the truth where there is one; the axis limits are the loop's own.
+
+    ``force`` + ``suffix`` against ``motion`` + ``suffix``, over the record's last ``LOOP_PERIODS`` periods.
+    """
     sel = _last_periods(ds)
     x, y = 1e6 * ds[motion + suffix].values[sel], ds[force + suffix].values[sel]
     if f"{force}_truth" in ds:
@@ -113,9 +148,22 @@ def _loop_panel(ax, ds: xr.Dataset, force: str, motion: str, suffix: str, colour
 
 @ps.print_figure
 def plot_fig06(forces: Mapping[str, xr.Dataset], png: str, pdf: str) -> None:
-    """Fig. 6: S-xi and N-eta loops per load case (the record's last ``LOOP_PERIODS`` periods): the working method
-    (the correction) over the rig truth where it exists, limits from the working method; the paper's chain (the
-    reproduction) in rows of its own, on its own scale; one legend for every panel."""
+    """Draw Fig. 6: S-xi and N-eta loops per load case (the record's last ``LOOP_PERIODS`` periods).
+
+    The working method (the correction) over the rig truth where it exists, limits from the working method; the
+    paper's chain (the reproduction) in rows of its own, on its own scale; one legend for every panel.
+
+    Parameters
+    ----------
+    forces
+        Load case -> its identified contact forces (rule contact_forces): ``S`` [N], ``xi`` [m], ``N_dyn`` [N] and
+        ``eta`` [m] over ``time`` [s], the same with the suffix ``_paper`` (the paper's chain) and, from the rig,
+        ``_truth``; the attribute ``excitation_frequency_hz``.
+    png
+        Path of the PNG written.
+    pdf
+        Path of the PDF written.
+    """
     plt = ps.pyplot()
     cases = list(forces)
     fig, axes = plt.subplots(4, len(cases), figsize=(ps.TEXT_WIDTH_IN, 8.2), squeeze=False)
@@ -140,7 +188,7 @@ def plot_fig06(forces: Mapping[str, xr.Dataset], png: str, pdf: str) -> None:
 
 
 def _fig07(fit: xr.Dataset, validations: Mapping[str, xr.Dataset], truth_friction: Mapping | None, png, pdf) -> None:
-    """Fig. 7: e_0 against N: identified, the paper's Table 4, the truth, and each load case's range of N."""
+    """Draw Fig. 7: e_0 against N: identified, the paper's Table 4, the truth, and each load case's range of N."""
     plt = ps.pyplot()
     n0 = fit.attrs["preload_n"]
     N = np.linspace(0, 2.5 * n0, 200)
@@ -165,7 +213,7 @@ def _fig07(fit: xr.Dataset, validations: Mapping[str, xr.Dataset], truth_frictio
 
 
 def _fig08_09(validations: Mapping[str, xr.Dataset], xvar: str, xlabel: str, scale: float, png, pdf) -> None:
-    """Figs. 8 and 9: S identified (circles) and predicted by the fitted law (line) against ``xvar``."""
+    """Draw Figs. 8 and 9: S identified (circles) and predicted by the fitted law (line) against ``xvar``."""
     plt = ps.pyplot()
     cases = list(validations)
     fig, axes = plt.subplots(1, len(cases), figsize=(ps.TEXT_WIDTH_IN, 2.6), squeeze=False)
@@ -187,7 +235,7 @@ def _fig08_09(validations: Mapping[str, xr.Dataset], xvar: str, xlabel: str, sca
 
 
 def _convergence(fit: xr.Dataset, png: str) -> None:
-    """The genetic algorithm's best and mean misfit per generation and the misfit after the polish."""
+    """Draw the genetic algorithm's best and mean misfit per generation and the misfit after the polish."""
     plt = ps.pyplot()
     fig, ax = plt.subplots(figsize=(ps.NARROW_WIDTH_IN, 2.8))
     ax.semilogy(fit["generation"].values, fit["ga_best"].values, label="best")
@@ -205,9 +253,29 @@ def _convergence(fit: xr.Dataset, png: str) -> None:
 
 @ps.print_figure
 def plot_friction_figures(
-    fit: xr.Dataset, validations: Mapping[str, xr.Dataset], truth_friction: Mapping | None, paths: Mapping[str, str]
+    fit: xr.Dataset,
+    validations: Mapping[str, xr.Dataset],
+    truth_friction: Mapping[str, Any] | None,
+    paths: Mapping[str, str],
 ) -> None:
-    """Fig. 7 (e_0 vs N), Fig. 8 (S vs xi), Fig. 9 (S vs xi'), and the GA convergence."""
+    """Draw Fig. 7 (e_0 vs N), Fig. 8 (S vs xi), Fig. 9 (S vs xi'), and the GA convergence.
+
+    Parameters
+    ----------
+    fit
+        The friction fit's dataset (``friction_datasets.friction_fit_dataset``): the law's parameters, ``ga_best``
+        and ``ga_mean`` per ``generation``, the attributes ``preload_n`` and ``misfit_nrmse``.
+    validations
+        Load case -> its validation dataset (``friction_datasets.validation_dataset``): ``xi`` [m], ``xi_dot``
+        [m/s], ``N`` [N], ``S_identified`` and ``S_predicted`` [N] over one period, the attribute
+        ``nrmse_vs_identified``.
+    truth_friction
+        The rig truth's friction law (``e_f_n_per_m``, ``k_c_per_m``, ...), or None (measured records: no truth
+        drawn).
+    paths
+        Output paths by name: ``fig07_png``, ``fig07_pdf``, ``fig08_png``, ``fig08_pdf``, ``fig09_png``,
+        ``fig09_pdf`` and ``convergence_png``.
+    """
     _fig07(fit, validations, truth_friction, paths["fig07_png"], paths["fig07_pdf"])
     _fig08_09(validations, "xi", r"$\xi$ ($\mu$m)", 1e6, paths["fig08_png"], paths["fig08_pdf"])
     _fig08_09(validations, "xi_dot", r"d$\xi$/dt (mm/s)", 1e3, paths["fig09_png"], paths["fig09_pdf"])

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import itertools
 import time
-from typing import Mapping
+from typing import Any, Mapping
 
 import numpy as np
 import pandas as pd
@@ -23,8 +23,27 @@ from .contact_laws import stiction_shear_stiffness
 QUANTITIES = ("mu", "e0", "k_t")
 
 
-def noise_study_table(study_cfg: Mapping | None) -> pd.DataFrame:
-    """The parameter table: one row per (noise_fraction, record_samples, seed), in that order."""
+def noise_study_table(study_cfg: Mapping[str, Any] | None) -> pd.DataFrame:
+    """Return the noise study's parameter table: one row per (noise_fraction, record_samples, seed), in that order.
+
+    Every combination of the configured axes; an axis the config leaves out takes the schema's default.
+
+    Parameters
+    ----------
+    study_cfg
+        The config's ``noise_study`` mapping (``noise_fractions``, ``record_samples``, ``seeds``; ``in_report`` is
+        not read), or None for the schema's defaults.
+
+    Returns
+    -------
+    table : pd.DataFrame
+        Columns ``noise_fraction`` (sensor noise rms over signal rms), ``record_samples`` and ``seed``.
+
+    Raises
+    ------
+    ValueError
+        When an axis is empty, a noise fraction is negative or a record is shorter than 1024 samples.
+    """
     from .schema import schema_defaults
 
     axes = {k: v for k, v in schema_defaults("noise_study").items() if k != "in_report"}  # the schema's defaults
@@ -44,14 +63,53 @@ def noise_study_table(study_cfg: Mapping | None) -> pd.DataFrame:
 
 
 def e0_at(e_f: float, k_c: float, normal_force: float) -> float:
-    """Tangential stiffness e_0 (N/m) of the modified Valanis law at the normal force N (N):
-    e_f (1 - exp(-k_c N / e_f)) (Eq. 22)."""
+    """Return the tangential stiffness e_0 of the modified Valanis law at a normal force.
+
+    e_0 = e_f (1 - exp(-k_c N / e_f)) (Eq. 22).
+
+    Parameters
+    ----------
+    e_f
+        The law's e_f [N/m].
+    k_c
+        The law's k_c [1/m].
+    normal_force
+        Total normal force N [N], compression positive.
+
+    Returns
+    -------
+    e0 : float
+        Tangential stiffness at stiction [N/m].
+    """
     return float(stiction_shear_stiffness(normal_force, e_f, k_c))
 
 
-def run_point(cfg: Mapping, noise_fraction: float, record_samples: int, seed: int) -> dict:
-    """One point: rig records at this noise and length (rig seed = config seed + ``seed``), the
-    identification, and the relative errors of mu, e_0 (at the preload) and k_t against the rig's truth."""
+def run_point(cfg: Mapping[str, Any], noise_fraction: float, record_samples: int, seed: int) -> dict:
+    """Run one point of the noise study: rig records, the identification and its errors against the rig's truth.
+
+    The virtual rig records a random test and the calibration case at this noise and length (rig seed = config seed +
+    ``seed``, no rig effects), the chain identifies k_t and the friction law from them (``gap.pipeline.identify``), and
+    the relative errors of mu, e_0 (at the preload) and k_t against the rig's truth are returned.
+
+    Parameters
+    ----------
+    cfg
+        The whole config (a copy at the schema's defaults is used; reads ``seed``, ``rig``, ``random_test``,
+        ``structure``, ``load_cases`` and ``nonlinear.calibration_case``).
+    noise_fraction
+        Sensor noise, rms over signal rms [-].
+    record_samples
+        Length of the dual-sine record, in samples.
+    seed
+        Seed offset of the point's rig records.
+
+    Returns
+    -------
+    point : dict
+        ``noise_fraction``, ``record_samples``, ``seed``; the identified ``mu`` [-], ``e0`` [N/m] and ``k_t`` [N/m]
+        with their truths (``*_true``) and relative errors (``error_*``, identified / truth - 1); ``seconds``: the wall
+        times [s] of the rig (``rig``) and of the identification (``identification``).
+    """
     from .gap.pipeline import identify
     from .rig.dual_sine import dual_sine_test
     from .rig.random_test import random_test_datasets
@@ -102,9 +160,20 @@ def run_point(cfg: Mapping, noise_fraction: float, record_samples: int, seed: in
     }
 
 
-def gather(rows: list) -> xr.Dataset:
-    """The points stacked on (noise_fraction, record_samples, seed): identified values, truths and
-    relative errors of mu, e_0 and k_t."""
+def gather(rows: list[dict]) -> xr.Dataset:
+    """Stack the noise study's points on (noise_fraction, record_samples, seed).
+
+    Parameters
+    ----------
+    rows
+        The points, as ``run_point`` returns them.
+
+    Returns
+    -------
+    study : xr.Dataset
+        Identified values, truths and relative errors of mu, e_0 and k_t (``mu``, ``mu_true``, ``error_mu``, ...,
+        with units), and ``seconds``, each point's total wall time [s].
+    """
     df = pd.DataFrame(
         [{**{k: v for k, v in r.items() if k != "seconds"}, "seconds": sum(r["seconds"].values())} for r in rows]
     )
@@ -128,8 +197,22 @@ def gather(rows: list) -> xr.Dataset:
 
 @ps.print_figure
 def plot_noise_study(ds: xr.Dataset, default_noise: float, png: str, pdf: str | None = None) -> None:
-    """|error| of mu, e_0 and k_t against the noise fraction: every seed as a dot, the median as a line
-    per record length; the default noise marked. Drawn at the report's text width (print_style)."""
+    """Draw |error| of mu, e_0 and k_t against the noise fraction.
+
+    Every seed as a dot, the median as a line per record length; the default noise marked. Drawn at the report's text
+    width (print_style).
+
+    Parameters
+    ----------
+    ds
+        The study (``gather``).
+    default_noise
+        The configured sensor noise, marked on the axes (rms over signal rms) [-].
+    png
+        Path of the PNG written.
+    pdf
+        Path of the PDF written; None: no PDF.
+    """
     import matplotlib.ticker
 
     plt = ps.pyplot()
@@ -167,8 +250,21 @@ def plot_noise_study(ds: xr.Dataset, default_noise: float, png: str, pdf: str | 
 
 
 def report_section(ds: xr.Dataset | None) -> str:
-    """The report's section on the study: medians over seeds at the default noise and at the largest, and
-    the figure; without the study (noise_study.in_report: false) a sentence saying how to run it."""
+    """Return the report's section on the noise study.
+
+    Medians over seeds at the default noise and at the largest, and the figure; without the study
+    (noise_study.in_report: false) a sentence saying how to run it.
+
+    Parameters
+    ----------
+    ds
+        The study (``gather``; the attribute ``default_noise_fraction`` marks the default noise), or None.
+
+    Returns
+    -------
+    section : str
+        The section, in LaTeX.
+    """
     head = "\\section{Identification accuracy against sensor noise and record length}\n"
     if ds is None:
         return head + (
