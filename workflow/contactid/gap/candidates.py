@@ -112,7 +112,7 @@ class Parameter:
         return 0.0 if self.low <= 0.0 <= self.high else self.low
 
     def is_off(self, value: float) -> bool:
-        """Return whether ``value`` leaves the model as it is (within 1e-9 of the range of ``off``).
+        """Return whether ``value`` leaves the model as it is (within 1e-9 of the range's span).
 
         Parameters
         ----------

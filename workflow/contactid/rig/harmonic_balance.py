@@ -1,5 +1,6 @@
-"""Periodic steady state of the reduced rig model by harmonic balance (HB) with alternating
-frequency/time (AFT) evaluation of the contact laws, as NLvib and tmdsimpy compute it.
+"""Periodic steady state of the reduced rig model by harmonic balance (HB) with AFT evaluation of the contact laws.
+
+Alternating frequency/time (AFT) evaluation, as NLvib and tmdsimpy compute it.
 
 The equations are the time integrator's (``rig.nonlinear``), in mass-normalised coordinates z:
 
@@ -45,10 +46,31 @@ from .nonlinear import (
 
 @dataclass
 class PeriodicResponse:
-    """A periodic steady state: Z (n_r, H + 1) complex harmonics of z (column 0 the mean, real) and A
-    those of the acceleration (as the integrator computes it); w (rad/s); the period's grid signals (M points from
-    t = 0): z, v, a (M, n_r), f, S, N, xi, eta, dxi, deta (M,), the friction law's own state S_valanis (M,) and
-    the Iwan anchors at t = 0; whether Newton converged, its iterations and the final relative residual."""
+    """A periodic steady state found by harmonic balance.
+
+    Attributes
+    ----------
+    Z
+        Complex harmonics of the mass-normalised coordinates z [kg^0.5 m], shape (n_r, H + 1): column 0 the mean
+        (real), column h the amplitude Z_h of Im(Z_h e^{i h w t}).
+    A
+        Complex harmonics of the acceleration, as the integrator computes it (the second difference) [kg^0.5 m/s^2],
+        shape (n_r, H + 1).
+    w
+        Excitation angular frequency [rad/s].
+    grid
+        The period's signals on its M steps from t = 0: ``t`` [s], ``z`` [kg^0.5 m], ``v`` [kg^0.5 m/s] and ``a``
+        [kg^0.5 m/s^2] (M, n_r); ``xi``, ``eta`` [m], ``dxi``, ``deta`` [m/s], ``N``, ``S`` and the friction law's
+        own state ``S_valanis`` [N] (M,).
+    converged
+        Whether Newton converged.
+    iterations
+        Newton's iterations.
+    residual
+        The final residual relative to the force's norm (both in the real basis) [-].
+    iwan_anchors
+        The Iwan sliders' anchors at t = 0 [m], shape (n_sliders,).
+    """
 
     Z: np.ndarray
     A: np.ndarray
@@ -62,13 +84,15 @@ class PeriodicResponse:
 
 @njit(cache=True)
 def _periodic_friction(xi, N_from, N, fr, n_min, iw_share, iw_w, tol, max_periods, S_out, S_val_out, iw_x, iw_flag):
-    """Friction along a periodic path on the integrator's steps: step i moves xi[i-1] -> xi[i] while N
-    moves N_from[i] -> N[i] (the integrator's pair: the last step's final normal force and this step's
-    explicit estimate). The Valanis state is stepped with the integrator's ``valanis_step`` around the
-    loop until it repeats (change below tol x max|S|), the Iwan share's sliders as the integrator's
-    ``friction.iwan_force`` steps them; S_val_out the Valanis state, S_out (1 - s) S_val + s S_iwan (zero where
-    N <= 0, the contact open); iw_x (M, sliders) the anchors after each step and iw_flag how each slider
-    moved (0 stuck, +1 / -1 slipping, 2 reset by an open contact)."""
+    """Step the friction law along a periodic path on the integrator's steps until it repeats.
+
+    Step i moves xi[i-1] -> xi[i] while N moves N_from[i] -> N[i] (the integrator's pair: the last step's final normal
+    force and this step's explicit estimate). The Valanis state is stepped with the integrator's ``valanis_step``
+    around the loop until it repeats (change below tol x max|S|), the Iwan share's sliders as the integrator's
+    ``friction.iwan_force`` steps them; S_val_out the Valanis state, S_out (1 - s) S_val + s S_iwan (zero where N <= 0,
+    the contact open); iw_x (M, sliders) the anchors after each step and iw_flag how each slider moved (0 stuck, +1 / -1
+    slipping, 2 reset by an open contact).
+    """
     e_f, k_c, e_t, kappa, mu, slip_limit = fr[0], fr[1], fr[2], fr[3], fr[4], fr[5] > 0.5
     m = xi.size
     n_sl = iw_w.size
@@ -105,10 +129,12 @@ def _periodic_friction(xi, N_from, N, fr, n_min, iw_share, iw_w, tol, max_period
 
 @njit(cache=True)
 def _iwan_propagate(xi, N, iw_x, iw_flag, iw_w, e_f, k_c, mu, dxi, dN, out):
-    """Periodic linearisation of the Iwan element along the path (see ``_periodic_friction``): for every
-    column, the change of its force dS (M, n_cols) from changes of xi and of N (the sliders' stiffness
-    e_0(N) / n and limits mu N w_q), with each slider's memory of its anchor (kept while it sticks,
-    reset where it slips or the contact opens)."""
+    """Linearise the Iwan element periodically along the path (see ``_periodic_friction``).
+
+    For every column, the change of its force dS (M, n_cols) from changes of xi and of N (the sliders' stiffness
+    e_0(N) / n and limits mu N w_q), with each slider's memory of its anchor (kept while it sticks, reset where it slips
+    or the contact opens).
+    """
     m, n_cols = dxi.shape
     n_sl = iw_w.size
     for i in range(m):
@@ -142,9 +168,11 @@ def _iwan_propagate(xi, N, iw_x, iw_flag, iw_w, e_f, k_c, mu, dxi, dN, out):
 
 @njit(cache=True)
 def _friction_tangents(xi, N_from, N, S_val, fr, n_min, coef):
-    """Partial derivatives of the integrator's friction step along the converged periodic path:
-    S_i = step(S_{i-1}, xi_{i-1}, xi_i, N_from_i, N_i); coef[i] = d S_i / d(S_{i-1}, xi_{i-1}, xi_i,
-    N_from_i, N_i) by central differences (the step's clamps included)."""
+    """Write the partial derivatives of the integrator's friction step along the converged periodic path into ``coef``.
+
+    S_i = step(S_{i-1}, xi_{i-1}, xi_i, N_from_i, N_i); coef[i] = d S_i / d(S_{i-1}, xi_{i-1}, xi_i, N_from_i, N_i) by
+    central differences (the step's clamps included).
+    """
     e_f, k_c, e_t, kappa, mu, slip_limit = fr[0], fr[1], fr[2], fr[3], fr[4], fr[5] > 0.5
     m = xi.size
     for i in range(m):
@@ -170,8 +198,10 @@ def _friction_tangents(xi, N_from, N, S_val, fr, n_min, coef):
 
 @njit(cache=True)
 def _propagate(coef, dxi, dN_from, dN, out):
-    """Periodic solution dS (M, n_cols) of the linearised step recurrence
-    dS_i = a_i dS_{i-1} + b_i dxi_{i-1} + c_i dxi_i + d_i dN_from_i + e_i dN_i for every column."""
+    """Write the periodic solution dS (M, n_cols) of the linearised step recurrence into ``out``.
+
+    dS_i = a_i dS_{i-1} + b_i dxi_{i-1} + c_i dxi_i + d_i dN_from_i + e_i dN_i, for every column.
+    """
     m, n_cols = dxi.shape
     prod = 1.0
     for i in range(m):
@@ -192,8 +222,48 @@ def _propagate(coef, dxi, dN_from, dN, out):
 
 
 @njit(cache=True)
-def normal_path(eta, deta, n0, delta0, p, cubic, hc, unilateral, N, dN_deta, dN_ddeta):
-    """Normal force and its tangents along the path (the integrator's ``normal_force``)."""
+def normal_path(
+    eta: np.ndarray,
+    deta: np.ndarray,
+    n0: float,
+    delta0: float,
+    p: float,
+    cubic: float,
+    hc: float,
+    unilateral: bool,
+    N: np.ndarray,
+    dN_deta: np.ndarray,
+    dN_ddeta: np.ndarray,
+) -> None:
+    """Write the normal force and its tangents along the path (the integrator's ``normal_force``) into the outputs.
+
+    Where a unilateral contact is open (eta >= delta0 or N <= 0) both tangents are zero.
+
+    Parameters
+    ----------
+    eta
+        Normal approach eta along the path [m], shape (M,).
+    deta
+        Its rate d eta/dt [m/s], shape (M,).
+    n0
+        Static normal preload N0 [N].
+    delta0
+        Static approach delta0 of the normal law [m].
+    p
+        Exponent of the unilateral power law [-].
+    cubic
+        Cubic hardening k_3 [N/m^3].
+    hc
+        Hunt-Crossley damping alpha of N (1 - alpha deta/dt) [s/m].
+    unilateral
+        Whether the contact may open (the power law); False: the bilateral linear spring of Eq. 13 plus the cubic.
+    N
+        Output: the normal force [N], shape (M,).
+    dN_deta
+        Output: dN/d eta [N/m], shape (M,).
+    dN_ddeta
+        Output: dN/d(d eta/dt) [N s/m], shape (M,).
+    """
     for i in range(eta.size):
         N[i] = normal_force(eta[i], deta[i], n0, delta0, p, hc, unilateral, cubic)
         if unilateral and (eta[i] >= delta0 or N[i] <= 0.0):
@@ -208,33 +278,74 @@ def normal_path(eta, deta, n0, delta0, p, cubic, hc, unilateral, N, dN_deta, dN_
 
 
 def grid_bytes(M: int, H: int, n: int) -> int:
-    """Peak memory (bytes) of a ``HarmonicBalance`` of ``n`` coordinates and ``H`` harmonics on ``M`` points per
-    period while it solves (its bases E, Ec, Eb, the path's signals and the friction law's tangents, all (M, ...)):
-    measured 5.0 kB per point at H = 18, n = 11 and 2.8 kB at H = 9 (M = 80000 and 160000; the fixed part is small),
-    8 (17 (2H + 1) + 8 n) bytes per point bound both."""
+    """Return the peak memory of a ``HarmonicBalance`` while it solves.
+
+    Its bases E, Ec, Eb, the path's signals and the friction law's tangents, all (M, ...): measured 5.0 kB per point at
+    H = 18, n = 11 and 2.8 kB at H = 9 (M = 80000 and 160000; the fixed part is small), 8 (17 (2H + 1) + 8 n) bytes per
+    point bound both.
+
+    Parameters
+    ----------
+    M
+        Points (integrator steps) per period.
+    H
+        Number of harmonics.
+    n
+        Number of coordinates of the reduced model.
+
+    Returns
+    -------
+    int
+        The memory bound, in bytes.
+    """
     return int(M) * 8 * (17 * (2 * int(H) + 1) + 8 * int(n))
 
 
 class HarmonicBalance:
-    """HB of one reduced model with its contact laws at one excitation frequency, on the time
-    integrator's own steps.
+    """HB of one reduced model and its contact laws at one excitation frequency, on the integrator's own steps.
 
-    red, contact, zeta as for ``DualSineSimulator``; w (rad/s); H harmonics; M steps per period
-    (the integrator's dt = 2 pi / (w M)). The equations are the integrator's discrete ones: velocity
-    Verlet is the central difference a_n = (z_{n+1} - 2 z_n + z_{n-1}) / dt^2 with the velocity
-    v_n = (z_{n+1} - z_{n-1}) / (2 dt) in the damping and the normal contact's dashpot, the half-step
-    velocity (z_n - z_{n-1}) / dt in the explicit normal-force estimate and the viscous friction, and
-    the friction law stepped once per step. On the harmonics these differences are exact operators
-    (4 sin^2(h w dt / 2) / dt^2 in place of (h w)^2, sin(h w dt) / dt in place of h w), so the
-    solution is the integrator's periodic orbit up to the harmonics above H, and it shares the
-    integrator's (and the rig's) discretisation instead of differing from it by it."""
+    The integrator's dt = 2 pi / (w M). The equations are the integrator's discrete ones: velocity Verlet is the
+    central difference a_n = (z_{n+1} - 2 z_n + z_{n-1}) / dt^2 with the velocity v_n = (z_{n+1} - z_{n-1}) / (2 dt) in
+    the damping and the normal contact's dashpot, the half-step velocity (z_n - z_{n-1}) / dt in the explicit
+    normal-force estimate and the viscous friction, and the friction law stepped once per step. On the harmonics these
+    differences are exact operators (4 sin^2(h w dt / 2) / dt^2 in place of (h w)^2, sin(h w dt) / dt in place of h w),
+    so the solution is the integrator's periodic orbit up to the harmonics above H, and it shares the integrator's (and
+    the rig's) discretisation instead of differing from it by it.
+
+    Parameters
+    ----------
+    red
+        The reduced model (as for ``DualSineSimulator``).
+    contact
+        The contact laws (as for ``DualSineSimulator``).
+    zeta
+        Modal damping ratios of the reduced coordinates [-], shape (n_r,).
+    w
+        Excitation angular frequency [rad/s].
+    H
+        Number of harmonics.
+    M
+        Integrator steps per period (at least 4 H).
+
+    Raises
+    ------
+    ValueError
+        When the contact's preload drifts (not periodic: use the time integrator) or M < 4 H.
+    work_limit_error
+        A ``contactid.io.WorkLimitError``, made by ``rig.nonlinear.work_limit_error``, when the grid's memory
+        (``grid_bytes``) passes ``rig.nonlinear.WORK_LIMIT_BYTES``; the message names the model's stiffest mode, which
+        sets the step.
+    """
 
     _last_lu: dict = {}  # the last factorised Jacobian, {(n, H, M): factor}: the next solve's chord (``forget``)
 
     @classmethod
     def forget(cls) -> None:
-        """Drop the factorised Jacobian kept for the next solve's chord steps, so that what follows does not depend
-        on what was solved before in this process (Newton's path, and so its state within its tolerance)."""
+        """Drop the factorised Jacobian kept for the next solve's chord steps.
+
+        So that what follows does not depend on what was solved before in this process (Newton's path, and so its state
+        within its tolerance).
+        """
         cls._last_lu = {}
 
     def __init__(self, red: ReducedModel, contact: ContactParameters, zeta: np.ndarray, w: float, H: int, M: int):
@@ -291,8 +402,10 @@ class HarmonicBalance:
 
     # -- conversions ---------------------------------------------------------------------------
     def _block_apply(self, blk: tuple, X: np.ndarray) -> np.ndarray:
-        """A 2 x 2-per-harmonic operator (mean, a_h, b_h) on X (2H + 1, ...) or, with per-mode
-        coefficients (n, ...), on X (n, 2H + 1)."""
+        """Apply a 2 x 2-per-harmonic operator (mean, a_h, b_h) to X.
+
+        X (2H + 1, ...) or, with per-mode coefficients (n, ...), X (n, 2H + 1).
+        """
         H = self.H
         c0, ca, cb = blk
         if np.ndim(c0) == 1:  # per mode, X (n, 2H + 1)
@@ -303,14 +416,38 @@ class HarmonicBalance:
         return np.concatenate([c0 * X[:1], ca * re + cb * im, ca * im - cb * re])
 
     def project(self, X: np.ndarray) -> np.ndarray:
-        """The mean, sine and cosine coefficients (2H + 1, ...) of the columns of X (M, ...), by FFT: the
-        projection onto E's basis, E.T @ X scaled by 1 / M (mean) and 2 / M (harmonics)."""
+        """Return the mean, sine and cosine coefficients of the columns of X, by FFT.
+
+        The projection onto E's basis, E.T @ X scaled by 1 / M (mean) and 2 / M (harmonics).
+
+        Parameters
+        ----------
+        X
+            Signals on the period's M steps, in any unit [unit of X], shape (M, ...).
+
+        Returns
+        -------
+        coefficients : np.ndarray
+            Mean, sine (h = 1..H) and cosine (h = 1..H) coefficients [unit of X], shape (2H + 1, ...).
+        """
         F = np.fft.rfft(X, axis=0)
         H, M = self.H, self.M
         return np.concatenate([F[:1].real / M, F[1 : H + 1].imag * (-2.0 / M), F[1 : H + 1].real * (2.0 / M)])
 
     def synthesise(self, U: np.ndarray) -> np.ndarray:
-        """E @ U.T by inverse FFT: the signals (M, n) of the real-basis harmonics U (n, 2H + 1)."""
+        """Return the signals of real-basis harmonics U on the period's steps: E @ U.T by inverse FFT.
+
+        Parameters
+        ----------
+        U
+            Real-basis harmonics (mean, sine, cosine coefficients) of n signals, e.g. of z [kg^0.5 m],
+            shape (n, 2H + 1).
+
+        Returns
+        -------
+        signals : np.ndarray
+            The signals on the M steps [unit of U], shape (M, n).
+        """
         H, M = self.H, self.M
         F = np.zeros((M // 2 + 1, U.shape[0]), dtype=complex)
         F[0] = U[:, 0] * M
@@ -318,17 +455,51 @@ class HarmonicBalance:
         return np.fft.irfft(F, n=M, axis=0)
 
     def to_real(self, Z: np.ndarray) -> np.ndarray:
-        """(n, H + 1) complex -> (n, 2H + 1) real."""
+        """Return complex harmonics in the real basis: the mean, then the real and the imaginary parts of Z_h.
+
+        Parameters
+        ----------
+        Z
+            Complex harmonics (column 0 the mean), e.g. of z [kg^0.5 m], shape (n, H + 1).
+
+        Returns
+        -------
+        U : np.ndarray
+            Real-basis harmonics [unit of Z], shape (n, 2H + 1).
+        """
         return np.hstack([Z[:, :1].real, Z[:, 1:].real, Z[:, 1:].imag])
 
     def to_complex(self, U: np.ndarray) -> np.ndarray:
-        """(n, 2H + 1) real -> (n, H + 1) complex: the mean, then Z_h from its real and imaginary parts (the inverse of
-        ``to_real``)."""
+        """Return real-basis harmonics as complex ones: the mean, then Z_h from its real and imaginary parts.
+
+        The inverse of ``to_real``.
+
+        Parameters
+        ----------
+        U
+            Real-basis harmonics, e.g. of z [kg^0.5 m], shape (n, 2H + 1).
+
+        Returns
+        -------
+        Z : np.ndarray
+            Complex harmonics (column 0 the mean) [unit of U], shape (n, H + 1).
+        """
         H = self.H
         return np.hstack([U[:, :1] + 0j, U[:, 1 : H + 1] + 1j * U[:, H + 1 :]])
 
     def force_vector(self, force_coef: np.ndarray) -> np.ndarray:
-        """b f(t) in the real basis: (n, 2H + 1) from the force harmonics f = sum Im(F_h e^{ihwt})."""
+        """Return b f(t) in the real basis from the force harmonics f = sum Im(F_h e^{ihwt}).
+
+        Parameters
+        ----------
+        force_coef
+            Complex force harmonics F_h, h = 1..K, of the force at d_p [N], shape (K,) (those above H are left out).
+
+        Returns
+        -------
+        Fb : np.ndarray
+            The modal force's real-basis harmonics [kg^0.5 m/s^2], shape (n, 2H + 1).
+        """
         F = np.zeros(self.H + 1, dtype=complex)
         k = min(len(force_coef), self.H)
         F[1 : k + 1] = force_coef[:k]
@@ -336,7 +507,18 @@ class HarmonicBalance:
         return np.outer(self.red.force, Fr)
 
     def linear_start(self, force_coef: np.ndarray) -> np.ndarray:
-        """The stuck linear system's response (real basis)."""
+        """Return the stuck linear system's response to the force harmonics, in the real basis.
+
+        Parameters
+        ----------
+        force_coef
+            Complex force harmonics F_h, h = 1..K [N], shape (K,).
+
+        Returns
+        -------
+        U : np.ndarray
+            Real-basis harmonics of z [kg^0.5 m], shape (n, 2H + 1).
+        """
         rhs = self.force_vector(force_coef)
         return np.array([np.linalg.solve(self.L[j], rhs[j]) for j in range(self.n)])
 
@@ -360,7 +542,24 @@ class HarmonicBalance:
         return N, dN, dNd
 
     def path(self, U: np.ndarray) -> dict:
-        """The contact laws along the periodic path of U (real basis, (n, 2H + 1)) on the steps."""
+        """Return the contact laws along the periodic path of U on the steps.
+
+        Parameters
+        ----------
+        U
+            Real-basis harmonics of z [kg^0.5 m], shape (n, 2H + 1).
+
+        Returns
+        -------
+        path : dict
+            On the M steps: ``z`` [kg^0.5 m] and ``v`` (full-step velocity) [kg^0.5 m/s] (M, n); ``xi`` (with the
+            shortening) and ``xi_lin`` (its linear part), ``eta`` [m]; ``dxi`` (half-step) and ``deta`` (full-step)
+            [m/s]; the normal force acting ``N`` and its explicit estimate ``N_est`` [N] with their tangents
+            ``dN_deta``, ``dNe_deta`` [N/m] and ``dN_ddeta``, ``dNe_ddeta`` [N s/m]; the friction force ``S`` and the
+            Valanis state ``S_valanis`` [N]; the Iwan sliders' anchors ``iwan_x`` [m] and moves ``iwan_flag``
+            (M, n_sliders), ``iwan_anchors`` (t = 0); ``g``, the contact forces on z [kg^0.5 m/s^2] (M, n); ``contact``,
+            where the contact is closed.
+        """
         r, c = self.red, self.contact
         z = self.synthesise(U)  # (M, n); the velocities are the integrator's differences (Ec, Eb)
         v = (np.roll(z, -1, axis=0) - np.roll(z, 1, axis=0)) / (2.0 * self.dt)
@@ -414,17 +613,47 @@ class HarmonicBalance:
         }
 
     def residual(self, U: np.ndarray, Fb: np.ndarray, p: dict | None = None) -> tuple[np.ndarray, dict]:
-        """The HB residual R = L U - Fb - project(g) ((n, 2H + 1), real basis) of the harmonics U against the force Fb
-        (``force_vector``), with the contact path it used (``path``, or ``p`` where given)."""
+        """Return the HB residual R = L U - Fb - project(g) of the harmonics U against the force Fb.
+
+        With the contact path it used (``path``, or ``p`` where given).
+
+        Parameters
+        ----------
+        U
+            Real-basis harmonics of z [kg^0.5 m], shape (n, 2H + 1).
+        Fb
+            The force's real-basis harmonics (``force_vector``) [kg^0.5 m/s^2], shape (n, 2H + 1).
+        p
+            The contact path of U (``path``), or None to compute it.
+
+        Returns
+        -------
+        R : np.ndarray
+            The residual, real basis [kg^0.5 m/s^2], shape (n, 2H + 1).
+        path : dict
+            The contact path (``path``).
+        """
         p = self.path(U) if p is None else p
         R = np.einsum("jab,jb->ja", self.L, U) - Fb - self.project(p["g"]).T
         return R, p
 
     def jacobian(self, p: dict) -> np.ndarray:
-        """The dense Jacobian dR/dU ((n (2H + 1))^2, mode-major ordering) that ``factor`` inverts (Newton uses
-        that): blockdiag(L) - W B W^T with ``contact_blocks``' B, assembled term by term, and the beam
-        shortening's axial-force term (G S) that the factor leaves out; the shortening's share of the friction
-        direction (dxi/dz = xi_v - G z) is left out of both."""
+        """Return the dense Jacobian dR/dU that ``factor`` inverts (Newton uses that).
+
+        blockdiag(L) - W B W^T with ``contact_blocks``' B, assembled term by term, and the beam shortening's axial-force
+        term (G S) that the factor leaves out; the shortening's share of the friction direction (dxi/dz = xi_v - G z) is
+        left out of both.
+
+        Parameters
+        ----------
+        p
+            The contact path (``path``).
+
+        Returns
+        -------
+        J : np.ndarray
+            The Jacobian, mode-major ordering [1/s^2], shape (n (2H + 1), n (2H + 1)).
+        """
         r = self.red
         B = self.contact_blocks(p)
         nb = B.shape[0] // 2
@@ -437,11 +666,23 @@ class HarmonicBalance:
         return scipy.linalg.block_diag(*self.L) - Jnl
 
     def contact_blocks(self, p: dict) -> np.ndarray:
-        """B ((2 (2H + 1))^2) of the Jacobian's contact part W B W^T, W = [xi (x) I, eta (x) I]: the friction
-        law's linearised step recurrence around the path (its memory and its dependence on N exact, the
-        Iwan sliders' with their anchors' memory), the normal law's tangents, the viscous term. Left out:
-        the beam shortening's share (dxi/dz = xi_v - G z and the axial-force term G S), second order in z,
-        which costs Newton a step, not its convergence."""
+        """Return B of the Jacobian's contact part W B W^T, W = [xi (x) I, eta (x) I].
+
+        The friction law's linearised step recurrence around the path (its memory and its dependence on N exact, the
+        Iwan sliders' with their anchors' memory), the normal law's tangents, the viscous term. Left out: the beam
+        shortening's share (dxi/dz = xi_v - G z and the axial-force term G S), second order in z, which costs Newton a
+        step, not its convergence.
+
+        Parameters
+        ----------
+        p
+            The contact path (``path``).
+
+        Returns
+        -------
+        B : np.ndarray
+            The contact's blocks (xi-xi, xi-eta, eta-eta) [N/m], shape (2 (2H + 1), 2 (2H + 1)).
+        """
         c = self.contact
         E = self.E
         M = self.M
@@ -481,9 +722,21 @@ class HarmonicBalance:
         return B
 
     def factor(self, p: dict) -> tuple:
-        """The Newton matrix along path ``p``, factorised by the Woodbury identity: J = D - W B W^T with
-        D = blockdiag(L) (the linear modes, fixed) and the contact's B; J^-1 r = D^-1 (r + W B y) where
-        (I - C B) y = W^T D^-1 r and C = W^T D^-1 W. One (2 (2H + 1))^2 LU per Jacobian."""
+        """Return the Newton matrix along path ``p``, factorised by the Woodbury identity.
+
+        J = D - W B W^T with D = blockdiag(L) (the linear modes, fixed) and the contact's B; J^-1 r = D^-1 (r + W B y)
+        where (I - C B) y = W^T D^-1 r and C = W^T D^-1 W. One (2 (2H + 1))^2 LU per Jacobian.
+
+        Parameters
+        ----------
+        p
+            The contact path (``path``).
+
+        Returns
+        -------
+        factor : tuple
+            (this HarmonicBalance, B, the LU factor of I - C B), for ``apply_inverse``.
+        """
         B = self.contact_blocks(p)
         nb = B.shape[0] // 2
         C, ap = self.C, self._block_apply
@@ -493,8 +746,22 @@ class HarmonicBalance:
 
     @staticmethod
     def apply_inverse(f: tuple, R: np.ndarray) -> np.ndarray:
-        """J^-1 R for a factor ``f`` of ``factor`` (R (n, 2H + 1), mode-major); the factor may be a
-        neighbouring model's (a chord step), it carries its own linear part."""
+        """Return J^-1 R for a factor ``f`` of ``factor``.
+
+        The factor may be a neighbouring model's (a chord step): it carries its own linear part.
+
+        Parameters
+        ----------
+        f
+            A factor made by ``factor``.
+        R
+            A residual, real basis, mode-major [kg^0.5 m/s^2], shape (n, 2H + 1).
+
+        Returns
+        -------
+        step : np.ndarray
+            J^-1 R, real-basis harmonics of z [kg^0.5 m], shape (n, 2H + 1).
+        """
         hb, B, lu = f
         xi, eta = hb.red.xi, hb.red.eta
         DR = hb._block_apply(hb.Linv, R)
@@ -507,8 +774,28 @@ class HarmonicBalance:
     def solve(
         self, force_coef: np.ndarray, start: np.ndarray | None = None, tol: float = 1e-8, max_iter: int = 40
     ) -> PeriodicResponse:
-        """Newton iteration from ``start`` (Z, (n, H' + 1) complex, any H') or the linear solution.
-        Converged when the residual is below ``tol`` of the force's norm (both in the real basis)."""
+        """Find the periodic steady state by Newton's method from ``start`` or the linear solution.
+
+        Converged when the residual is below ``tol`` of the force's norm (both in the real basis). Steps are backtracked
+        on the residual norm; the last factorised Jacobian of this size (a neighbouring solve's) is reused as a chord
+        until it stops cutting the residual threefold.
+
+        Parameters
+        ----------
+        force_coef
+            Complex force harmonics F_h, h = 1..K, of the force at d_p [N], shape (K,).
+        start
+            Complex harmonics Z of z to start from [kg^0.5 m], shape (n, H' + 1) for any H'; None: the linear solution.
+        tol
+            Relative residual at which Newton stops [-].
+        max_iter
+            The most Newton iterations.
+
+        Returns
+        -------
+        response : PeriodicResponse
+            The steady state, with whether Newton converged.
+        """
         Fb = self.force_vector(force_coef)
         scale = max(np.linalg.norm(Fb), 1e-300)
         if start is None:
