@@ -75,6 +75,7 @@ lint: env
 	$(VENV)/bin/snakefmt --no-sort --check Snakefile workflow/rules
 	$(VENV)/bin/snakemake --lint
 	$(VENV)/bin/lint-imports
+	$(VENV)/bin/pydoclint -q workflow/contactid
 
 # optional (not in CI by default): the noise-study sweep through a local single-node SLURM against -c2 here
 slurm-test: env
