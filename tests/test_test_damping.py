@@ -133,7 +133,7 @@ def test_a_rig_damped_otherwise_in_its_dual_sine_tests_than_in_its_random_test_i
 
 
 def test_summary_and_report_say_the_factor_and_whether_the_other_load_cases_confirmed_it():
-    from contactid.latex import test_damping_text
+    from contactid.report_text import test_damping_text
     from contactid.test_damping import damping_summary
 
     p = _profile(

@@ -25,7 +25,7 @@ from __future__ import annotations
 import math
 from typing import Mapping
 
-# What a failed check means, said once for the rule logs (plain text) and the report (LaTeX, ``contactid.latex``):
+# What a failed check means, said once for the rule logs (plain text) and the report (LaTeX, ``contactid.report_text``):
 # the finding, then its consequence; {k_t}, {k_n} and {S} are the symbols as each medium writes them
 STIFFNESS_FINDING = (
     "the structure with contact springs cannot reproduce the identified frequencies within their uncertainty"

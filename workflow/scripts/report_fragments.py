@@ -5,16 +5,15 @@ from pathlib import Path
 
 import pandas as pd
 from contactid.gap.report import explained_law_note, updated_law_note
-from contactid.latex import (
+from contactid.latex import macros, tabular
+from contactid.logs import setup_logging
+from contactid.report_text import (
     contact_fragment,
     data_checks_text,
-    macros,
     records_alert_text,
     report_values,
     setup_table,
-    tabular,
 )
-from contactid.logs import setup_logging
 
 setup_logging(snakemake.log[0])
 
