@@ -190,8 +190,6 @@ def test_damping_text(td: Mapping[str, Any] | None) -> str:
     """
     if not td:
         return "The dual-sine tests were identified with the random test's damping ratios."
-    from .test_damping import ratio_words  # the report's fragments alone need it: kept off latex's import
-
     which = ratio_words(td["form"], td["driven_mode"])
     lo, hi = td["interval"]
     bound = (
