@@ -361,7 +361,7 @@ def write_measured_files(proj: Path, small_run: Path) -> None:
     """The measured run's files (``prepare_measured_run``) and its config."""
     import xarray as xr
     from contactid.importers.export import export_record
-    from contactid.importers.frf_uff import write_frf_uff58
+    from contactid.importers.frf_export import write_frf_uff58
     from contactid.linear_chain import complex_frf
 
     (proj / "measured").mkdir()

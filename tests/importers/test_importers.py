@@ -408,7 +408,8 @@ def _frf_sets(path):
 
 
 def test_rig_frfs_round_trip_through_pyuff_and_the_importer(rig_frf, tmp_path):
-    from contactid.importers.frf_uff import measured_frf_dataset, write_frf_uff58
+    from contactid.importers.frf_export import write_frf_uff58
+    from contactid.importers.frf_uff import measured_frf_dataset
     from contactid.linear_chain import complex_frf
 
     frf, structure = rig_frf
@@ -443,7 +444,8 @@ def test_rig_frfs_round_trip_through_pyuff_and_the_importer(rig_frf, tmp_path):
 def test_frfs_in_g_per_n_without_coherence_on_any_axis(rig_frf, tmp_path):
     """g/N is converted (x 9.80665); a sensor without coherence gets 1 and says so; lines whose spacing the
     header's 6 digits cannot keep are stored one by one and read back exactly."""
-    from contactid.importers.frf_uff import measured_frf_dataset, write_frf_uff58
+    from contactid.importers.frf_export import write_frf_uff58
+    from contactid.importers.frf_uff import measured_frf_dataset
     from contactid.linear_chain import complex_frf
 
     frf, structure = rig_frf
@@ -464,7 +466,7 @@ def test_frfs_in_g_per_n_without_coherence_on_any_axis(rig_frf, tmp_path):
 
 def _write_frfs(path, frf, sensors=("a1", "a2", "a3"), **labels):
     """The FRFs of ``sensors`` with the accelerance labels changed as given (a receptance file, say)."""
-    from contactid.importers.frf_uff import write_frf_uff58
+    from contactid.importers.frf_export import write_frf_uff58
     from contactid.linear_chain import complex_frf
 
     idx = [list(frf["sensor"].values).index(s) for s in sensors]
@@ -475,7 +477,8 @@ def test_synthesised_frfs_are_the_lsfd_fit_of_the_identified_modes(rig_frf, tmp_
     """The identified modes' FRFs (LSFD residues and residuals in the band) on every measured line, written as
     UFF58 type 4 and read back by the importer (coherence not given) on the same lines."""
     from contactid.frf_synthesis import identified_poles, synthesised_frf
-    from contactid.importers.frf_uff import measured_frf_dataset, write_frf_uff58
+    from contactid.importers.frf_export import write_frf_uff58
+    from contactid.importers.frf_uff import measured_frf_dataset
     from contactid.linear_chain import complex_frf, modal_dataset
     from contactid.modal_fit import lsfd_residues
 

@@ -245,7 +245,7 @@ def _record_format_errors(cfg: Mapping) -> list:
     """Return the errors of the measured records' formats.
 
     A measured record in another format than netCDF has a complete channel map (``importers.record_spec``, for measured
-    FRFs ``importers.frf_uff.frf_sensor_map``); a format other than netCDF is for measured records only, and FRFs
+    FRFs ``importers.frf_channels.frf_sensor_map``); a format other than netCDF is for measured records only, and FRFs
     (uff58_frf) are for the random test only.
     """
     errors = []
@@ -274,7 +274,7 @@ def _check_channel_map(block: Mapping, where: str, fmt: str, structure: Mapping)
     The map must be complete and consistent; raises RawDataError otherwise.
     """
     if fmt == "uff58_frf":
-        from .importers.frf_uff import frf_sensor_map
+        from .importers.frf_channels import frf_sensor_map
 
         frf_sensor_map(block, where, structure)
     else:

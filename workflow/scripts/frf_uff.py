@@ -7,7 +7,7 @@ The measured H1 FRFs with their coherence, or the FRFs the identified modes synt
 import json
 
 from contactid.frf_synthesis import synthesised_frf
-from contactid.importers.frf_uff import write_frf_uff58
+from contactid.importers.frf_export import write_frf_uff58
 from contactid.io import load_dataset
 from contactid.linear_chain import complex_frf
 from contactid.logs import setup_logging

@@ -1,47 +1,29 @@
-"""Frequency response functions in universal files (datasets 58), read in and written out.
+"""Frequency response functions in universal files (datasets 58), read in as the linear chain's FRF dataset.
 
-FRFs a lab hands over are read in as the linear chain's FRF dataset (results/linear/frf.nc), and the chain's
-measured and LSFD-synthesised FRFs written out.
+FRFs a lab hands over are read in as the linear chain's FRF dataset (results/linear/frf.nc); ``frf_channels`` holds
+the channel map that says which FRF is each sensor's, ``frf_export`` writes the chain's FRFs out.
 
 In a dataset 58 an FRF is function type 4 (complex ordinate) and a coherence function type 6 ("Coherence" in
 the dataset's description; type 9 is a power spectral density). The FRFs must be force-normalised accelerance
 (m/s^2/N, or g/N converted with 9.80665): receptance (displacement over force) and mobility (velocity over force)
-are refused, never differentiated here. Each sensor of ``structure.sensors`` is matched to one FRF by its ID line
-1 (``id1``, the sensor's name unless a channel map says otherwise) or by its response node and direction; its
-coherence is the type-6 dataset of the same response and reference node and direction. Nothing is guessed: the
-units come from the file's labels or from the map, and where both state them they must agree.
+are refused, never differentiated here. Each sensor's coherence is the type-6 dataset of the same response and
+reference node and direction as its FRF. Nothing is guessed: the units come from the file's labels or from the map,
+and where both state them they must agree.
 """
 
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
-from pathlib import Path
-from typing import Iterable, Mapping, Sequence
+from typing import Mapping, Sequence
 
 import numpy as np
 import xarray as xr
 
 from ..io import RawDataError
+from .frf_channels import ACCELERANCE_UNITS, NO_LABEL, FrfSensor, accelerance_unit, frf_sensor_map
 from .readers import datasets58
 
 FRF_FUNCTION, COHERENCE_FUNCTION = 4, 6
-# force-normalised accelerance, with the factor to m/s^2/N
-ACCELERANCE_UNITS = {"m/s^2/N": 1.0, "g/N": 9.80665, "mm/s^2/N": 1.0e-3}
-_UNIT_SPELLINGS = {
-    "m/s2/N": "m/s^2/N",
-    "(m/s^2)/N": "m/s^2/N",
-    "(m/s2)/N": "m/s^2/N",
-    "m/s**2/N": "m/s^2/N",
-    "m/s/s/N": "m/s^2/N",
-    "m s-2 N-1": "m/s^2/N",
-    "m/(s^2 N)": "m/s^2/N",
-    "m/N/s^2": "m/s^2/N",
-    "g0/N": "g/N",
-    "gn/N": "g/N",
-    "mm/s2/N": "mm/s^2/N",
-    "(mm/s^2)/N": "mm/s^2/N",
-}
 # other FRF kinds by unit label and by the ordinate's specific data type (8 displacement, 11 velocity)
 OTHER_KINDS = {
     "m/N": "receptance (displacement over force)",
@@ -57,154 +39,6 @@ OTHER_KINDS = {
 }
 SPEC_KINDS = {8: "receptance (displacement over force)", 11: "mobility (velocity over force)"}
 FORCE_SPEC_TYPES = (0, 1, 9, 13)  # unknown, general, reaction force, excitation force
-_NO_LABEL = ("", "NONE", "none", "-")
-
-
-@dataclass(frozen=True)
-class FrfSensor:
-    """One sensor of the FRF file: its name and position, the FRF dataset that holds it and the units the map states.
-
-    Attributes
-    ----------
-    name
-        The sensor's name (structure.sensors.names).
-    position_m
-        Its distance from the clamp (structure.sensors.positions_m) [m].
-    channel
-        ID line 1 (id1) of the FRF dataset that holds it; None where it is found by its node.
-    node
-        Response node of the FRF dataset that holds it; None where it is found by its id1.
-    direction
-        Response direction of that dataset; None for any.
-    units
-        The units the channel map states for its FRF, in the spelling of ``ACCELERANCE_UNITS``; None where the map
-        states none.
-    """
-
-    name: str
-    position_m: float
-    channel: str | None = None
-    node: int | None = None
-    direction: int | None = None
-    units: str | None = None
-
-    def describe(self) -> str:
-        """Return the FRF dataset that holds the sensor, in words for messages: its id1, or its response node.
-
-        Returns
-        -------
-        description : str
-            ``id1 'name'``, or ``response node n`` with ``direction d`` where one is given.
-        """
-        if self.channel is not None:
-            return f"id1 {self.channel!r}"
-        return f"response node {self.node}" + ("" if self.direction is None else f" direction {self.direction}")
-
-
-def accelerance_unit(label: str | None) -> str | None:
-    """Return a unit label of an FRF in the spelling of ACCELERANCE_UNITS / OTHER_KINDS (None for no label).
-
-    Parameters
-    ----------
-    label
-        A unit label as a file or a channel map writes it (``m/s2/N``, ``(m/s^2)/N``, ``g0/N``...); None, empty,
-        ``NONE`` or ``-`` for no label.
-
-    Returns
-    -------
-    unit : str | None
-        The label with its white space normalised and known spellings mapped to the table's (an unknown label comes
-        back as it is); None for no label.
-    """
-    if label is None or str(label).strip() in _NO_LABEL:
-        return None
-    s = " ".join(str(label).split())
-    s = s.replace(" / ", "/")
-    return _UNIT_SPELLINGS.get(s, s)
-
-
-def _map_entry(entry, i: int, names: list, positions: list, where: str) -> FrfSensor:
-    key = f"{where}: channels.sensors[{i}]"
-    if not isinstance(entry, Mapping) or not entry.get("name"):
-        raise RawDataError(f"{key}: give a mapping with the sensor's name and its channel (id1) or node")
-    name = str(entry["name"])
-    if name not in names:
-        raise RawDataError(f"{key}: sensor {name!r} is not one of structure.sensors.names {names}")
-    pos = positions[names.index(name)]
-    if entry.get("position_m") is not None and abs(float(entry["position_m"]) - pos) > 1e-3:
-        raise RawDataError(
-            f"{key}: position_m = {entry['position_m']} m but structure.sensors puts {name} at {pos} m; "
-            "make the model's sensor layout (config) match the test"
-        )
-    channel, node = entry.get("channel"), entry.get("node")
-    if (channel is None) == (node is None):
-        raise RawDataError(f"{key}: give either channel (the FRF's id1) or node (its response node), not both")
-    units = entry.get("units")
-    if units is not None and accelerance_unit(units) not in ACCELERANCE_UNITS:
-        raise RawDataError(
-            f"{key}: units = {units!r}; give force-normalised accelerance: {', '.join(ACCELERANCE_UNITS)}"
-        )
-    direction = entry.get("direction")
-    return FrfSensor(
-        name,
-        pos,
-        None if channel is None else str(channel),
-        None if node is None else int(node),
-        None if direction is None else int(direction),
-        None if units is None else accelerance_unit(units),
-    )
-
-
-def frf_sensor_map(block: Mapping, where: str, structure_cfg: Mapping) -> tuple:
-    """Return the FrfSensor of every structure sensor, in structure order.
-
-    From ``channels.sensors`` of the config block, or, without a map, the FRF whose id1 is the sensor's name.
-
-    Parameters
-    ----------
-    block
-        The config block of the FRF file (``random_test``); its ``channels`` (``{sensors: [{name, channel or node,
-        direction, units, position_m}]}``) is read.
-    where
-        The block's name in the config, named in the messages.
-    structure_cfg
-        The config's ``structure`` block; ``sensors.names`` and ``sensors.positions_m`` [m] are read.
-
-    Returns
-    -------
-    sensors : tuple
-        One FrfSensor per sensor of ``structure_cfg``, in its order.
-
-    Raises
-    ------
-    RawDataError
-        When the channel map is not of that form (or names a force), maps a sensor twice, or leaves one out; an
-        entry that names no known sensor, a position other than the structure's, both or neither of channel and
-        node, or units other than accelerance is refused too.
-    """
-    names = [str(n) for n in structure_cfg["sensors"]["names"]]
-    positions = [float(x) for x in structure_cfg["sensors"]["positions_m"]]
-    chans = block.get("channels")
-    if not chans:
-        return tuple(FrfSensor(n, p, channel=n) for n, p in zip(names, positions))
-    if not isinstance(chans, Mapping) or "force" in chans or not isinstance(chans.get("sensors"), (list, tuple)):
-        raise RawDataError(
-            f"{where}: an FRF file's channel map is channels: {{sensors: [{{name, channel or node, units}}]}} "
-            "(no force: the FRFs are already normalised by it)"
-        )
-    mapped = {}
-    for i, entry in enumerate(chans["sensors"]):
-        s = _map_entry(entry, i, names, positions, where)
-        if s.name in mapped:
-            raise RawDataError(f"{where}: channels.sensors maps {s.name} twice; give each sensor once")
-        mapped[s.name] = s
-    missing = [n for n in names if n not in mapped]
-    if missing:
-        raise RawDataError(
-            f"{where}: channels.sensors does not map {missing} of structure.sensors.names; "
-            "the modal fit needs an FRF at every sensor of the model"
-        )
-    return tuple(mapped[n] for n in names)
 
 
 def uff58_sets(path: str) -> list:
@@ -389,7 +223,7 @@ def _abscissa(s: Mapping, path: str) -> np.ndarray:
     if data is None or x is None or len(data) < 2:
         raise RawDataError(f"{path}: dataset 58 {_label(s)} holds fewer than two lines")
     unit = str(s.get("abscissa_axis_units_lab") or "").strip()
-    if unit not in _NO_LABEL and unit.lower() not in ("hz", "1/s"):
+    if unit not in NO_LABEL and unit.lower() not in ("hz", "1/s"):
         raise RawDataError(
             f"{path}: dataset 58 {_label(s)} has its abscissa in {unit!r}; export it over frequency in Hz"
         )
@@ -613,154 +447,3 @@ def measured_frf_dataset(block: Mapping, where: str, structure_cfg: Mapping, ban
             + json.dumps([n for n, g in given.items() if not g])
         )
     return ds
-
-
-# ---- writing FRFs as datasets 58 -----------------------------------------------------------------------------
-
-_SIX_DIGITS = "%13.5e"  # how a universal file's header keeps the abscissa minimum and increment
-
-
-def _even_axis(f: np.ndarray) -> bool:
-    """Return whether the header's 6-digit minimum and increment give back exactly the lines ``f`` (Hz)."""
-    inc = f[1] - f[0]
-    x0, dx = float(_SIX_DIGITS % f[0]), float(_SIX_DIGITS % inc)
-    return bool(np.array_equal(x0 + np.arange(f.size) * dx, f))
-
-
-def _dataset58(node: int, ref_node: int, f: np.ndarray, data: np.ndarray, labels: Mapping) -> dict:
-    even = _even_axis(f)
-    return {
-        "type": 58,
-        "binary": 1,
-        "id3": "",
-        "id4": "",
-        "id5": "",
-        "ver_num": 0,
-        "load_case_id": 0,
-        "rsp_ent_name": "beam",
-        "rsp_node": node,
-        "rsp_dir": 3,
-        "ref_ent_name": "beam",
-        "ref_node": ref_node,
-        "ref_dir": 3,
-        "abscissa_spacing": int(even),
-        "abscissa_inc": float(f[1] - f[0]) if even else 0.0,
-        "z_axis_value": 0.0,
-        "abscissa_spec_data_type": 18,
-        "abscissa_len_unit_exp": 0,
-        "abscissa_force_unit_exp": 0,
-        "abscissa_temp_unit_exp": 0,
-        "abscissa_axis_lab": "Frequency",
-        "abscissa_axis_units_lab": "Hz",
-        "ordinate_temp_unit_exp": 0,
-        "orddenom_temp_unit_exp": 0,
-        "z_axis_spec_data_type": 0,
-        "z_axis_len_unit_exp": 0,
-        "z_axis_force_unit_exp": 0,
-        "z_axis_temp_unit_exp": 0,
-        "z_axis_axis_lab": "NONE",
-        "z_axis_axis_units_lab": "NONE",
-        "num_pts": f.size,
-        "data": data,
-        "x": np.asarray(f, dtype=float),
-        **labels,
-    }
-
-
-ACCELERANCE_LABELS = {
-    "func_type": FRF_FUNCTION,
-    "ordinate_spec_data_type": 12,
-    "ordinate_len_unit_exp": 1,
-    "ordinate_force_unit_exp": 0,
-    "ordinate_axis_lab": "Acceleration",
-    "ordinate_axis_units_lab": "m/s^2",
-    "orddenom_spec_data_type": 13,
-    "orddenom_len_unit_exp": 0,
-    "orddenom_force_unit_exp": 1,
-    "orddenom_axis_lab": "Force",
-    "orddenom_axis_units_lab": "N",
-}
-COHERENCE_LABELS = {
-    "func_type": COHERENCE_FUNCTION,
-    "ordinate_spec_data_type": 1,
-    "ordinate_len_unit_exp": 0,
-    "ordinate_force_unit_exp": 0,
-    "ordinate_axis_lab": "Coherence",
-    "ordinate_axis_units_lab": "NONE",
-    "orddenom_spec_data_type": 0,
-    "orddenom_len_unit_exp": 0,
-    "orddenom_force_unit_exp": 0,
-    "orddenom_axis_lab": "NONE",
-    "orddenom_axis_units_lab": "NONE",
-}
-
-
-def write_frf_uff58(
-    path: Path | str,
-    frequency_hz: np.ndarray,
-    frf: np.ndarray,
-    sensors: Iterable[str],
-    coherence: np.ndarray | Sequence[np.ndarray | None] | None = None,
-    description: str = "contactid FRF",
-    reference: int = 0,
-    labels: Mapping | None = None,
-) -> dict:
-    """Write accelerance FRFs and their coherences as datasets 58 of a universal file.
-
-    The FRFs go as function type 4, binary double precision, one per sensor (id1 = the sensor's name, response
-    node = its number from 1, direction 3, reference node = the number of sensor ``reference``, the driving point),
-    and their coherences as function type 6 of the same nodes. Lines evenly spaced to the header's 6 digits are
-    written as an even abscissa, any others with every line stored. Replaces ``path`` whole.
-
-    Parameters
-    ----------
-    path
-        The universal file to write.
-    frequency_hz
-        The frequency lines [Hz], shape (n_f,).
-    frf
-        The accelerance FRFs, complex [m/s^2/N] (or in the units ``labels`` states), shape (n_sensors, n_f).
-    sensors
-        The sensors' names, n_sensors of them, in the order of ``frf``'s rows.
-    coherence
-        Their coherences [-], shape (n_sensors, n_f), or a list with one row per sensor and None for a sensor
-        without; None to write no coherence.
-    description
-        ID line 2 of every dataset (", coherence" appended on the coherences').
-    reference
-        Index of the driving point's sensor among ``sensors`` (the datasets' reference node is its number).
-    labels
-        Fields that override the FRF datasets' own (a file as another tool writes it: g/N, receptance...); None
-        for none.
-
-    Returns
-    -------
-    block : dict
-        The random_test block that reads the file back (source measured, format uff58_frf, the file).
-    """
-    import pyuff
-
-    path = Path(path)
-    f = np.asarray(frequency_hz, dtype=float)
-    h = np.atleast_2d(np.asarray(frf, dtype=complex))
-    names = [str(s) for s in sensors]
-    tmp = path.with_name(path.name + ".tmp")
-    if tmp.exists():
-        tmp.unlink()
-    uff = pyuff.UFF(str(tmp))
-    for i, name in enumerate(names):
-        ids = {"id1": name, "id2": description, "func_id": i + 1}
-        uff.write_sets(
-            _dataset58(i + 1, reference + 1, f, h[i], {**ids, **ACCELERANCE_LABELS, **(labels or {})}),
-            mode="add",
-            force_double=True,
-        )
-    for i, name in enumerate(names):
-        c = None if coherence is None else coherence[i]
-        if c is not None:
-            ids = {"id1": name, "id2": f"{description}, coherence", "func_id": len(names) + i + 1}
-            labels = {**ids, **COHERENCE_LABELS}
-            c = np.asarray(c, dtype=float)
-            uff.write_sets(_dataset58(i + 1, reference + 1, f, c, labels), mode="add", force_double=True)
-    os.replace(tmp, path)
-    return {"source": "measured", "format": "uff58_frf", "file": str(path)}
