@@ -15,6 +15,7 @@ import pandas as pd
 
 from .latex import escape, latex_number, plain_text, tabular
 from .model_checks import FRICTION_CONSEQUENCE, FRICTION_FINDING, STIFFNESS_CONSEQUENCE, STIFFNESS_FINDING
+from .test_damping import ratio_words
 
 
 def case_words(case: str) -> str:
