@@ -58,7 +58,7 @@ def _stiction(modal_frequencies, modal_std, structure_cfg, stiction_cfg):
 def test_a_doubled_sampling_rate_is_refused_naming_the_file_the_ranges_and_the_factor(
     foreign_structure, default_config
 ):
-    from contactid.stiction import refuse_unreachable
+    from contactid.stiction_refusal import refuse_unreachable
 
     stiction_cfg = default_config["stiction"]
     ds = _stiction(*DOUBLED_RATE, foreign_structure, stiction_cfg)
@@ -84,7 +84,7 @@ def test_a_doubled_sampling_rate_is_refused_naming_the_file_the_ranges_and_the_f
 
 
 def test_a_halved_sampling_rate_names_the_reciprocal_factor(foreign_structure, default_config):
-    from contactid.stiction import reachability
+    from contactid.stiction_refusal import reachability
 
     f, s = FOREIGN["plain"]
     f = np.asarray(f) / 2
@@ -107,7 +107,7 @@ def test_a_halved_sampling_rate_names_the_reciprocal_factor(foreign_structure, d
 
 @pytest.mark.parametrize("name", sorted(FOREIGN))
 def test_the_foreign_records_are_far_inside_the_structures_reach(foreign_structure, default_config, name):
-    from contactid.stiction import UNREACHABLE_SIGMAS, refuse_unreachable
+    from contactid.stiction_refusal import UNREACHABLE_SIGMAS, refuse_unreachable
 
     ds = _stiction(*FOREIGN[name], foreign_structure, default_config["stiction"])
     reach = refuse_unreachable(
@@ -120,7 +120,8 @@ def test_the_foreign_records_are_far_inside_the_structures_reach(foreign_structu
 
 def test_the_project_rigs_frequencies_are_reachable(default_config):
     from contactid.beam_model import natural_frequencies
-    from contactid.stiction import frequency_sigma, reachability
+    from contactid.stiction import frequency_sigma
+    from contactid.stiction_refusal import reachability
 
     params = structure_from_config(default_config["structure"], 1.43e7, 2.37e7)
     f = natural_frequencies(params, 3)
@@ -142,7 +143,7 @@ def test_the_project_rigs_frequencies_are_reachable(default_config):
 
 def test_a_fit_pinned_at_a_bound_far_from_the_data_is_refused_even_within_the_ranges(foreign_structure):
     """The second criterion: every frequency within its own range, but no stiffness reproduces them together."""
-    from contactid.stiction import reachability
+    from contactid.stiction_refusal import reachability
 
     params = structure_from_config(foreign_structure, 1e7, 1e8)
     f = np.array([60.0, 120.0, 480.0])  # mode 1 asks for a stiff contact, mode 2 for a soft one
@@ -159,7 +160,7 @@ def test_a_fit_pinned_at_a_bound_far_from_the_data_is_refused_even_within_the_ra
 
 
 def test_amplitudes_in_g_are_refused_by_the_stiffness_step_and_true_ones_pass(foreign_structure, default_config):
-    from contactid.stiction import refuse_unreachable
+    from contactid.stiction_refusal import refuse_unreachable
     from contactid.updating_model import modal_predictions
 
     st = default_config["stiction"]

@@ -163,7 +163,8 @@ def test_jobs_that_fit_nothing_do_not_import_scipy_optimize():
     by the fits that use it."""
     code = (
         "import contactid.linear_chain, contactid.updating, contactid.updating_model, contactid.updating_result, "
-        "contactid.raw_checks, contactid.raw_checks_dual_sine, contactid.raw_checks_random, contactid.stiction"
+        "contactid.raw_checks, contactid.raw_checks_dual_sine, contactid.raw_checks_random, contactid.stiction, "
+        "contactid.stiction_refusal"
     )
     assert not _imports_in_a_fresh_process("scipy.optimize", code)
 

@@ -5,7 +5,7 @@ from contactid.linear_chain import stiction_dataset
 from contactid.logs import fmt, setup_logging
 from contactid.model_checks import stiffness_fit_check
 from contactid.parameters import structure_from_config
-from contactid.stiction import random_test_source, refuse_unreachable
+from contactid.stiction_refusal import random_test_source, refuse_unreachable
 
 log = setup_logging(snakemake.log[0])
 p = snakemake.params
