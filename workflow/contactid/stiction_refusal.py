@@ -441,8 +441,8 @@ def amplitude_message(ratio: float, source: str) -> str:
         f"random test {source}: its FRFs' amplitudes are {ratio:.3g} times what the described structure gives (the "
         "median over sensors and modes of the measured modal residues over the fitted structure's, whose natural "
         f"frequencies it reproduces), beyond a factor {AMPLITUDE_FACTOR_LIMIT:g} either way "
-        "(contactid.stiction.AMPLITUDE_FACTOR_LIMIT; no error in a structure's described masses comes near it, and "
-        "the model updating would take it for masses and contact stiffnesses that no rig has). "
+        "(contactid.stiction_refusal.AMPLITUDE_FACTOR_LIMIT; no error in a structure's described masses comes near "
+        "it, and the model updating would take it for masses and contact stiffnesses that no rig has). "
         "results/linear/stiction.nc is not written. Likely causes, most likely first: "
         + "; ".join(f"({i + 1}) {c}" for i, c in enumerate(causes))
     )
