@@ -16,8 +16,7 @@ import numpy as np
 
 from .beam_model import ContactFrequencyMap
 from .parameters import StructureParameters
-from .stiction import LN_SCALE_BOUNDS
-from .stiction import quick_chi2 as _quick_chi2
+from .stiction import LN_SCALE_BOUNDS, quick_chi2
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -215,7 +214,7 @@ def reachability(
             if inside:
                 factor = float(inside[0])
                 lt, ln = np.log10(k_t_bounds), np.log10(k_n_bounds)
-                chi2_factor = _quick_chi2(fmap, f_id / factor, sigma / factor, lt, ln, s_sd)
+                chi2_factor = quick_chi2(fmap, f_id / factor, sigma / factor, lt, ln, s_sd)
     return Reachability(
         ranges, outside, tuple(at_bound), float(chi2_min), dof, factor_range, factor, chi2_factor, tuple(reasons)
     )
