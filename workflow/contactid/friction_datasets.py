@@ -13,8 +13,9 @@ import numpy as np
 from .friction import PARAMETER_NAMES, REGULARIZATIONS, valanis_friction_force
 
 # log: contactid.friction_fit's logger, the name every line of the friction fit carries
-from .friction_fit import N_OPEN, FitResult, FitSettings, fit_friction_law, log
+from .friction_fit import FitResult, FitSettings, fit_friction_law, log
 from .friction_parameters import ESTIMATES, GRID_FIELDS, fitted_parameters, parameter_variables
+from .friction_problem import N_OPEN
 from .harmonics import periodic_grid
 
 if TYPE_CHECKING:

@@ -16,7 +16,7 @@ from numba import njit
 
 from ..beam_model import all_modes
 from ..friction import initial_stiffness, iwan_force, valanis_friction_force
-from ..friction_fit import FitProblem, least_squares_polish
+from ..friction_problem import FitProblem, least_squares_polish
 from ..harmonics import periodic_grid
 from ..identification import InverseHarmonics, inverse_harmonics, modal_damping_vector
 from ..rig.nonlinear import iwan_slip_weights
