@@ -12,7 +12,8 @@ from contactid.identification import (
     nonlinear_mode_coefficients,
     nrmse,
 )
-from contactid.rig.nonlinear import ContactParameters, DualSineSimulator, reduced_model
+from contactid.rig.nonlinear import ContactParameters, reduced_model
+from contactid.rig.simulator import DualSineSimulator
 from structures import configured_structure, dual_sine_harmonics
 
 P = configured_structure(tangential_lever_arm=0.00458, youngs_modulus=2.164e11, k_t=1.4276e7, k_n=2.37e7, n_elements=24)

@@ -46,7 +46,7 @@ def _rig_kernels(structure: Mapping, rig: Mapping) -> None:
 def _harmonic_balance_kernels(structure: Mapping, rig: Mapping) -> None:
     """Compile harmonic balance's contact paths and tangents (the gap diagnosis and the friction intervals)."""
     from .rig.harmonic_balance import HarmonicBalance
-    from .rig.nonlinear import force_coefficients
+    from .rig.simulator import force_coefficients
 
     sim, w = _simulator(structure, rig)
     for contact in (sim.contact, dataclasses.replace(sim.contact, iwan_share=0.3)):  # with Iwan's sliders

@@ -18,11 +18,11 @@ from ..io import WorkLimitError
 from ..rig.nonlinear import (
     WORK_LIMIT_BYTES,
     ContactParameters,
-    DualSineSimulator,
     gib,
     record_bytes,
     stable_oversampling,
 )
+from ..rig.simulator import DualSineSimulator
 from .model import Augmentation, IdentifiedModel, reduced
 from .numerics import DEFAULT, Numerics
 from .records import RecordHarmonics

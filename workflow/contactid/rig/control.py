@@ -1,7 +1,7 @@
 """The virtual rig's response control: the dual-sine test's force amplitudes tuned to the target response.
 
 F1 and F3 are tuned until the driving point's acceleration harmonics at w and 3w reach their targets (Broyden's
-method, Section 3), on ``rig.nonlinear.DualSineSimulator``.
+method, Section 3), on ``rig.simulator.DualSineSimulator``.
 """
 
 from __future__ import annotations
@@ -11,7 +11,8 @@ from dataclasses import dataclass
 import numpy as np
 
 # progress: the logger of the response control's iterations, contactid.rig.nonlinear's (the name its lines carry)
-from .nonlinear import DualSineSimulator, SteadyStateLog, progress
+from .nonlinear import progress
+from .simulator import DualSineSimulator, SteadyStateLog
 
 
 @dataclass

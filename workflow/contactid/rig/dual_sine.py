@@ -24,10 +24,10 @@ from .effects import effect_magnitudes
 from .frontend import add_noise, anti_alias_decimate, delay_channels
 from .nonlinear import (
     ContactParameters,
-    DualSineSimulator,
     reduced_model,
     stable_oversampling,
 )
+from .simulator import DualSineSimulator
 from .structure import channel_delays, channel_gains, rig_structure, true_structure_config
 
 log = logging.getLogger(__name__)

@@ -4,7 +4,7 @@ The contact laws are the normal force with its Hunt-Crossley damping and the mod
 Iwan sliders and the viscous friction; the integrator, explicit central differences (velocity Verlet) with the
 diagonal modal damping taken implicitly, with the excitation and the preload's drift.
 
-``rig.nonlinear.DualSineSimulator`` calls ``integrate`` with the reduced model, the contact laws and the drive as
+``rig.simulator.DualSineSimulator`` calls ``integrate`` with the reduced model, the contact laws and the drive as
 the NamedTuples here read them; the equations are in ``rig.nonlinear``'s docstring. Every kernel is
 ``@njit(cache=True)``; one that calls another imports it at module level (numba resolves globals when it
 compiles).
