@@ -233,8 +233,9 @@ def test_legitimate_models_stay_well_within_the_step_limit(foreign_structure, de
 def test_the_harmonic_balance_grid_and_the_stored_record_are_bounded(foreign_structure):
     from contactid.gap.model import NONE
     from contactid.gap.simulation import simulator
-    from contactid.rig.harmonic_balance import HarmonicBalance, grid_bytes
+    from contactid.rig.harmonic_balance import HarmonicBalance
     from contactid.rig.nonlinear import WORK_LIMIT_BYTES, record_bytes
+    from contactid.rig.periodic_response import grid_bytes
 
     sim = simulator(_identified(structure_from_config(foreign_structure, 1.43e7, 2.53e7)), NONE, 5400.0, 54.0)
     n = sim.red.omega.size

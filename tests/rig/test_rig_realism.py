@@ -9,8 +9,8 @@ from contactid.config import check_config
 from contactid.parameters import structure_from_config
 from contactid.rig.damping import damping_ratios
 from contactid.rig.dual_sine import contact_parameters, dual_sine_test
-from contactid.rig.harmonic_balance import normal_path
 from contactid.rig.integrator import normal_force
+from contactid.rig.periodic_path import normal_path
 from contactid.rig.random_test import random_test_datasets
 from contactid.rig.structure import rig_structure
 from contactid.schema import ConfigError

@@ -277,7 +277,7 @@ def _check_work(sim: DualSineSimulator, rec: RecordHarmonics, n_per: int, n_hb: 
     pass the limit; the message says whether the model's step (its steps per sample) or the record (its samples per
     period, its periods) makes it so.
     """
-    from ..rig.harmonic_balance import grid_bytes
+    from ..rig.periodic_response import grid_bytes
 
     n = sim.red.omega.size
     needs = {"the record's simulation": record_bytes(periods * n_per, n, state=False)}

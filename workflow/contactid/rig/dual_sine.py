@@ -142,7 +142,7 @@ def normal_tangent_ratio(contact: ContactParameters, k_n: float, load: float) ->
     """
     from scipy.optimize import brentq
 
-    from .harmonic_balance import normal_path
+    from .periodic_path import normal_path
 
     c = contact
 

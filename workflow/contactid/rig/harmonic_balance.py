@@ -17,7 +17,8 @@ projects g back onto the harmonics. Newton's method solves the residual with a J
 laws' tangents along the path (the friction law's slope, the normal law's stiffness and
 damping, the shortening's axial-force term); the tangent Jacobian is exact where the contact
 sticks and close elsewhere, so Newton converges in a few steps from the linear solution or
-from a neighbouring solution (``start``).
+from a neighbouring solution (``start``). The contact laws' kernels along the path are in ``rig.periodic_path``,
+the solve's result and its grid's memory bound in ``rig.periodic_response``.
 
 The time integrator stays the reference: ``tests/rig/test_harmonic_balance.py`` checks that the
 harmonics agree within 0.1 % on every load case and model effect.
@@ -25,14 +26,9 @@ harmonics agree within 0.1 % on every load case and model effect.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 import scipy.linalg
-from numba import njit
 
-from ..friction import initial_stiffness, iwan_force, valanis_step
-from .integrator import normal_force
 from .nonlinear import (
     WORK_LIMIT_BYTES,
     ContactParameters,
@@ -42,263 +38,8 @@ from .nonlinear import (
     stiffest_mode,
     work_limit_error,
 )
-
-
-@dataclass
-class PeriodicResponse:
-    """A periodic steady state found by harmonic balance.
-
-    Attributes
-    ----------
-    Z
-        Complex harmonics of the mass-normalised coordinates z [kg^0.5 m], shape (n_r, H + 1): column 0 the mean
-        (real), column h the amplitude Z_h of Im(Z_h e^{i h w t}).
-    A
-        Complex harmonics of the acceleration, as the integrator computes it (the second difference) [kg^0.5 m/s^2],
-        shape (n_r, H + 1).
-    w
-        Excitation angular frequency [rad/s].
-    grid
-        The period's signals on its M steps from t = 0: ``t`` [s], ``z`` [kg^0.5 m], ``v`` [kg^0.5 m/s] and ``a``
-        [kg^0.5 m/s^2] (M, n_r); ``xi``, ``eta`` [m], ``dxi``, ``deta`` [m/s], ``N``, ``S`` and the friction law's
-        own state ``S_valanis`` [N] (M,).
-    converged
-        Whether Newton converged.
-    iterations
-        Newton's iterations.
-    residual
-        The final residual relative to the force's norm (both in the real basis) [-].
-    iwan_anchors
-        The Iwan sliders' anchors at t = 0 [m], shape (n_sliders,).
-    """
-
-    Z: np.ndarray
-    A: np.ndarray
-    w: float
-    grid: dict
-    converged: bool
-    iterations: int
-    residual: float
-    iwan_anchors: np.ndarray
-
-
-@njit(cache=True)
-def _periodic_friction(xi, N_from, N, fr, n_min, iw_share, iw_w, tol, max_periods, S_out, S_val_out, iw_x, iw_flag):
-    """Step the friction law along a periodic path on the integrator's steps until it repeats.
-
-    Step i moves xi[i-1] -> xi[i] while N moves N_from[i] -> N[i] (the integrator's pair: the last step's final normal
-    force and this step's explicit estimate). The Valanis state is stepped with the integrator's ``valanis_step``
-    around the loop until it repeats (change below tol x max|S|), the Iwan share's sliders as the integrator's
-    ``friction.iwan_force`` steps them; S_val_out the Valanis state, S_out (1 - s) S_val + s S_iwan (zero where N <= 0,
-    the contact open); iw_x (M, sliders) the anchors after each step and iw_flag how each slider moved (0 stuck, +1 / -1
-    slipping, 2 reset by an open contact).
-    """
-    e_f, k_c, e_t, kappa, mu, slip_limit = fr[0], fr[1], fr[2], fr[3], fr[4], fr[5] > 0.5
-    m = xi.size
-    n_sl = iw_w.size
-    x_sl = np.zeros(n_sl)
-    S = 0.0
-    for period in range(max_periods):
-        change = 0.0
-        peak = 0.0
-        for i in range(m):
-            j = i - 1 if i > 0 else m - 1
-            S = valanis_step(S, xi[j], xi[i], N_from[i], N[i], e_f, k_c, e_t, kappa, mu, n_min, slip_limit)
-            s_iw = 0.0
-            if iw_share > 0.0:
-                if N[i] > 0.0:
-                    s_iw = iwan_force(xi[i], x_sl, iw_w, initial_stiffness(N[i], e_f, k_c), mu * N[i], iw_flag[i])
-                    for q in range(n_sl):
-                        iw_x[i, q] = x_sl[q]
-                else:
-                    for q in range(n_sl):
-                        x_sl[q] = xi[i]
-                        iw_x[i, q] = xi[i]
-                        iw_flag[i, q] = 2
-            tot = (1.0 - iw_share) * S + iw_share * s_iw if N[i] > 0.0 else 0.0
-            d = abs(tot - S_out[i])
-            if d > change:
-                change = d
-            if abs(tot) > peak:
-                peak = abs(tot)
-            S_out[i] = tot
-            S_val_out[i] = S
-        if period > 0 and change <= tol * max(peak, 1e-300):
-            break
-
-
-@njit(cache=True)
-def _iwan_propagate(xi, N, iw_x, iw_flag, iw_w, e_f, k_c, mu, dxi, dN, out):
-    """Linearise the Iwan element periodically along the path (see ``_periodic_friction``).
-
-    For every column, the change of its force dS (M, n_cols) from changes of xi and of N (the sliders' stiffness
-    e_0(N) / n and limits mu N w_q), with each slider's memory of its anchor (kept while it sticks, reset where it slips
-    or the contact opens).
-    """
-    m, n_cols = dxi.shape
-    n_sl = iw_w.size
-    for i in range(m):
-        for c in range(n_cols):
-            out[i, c] = 0.0
-    dx = np.zeros(n_cols)  # the anchor's change per column
-    for q in range(n_sl):
-        for c in range(n_cols):
-            dx[c] = 0.0
-        for sweep in range(2):  # one pass sets the anchor's change wherever the slider slips, the second records
-            for i in range(m):
-                flag = iw_flag[i, q]
-                if flag == 2:
-                    for c in range(n_cols):
-                        dx[c] = dxi[i, c]
-                    continue
-                ex = np.exp(-k_c * N[i] / e_f)  # d e_0 / dN = k_c ex (Eq. 22)
-                k = initial_stiffness(N[i], e_f, k_c) / n_sl
-                lim = mu * N[i] * iw_w[q]
-                for c in range(n_cols):
-                    dk = k_c * ex * dN[i, c] / n_sl
-                    if flag == 0:
-                        df = dk * (xi[i] - iw_x[i, q]) + k * (dxi[i, c] - dx[c])
-                    else:
-                        dlim = mu * iw_w[q] * dN[i, c]
-                        df = flag * dlim
-                        dx[c] = dxi[i, c] - flag * (dlim * k - lim * dk) / (k * k)
-                    if sweep == 1:
-                        out[i, c] += df
-
-
-@njit(cache=True)
-def _friction_tangents(xi, N_from, N, S_val, fr, n_min, coef):
-    """Write the partial derivatives of the integrator's friction step along the converged periodic path into ``coef``.
-
-    S_i = step(S_{i-1}, xi_{i-1}, xi_i, N_from_i, N_i); coef[i] = d S_i / d(S_{i-1}, xi_{i-1}, xi_i, N_from_i, N_i) by
-    central differences (the step's clamps included).
-    """
-    e_f, k_c, e_t, kappa, mu, slip_limit = fr[0], fr[1], fr[2], fr[3], fr[4], fr[5] > 0.5
-    m = xi.size
-    for i in range(m):
-        j = i - 1 if i > 0 else m - 1
-        x = (S_val[j], xi[j], xi[i], N_from[i], N[i])
-        scale = (
-            max(abs(S_val[j]), 1e-3),
-            max(abs(xi[j]), abs(xi[i]), 1e-12),
-            max(abs(xi[j]), abs(xi[i]), 1e-12),
-            max(abs(N_from[i]), 1.0),
-            max(abs(N[i]), 1.0),
-        )
-        for k in range(5):
-            h = 1e-7 * scale[k]
-            xp = [x[0], x[1], x[2], x[3], x[4]]
-            xm = [x[0], x[1], x[2], x[3], x[4]]
-            xp[k] += h
-            xm[k] -= h
-            fp = valanis_step(xp[0], xp[1], xp[2], xp[3], xp[4], e_f, k_c, e_t, kappa, mu, n_min, slip_limit)
-            fm = valanis_step(xm[0], xm[1], xm[2], xm[3], xm[4], e_f, k_c, e_t, kappa, mu, n_min, slip_limit)
-            coef[i, k] = (fp - fm) / (2.0 * h)
-
-
-@njit(cache=True)
-def _propagate(coef, dxi, dN_from, dN, out):
-    """Write the periodic solution dS (M, n_cols) of the linearised step recurrence into ``out``.
-
-    dS_i = a_i dS_{i-1} + b_i dxi_{i-1} + c_i dxi_i + d_i dN_from_i + e_i dN_i, for every column.
-    """
-    m, n_cols = dxi.shape
-    prod = 1.0
-    for i in range(m):
-        prod *= coef[i, 0]
-    closure = 1.0 / (1.0 - prod) if abs(1.0 - prod) > 1e-9 else 0.0
-    s = np.zeros(n_cols)  # one pass from zero gives the response r; the periodic start is r_end / (1 - prod a)
-    for sweep in range(2):
-        if sweep == 1:
-            for c in range(n_cols):
-                s[c] *= closure
-        for i in range(m):
-            j = i - 1 if i > 0 else m - 1
-            a, b, cc, d, e = coef[i, 0], coef[i, 1], coef[i, 2], coef[i, 3], coef[i, 4]
-            for c in range(n_cols):
-                s[c] = a * s[c] + b * dxi[j, c] + cc * dxi[i, c] + d * dN_from[i, c] + e * dN[i, c]
-                if sweep == 1:
-                    out[i, c] = s[c]
-
-
-@njit(cache=True)
-def normal_path(
-    eta: np.ndarray,
-    deta: np.ndarray,
-    n0: float,
-    delta0: float,
-    p: float,
-    cubic: float,
-    hc: float,
-    unilateral: bool,
-    N: np.ndarray,
-    dN_deta: np.ndarray,
-    dN_ddeta: np.ndarray,
-) -> None:
-    """Write the normal force and its tangents along the path (the integrator's ``normal_force``) into the outputs.
-
-    Where a unilateral contact is open (eta >= delta0 or N <= 0) both tangents are zero.
-
-    Parameters
-    ----------
-    eta
-        Normal approach eta along the path [m], shape (M,).
-    deta
-        Its rate d eta/dt [m/s], shape (M,).
-    n0
-        Static normal preload N0 [N].
-    delta0
-        Static approach delta0 of the normal law [m].
-    p
-        Exponent of the unilateral power law [-].
-    cubic
-        Cubic hardening k_3 [N/m^3].
-    hc
-        Hunt-Crossley damping alpha of N (1 - alpha deta/dt) [s/m].
-    unilateral
-        Whether the contact may open (the power law); False: the bilateral linear spring of Eq. 13 plus the cubic.
-    N
-        Output: the normal force [N], shape (M,).
-    dN_deta
-        Output: dN/d eta [N/m], shape (M,).
-    dN_ddeta
-        Output: dN/d(d eta/dt) [N s/m], shape (M,).
-    """
-    for i in range(eta.size):
-        N[i] = normal_force(eta[i], deta[i], n0, delta0, p, hc, unilateral, cubic)
-        if unilateral and (eta[i] >= delta0 or N[i] <= 0.0):
-            dN_deta[i] = 0.0
-            dN_ddeta[i] = 0.0
-            continue
-        power = n0 * ((delta0 - eta[i]) / delta0) ** p if unilateral else n0 * (delta0 - eta[i]) / delta0
-        nel = power - cubic * eta[i] ** 3
-        dnel = (-p * power / (delta0 - eta[i]) if unilateral else -n0 / delta0) - 3.0 * cubic * eta[i] ** 2
-        dN_deta[i] = dnel * (1.0 - hc * deta[i])
-        dN_ddeta[i] = -hc * nel
-
-
-def grid_bytes(M: int, H: int, n: int) -> int:
-    """Return the peak memory of a ``HarmonicBalance`` while it solves.
-
-    Its bases E, Ec, Eb, the path's signals and the friction law's tangents, all (M, ...): measured 5.0 kB per point at
-    H = 18, n = 11 and 2.8 kB at H = 9 (M = 80000 and 160000; the fixed part is small), 8 (17 (2H + 1) + 8 n) bytes per
-    point bound both.
-
-    Parameters
-    ----------
-    M
-        Points (integrator steps) per period.
-    H
-        Number of harmonics.
-    n
-        Number of coordinates of the reduced model.
-
-    Returns
-    -------
-    int
-        The memory bound, in bytes.
-    """
-    return int(M) * 8 * (17 * (2 * int(H) + 1) + 8 * int(n))
+from .periodic_path import friction_tangents, iwan_propagate, normal_path, periodic_friction, propagate
+from .periodic_response import PeriodicResponse, grid_bytes
 
 
 class HarmonicBalance:
@@ -577,7 +318,7 @@ class HarmonicBalance:
         M = self.M
         S, S_val = np.zeros(M), np.empty(M)
         iw_x, iw_flag = np.zeros((M, self.iw_w.size)), np.zeros((M, self.iw_w.size), dtype=np.int8)
-        _periodic_friction(
+        periodic_friction(
             xi, np.roll(N, 1), N_est, self.fr, c.n_min, c.iwan_share, self.iw_w, 1e-12, 400, S, S_val, iw_x, iw_flag
         )
         contact = N_est > 0.0
@@ -688,17 +429,17 @@ class HarmonicBalance:
         M = self.M
         nb = E.shape[1]
         coef = np.empty((M, 5))
-        _friction_tangents(p["xi"], np.roll(p["N"], 1), p["N_est"], p["S_valanis"], self.fr, c.n_min, coef)
+        friction_tangents(p["xi"], np.roll(p["N"], 1), p["N_est"], p["S_valanis"], self.fr, c.n_min, coef)
         dN_full = p["dN_deta"][:, None] * E + p["dN_ddeta"][:, None] * self.Ec
         dN_est = p["dNe_deta"][:, None] * E + p["dNe_ddeta"][:, None] * self.Eb
         zero = np.zeros((M, nb))
         dS = np.empty((M, 2 * nb))
         dxi_cols, dN_est_cols = np.hstack([E, zero]), np.hstack([zero, dN_est])  # columns: U's xi part, then its N part
-        _propagate(coef, dxi_cols, np.hstack([zero, np.roll(dN_full, 1, axis=0)]), dN_est_cols, dS)
+        propagate(coef, dxi_cols, np.hstack([zero, np.roll(dN_full, 1, axis=0)]), dN_est_cols, dS)
         dS *= (1.0 - c.iwan_share) * p["contact"][:, None]
         if c.iwan_share:  # the Iwan element's share, linearised with its sliders' memory
             dS_iw = np.empty_like(dS)
-            _iwan_propagate(
+            iwan_propagate(
                 p["xi"],
                 p["N_est"],
                 p["iwan_x"],

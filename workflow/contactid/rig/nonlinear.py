@@ -103,7 +103,7 @@ a record read in the wrong units)."""
 
 WORK_LIMIT_BYTES = 1 << 30
 """The most memory (bytes, 1 GiB) one simulation's stored signals (``DualSineSimulator.run``, ``record_bytes``) or
-one harmonic-balance grid (``rig.harmonic_balance.grid_bytes``) may take. With the job's own memory (the largest job
+one harmonic-balance grid (``rig.periodic_response.grid_bytes``) may take. With the job's own memory (the largest job
 of a run on the foreign records peaked at 0.75 GiB) and the copies the callers make of a stored record (a sixth of
 it), no job passes about 2.5 GiB, below the 4 GiB a job may use. Legitimate work stays far below it (estimates by
 those two functions): the rig's dual-sine record (16384 samples, eight steps each, with its margins) 89 MB; the gap
