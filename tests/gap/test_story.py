@@ -2,7 +2,8 @@
 on hand-made numbers (milliseconds). tests/gap/test_gap.py checks the same decisions on rig data."""
 
 import pytest
-from contactid.gap.story import held_out, one_story_holds, resolution, tell
+from contactid.gap.story import one_story_holds, tell
+from contactid.gap.story_decisions import held_out
 
 SETTINGS = {"min_gap": 0.006, "noise_factor": 3.0, "min_reduction": 0.5, "separation": 1.5}  # the config's defaults
 PLACE = "tangential_contact"
@@ -234,19 +235,6 @@ def test_an_empty_explanation_names_the_first_pass_best_in_its_reason():
     low = story([], [row("viscous_friction", 0.0025, 0.003)], before=0.003)
     assert low.reason.startswith("the held-out gap 0.3 % is below gap.min_gap 0.6 %")
     assert low.trace[-1]["test"] == "above_floor" and not low.trace[-1]["passed"]
-
-
-def test_resolution():
-    # the form candidate leaves 0.839 % of 1.49 %: an effect must leave less than 0.839 / 1.5
-    r = resolution(0.0149, {"structural_damping": 0.00839}, 1e-4, SETTINGS)
-    assert r["heldout_gap"] == pytest.approx(0.0149 - 0.00839 / 1.5)
-    assert r["form_candidate"] == "structural_damping" and "by less than 0.931 %" in r["how"]
-    # a form candidate that explains nothing: min_reduction binds
-    r = resolution(0.0148, {"structural_damping": 0.0174}, 1e-4, SETTINGS)
-    assert r["heldout_gap"] == pytest.approx(0.5 * 0.0148) and "gap.min_reduction" in r["how"]
-    # at the floor, or with nothing held out, no change is attributed
-    assert resolution(0.005, {}, 1e-4, SETTINGS)["heldout_gap"] == 0.005
-    assert resolution(0.02, {}, 1e-4, SETTINGS, held=False)["heldout_gap"] == 0.02
 
 
 def test_one_story_holds_says_when_two_stories_are_told():

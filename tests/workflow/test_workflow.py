@@ -208,7 +208,8 @@ def test_gap_runs_on_a_directory_of_raw_files_alone(measured_run):
     # nothing from the rig (data/raw, data/truth): data/ holds only the importers' netCDF files
     assert sorted(p.name for p in (proj / "data").iterdir()) == ["imported"]
     d = json.loads((proj / "results" / "gap" / "diagnosis.json").read_text())
-    # the library in use (gap.candidates) and the form candidate, tried in every diagnosis (story.beyond_model_form)
+    # the library in use (gap.candidates) and the form candidate, tried in every diagnosis
+    # (story_decisions.beyond_model_form)
     assert d["verdict"] == "none" and {r["effect"] for r in d["ranking"]} == {"viscous_friction", "structural_damping"}
     assert [t["test"] for t in d["trace"]][0] == "held_out" and d["resolution"]["heldout_gap"] > 0
 

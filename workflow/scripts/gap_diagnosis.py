@@ -13,7 +13,7 @@ from contactid.gap.output import diagnosis_json, gap_dataset, updated_model_json
 from contactid.gap.pipeline import workflow_models
 from contactid.gap.record_checks import diagnosis_outcome
 from contactid.gap.settings import GapSettings
-from contactid.gap.story import records_agree
+from contactid.gap.story_decisions import records_agree
 from contactid.gap.workers import prepare_workers
 from contactid.io import load_dataset, provenance, write_dataset, write_text
 from contactid.logs import setup_logging

@@ -16,8 +16,8 @@ Modules, by role:
   searches), ``workers`` (the candidates' refits in worker processes), ``ranking`` (the first pass's rows),
   ``pipeline`` (the models a diagnosis of the workflow's files works with);
 - decisions: ``verdict`` (where the gap lies, whether a step explains materially), ``explain`` (the additive
-  explanation and the model it arrives at), ``story`` (the verdict told from the explanation, with its trace and the
-  resolution);
+  explanation and the model it arrives at), ``story`` (the verdict told from the explanation, with its trace),
+  ``story_decisions`` (the decisions of the trace, and the resolution);
 - outputs: ``output`` (diagnosis.json, gap.nc), ``figures``, ``report`` (the report's section: its assembly, the
   candidates' table, the friction law's notes), ``report_diagnosis`` (the diagnosis in words), ``report_base_model``
   (the base model's update in words), ``report_benchmark`` (the benchmarks' paragraphs), ``report_format`` (their

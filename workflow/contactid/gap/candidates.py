@@ -150,7 +150,7 @@ class Candidate:
     form
         The candidate changes the base model's form (its damping) rather than adding an effect at the contact or in
         the measurement: what it explains is the reference of what model-form differences leave on the records
-        (``story.beyond_model_form``), and it is tried even where the library in use leaves it out.
+        (``story_decisions.beyond_model_form``), and it is tried even where the library in use leaves it out.
     """
 
     name: str

@@ -34,7 +34,8 @@ from .ranking import rank_candidates
 from .records import RecordHarmonics
 from .refit import baseline, gap_residual
 from .settings import GapSettings
-from .story import resolution, tell
+from .story import tell
+from .story_decisions import resolution
 from .verdict import at_floor, gap_shares, retried
 from .workers import start_candidates
 
@@ -87,7 +88,7 @@ class Diagnosis:
     trace
         The decisions' trace (``story.tell``).
     resolution
-        What the records can attribute (``story.resolution``), with the candidates' isolability.
+        What the records can attribute (``story_decisions.resolution``), with the candidates' isolability.
     updated_model
         The model with the explained effects (``explain.updated_model_summary``).
     """
