@@ -30,7 +30,8 @@ sys.path.insert(0, str(ROOT / "tests"))
 
 import contactid.identification as ident  # noqa: E402
 from contactid.beam_model import ContactFrequencyMap, all_modes, assemble  # noqa: E402
-from contactid.identification import inverse_harmonics, modal_damping_vector  # noqa: E402
+from contactid.identification import inverse_harmonics  # noqa: E402
+from contactid.modal_damping import modal_damping_vector  # noqa: E402
 from contactid.signals import h1_frf  # noqa: E402
 from structures import (  # noqa: E402
     configured_structure,

@@ -18,11 +18,11 @@ from .identification import (
     generalized_coordinates,
     inverse_harmonics,
     inverse_identification,
-    modal_damping_vector,
     nnm_coordinates,
     nonlinear_mode_coefficients,
     nrmse,
 )
+from .modal_damping import modal_damping_vector
 from .parameters import StructureParameters, identified_structure
 from .raw_checks_dual_sine import driving_point_index
 

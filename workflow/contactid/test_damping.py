@@ -40,7 +40,8 @@ import xarray as xr
 
 from .friction_fit import FitSettings, fit_friction_law
 from .friction_parameters import PARAMETER_NAMES, PARAMETER_UNITS
-from .identification import inverse_harmonics, modal_damping_vector
+from .identification import inverse_harmonics
+from .modal_damping import modal_damping_vector
 
 if TYPE_CHECKING:
     from .beam_model import FEModel

@@ -16,7 +16,7 @@ import xarray as xr
 
 from ..beam_model import all_modes, structural_modes
 from ..harmonics import periodic_grid
-from ..identification import modal_damping_vector
+from ..modal_damping import modal_damping_vector
 from .model import NONE, Augmentation, IdentifiedModel, fe_model
 from .records import RecordHarmonics
 from .refit import contact_grids, identified_forces, law_friction_force

@@ -18,7 +18,8 @@ from ..beam_model import all_modes
 from ..friction import initial_stiffness, iwan_force, valanis_friction_force
 from ..friction_problem import FitProblem, least_squares_polish
 from ..harmonics import periodic_grid
-from ..identification import InverseHarmonics, inverse_harmonics, modal_damping_vector
+from ..identification import InverseHarmonics, inverse_harmonics
+from ..modal_damping import modal_damping_vector
 from ..rig.nonlinear import iwan_slip_weights
 from .model import NONE, Augmentation, IdentifiedModel, fe_model
 from .numerics import DEFAULT, Numerics

@@ -13,8 +13,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..harmonics import aperiodic_share, periodic_grid, periodic_harmonics
-from ..identification import damping_by_mode
 from ..io import WorkLimitError
+from ..modal_damping import damping_by_mode
 from ..rig.nonlinear import (
     WORK_LIMIT_BYTES,
     ContactParameters,
