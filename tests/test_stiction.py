@@ -232,14 +232,14 @@ def test_where_k_n_is_the_prior_a_mass_candidates_refit_keeps_it(default_config)
 
 
 def test_records_attribution_structure_without_a_factor_keeps_the_prior_k_n(default_config):
-    """The records' attribution (``gap.pipeline._without_factor``) redoes the stiffness fit of the proposal with one
+    """The records' attribution (``gap.base_model._without_factor``) redoes the stiffness fit of the proposal with one
     factor at 1 as a mass candidate's refit does: where the chain's modes use the prior k_n, it keeps it (before,
     the fit's flat k_n ran towards the cap, and the structure without the factor stood for another normal
     contact); where the frequencies bound k_n, it is refitted."""
     from types import SimpleNamespace
 
+    from contactid.gap.base_model import _without_factor
     from contactid.gap.model import IdentifiedModel
-    from contactid.gap.pipeline import _without_factor
     from contactid.parameters import structure_from_config
 
     nominal = structure_from_config(default_config["structure"], 1.0e7, 1.0e8)

@@ -1,4 +1,4 @@
-"""The damping at test level (contactid/test_damping.py, gap.pipeline.test_level_damping, and what the gap diagnosis
+"""The damping at test level (contactid/test_damping.py, gap.damping.test_level_damping, and what the gap diagnosis
 does with it, gap.explain.with_damping_at_test_level): small pure parts on hand-made numbers; the profile and its test
 on rig records damped otherwise in their dual-sine tests (slow); the default run's in
 tests/workflow/test_workflow.py."""
@@ -99,7 +99,8 @@ def test_a_rig_damped_otherwise_in_its_dual_sine_tests_than_in_its_random_test_i
     import copy
 
     from contactid.friction_fit import settings_from_config
-    from contactid.gap.pipeline import identify, rig_records, test_level_damping
+    from contactid.gap.damping import test_level_damping
+    from contactid.gap.pipeline import identify, rig_records
     from contactid.gap.records import record_harmonics
     from contactid.gap.settings import GapSettings
     from contactid.schema import schema_defaults
@@ -161,7 +162,7 @@ def test_summary_and_report_say_the_factor_and_whether_the_other_load_cases_conf
 def test_the_held_out_records_choose_among_the_forms():
     import dataclasses
 
-    from contactid.gap.pipeline import chosen_test_damping
+    from contactid.gap.damping import chosen_test_damping
 
     def tested(form, misfit, accepted, after):
         p = _profile(0.9, {"accepted": accepted, "heldout_gap_chain": 0.015, "heldout_gap_updated": after})

@@ -287,8 +287,9 @@ def test_records_that_drift_judge_an_update_on_what_the_drift_leaves(small_confi
     import copy
 
     from contactid.friction_fit import settings_from_config
+    from contactid.gap.base_model import _refitted, structure_update
     from contactid.gap.evidence import records_drift, records_test_of_update
-    from contactid.gap.pipeline import _refitted, identify, rig_records, structure_update
+    from contactid.gap.pipeline import identify, rig_records
     from contactid.gap.records import record_harmonics
 
     cfg = copy.deepcopy(small_config)

@@ -762,7 +762,7 @@ def test_channels_read_off_their_sensitivity_are_named_from_the_random_tests_rel
     """The rig reads its three channels with 1.01, 0.98 and 1.03 (channel_gain_error 0.03), in every test. The random
     test's residues give the gains relative to one another (the update fits them as the measurement chain's); the
     candidate applies them on the dual-sine records and explains the gap, searching nothing."""
-    from contactid.gap.pipeline import updated_model
+    from contactid.gap.base_model import updated_model
 
     cfg = copy.deepcopy(small_config)
     recs, _ = rig_records(cfg, {"channel_gain_error": 0.03}, 3, CASES)

@@ -949,8 +949,8 @@ def test_the_records_call_for_the_channels_gains_only_where_they_shrink_the_gap_
 def test_the_records_choose_between_the_update_with_the_gains_and_the_structure_alone(monkeypatch):
     from dataclasses import dataclass
 
+    import contactid.gap.base_model as base_model
     import contactid.gap.evidence as evidence
-    import contactid.gap.pipeline as pipeline
 
     settled = []
 
@@ -968,7 +968,7 @@ def test_the_records_choose_between_the_update_with_the_gains_and_the_structure_
         def without_gains(self):
             return Upd("alone", None, self.channel_gains)
 
-    monkeypatch.setattr(pipeline, "settled_update", settle)
+    monkeypatch.setattr(base_model, "settled_update", settle)
     alone = {"gains_needed": False, "gains_drop": 0.06, "gains_threshold": 5.99}
     upd = Upd("gains", alone)
     for preferred, chosen in ((False, "alone"), (True, "gains")):
@@ -980,7 +980,7 @@ def test_the_records_choose_between_the_update_with_the_gains_and_the_structure_
             "records_test_of_gains",
             lambda *a, p=preferred, t=test, **kw: {**t, "gains_preferred": p, "chain": kw.get("chain")},
         )
-        model, out = pipeline.updated_model("chain", None, "cal", None, None, 1, upd, {"lc2": "rec"})
+        model, out = base_model.updated_model("chain", None, "cal", None, None, 1, upd, {"lc2": "rec"})
         assert settled == ["gains", "alone"] and model == f"model {chosen}" and out.label == chosen
         assert out.gains_versus_structure["gains_preferred"] is preferred
         assert out.gains_versus_structure["gains_drop"] == 0.06
@@ -988,7 +988,7 @@ def test_the_records_choose_between_the_update_with_the_gains_and_the_structure_
     # gains the random test needs beyond the structure, or no records to ask: the update as it is, settled once
     for upd2, held in ((Upd("gains", {**alone, "gains_needed": True}), {"lc2": "rec"}), (upd, None)):
         settled.clear()
-        model, out = pipeline.updated_model(None, None, "cal", None, None, 1, upd2, held)
+        model, out = base_model.updated_model(None, None, "cal", None, None, 1, upd2, held)
         assert settled == ["gains"] and out is upd2
 
 

@@ -14,13 +14,13 @@ where the misfit stays within the friction fit's own profile-likelihood threshol
 at ``FitSettings.confidence``). Two forms (``FORMS``) are profiled: the factor on the ratio of the mode the test drives
 near resonance alone (where the random test's estimate of that lightly damped mode is off, the others right), and on
 every mode's ratio (a damping that changes with level everywhere; the drive's harmonics sit near the higher modes, the
-third near the second mode); the held-out load cases choose between them (``gap.pipeline.chosen_test_damping``).
+third near the second mode); the held-out load cases choose between them (``gap.damping.chosen_test_damping``).
 
 A factor away from 1 is a change of the base model suggested by one record, and a stand-in for anything else the law
 cannot represent takes the same road (a viscous friction at the contact, a clamp, transducer masses: on such rigs the
 least misfit wanders and the law with it). So the identification chain keeps the random test's ratios, and the factor
 is weighed twice. First by the load cases it was not fitted on, as an update of the structure is
-(``contactid.gap.pipeline.confirmed_test_damping``, the records' test of ``contactid.gap.evidence.
+(``contactid.gap.damping.confirmed_test_damping``, the records' test of ``contactid.gap.evidence.
 records_test_of_update``): the model at the factor, its law refitted, leaves a held-out gap smaller than the model at
 the random test's ratios by min_reduction of it and by more than noise_factor x the records' scatter. Then by the gap
 diagnosis, whose candidates compete for the same gap: only where it explains no effect (a viscous friction at the

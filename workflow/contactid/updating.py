@@ -26,7 +26,7 @@ data leave a factor at its prior (the drop's null distribution from the hat matr
 ``null_drop_weights``; a rigid clamp's compliance, a lever arm the data do not see add nothing to it). Otherwise the
 nominal structure is kept and the update is offered as ``proposal``: the gap diagnosis may still accept it when it
 shrinks the held-out gap of the dual-sine records materially (``UpdatingResult.accept_proposal``,
-``gap.pipeline.updated_model``): with the frequency floor the random test alone cannot make transducer masses 7-22 %
+``gap.base_model.updated_model``): with the frequency floor the random test alone cannot make transducer masses 7-22 %
 off significant, yet the update finds them (docs/gap.md, "Model updating").
 """
 

@@ -167,7 +167,7 @@ class UpdatingResult:
 
         The gains are still reported (as the nominal structure's residues show them) but not significant: the random
         test cannot tell them from the structure's factors (``gains_needed`` false) and the dual-sine records did not
-        call for them (``gap.pipeline.updated_model``).
+        call for them (``gap.base_model.updated_model``).
 
         Returns
         -------

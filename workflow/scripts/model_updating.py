@@ -2,7 +2,7 @@
 
 import json
 
-from contactid.gap.pipeline import structure_update
+from contactid.gap.base_model import structure_update
 from contactid.gap.settings import GapSettings
 from contactid.io import load_dataset, write_text
 from contactid.logs import setup_logging

@@ -5,8 +5,9 @@ Profiled by the friction law's misfit on the calibration record and applied wher
 
 from contactid.friction_fit import settings_from_config
 from contactid.friction_parameters import parameter_dataset
+from contactid.gap.damping import test_level_damping
 from contactid.gap.model import identified_model
-from contactid.gap.pipeline import test_level_damping, workflow_records
+from contactid.gap.pipeline import workflow_records
 from contactid.gap.settings import GapSettings
 from contactid.io import load_dataset, provenance, write_dataset
 from contactid.logs import setup_logging

@@ -14,7 +14,9 @@ Modules, by role:
   steady-state simulation under the measured force), ``candidates`` (the library of effects), ``refit`` (the chain
   redone with an effect in the model, and the gap), ``calibration`` and ``search`` (a candidate's calibration
   searches), ``workers`` (the candidates' refits in worker processes), ``ranking`` (the first pass's rows),
-  ``pipeline`` (the models a diagnosis of the workflow's files works with);
+  ``pipeline`` (the identified model and the records a diagnosis starts from: the chain run in one process, or the
+  workflow's files), ``base_model`` (the structure updated from the random test before the candidates, the friction
+  law refitted), ``damping`` (the damping at test level, in the form the held-out records choose);
 - decisions: ``verdict`` (where the gap lies, whether a step explains materially), ``explain`` (the additive
   explanation and the model it arrives at), ``story`` (the verdict told from the explanation, with its trace),
   ``story_decisions`` (the decisions of the trace, and the resolution);

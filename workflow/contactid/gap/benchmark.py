@@ -178,7 +178,7 @@ class ItemDiagnosis:
 def diagnose_item(spec: Mapping, cfg: Mapping, recs: Mapping, cases: list, t0: float, t_rig: float) -> ItemDiagnosis:
     """Identify the model from an item's rig records and diagnose it with the item's library.
 
-    The identification is the chain's (``pipeline.identify``), then model updating (``pipeline.updated_model``, the
+    The identification is the chain's (``pipeline.identify``), then model updating (``base_model.updated_model``, the
     load cases other than the calibration case held out).
 
     Parameters
@@ -205,9 +205,10 @@ def diagnose_item(spec: Mapping, cfg: Mapping, recs: Mapping, cases: list, t0: f
         The diagnosis, the models, the update, the records' harmonics and the times.
     """
     from ..friction_fit import settings_from_config
+    from .base_model import updated_model
     from .diagnosis import diagnose
     from .localise import linear_stage, random_test_delays
-    from .pipeline import identify, updated_model
+    from .pipeline import identify
     from .records import record_harmonics
     from .settings import GapSettings
 

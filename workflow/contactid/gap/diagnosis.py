@@ -345,7 +345,7 @@ def diagnose(
     Parameters
     ----------
     model
-        The model to diagnose: the chain's identified model, or its update (``gap.pipeline.updated_model``).
+        The model to diagnose: the chain's identified model, or its update (``gap.base_model.updated_model``).
     records
         {load case: its dual-sine record's harmonics}.
     calibration_case

@@ -150,7 +150,7 @@ class IdentifiedModel:
         """The identified modes' damping ratios in the dual-sine tests [-].
 
         ``test_damping_ratios`` where given (the model at a factor of ``contactid.test_damping``, weighed by
-        ``gap.pipeline.confirmed_test_damping``), else the random test's (``damping``), as the chain identifies them.
+        ``gap.damping.confirmed_test_damping``), else the random test's (``damping``), as the chain identifies them.
 
         Returns
         -------

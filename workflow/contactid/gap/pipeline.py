@@ -1,13 +1,15 @@
-"""The identification chain run in one process from raw records to the identified model.
+"""The identified model and the records a diagnosis starts from: the chain run in one process, or the workflow's files.
 
-It serves data sets that do not go through the workflow's rules one by one (the blind benchmark). It calls the same
-package functions as the rules, with the same settings from the config.
+In one process from raw records (``linear_chain``, ``identify``, ``rig_records``), it serves data sets that do not go
+through the workflow's rules one by one (the blind benchmark): it calls the same package functions as the rules, with
+the same settings from the config. From the workflow's files (``workflow_models``, ``workflow_records``,
+``workflow_record_checks``), it gives the gap's rules the records' harmonics, the chain's model and the model to
+diagnose (the base model, ``base_model.updated_model``); ``records_check_of`` checks records against a model.
 """
 
 from __future__ import annotations
 
 import copy
-import dataclasses
 from typing import TYPE_CHECKING, Any, Iterable, Mapping, Sequence
 
 import numpy as np
@@ -17,6 +19,7 @@ from ..friction_fit import fit_friction_law, settings_from_config
 from ..friction_parameters import parameter_dataset
 from ..linear_chain import frf_dataset, linear_modes_dataset, modal_dataset, stiction_dataset
 from ..schema import with_defaults
+from .base_model import updated_model
 from .model import identified_model
 from .records import record_harmonics
 from .refit import identified_forces
@@ -25,8 +28,6 @@ if TYPE_CHECKING:
     import os
 
     from ..friction_fit import FitSettings
-    from ..parameters import StructureParameters
-    from ..test_damping import DampingProfile
     from ..updating_result import UpdatingResult
     from .model import IdentifiedModel
     from .record_checks import Thresholds
@@ -116,163 +117,6 @@ def identify(
     return model.with_friction(fit.params), modes, modal, frf
 
 
-def test_level_damping(
-    model: IdentifiedModel,
-    calibration: RecordHarmonics,
-    held_out: Mapping[str, RecordHarmonics],
-    fit_settings: FitSettings,
-    settings: GapSettings,
-    seed: int,
-    scales: Sequence[float],
-) -> DampingProfile:
-    """Return the damping at test level (``contactid.test_damping``).
-
-    The friction law's misfit on the ``calibration`` record is profiled over ``scales`` with ``model``'s structure and
-    random-test ratios, in each form of ``test_damping.FORMS`` (the driven mode's ratio alone; every mode's), each
-    confirmed or not by the ``held_out`` records (``confirmed_test_damping``), one of them chosen
-    (``chosen_test_damping``), and the chosen one, where confirmed, given its law's intervals.
-
-    Parameters
-    ----------
-    model
-        The identified model (its structure, damping ratios, frequencies and preload are used).
-    calibration
-        The calibration record's harmonics.
-    held_out
-        {case: harmonics} of the other load cases.
-    fit_settings
-        The friction fit's settings (``friction_fit.FitSettings``).
-    settings
-        The gap's settings (``settings.GapSettings``).
-    seed
-        The fits' random seed.
-    scales
-        The factors on the damping ratios to profile [-] (``nonlinear.test_damping_scales`` with 1).
-
-    Returns
-    -------
-    profile : DampingProfile
-        The chosen profile; ``test_damping.unprofiled`` where ``scales`` hold one factor.
-    """
-    from ..test_damping import FORMS, damping_profile, unprofiled, with_intervals
-    from .model import NONE, fe_model
-
-    if len(set(scales)) < 2:
-        return unprofiled()
-    fe = fe_model(model, NONE)
-    profiles = [
-        damping_profile(
-            fe,
-            model.damping,
-            model.frequencies,
-            calibration.force,
-            calibration.acceleration,
-            calibration.f0,
-            model.preload,
-            fit_settings,
-            seed,
-            scales,
-            form,
-        )
-        for form in FORMS
-    ]
-    tested = [confirmed_test_damping(model, p, calibration, held_out, fit_settings, settings) for p in profiles]
-    chosen = chosen_test_damping(tested)
-    if not chosen.accepted:
-        return chosen
-    return with_intervals(
-        chosen,
-        fe,
-        model.damping,
-        calibration.force,
-        calibration.acceleration,
-        calibration.f0,
-        model.preload,
-        fit_settings,
-        seed,
-    )
-
-
-def chosen_test_damping(tested: Sequence[DampingProfile]) -> DampingProfile:
-    """Return the profile chosen among the forms: the confirmed one whose held-out gap is least.
-
-    Where none is confirmed, it is the one whose misfit is least, which then is not applied. The held-out records
-    choose among the forms, not the calibration record's misfit: a form can fit the calibration record better and
-    widen the held-out gap where the other form narrows it (the other simulator's records, docs/measurements.md).
-
-    Parameters
-    ----------
-    tested
-        The profiles of each form, each with the held-out records' test (``confirmed_test_damping``).
-
-    Returns
-    -------
-    profile : DampingProfile
-        The chosen profile.
-    """
-    confirmed = [p for p in tested if p.accepted]
-    if confirmed:
-        return min(confirmed, key=lambda p: float(p.check["heldout_gap_updated"]))
-    return min(tested, key=lambda p: float(np.min(p.misfits)))
-
-
-def confirmed_test_damping(
-    model: IdentifiedModel,
-    profile: DampingProfile,
-    calibration: RecordHarmonics,
-    held_out: Mapping[str, RecordHarmonics],
-    fit_settings: FitSettings,
-    settings: GapSettings,
-) -> DampingProfile:
-    """Return ``profile`` with the held-out records' test of its factor (``profile.check``).
-
-    The model with the random test's ratios and the model with the form's ratios times ``profile.scale``, each with
-    the law fitted at its factor, are weighed on the ``held_out`` records as an update of the structure is
-    (``evidence.records_test_of_update``: the gap shrinks by min_reduction of it and beyond noise_factor x the records'
-    scatter), with no floor below which the gap is left alone: the floor is measured with the chain's law (rule
-    gap_floor), downstream of this choice, and a factor that halves the held-out gap is confirmed at any level. No test
-    where the factor is 1 or nothing is held out (the factor then is not applied).
-
-    Parameters
-    ----------
-    model
-        The identified model.
-    profile
-        The damping profile of one form.
-    calibration
-        The calibration record's harmonics.
-    held_out
-        {case: harmonics} of the other load cases.
-    fit_settings
-        The friction fit's settings (``friction_fit.FitSettings``).
-    settings
-        The gap's settings (``settings.GapSettings``).
-
-    Returns
-    -------
-    profile : DampingProfile
-        ``profile`` with ``check`` set where the test ran; ``profile`` itself otherwise.
-    """
-    import logging
-
-    from ..test_damping import check_reason
-    from .evidence import records_test_of_update
-
-    if abs(profile.scale - 1.0) < 1e-9 or not held_out:
-        logging.getLogger(__name__).info("damping at test level: %s", check_reason(profile))
-        return profile
-    base = dataclasses.replace(model, test_damping_ratios=()).with_friction(profile.law_at(1.0))
-    scaled = dataclasses.replace(model, test_damping_ratios=tuple(profile.scaled_ratios(model.damping))).with_friction(
-        profile.law_at_scale()
-    )
-    test = records_test_of_update(
-        base, scaled, held_out, dataclasses.replace(settings, min_gap=0.0), calibration, fit_settings
-    )
-    out = dataclasses.replace(profile, check=test)
-    logging.getLogger(__name__).info("damping at test level, x%.3g: %s", profile.scale, check_reason(out))
-    return out
-
-
 def rig_records(
     cfg: Mapping, effects: Mapping, seed: int, cases: Iterable[str], random_test: bool = True
 ) -> tuple[dict, dict]:
@@ -328,43 +172,6 @@ def rig_records(
         converged[case] = int(truth.attrs["control_converged"])
         out[case] = raw
     return out, converged
-
-
-def structure_update(structure: StructureParameters, modal: xr.Dataset, settings: GapSettings) -> UpdatingResult | None:
-    """Return the base structure updated from the random test's modal fit (``contactid.updating``).
-
-    Parameters
-    ----------
-    structure
-        The base structure, with the chain's k_t and k_n.
-    modal
-        The modal fit (modal.nc's content: natural frequencies, their sd and the residues).
-    settings
-        The gap's settings (``settings.GapSettings``): model_updating and the updating's parameters.
-
-    Returns
-    -------
-    update : UpdatingResult | None
-        The update; None when gap.model_updating is off.
-    """
-    from ..stiction import frequency_sigma
-    from ..updating import update_structure
-
-    if not settings.model_updating:
-        return None
-    f = modal["natural_frequency"].values
-    sigma = frequency_sigma(f, modal["natural_frequency_std"].values, settings.frequency_floor)
-    return update_structure(
-        structure,
-        f,
-        sigma,
-        modal["residue_abs"].values,
-        settings.residue_accuracy,
-        settings.updating_parameters,
-        confidence=settings.updating_confidence,
-        prior_sd=dict(settings.updating_prior_sd),
-        gain_sd=float(getattr(settings, "updating_gain_sd", 0.0)),
-    )
 
 
 def workflow_models(
@@ -493,233 +300,6 @@ def diagnosed_model(
     upd = UpdatingResult.from_summary(updating_summary, chain.structure)
     model, upd = updated_model(chain, modal, calibration, fit_settings, settings, seed, upd, held_out)
     return chain, model, upd
-
-
-def updated_model(
-    model: IdentifiedModel,
-    modal: xr.Dataset,
-    calibration: RecordHarmonics | None,
-    fit_settings: FitSettings,
-    settings: GapSettings,
-    seed: int,
-    upd: UpdatingResult | None = None,
-    held_out: Mapping[str, RecordHarmonics] | None = None,
-) -> tuple[IdentifiedModel, UpdatingResult | None]:
-    """Return the base model updated from the random test before the candidates, settled by ``settled_update``.
-
-    Where the accelerometer channels' gains took part in the update but the random test cannot tell them from the
-    structure's factors (``UpdatingResult.structure_alone``'s ``gains_needed`` false), both updates are settled and
-    the ``held_out`` records choose (``evidence.records_test_of_gains``): the one without the gains unless the records
-    call for them; the test is kept in ``gains_versus_structure``.
-
-    Parameters
-    ----------
-    model
-        The base model (the chain's).
-    modal
-        The random test's modal fit (modal.nc's content).
-    calibration
-        The calibration record's harmonics (None: the gains are not weighed by the records).
-    fit_settings
-        The friction fit's settings (``friction_fit.FitSettings``).
-    settings
-        The gap's settings (``settings.GapSettings``).
-    seed
-        The random seed.
-    upd
-        The update when already computed (None: ``structure_update`` computes it).
-    held_out
-        {case: harmonics} of the other load cases (None: none).
-
-    Returns
-    -------
-    model : IdentifiedModel
-        The model to diagnose.
-    updating : UpdatingResult | None
-        The update; None when updating is off.
-    """
-    import logging
-
-    if upd is None:
-        upd = structure_update(model.structure, modal, settings)
-    if upd is None:
-        return model, None
-    alone = upd.structure_alone
-    if not alone or alone.get("gains_needed") or not held_out or calibration is None:
-        return settled_update(model, calibration, fit_settings, settings, seed, upd, held_out)
-    from .evidence import records_test_of_gains
-
-    m_gains, u_gains = settled_update(model, calibration, fit_settings, settings, seed, upd, held_out)
-    m_alone, u_alone = settled_update(model, calibration, fit_settings, settings, seed, upd.without_gains(), held_out)
-    test = records_test_of_gains(
-        m_gains, u_gains.channel_gains, m_alone, held_out, calibration, fit_settings, settings, chain=model
-    )
-    test.update(gains_drop=alone["gains_drop"], gains_threshold=alone["gains_threshold"])
-    logging.getLogger(__name__).info(
-        "model updating: the random test cannot tell the channels' gains from the structure's factors (chi^2 %.3g "
-        "lower with them, %.3g needed); held-out gap %.4g with the gains, %.4g without them, %.4g not updated "
-        "(records' scatter %.2g): the update %s them",
-        test["gains_drop"],
-        test["gains_threshold"],
-        test["heldout_gap_gains"],
-        test["heldout_gap_structure"],
-        test["heldout_gap_chain"],
-        test["record_scatter"],
-        "with" if test["gains_preferred"] else "without",
-    )
-    if test["gains_preferred"]:
-        return m_gains, dataclasses.replace(u_gains, gains_versus_structure=test)
-    return m_alone, dataclasses.replace(u_alone, gains_versus_structure=test)
-
-
-def settled_update(
-    model: IdentifiedModel,
-    calibration: RecordHarmonics,
-    fit_settings: FitSettings,
-    settings: GapSettings,
-    seed: int,
-    upd: UpdatingResult,
-    held_out: Mapping[str, RecordHarmonics] | None = None,
-) -> tuple[IdentifiedModel, UpdatingResult]:
-    """Return the base model updated by ``upd``, with the inverse identification and the friction fit redone.
-
-    They are redone on the calibration record. The model is the chain's own when the update is not accepted. An
-    update the random test's chi^2 test did not accept (its ``proposal``) is accepted when the ``held_out`` records
-    show a held-out gap above the floor that the update explains materially (``settings.updating_records_test``;
-    ``evidence.records_test_of_update``); the result then says ``accepted_by`` "records" and keeps the test in
-    ``records_test``.
-
-    Parameters
-    ----------
-    model
-        The base model (the chain's).
-    calibration
-        The calibration record's harmonics.
-    fit_settings
-        The friction fit's settings (``friction_fit.FitSettings``).
-    settings
-        The gap's settings (``settings.GapSettings``).
-    seed
-        The random seed.
-    upd
-        The random test's update.
-    held_out
-        {case: RecordHarmonics} of the load cases other than the calibration case (None: none).
-
-    Returns
-    -------
-    model : IdentifiedModel
-        The model to diagnose.
-    updating : UpdatingResult
-        The update, accepted by the records where they did (with ``records_test``).
-    """
-    import logging
-
-    log = logging.getLogger(__name__)
-    if not upd.accepted:
-        if upd.proposal is None or not held_out or not getattr(settings, "updating_records_test", False):
-            log.info(
-                "model updating: not accepted (chi2 %.3g -> %.3g, a drop below %.3g for the %.2g factors the data "
-                "bind); the chain's structure is kept",
-                upd.chi2_nominal,
-                upd.chi2_updated,
-                upd.chi2_threshold,
-                upd.effective_factors,
-            )
-            return model, upd
-        from .evidence import records_attribution, records_test_of_update
-
-        p = upd.proposal
-        m2 = _refitted(model, upd.proposed_structure(), calibration, fit_settings, seed)
-        test = records_test_of_update(model, m2, held_out, settings, calibration, fit_settings)
-        factors = ", ".join(f"{k} {v:.4g}" for k, v in p["factors"].items())
-        if not test["accepted"]:
-            log.info(
-                "model updating: not accepted (chi2 %.3g -> %.3g, a drop below %.3g for the %.2g factors the data "
-                "bind; held-out gap %.4g -> %.4g with it, records' scatter %.2g); the chain's structure is kept",
-                upd.chi2_nominal,
-                upd.chi2_updated,
-                upd.chi2_threshold,
-                upd.effective_factors,
-                test["heldout_gap_chain"],
-                test["heldout_gap_updated"],
-                test["record_scatter"],
-            )
-            return model, dataclasses.replace(upd, records_test=test)
-        test["attribution"] = records_attribution(
-            model,
-            p["factors"],
-            lambda f: _without_factor(model, upd, f),
-            calibration,
-            held_out,
-            fit_settings.bounds,
-            test["record_scatter"],
-            test.get("heldout_gap_chain_alone", test["heldout_gap_chain"]),  # the attribution's gaps hold no drift
-            settings,
-        )
-        log.info(
-            "model updating: accepted by the records (chi2 %.3g -> %.3g, not significant alone; held-out gap "
-            "%.4g -> %.4g, records' scatter %.2g): %s, k_t %.4g, k_n %.4g N/m; friction law refitted",
-            upd.chi2_nominal,
-            upd.chi2_updated,
-            test["heldout_gap_chain"],
-            test["heldout_gap_updated"],
-            test["record_scatter"],
-            factors,
-            float(p["k_t"]),
-            float(p["k_n"]),
-        )
-        return m2, upd.accept_proposal(test)
-    log.info(
-        "model updating: accepted (chi2 %.3g -> %.3g, a drop above %.3g for the %.2g factors the data bind): %s, "
-        "k_t %.4g, k_n %.4g N/m; friction law refitted",
-        upd.chi2_nominal,
-        upd.chi2_updated,
-        upd.chi2_threshold,
-        upd.effective_factors,
-        ", ".join(f"{k} {v:.4g}" for k, v in upd.factors.items()),
-        upd.k_t,
-        upd.k_n,
-    )
-    return _refitted(model, upd.structure, calibration, fit_settings, seed), upd
-
-
-def _without_factor(model, upd, factor: str):
-    """Return the structure of ``upd``'s proposal with ``factor`` at 1 (the others as proposed).
-
-    Its stiffness fit is redone as a mass candidate's is (``IdentifiedModel.refit_stiffness``: k_t and k_n refitted
-    to the chain's frequencies, k_n kept where the chain's modes use the prior k_n), E as the factors set it.
-    """
-    from ..updating_model import apply_factors
-
-    p = upd.proposal
-    factors = {k: (1.0 if k == factor else float(v)) for k, v in p["factors"].items()}
-    s = apply_factors(upd.nominal.with_contact(float(p["k_t"]), float(p["k_n"])), factors)
-    return model.refit_stiffness(s, free_modulus=False)
-
-
-def _refitted(model, structure, calibration, fit_settings, seed: int):
-    """Return the model with ``structure``, its contact forces identified again and its friction law fitted to them.
-
-    The forces are identified from the calibration record.
-    """
-    from .model import NONE
-
-    m2 = dataclasses.replace(model, structure=structure)
-    forces = identified_forces(m2, NONE, calibration)
-    fit = fit_friction_law(
-        forces.xi,
-        forces.N_dyn,
-        forces.S,
-        calibration.f0,
-        m2.preload,
-        fit_settings,
-        int(seed),
-        calibration.acceleration.shape[1],
-        intervals=False,
-        label="friction fit after updating",
-    )
-    return m2.with_friction(fit.params)
 
 
 def workflow_record_checks(
