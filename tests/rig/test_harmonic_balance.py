@@ -58,7 +58,6 @@ def record(case: str) -> RecordHarmonics:
         zeros,
         zeros,
         ("a1", "a2", "a3"),
-        np.array([0.55, 0.3, 0.05]),
     )
 
 

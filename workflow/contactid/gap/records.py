@@ -51,9 +51,6 @@ class RecordHarmonics:
         The accelerations' harmonics over the record's last third [m/s^2], complex, shape (j, H).
     sensors
         The accelerometers' names, j of them.
-    sensor_positions
-        The accelerometers' distances from the clamp [m], shape (j,), from a ``sensor_position`` variable of the
-        record; shape (0,) where it has none (the raw format's coordinate is named ``position``).
     aperiodic
         Each accelerometer's share of its rms that is not periodic at the drive frequency [-], shape (j,)
         (``harmonics.aperiodic_share`` at the frequency the force record shows: the noise alone where the response
@@ -71,7 +68,6 @@ class RecordHarmonics:
     first: np.ndarray
     last: np.ndarray
     sensors: tuple
-    sensor_positions: np.ndarray
     aperiodic: np.ndarray | None = None
 
 
@@ -151,7 +147,6 @@ def record_harmonics(raw: xr.Dataset, case: str, n_harmonics: int, n_blocks: int
         thirds[0],
         thirds[1],
         tuple(str(s) for s in raw["sensor"].values),
-        np.asarray(raw["sensor_position"].values if "sensor_position" in raw else [], dtype=float),
         aperiodic_share(acc[:, :n_use], fs, _drive_frequency(force, fs, f0)),
     )
 
