@@ -6,7 +6,7 @@ Each package function is timed beside the plain version it replaced, run in the 
 the two results are compared (the change is one of speed only):
 - ``identification.inverse_harmonics``: its nonlinear term on 4K points with the real FFT, against 8K points with the
   complex FFT (the harmonics must agree within 1e-12 of their norm);
-- ``beam_model.ContactFrequencyMap`` on a structure whose Ritz basis the Cholesky factor of V^T M V could not make
+- ``beam_modes.ContactFrequencyMap`` on a structure whose Ritz basis the Cholesky factor of V^T M V could not make
   (transducer masses 7.5 % heavy), against the full eigenproblem it then fell back to (within 1e-8);
 - ``signals.h1_frf`` on a random-test-sized record (a force and three responses), from each channel's segment spectra
   computed once, against scipy.signal.welch and csd per response as it was computed before (H1 and coherence within
@@ -29,7 +29,8 @@ sys.path.insert(0, str(ROOT / "workflow"))
 sys.path.insert(0, str(ROOT / "tests"))
 
 import contactid.identification as ident  # noqa: E402
-from contactid.beam_model import ContactFrequencyMap, all_modes, assemble  # noqa: E402
+from contactid.beam_model import assemble  # noqa: E402
+from contactid.beam_modes import ContactFrequencyMap, all_modes  # noqa: E402
 from contactid.identification import inverse_harmonics  # noqa: E402
 from contactid.modal_damping import modal_damping_vector  # noqa: E402
 from contactid.signals import h1_frf  # noqa: E402

@@ -119,7 +119,7 @@ def test_the_foreign_records_are_far_inside_the_structures_reach(foreign_structu
 
 
 def test_the_project_rigs_frequencies_are_reachable(default_config):
-    from contactid.beam_model import natural_frequencies
+    from contactid.beam_modes import natural_frequencies
     from contactid.stiction import frequency_sigma
     from contactid.stiction_refusal import reachability
 

@@ -2,7 +2,8 @@
 
 import numpy as np
 import pytest
-from contactid.beam_model import all_modes, assemble, shortening_matrix, structural_modes
+from contactid.beam_model import assemble, shortening_matrix
+from contactid.beam_modes import all_modes, structural_modes
 from contactid.contact_laws import NormalLaw
 from contactid.identification import (
     IdentificationError,

@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from contactid.beam_model import natural_frequencies
+from contactid.beam_modes import natural_frequencies
 from contactid.model_checks import friction_fit_check, model_checks, stiffness_fit_check
 from contactid.report_text import model_checks_text
 from contactid.stiction import frequency_sigma, stiction_stiffness

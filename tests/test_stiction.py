@@ -2,7 +2,7 @@ import math
 
 import numpy as np
 import pytest
-from contactid.beam_model import natural_frequencies
+from contactid.beam_modes import natural_frequencies
 from contactid.stiction import frequency_sigma, stiction_stiffness
 from structures import configured_structure
 
@@ -70,7 +70,7 @@ def test_the_fits_end_at_the_same_optimum_when_the_frequencies_move_by_rounding(
     joint fit, a profile point and the gap diagnosis' contact refit where they were: their Jacobian resolves the flat
     directions (``stiction.JACOBIAN``). With scipy's default forward steps (1.5e-8) the joint fit from the same start
     ended 0.07 apart in log10 k_t and 0.8 in log10 k_n, and a profile point's refit missed its own misfit."""
-    from contactid.beam_model import ContactFrequencyMap
+    from contactid.beam_modes import ContactFrequencyMap
     from contactid.gap.model import _refit_contact
     from contactid.parameters import structure_from_config
     from contactid.stiction import _fit_one, _joint_fit
@@ -101,7 +101,8 @@ def test_a_mass_change_refits_k_n_only_where_the_frequencies_feel_it(default_con
     floor, 1e-3), and the reduced model's stiff normal mode rose ten-fold, which the integrator resolves with as many
     times the steps; capped at ``KN_REFIT_ABOVE`` (one decade) the misfit is nearly the same and the mode rises at
     most sqrt(10)-fold."""
-    from contactid.beam_model import ContactFrequencyMap, assemble
+    from contactid.beam_model import assemble
+    from contactid.beam_modes import ContactFrequencyMap
     from contactid.gap import model as gm
     from contactid.parameters import structure_from_config
     from contactid.rig.nonlinear import reduced_model

@@ -15,7 +15,7 @@ from typing import Any, Mapping
 import numpy as np
 import pandas as pd
 
-from .beam_model import natural_frequencies
+from .beam_modes import natural_frequencies
 from .contact_laws import ValanisParameters, stiction_shear_stiffness
 from .parameters import StructureParameters, structure_from_config
 

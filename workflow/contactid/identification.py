@@ -28,7 +28,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .beam_model import FEModel, all_modes, shortening_matrix
+from .beam_model import FEModel, shortening_matrix
+from .beam_modes import all_modes
 from .harmonics import fourier_series, periodic_grid, positive_spectrum, synthesize
 
 

@@ -12,7 +12,8 @@ from typing import Collection, Mapping, Sequence
 import numpy as np
 import xarray as xr
 
-from .beam_model import assemble, shape_on_grid, structural_modes
+from .beam_model import assemble, shape_on_grid
+from .beam_modes import structural_modes
 from .io import RawDataError
 from .modal_fit import fit_modes
 from .parameters import identified_structure, structure_from_config

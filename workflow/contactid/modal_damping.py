@@ -13,7 +13,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from .beam_model import FEModel, all_modes
+from .beam_model import FEModel
+from .beam_modes import all_modes
 
 # the extrapolated damping ratio's ceiling (an overdamped static contact shape stays overdamped; the rig's own cap)
 MAX_EXTRAPOLATED_ZETA = 2.0
@@ -177,7 +178,7 @@ def modal_damping_vector(model: FEModel, identified_zeta: np.ndarray) -> np.ndar
     Parameters
     ----------
     model
-        The linear FE model; all its undamped modes (``beam_model.all_modes``) are given a ratio.
+        The linear FE model; all its undamped modes (``beam_modes.all_modes``) are given a ratio.
     identified_zeta
         The damping ratios identified on the lowest structural modes, in order (the modal fit's
         ``damping_ratio``) [-], shape (n_id,).

@@ -11,7 +11,8 @@ from typing import Iterable, Mapping, Sequence
 import numpy as np
 import xarray as xr
 
-from .beam_model import FEModel, assemble, structural_modes
+from .beam_model import FEModel, assemble
+from .beam_modes import structural_modes
 from .harmonics import fourier_series, synthesize
 from .identification import (
     galerkin_contact_forces,

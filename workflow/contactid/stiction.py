@@ -11,7 +11,7 @@ from typing import Callable
 
 import numpy as np
 
-from .beam_model import ContactFrequencyMap
+from .beam_modes import ContactFrequencyMap
 from .parameters import StructureParameters
 
 

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Mapping
 
 import numpy as np
 
-from .beam_model import ContactFrequencyMap
+from .beam_modes import ContactFrequencyMap
 from .parameters import StructureParameters
 from .stiction import LN_SCALE_BOUNDS, quick_chi2
 

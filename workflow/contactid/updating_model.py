@@ -13,7 +13,8 @@ from typing import Callable
 
 import numpy as np
 
-from .beam_model import assemble, structural_modes
+from .beam_model import assemble
+from .beam_modes import structural_modes
 from .parameters import StructureParameters
 
 
@@ -152,7 +153,7 @@ def modal_predictions(params: StructureParameters, n_modes: int) -> tuple[np.nda
     The residues are |phi_i(x_s) phi_i(x_d)| / (2 omega_i) of the driving-point force's accelerance, with the
     mass-normalised modes phi_i: the magnitudes of the modal fit's LSFD residues (``modal_fit.lsfd_fit``'s
     convention, H = sum (i w)^2 R / (i w - s) + ..., undamped). A structure with fewer structural modes raises
-    ValueError (``beam_model.structural_modes``).
+    ValueError (``beam_modes.structural_modes``).
 
     Parameters
     ----------

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Mapping, Sequence
 import numpy as np
 import xarray as xr
 
-from ..beam_model import all_modes, structural_modes
+from ..beam_modes import all_modes, structural_modes
 from ..harmonics import periodic_grid
 from ..modal_damping import modal_damping_vector
 from .model import NONE, Augmentation, IdentifiedModel, fe_model

@@ -329,7 +329,7 @@ def _refit_contact(
     """
     from scipy.optimize import least_squares
 
-    from ..beam_model import ContactFrequencyMap
+    from ..beam_modes import ContactFrequencyMap
     from ..stiction import JACOBIAN, LN_SCALE_BOUNDS
 
     f_id = np.asarray(frequencies)

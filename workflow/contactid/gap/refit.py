@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any, Sequence
 import numpy as np
 from numba import njit
 
-from ..beam_model import all_modes
+from ..beam_modes import all_modes
 from ..friction import initial_stiffness, iwan_force, valanis_friction_force
 from ..friction_problem import FitProblem, least_squares_polish
 from ..harmonics import periodic_grid

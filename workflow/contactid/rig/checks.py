@@ -12,7 +12,8 @@ from typing import Mapping
 import numpy as np
 import pandas as pd
 
-from ..beam_model import all_modes, assemble
+from ..beam_model import assemble
+from ..beam_modes import all_modes
 from ..harmonics import harmonic_amplitudes
 from .control import control_response
 from .damping import dual_sine_damping_ratios

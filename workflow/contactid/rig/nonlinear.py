@@ -33,7 +33,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.linalg
 
-from ..beam_model import FEModel, all_modes, fix_signs, shortening_matrix
+from ..beam_model import FEModel, shortening_matrix
+from ..beam_modes import all_modes, fix_signs
 from ..friction import slip_limit_flag
 
 progress = logging.getLogger(__name__)  # the response control's iterations (rig.control logs with it)

@@ -17,7 +17,8 @@ import numpy as np
 import scipy.signal
 from numba import njit
 
-from ..beam_model import FEModel, all_modes
+from ..beam_model import FEModel
+from ..beam_modes import all_modes
 from ..random_streams import generator
 from .damping import damping_ratios
 from .frontend import add_noise, anti_alias_decimate, delay_channels
@@ -319,7 +320,8 @@ def random_test_datasets(
 
     import xarray as xr
 
-    from ..beam_model import assemble, structural_modes
+    from ..beam_model import assemble
+    from ..beam_modes import structural_modes
     from ..io import raw_dataset
     from .structure import rig_structure
 
