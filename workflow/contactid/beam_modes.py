@@ -203,7 +203,7 @@ class ContactFrequencyMap:
         """Return the structural natural frequencies with contact springs k_t, k_n and a scaled Young's modulus.
 
         Solved in the Ritz basis of the structure's own modes: within 1e-8 of the full eigenproblem for scales of
-        0.9-1.1 (tests/test_beam_model.py).
+        0.9-1.1 (tests/test_beam_modes.py).
 
         Parameters
         ----------
