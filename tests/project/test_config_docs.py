@@ -124,8 +124,8 @@ def test_the_settings_objects_defaults_are_the_schemas():
     import dataclasses
 
     from contactid.friction_fit import FitSettings, settings_from_config
+    from contactid.gap.place import PlaceThresholds
     from contactid.gap.settings import GapSettings
-    from contactid.gap.verdict import PlaceThresholds
 
     pairs = [
         (GapSettings(), GapSettings.from_config({}, 0, GapSettings().identification_harmonics)),

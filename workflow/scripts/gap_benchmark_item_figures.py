@@ -4,8 +4,8 @@ import json
 from pathlib import Path
 
 from contactid.gap.figures import all_figures, failed_item_figures
+from contactid.gap.place import PlaceThresholds
 from contactid.gap.report import gap_section
-from contactid.gap.verdict import PlaceThresholds
 from contactid.io import write_text
 from contactid.logs import setup_logging
 

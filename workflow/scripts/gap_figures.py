@@ -1,7 +1,7 @@
 """Rule gap_figures: one figure per question of the diagnosis (PDF too for those the report includes)."""
 
 from contactid.gap.figures import all_figures
-from contactid.gap.verdict import PlaceThresholds
+from contactid.gap.place import PlaceThresholds
 from contactid.logs import setup_logging
 
 log = setup_logging(snakemake.log[0])

@@ -17,9 +17,9 @@ Modules, by role:
   ``pipeline`` (the identified model and the records a diagnosis starts from: the chain run in one process, or the
   workflow's files), ``base_model`` (the structure updated from the random test before the candidates, the friction
   law refitted), ``damping`` (the damping at test level, in the form the held-out records choose);
-- decisions: ``verdict`` (where the gap lies, whether a step explains materially), ``explain`` (the additive
-  explanation and the model it arrives at), ``story`` (the verdict told from the explanation, with its trace),
-  ``story_decisions`` (the decisions of the trace, and the resolution);
+- decisions: ``place`` (where the gap lies, where an effect acts), ``verdict`` (whether a step or a model update
+  explains the gap), ``explain`` (the additive explanation and the model it arrives at), ``story`` (the verdict told
+  from the explanation, with its trace), ``story_decisions`` (the decisions of the trace, and the resolution);
 - outputs: ``output`` (diagnosis.json, gap.nc), ``figures``, ``report`` (the report's section: its assembly, the
   candidates' table, the friction law's notes), ``report_diagnosis`` (the diagnosis in words), ``report_base_model``
   (the base model's update in words), ``report_benchmark`` (the benchmarks' paragraphs), ``report_format`` (their

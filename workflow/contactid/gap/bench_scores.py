@@ -80,7 +80,7 @@ def score(rows: list) -> dict:
     correct = [r for r in blind if r["verdict"] == r["effect"]]
     shrink = [r["shrink_true"] for r in correct]
     place_ok = []
-    from .verdict import acts_where
+    from .place import acts_where
 
     for r in lo:  # "contact" (eta not observable) is right for a normal or tangential effect, if less specific
         place_ok.append(acts_where(EXPECTED_PLACE[r["effect"]], r["where"].get("place")))

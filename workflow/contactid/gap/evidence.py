@@ -20,9 +20,10 @@ from .calibration import calibrate
 from .candidates import LIBRARY
 from .localise import record_drift, relative_difference
 from .model import NONE, Augmentation, IdentifiedModel
+from .place import DEFAULT_PLACE, PlaceThresholds
 from .records import RecordHarmonics
 from .refit import baseline, evaluate
-from .verdict import DEFAULT_PLACE, UPDATING_EFFECTS, PlaceThresholds, records_carry_factor
+from .verdict import UPDATING_EFFECTS, records_carry_factor
 
 if TYPE_CHECKING:
     from ..parameters import StructureParameters
@@ -387,7 +388,7 @@ def records_test_of_gains(
 
 
 def records_drift(records: Mapping[str, RecordHarmonics], H: int, thresholds: PlaceThresholds = DEFAULT_PLACE) -> bool:
-    """Return whether the records drift as the localisation's place tells it (``verdict.place``).
+    """Return whether the records drift as the localisation's place tells it (``place.place``).
 
     The median over the records of the trend's size in standard errors (``record_drift``) is compared with
     ``thresholds.drift_z``.

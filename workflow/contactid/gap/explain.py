@@ -17,8 +17,8 @@ from ..contact_laws import stiction_shear_stiffness
 from ..friction_parameters import PARAMETER_NAMES
 from .candidates import LIBRARY
 from .model import NONE, IdentifiedModel
+from .place import DEFAULT_PLACE
 from .verdict import (
-    DEFAULT_PLACE,
     UPDATING_EFFECTS,
     UPDATING_Z,
     at_floor,

@@ -13,7 +13,7 @@ import numpy as np
 import xarray as xr
 
 from .. import print_style as ps
-from .verdict import DEFAULT_PLACE, PlaceThresholds, never_opens
+from .place import DEFAULT_PLACE, PlaceThresholds, never_opens
 
 W = ps.TEXT_WIDTH_IN
 XI_UM, XI_DOT, ETA_UM, ETA_DOT = r"$\xi$ ($\mu$m)", r"d$\xi$/dt (mm/s)", r"$\eta$ ($\mu$m)", r"d$\eta$/dt (mm/s)"

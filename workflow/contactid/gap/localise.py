@@ -18,10 +18,10 @@ from ..beam_modes import all_modes, structural_modes
 from ..harmonics import periodic_grid
 from ..modal_damping import modal_damping_vector
 from .model import NONE, Augmentation, IdentifiedModel, fe_model
+from .place import DEFAULT_PLACE, PlaceThresholds, open_fraction
+from .place import place as _place_of
 from .records import RecordHarmonics
 from .refit import contact_grids, identified_forces, law_friction_force
-from .verdict import DEFAULT_PLACE, PlaceThresholds, open_fraction
-from .verdict import place as _place_of
 
 if TYPE_CHECKING:
     from ..parameters import StructureParameters
@@ -428,8 +428,8 @@ def eta_model_spread(
     return out
 
 
-# the place's thresholds (PlaceThresholds, config gap.place) and its logic live in verdict.py (pure functions,
-# unit-tested in tests/gap/test_verdict.py)
+# the place's thresholds (PlaceThresholds, config gap.place) and its logic live in place.py (pure functions,
+# unit-tested in tests/gap/test_place.py)
 
 
 def random_test_delays(frf: xr.Dataset, modal: xr.Dataset) -> np.ndarray | None:

@@ -13,9 +13,9 @@ import numpy as np
 
 from .candidates import LIBRARY
 from .explain import model_periodicity, parameter_values
+from .place import acts_where
 from .records import RecordHarmonics
 from .refit import gap_value, identified_forces
-from .verdict import acts_where
 
 
 def _ranking_row(

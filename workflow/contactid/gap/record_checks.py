@@ -67,7 +67,7 @@ class Thresholds:
 
     @classmethod
     def from_config(cls, block: Mapping | None) -> "Thresholds":
-        """Return the thresholds of the ``gap.record_checks`` block, as ``verdict.PlaceThresholds`` does.
+        """Return the thresholds of the ``gap.record_checks`` block, as ``place.PlaceThresholds`` does.
 
         Parameters
         ----------

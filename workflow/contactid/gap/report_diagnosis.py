@@ -10,9 +10,9 @@ from __future__ import annotations
 from ..latex import latex_number
 from ..latex import plain_text as _t
 from ..test_damping import ratio_words
+from .place import never_opens
 from .report_base_model import updating_paragraph
 from .report_format import num, pct
-from .verdict import never_opens
 
 
 def _law_note(step: dict) -> str:

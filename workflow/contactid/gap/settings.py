@@ -12,7 +12,7 @@ from typing import Mapping
 
 from .candidates import LIBRARY
 from .numerics import DEFAULT, Numerics
-from .verdict import DEFAULT_PLACE, PlaceThresholds
+from .place import DEFAULT_PLACE, PlaceThresholds
 
 
 @dataclass(frozen=True)

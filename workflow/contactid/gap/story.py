@@ -35,6 +35,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Mapping, Sequence
 
+from .place import acts_where, never_opens
 from .story_decisions import (
     Test,
     above_floor,
@@ -46,7 +47,7 @@ from .story_decisions import (
     shrinks_gap,
     update_counts,
 )
-from .verdict import acts_where, gap_shares, never_opens, percent, setting
+from .verdict import gap_shares, percent, setting
 
 if TYPE_CHECKING:
     from .settings import GapSettings

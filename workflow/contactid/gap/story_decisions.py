@@ -15,7 +15,8 @@ from typing import TYPE_CHECKING, Mapping, Sequence
 
 import numpy as np
 
-from .verdict import acts_where, percent, setting
+from .place import acts_where
+from .verdict import percent, setting
 
 if TYPE_CHECKING:
     from .settings import GapSettings
@@ -173,7 +174,7 @@ def acts_where_gap_lies(effect: str, acts_on: str, place: str, ok: bool | None =
     place
         Where the localisation puts the gap.
     ok
-        Whether one of them acts there, when several; None: ``verdict.acts_where(acts_on, place)``.
+        Whether one of them acts there, when several; None: ``place.acts_where(acts_on, place)``.
 
     Returns
     -------
