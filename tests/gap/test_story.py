@@ -4,8 +4,10 @@ on hand-made numbers (milliseconds). tests/gap/test_gap.py checks the same decis
 import pytest
 from contactid.gap.story import one_story_holds, tell
 from contactid.gap.story_decisions import held_out
+from contactid.schema import schema_defaults
 
-SETTINGS = {"min_gap": 0.006, "noise_factor": 3.0, "min_reduction": 0.5, "separation": 1.5}  # the config's defaults
+GAP = schema_defaults("gap")  # the config's defaults, from the schema (the hand-made numbers assume them)
+SETTINGS = {key: GAP[key] for key in ("min_gap", "noise_factor", "min_reduction", "separation")}
 PLACE = "tangential_contact"
 FORM = ["structural_damping"]
 

@@ -3,8 +3,10 @@ attribute, the resolution."""
 
 import pytest
 from contactid.gap.story_decisions import resolution
+from contactid.schema import schema_defaults
 
-SETTINGS = {"min_gap": 0.006, "noise_factor": 3.0, "min_reduction": 0.5, "separation": 1.5}  # the config's defaults
+GAP = schema_defaults("gap")  # the config's defaults, from the schema (the hand-made numbers assume them)
+SETTINGS = {key: GAP[key] for key in ("min_gap", "noise_factor", "min_reduction", "separation")}
 
 
 def test_resolution():
